@@ -1,0 +1,145 @@
+// zcheck — the command line. Thin: parse, call the libraries, print.
+// Exit status: 0 consistent, 1 inconsistent, 2 usage or input error (one line on stderr).
+#include "check.h"
+
+#include "zcheck/atomic_file.h"
+#include "zcheck/camera_file.h"
+#include "zcheck/error.h"
+#include "zcheck/image_io.h"
+#include "zcheck/mesh_loader.h"
+
+#include <CLI/CLI.hpp>
+#include <tbb/global_control.h>
+
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <optional>
+
+namespace {
+
+using namespace zcheck;
+
+constexpr int kExitConsistent = 0;
+constexpr int kExitInconsistent = 1;
+constexpr int kExitUsage = 2;
+
+struct CheckOptions {
+    std::string scene = "builtin:default";
+    std::string cameraFile;
+    std::string convention;
+    std::optional<int> width, height;
+    std::string depthFormat;
+    bool reversedZ = false;
+    std::string outDir;
+    bool json = false;
+    int threads = 0;
+};
+
+std::vector<float> asFloats(const DepthImage& image)
+{
+    return std::vector<float>(image.value.begin(), image.value.end());
+}
+
+void writeOutputs(const std::string& dir, const CheckRun& run)
+{
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (!fs::is_directory(dir)) throw Error("cannot write to --out '" + dir + "': not a directory");
+    const int W = run.comparison.report.width, H = run.comparison.report.height;
+    const auto path = [&](const char* name) { return (fs::path(dir) / name).string(); };
+    writeExr(path("ray_depth.exr"), W, H, {"Z"}, asFloats(run.ray.windowDepth));
+    writeExr(path("raster_depth.exr"), W, H, {"Z"}, asFloats(run.raster.windowDepth));
+    writePng8(path("error_heatmap.png"), W, H, errorHeatmapRgb(run.comparison));
+    writePng8(path("coverage_classes.png"), W, H, pixelClassRgb(run.comparison));
+    writeTextFileAtomically(path("report.json"), toJson(run.report).dump(2) + "\n");
+}
+
+int runCheckCommand(const CheckOptions& options)
+{
+    std::unique_ptr<tbb::global_control> threadLimit;
+    if (options.threads > 0)
+        threadLimit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                            std::size_t(options.threads));
+    const Scene scene = loadScene(options.scene);
+    CameraSpec spec = options.cameraFile.empty() ? scene.defaultCamera : readCameraFile(options.cameraFile);
+    if (!options.convention.empty()) spec.convention = Convention::preset(options.convention);
+    if (options.width) spec.width = *options.width;
+    if (options.height) spec.height = *options.height;
+    if (!options.depthFormat.empty()) spec.depth.format = depthFormatFromName(options.depthFormat);
+    if (options.reversedZ) spec.depth.reversed = true;
+    const Camera camera(spec);
+
+    const RayRenderer rays(scene);
+    const RasterRenderer raster(scene);
+    const CheckRun run = runCheck(scene, camera, rays, raster);
+    if (options.json)
+        std::cout << toJson(run.report).dump(2) << "\n";
+    else
+        std::cout << formatSummary(run.report);
+    if (!options.outDir.empty()) writeOutputs(options.outDir, run);
+    return run.report.comparison.consistent() ? kExitConsistent : kExitInconsistent;
+}
+
+}  // namespace
+
+int main(int argc, char** argv)
+{
+    CLI::App app{"zcheck proves a graphics transform chain correct by computing every pixel's depth twice —\n"
+                 "by ray casting through the inverse projection (Embree) and by rasterizing forward through\n"
+                 "view, projection, clipping, divide and viewport — and demanding agreement.",
+                 "zcheck"};
+    app.require_subcommand(1);
+    app.set_version_flag("--version", std::string(ZCHECK_VERSION));
+
+    CheckOptions check;
+    CLI::App* checkCommand = app.add_subcommand(
+        "check", "Check one scene through one camera: ray route vs raster route, per pixel.\n"
+                 "Exit status 0 consistent, 1 inconsistent, 2 usage or input error.");
+    checkCommand->add_option("--scene", check.scene,
+                             "builtin:default | builtin:terrain[?n=N] | builtin:near-crossing | a mesh file "
+                             "(OBJ, PLY, glTF/glb)")
+        ->capture_default_str();
+    checkCommand->add_option("--camera", check.cameraFile,
+                             "camera file (JSON, see README); default: the scene's own camera");
+    checkCommand->add_option("--convention", check.convention,
+                             "override the convention: opengl | direct3d | vulkan | metal | opencv");
+    checkCommand->add_option("--width", check.width, "override the image width in pixels (1..16384)");
+    checkCommand->add_option("--height", check.height, "override the image height in pixels (1..16384)");
+    checkCommand->add_option("--depth-format", check.depthFormat, "override the depth format: float32 | unorm24 | unorm16");
+    checkCommand->add_flag("--reversed-z", check.reversedZ, "use reversed-Z (near -> far end of the range, test GREATER)");
+    checkCommand->add_option("--out", check.outDir,
+                             "write ray_depth.exr, raster_depth.exr, error_heatmap.png, coverage_classes.png "
+                             "and report.json into this directory");
+    checkCommand->add_flag("--json", check.json, "print the report as JSON instead of the summary");
+    checkCommand->add_option("--threads", check.threads, "worker threads (default: all cores)")
+        ->check(CLI::Range(1, 1024));
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForAllHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForVersion& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        std::cerr << "zcheck: error: " << e.what() << " (see 'zcheck --help')\n";
+        return kExitUsage;
+    }
+
+    try {
+        if (checkCommand->parsed()) return runCheckCommand(check);
+    } catch (const zcheck::Error& e) {
+        std::cerr << "zcheck: error: " << e.what() << "\n";
+        return kExitUsage;
+    } catch (const std::bad_alloc&) {
+        std::cerr << "zcheck: error: out of memory (is the image or the mesh too large?)\n";
+        return kExitUsage;
+    } catch (const std::exception& e) {
+        std::cerr << "zcheck: error: " << e.what() << "\n";
+        return kExitUsage;
+    }
+    return kExitUsage;
+}

@@ -1,0 +1,111 @@
+#pragma once
+// Comparison of the two routes and the tolerance model (DESIGN.md).
+//
+// Per pixel, four classes by coverage: both hit, both miss, ray-only, raster-only.
+//
+// Both hit, on the same primitive: consistent iff |d_raster − d_ray| ≤ C·q + S·m, where
+//   q = storage quantum at d_ray (1 LSB for unorm-N, 1 ulp of binary32 for float32),
+//   m = max(|∂d/∂x|, |∂d/∂y|), the window-depth slope of the hit plane per pixel,
+//   S = 2^−subpixelBits (the rasterizer's vertex snapping, 2^−8 for 16.8 fixed point),
+//   C = 1 (unorm16), 4 (unorm24, float32), 8 (float32 with reversed-Z).
+// Both hit, on different primitives (adjacent triangles, or surfaces closer together than
+// the depth buffer resolves): the raster's surface may legitimately win, so the bound is
+// the sum of both surfaces' tolerances, 2·C·q + S·(m_ray + m_raster).
+// Otherwise a mismatch is *explained* only when the pixel centre lies within S pixels of an
+// edge of a triangle involved (as drawn: clipped to the near and far planes), i.e. where
+// vertex snapping can move the edge across the sample point. Everything else is an
+// unexplained mismatch; a half-pixel or one-row shift can never hide among edge pixels.
+//
+// Verdict: consistent ⇔ no unexplained coverage mismatch and no depth error.
+#include "zcheck/camera.h"
+#include "zcheck/render.h"
+#include "zcheck/scene.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace zcheck {
+
+enum class PixelClass : std::uint8_t {
+    BothMiss,            // neither route sees a surface
+    Agree,               // both hit, depths agree within tolerance
+    EdgeSurface,         // both hit different surfaces beyond tolerance, pixel centre at an edge: explained
+    DepthError,          // both hit, depths disagree beyond tolerance, unexplained
+    RayOnlyEdge,         // only the ray hits, pixel centre at an edge: explained
+    RasterOnlyEdge,      // only the raster hits, pixel centre at an edge: explained
+    RayOnly,             // only the ray hits, unexplained
+    RasterOnly,          // only the raster hits, unexplained
+};
+std::string toString(PixelClass pixelClass);
+
+struct ToleranceModel {
+    int subpixelBits = 8;  // S = 2^−subpixelBits pixels
+
+    double snapPixels() const { return 1.0 / double(1 << subpixelBits); }
+    // C, in storage quanta.
+    static double constantQuanta(const DepthSettings& depth);
+};
+
+// One pixel as the report shows it.
+struct PixelFinding {
+    int col = 0, row = 0;       // row 0 at the top
+    PixelClass pixelClass = PixelClass::BothMiss;
+    double rayWindowDepth = 0;      // d_ray (exact, or the clear value on a miss)
+    double rasterWindowDepth = 0;   // d_raster (stored value, or the clear value on a miss)
+    double errorQuanta = 0;         // |d_raster − d_ray| / q (both hit only)
+    double toleranceQuanta = 0;     // the pixel's tolerance / q (both hit only)
+    std::uint32_t rayPrimitive = kNoPrimitive;
+    std::uint32_t rasterPrimitive = kNoPrimitive;
+};
+
+struct ComparisonReport {
+    int width = 0, height = 0;
+    // Coverage classes; bothHit + bothMiss + rayOnly + rasterOnly = width·height.
+    std::int64_t bothHit = 0;       // both routes see a surface
+    std::int64_t bothMiss = 0;      // neither does
+    std::int64_t rayOnly = 0;       // the ray hits, the raster does not
+    std::int64_t rasterOnly = 0;    // the raster hits, the ray does not
+    // Both-hit pixels split by outcome; agree + edgeSurface + depthErrors = bothHit.
+    std::int64_t agree = 0;         // depths within tolerance
+    std::int64_t edgeSurface = 0;   // different surfaces beyond tolerance at an edge (explained)
+    std::int64_t depthErrors = 0;   // beyond tolerance, unexplained
+    // Coverage mismatches split; explained + unexplained = rayOnly + rasterOnly.
+    std::int64_t coverageExplained = 0;    // pixel centre within S of an edge
+    std::int64_t coverageUnexplained = 0;  // anything else
+    // Over the both-hit pixels compared on depth (agree + depthErrors):
+    double maxErrorQuanta = 0;      // max |d_raster − d_ray| / q
+    double p99ErrorQuanta = 0;      // its 99th percentile
+    double maxErrorOverTolerance = 0;  // max |d_raster − d_ray| / tolerance; ≤ 1 means within
+    double maxRelativeEyeZError = 0;   // max |z_eye(d_raster) − z_eye(d_ray)| / z_eye(d_ray)
+    double p99RelativeEyeZError = 0;   // its 99th percentile
+    PixelFinding worst;             // the pixel with the largest error / tolerance
+    // Up to 20 unexplained pixels, in scan order, and the bounding box of all of them
+    // (inclusive; empty when there are none).
+    std::vector<PixelFinding> unexplainedSamples;
+    int unexplainedMinCol = 0, unexplainedMinRow = 0, unexplainedMaxCol = -1, unexplainedMaxRow = -1;
+
+    std::int64_t unexplained() const { return depthErrors + coverageUnexplained; }
+    bool consistent() const { return unexplained() == 0; }
+};
+
+struct Comparison {
+    ComparisonReport report;
+    std::vector<PixelClass> pixelClass;      // per pixel
+    std::vector<float> errorOverTolerance;   // per pixel: |Δ| / tolerance for both-hit, 0 elsewhere
+};
+
+// Compares two renders of `scene` through `camera`. `ray` must carry exact depths (the ray
+// route); `raster` holds stored depth-buffer values.
+Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderResult& ray,
+                         const RenderResult& raster, const ToleranceModel& tolerance = {});
+
+// Window-depth slope m of a world-space triangle's plane, per pixel (may be +inf for a plane
+// seen edge-on).
+double windowDepthSlope(const Camera& camera, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c);
+
+// Distance in pixels from window point pWindow to the boundary of the triangle as drawn
+// (clipped to the near and far planes, projected to the window); +inf if nothing is drawn.
+double distanceToDrawnEdge(const Camera& camera, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c,
+                           const glm::dvec2& pWindow);
+
+}  // namespace zcheck

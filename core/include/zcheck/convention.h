@@ -1,0 +1,68 @@
+#pragma once
+// Conventions as data.
+//
+// A Convention says how one graphics API lays out the spaces of the transform chain:
+//   eye    — camera at the origin; which way it looks and which way +y points,
+//   NDC    — after the divide by w; the range of z and which way +y points,
+//   window — continuous viewport coordinates; where the origin is,
+// and how matrices are printed. It never changes the picture: the same camera (position,
+// orientation, field of view) yields the same image in every convention; only numbers
+// change. Pixel (col,row) has row 0 at the top of the stored image in every convention,
+// and pixel centres are at +0.5 in window coordinates.
+//
+// Depth settings are the switches orthogonal to the preset: reversed-Z (which lives in the
+// projection matrix: clipFromEye maps the near plane to the far end of NDC z), the depth
+// range [min,max] the viewport maps NDC z to (glDepthRange / MinDepth-MaxDepth), and the
+// storage format of the depth buffer.
+#include <string>
+#include <vector>
+
+namespace zcheck {
+
+enum class NdcDepthRange {
+    MinusOneToOne,  // OpenGL: z_ndc in [-1, 1]  (GLM's _NO)
+    ZeroToOne,      // Direct3D, Vulkan, Metal: z_ndc in [0, 1]  (GLM's _ZO)
+};
+
+struct Convention {
+    std::string name;
+    int eyeForwardZ;        // z of the viewing direction in eye space: -1 (looks down -Z, RH) or +1
+    int eyeUpY;             // +1: eye +y points up in the image; -1: down (opencv)
+    NdcDepthRange ndcDepth;
+    int ndcUpY;             // +1: NDC +y points up in the image; -1: down (vulkan, opencv)
+    bool windowOriginTop;   // true: window y = 0 is the top edge and grows downwards
+    bool rowVectors;        // matrices are printed for row vectors (p' = p·M), as Direct3D does
+
+    double ndcZMin() const { return ndcDepth == NdcDepthRange::MinusOneToOne ? -1.0 : 0.0; }
+
+    // The presets: opengl, direct3d, vulkan, metal, opencv. Throws Error for another name.
+    static Convention preset(const std::string& name);
+    static const std::vector<std::string>& presetNames();
+};
+
+enum class DepthFormat {
+    Float32,  // IEEE binary32, round to nearest
+    Unorm24,  // stores round(d · (2^24 − 1))
+    Unorm16,  // stores round(d · (2^16 − 1))
+};
+
+std::string toString(DepthFormat format);
+DepthFormat depthFormatFromName(const std::string& name);  // throws Error naming the value
+const std::vector<std::string>& depthFormatNames();
+
+// The value the depth buffer stores for window depth `windowDepth` (clamped to [0,1] for
+// unorm formats), returned as a double so that all formats compare alike.
+double quantizeDepth(DepthFormat format, double windowDepth);
+
+// The storage quantum q at a stored value: 1 LSB = 1/(2^N − 1) for unorm-N, the spacing of
+// binary32 numbers above |value| (1 ulp) for float32.
+double storageQuantum(DepthFormat format, double windowDepth);
+
+struct DepthSettings {
+    DepthFormat format = DepthFormat::Float32;
+    bool reversed = false;   // reversed-Z: near → far end of the range, depth test GREATER
+    double rangeMin = 0.0;   // window depth of NDC z_min (glDepthRange near argument)
+    double rangeMax = 1.0;   // window depth of NDC z = 1
+};
+
+}  // namespace zcheck

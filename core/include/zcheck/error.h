@@ -1,0 +1,19 @@
+#pragma once
+// The one exception type zcheck throws at its boundaries (files, parsing, Embree and
+// OpenImageIO set-up, validating factories). Its message is one line that names the file,
+// key or value at fault; the command line prints it and exits with status 2.
+// Hot loops never throw.
+#include <stdexcept>
+#include <string>
+
+namespace zcheck {
+
+class Error : public std::runtime_error {
+public:
+    explicit Error(const std::string& message);
+};
+
+// "1.5", "inf", "nan": numbers in messages printed the way a user would type them back.
+std::string formatNumber(double value);
+
+}  // namespace zcheck

@@ -1,0 +1,66 @@
+#pragma once
+// The inverse-projection module: from window coordinates back into eye and world space.
+//
+// One rule serves every projective camera (perspective, orthographic, off-axis frustum and,
+// later, oblique and raw matrices): the ray through a window point (x, y) is obtained by
+// unprojecting (x, y) at the window depths of the near and far planes through
+// eyeFromClip = inverse(clipFromEye) and dividing by w. A far point with w = 0 (infinite far
+// plane) is a direction. Everything is computed in double.
+//
+// Consumes window coordinates (see camera.h; pixel centres at +0.5) and depth values as
+// stored in the depth buffer (window depth); produces eye- or world-space points and rays.
+#include "zcheck/camera.h"
+
+#include <glm/glm.hpp>
+
+namespace zcheck {
+
+// Points origin + t·direction for t ∈ [0, tMax]. origin lies on the near plane; direction
+// is (far point − near point) with tMax = 1, or, when the far plane is at infinity, a unit
+// direction with tMax = +inf.
+struct Ray {
+    glm::dvec3 origin;
+    glm::dvec3 direction;
+    double tMax;
+};
+
+// Window coordinates of the centre of pixel (col, row); row 0 is the top row of the image.
+glm::dvec2 windowFromPixelCentre(const Camera& camera, int col, int row);
+
+// The viewing ray through a window point, between the near and far planes.
+Ray eyeRayThroughWindow(const Camera& camera, const glm::dvec2& pWindow);
+Ray worldRayThroughWindow(const Camera& camera, const glm::dvec2& pWindow);
+
+// The same viewing ray parametrized from the eye plane: origin where the ray crosses
+// z_eye = 0 (the centre of projection for a perspective camera), unit direction, and the
+// interval [tNear, tFar] between the near and far planes (tFar = +inf for an infinite far
+// plane). t is then the `distance` quantity. Tracers want this form: an origin on the near
+// plane, close to the eye, would lose the ray's angle to float rounding.
+struct EyePlaneRay {
+    glm::dvec3 origin;
+    glm::dvec3 direction;  // unit length
+    double tNear;
+    double tFar;
+};
+EyePlaneRay eyePlaneRayFrom(const Ray& ray);
+// In world space, for the tracer.
+EyePlaneRay worldEyePlaneRayThroughWindow(const Camera& camera, const glm::dvec2& pWindow);
+
+// Window point (x, y, window depth) → eye-space point, and the forward map.
+glm::dvec3 eyeFromWindow(const Camera& camera, const glm::dvec3& pWindow);
+glm::dvec3 windowFromEye(const Camera& camera, const glm::dvec3& pEye);
+glm::dvec3 windowFromWorld(const Camera& camera, const glm::dvec3& pWorld);
+
+// Depth value conversions at window point (x, y). eye-z is planar depth (positive, along
+// the viewing axis); distance is the Euclidean range from the centre of projection, or for
+// parallel projections from the eye plane (z_eye = 0) along the ray.
+double eyeZFromWindowDepth(const Camera& camera, const glm::dvec2& pWindow, double windowDepth);
+double windowDepthFromEyeZ(const Camera& camera, const glm::dvec2& pWindow, double eyeZ);
+double distanceFromEyeZ(const Camera& camera, const glm::dvec2& pWindow, double eyeZ);
+double eyeZFromDistance(const Camera& camera, const glm::dvec2& pWindow, double distance);
+
+// Range of an eye-space point from the centre of projection (or from the eye plane, along
+// the viewing ray, for parallel projections).
+double distanceOfEyePoint(const Camera& camera, const glm::dvec3& pEye);
+
+}  // namespace zcheck

@@ -1,0 +1,45 @@
+#pragma once
+// Scenes: a triangle soup in world space plus the camera it is best looked at with.
+//
+// Positions are binary32 (what a GPU and Embree consume); every route converts them to
+// double before it transforms them. Scenes are addressed by name: `builtin:NAME[?k=v&…]`
+// or a mesh file path (loaded by zcheck_meshio).
+#include "zcheck/camera.h"
+
+#include <glm/glm.hpp>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace zcheck {
+
+struct Scene {
+    std::string name;                     // as addressed: "builtin:default", a file path
+    std::vector<glm::vec3> positions;     // world space
+    std::vector<glm::uvec3> triangles;    // indices into positions; the index is the primitive id
+    CameraSpec defaultCamera;             // used when the user gives no camera file
+
+    std::size_t triangleCount() const { return triangles.size(); }
+    glm::dvec3 boundsMin() const;
+    glm::dvec3 boundsMax() const;
+    // Appends another soup (indices are offset).
+    void append(const std::vector<glm::vec3>& morePositions, const std::vector<glm::uvec3>& moreTriangles);
+};
+
+// Throws Error for a scene with no triangles or an index out of range.
+void validateScene(const Scene& scene);
+
+bool isBuiltinSceneName(const std::string& name);
+const std::vector<std::string>& builtinSceneNames();  // "default", "terrain", "near-crossing"
+
+// builtin:default      ground plane, boxes and spheres at several depths, a thin slanted
+//                      panel and two nearly coplanar quads, asymmetric left/right and
+//                      top/bottom so that flips change the picture.
+// builtin:terrain?n=N  heightfield of N×N vertices, 2(N−1)² triangles (N = 708 ≈ 1 M), N in 2…4096,
+//                      default 256.
+// builtin:near-crossing geometry that crosses the near plane and lies partly behind the camera.
+// Throws Error naming an unknown scene or parameter.
+Scene builtinScene(const std::string& name);
+
+}  // namespace zcheck

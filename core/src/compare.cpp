@@ -1,0 +1,223 @@
+#include "zcheck/compare.h"
+
+#include "zcheck/clip.h"
+#include "zcheck/inverse_projection.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace zcheck {
+
+std::string toString(PixelClass pixelClass)
+{
+    switch (pixelClass) {
+    case PixelClass::BothMiss: return "both-miss";
+    case PixelClass::Agree: return "agree";
+    case PixelClass::EdgeSurface: return "edge-surface";
+    case PixelClass::DepthError: return "depth-error";
+    case PixelClass::RayOnlyEdge: return "ray-only-edge";
+    case PixelClass::RasterOnlyEdge: return "raster-only-edge";
+    case PixelClass::RayOnly: return "ray-only";
+    case PixelClass::RasterOnly: return "raster-only";
+    }
+    return "?";
+}
+
+std::string toString(DepthQuantity quantity)
+{
+    switch (quantity) {
+    case DepthQuantity::Window: return "window";
+    case DepthQuantity::Ndc: return "ndc";
+    case DepthQuantity::EyeZ: return "eye-z";
+    case DepthQuantity::Distance: return "distance";
+    }
+    return "?";
+}
+
+double ToleranceModel::constantQuanta(const DepthSettings& depth)
+{
+    switch (depth.format) {
+    case DepthFormat::Unorm16: return 1.0;
+    case DepthFormat::Unorm24: return 4.0;
+    case DepthFormat::Float32: return depth.reversed ? 8.0 : 4.0;
+    }
+    return 4.0;
+}
+
+double windowDepthSlope(const Camera& camera, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c)
+{
+    // The plane n·p + d = 0 in world space maps to clip space through the transpose of
+    // worldFromClip; there a·x + b·y + c·z + d·w = 0, so in NDC z = −(a·x + b·y + d)/c.
+    const glm::dvec3 normal = glm::cross(b - a, c - a);
+    const glm::dvec4 planeWorld(normal, -glm::dot(normal, a));
+    const glm::dvec4 planeClip = glm::transpose(camera.worldFromClip) * planeWorld;
+    if (planeClip.z == 0) return INFINITY;
+    const double zWindowPerZNdc = std::abs(camera.windowFromNdc[2][2]);
+    const double dzdx = zWindowPerZNdc * std::abs(planeClip.x / planeClip.z) * std::abs(camera.ndcFromWindow[0][0]);
+    const double dzdy = zWindowPerZNdc * std::abs(planeClip.y / planeClip.z) * std::abs(camera.ndcFromWindow[1][1]);
+    return std::max(dzdx, dzdy);
+}
+
+namespace {
+
+double distanceToSegment(const glm::dvec2& p, const glm::dvec2& a, const glm::dvec2& b)
+{
+    const glm::dvec2 ab = b - a;
+    const double lengthSquared = glm::dot(ab, ab);
+    const double t = lengthSquared > 0 ? std::clamp(glm::dot(p - a, ab) / lengthSquared, 0.0, 1.0) : 0.0;
+    return glm::length(p - (a + t * ab));
+}
+
+}  // namespace
+
+double distanceToDrawnEdge(const Camera& camera, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c,
+                           const glm::dvec2& pWindow)
+{
+    const ClipPolygon polygon =
+        clipTriangle(camera.clipFromWorld * glm::dvec4(a, 1.0), camera.clipFromWorld * glm::dvec4(b, 1.0),
+                     camera.clipFromWorld * glm::dvec4(c, 1.0), depthClipPlanes(camera.convention().ndcZMin()));
+    double nearest = INFINITY;
+    glm::dvec2 vertexWindow[ClipPolygon::kMaxVertices];
+    for (int i = 0; i < polygon.size; ++i) {
+        const glm::dvec4& pClip = polygon.pClip[i];
+        vertexWindow[i] = glm::dvec2(camera.windowFromNdc * glm::dvec4(glm::dvec3(pClip) / pClip.w, 1.0));
+    }
+    for (int i = 0; i < polygon.size; ++i)
+        nearest = std::min(nearest, distanceToSegment(pWindow, vertexWindow[i], vertexWindow[(i + 1) % polygon.size]));
+    return nearest;
+}
+
+namespace {
+
+double percentile99(std::vector<double>& values)
+{
+    if (values.empty()) return 0.0;
+    const std::size_t k = std::min(values.size() - 1, static_cast<std::size_t>(std::ceil(0.99 * values.size())) - 1);
+    std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(k), values.end());
+    return values[k];
+}
+
+struct TriangleView {
+    const Scene& scene;
+    glm::dvec3 vertex(std::uint32_t primitive, int corner) const
+    {
+        return glm::dvec3(scene.positions[scene.triangles[primitive][corner]]);
+    }
+    double slope(const Camera& camera, std::uint32_t primitive) const
+    {
+        return windowDepthSlope(camera, vertex(primitive, 0), vertex(primitive, 1), vertex(primitive, 2));
+    }
+    bool nearEdge(const Camera& camera, std::uint32_t primitive, const glm::dvec2& pWindow, double radius) const
+    {
+        if (primitive == kNoPrimitive) return false;
+        return distanceToDrawnEdge(camera, vertex(primitive, 0), vertex(primitive, 1), vertex(primitive, 2),
+                                   pWindow) <= radius;
+    }
+};
+
+bool isUnexplained(PixelClass c)
+{
+    return c == PixelClass::DepthError || c == PixelClass::RayOnly || c == PixelClass::RasterOnly;
+}
+
+}  // namespace
+
+Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderResult& ray,
+                         const RenderResult& raster, const ToleranceModel& tolerance)
+{
+    const int W = camera.width(), H = camera.height();
+    Comparison out;
+    ComparisonReport& r = out.report;
+    r.width = W, r.height = H;
+    out.pixelClass.assign(std::size_t(W) * H, PixelClass::BothMiss);
+    out.errorOverTolerance.assign(std::size_t(W) * H, 0.0f);
+
+    const TriangleView triangles{scene};
+    const DepthFormat format = camera.depth().format;
+    const double C = ToleranceModel::constantQuanta(camera.depth());
+    const double S = tolerance.snapPixels();
+    std::vector<double> errorQuanta, relativeEyeZ;
+
+    for (int row = 0; row < H; ++row) {
+        for (int col = 0; col < W; ++col) {
+            const std::size_t i = std::size_t(row) * W + col;
+            const bool rayHit = ray.hit(i), rasterHit = raster.hit(i);
+            const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
+            PixelFinding f;
+            f.col = col, f.row = row;
+            f.rayWindowDepth = ray.windowDepth.value[i];
+            f.rasterWindowDepth = raster.windowDepth.value[i];
+            f.rayPrimitive = ray.primitiveId[i];
+            f.rasterPrimitive = raster.primitiveId[i];
+
+            if (!rayHit && !rasterHit) {
+                ++r.bothMiss;
+                f.pixelClass = PixelClass::BothMiss;
+            } else if (rayHit && rasterHit) {
+                ++r.bothHit;
+                const double q = storageQuantum(format, f.rayWindowDepth);
+                const double error = std::abs(f.rasterWindowDepth - f.rayWindowDepth);
+                const bool samePrimitive = f.rayPrimitive == f.rasterPrimitive;
+                const double mRay = triangles.slope(camera, f.rayPrimitive);
+                const double bound = samePrimitive
+                                         ? C * q + S * mRay
+                                         : 2 * C * q + S * (mRay + triangles.slope(camera, f.rasterPrimitive));
+                f.errorQuanta = error / q;
+                f.toleranceQuanta = bound / q;
+                const double ratio = bound > 0 ? error / bound : (error > 0 ? INFINITY : 0.0);
+                if (error <= bound) {
+                    f.pixelClass = PixelClass::Agree;
+                } else if (!samePrimitive && (triangles.nearEdge(camera, f.rayPrimitive, pWindow, S) ||
+                                              triangles.nearEdge(camera, f.rasterPrimitive, pWindow, S))) {
+                    f.pixelClass = PixelClass::EdgeSurface;
+                } else {
+                    f.pixelClass = PixelClass::DepthError;
+                }
+                if (f.pixelClass == PixelClass::EdgeSurface) {
+                    ++r.edgeSurface;
+                } else {
+                    f.pixelClass == PixelClass::Agree ? ++r.agree : ++r.depthErrors;
+                    out.errorOverTolerance[i] = static_cast<float>(ratio);
+                    errorQuanta.push_back(f.errorQuanta);
+                    const double eyeZRay = eyeZFromWindowDepth(camera, pWindow, f.rayWindowDepth);
+                    const double eyeZRaster = eyeZFromWindowDepth(camera, pWindow, f.rasterWindowDepth);
+                    relativeEyeZ.push_back(std::abs(eyeZRaster - eyeZRay) / std::abs(eyeZRay));
+                    r.maxErrorQuanta = std::max(r.maxErrorQuanta, f.errorQuanta);
+                    if (ratio > r.maxErrorOverTolerance || r.agree + r.depthErrors == 1) {
+                        r.maxErrorOverTolerance = std::max(r.maxErrorOverTolerance, ratio);
+                        r.worst = f;
+                    }
+                }
+            } else if (rayHit) {
+                ++r.rayOnly;
+                const bool edge = triangles.nearEdge(camera, f.rayPrimitive, pWindow, S);
+                f.pixelClass = edge ? PixelClass::RayOnlyEdge : PixelClass::RayOnly;
+                edge ? ++r.coverageExplained : ++r.coverageUnexplained;
+            } else {
+                ++r.rasterOnly;
+                const bool edge = triangles.nearEdge(camera, f.rasterPrimitive, pWindow, S);
+                f.pixelClass = edge ? PixelClass::RasterOnlyEdge : PixelClass::RasterOnly;
+                edge ? ++r.coverageExplained : ++r.coverageUnexplained;
+            }
+
+            out.pixelClass[i] = f.pixelClass;
+            if (isUnexplained(f.pixelClass)) {
+                if (r.unexplainedSamples.size() < 20) r.unexplainedSamples.push_back(f);
+                if (r.unexplainedMaxCol < 0) {
+                    r.unexplainedMinCol = r.unexplainedMaxCol = col;
+                    r.unexplainedMinRow = r.unexplainedMaxRow = row;
+                }
+                r.unexplainedMinCol = std::min(r.unexplainedMinCol, col);
+                r.unexplainedMaxCol = std::max(r.unexplainedMaxCol, col);
+                r.unexplainedMinRow = std::min(r.unexplainedMinRow, row);
+                r.unexplainedMaxRow = std::max(r.unexplainedMaxRow, row);
+            }
+        }
+    }
+    for (double v : relativeEyeZ) r.maxRelativeEyeZError = std::max(r.maxRelativeEyeZError, v);
+    r.p99ErrorQuanta = percentile99(errorQuanta);
+    r.p99RelativeEyeZError = percentile99(relativeEyeZ);
+    return out;
+}
+
+}  // namespace zcheck

@@ -1,0 +1,26 @@
+#include "zcheck/error.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+namespace zcheck {
+
+Error::Error(const std::string& message) : std::runtime_error(message) {}
+
+std::string formatNumber(double value)
+{
+    if (std::isnan(value)) return "nan";
+    if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%.17g", value);
+    // Prefer the shortest form that reads back to the same double.
+    for (int precision = 1; precision <= 17; ++precision) {
+        char shorter[32];
+        std::snprintf(shorter, sizeof shorter, "%.*g", precision, value);
+        if (std::strtod(shorter, nullptr) == value) return shorter;
+    }
+    return buffer;
+}
+
+}  // namespace zcheck

@@ -1,0 +1,123 @@
+#include "zcheck/inverse_projection.h"
+
+#include <cmath>
+
+namespace zcheck {
+
+namespace {
+
+glm::dvec4 clipFromWindow(const Camera& camera, const glm::dvec3& pWindow)
+{
+    return glm::dvec4(glm::dvec3(camera.ndcFromWindow * glm::dvec4(pWindow, 1.0)), 1.0);
+}
+
+}  // namespace
+
+EyePlaneRay eyePlaneRayFrom(const Ray& rayEye)
+{
+    // Where the ray crosses the eye plane z = 0: the centre of projection for a perspective
+    // camera, the foot of the ray on the eye plane for a parallel one.
+    const double tEyePlane = -rayEye.origin.z / rayEye.direction.z;
+    const double length = glm::length(rayEye.direction);
+    EyePlaneRay out;
+    out.origin = rayEye.origin + tEyePlane * rayEye.direction;
+    out.direction = rayEye.direction / length;
+    out.tNear = -tEyePlane * length;
+    out.tFar = std::isinf(rayEye.tMax) ? INFINITY : (rayEye.tMax - tEyePlane) * length;
+    return out;
+}
+
+EyePlaneRay worldEyePlaneRayThroughWindow(const Camera& camera, const glm::dvec2& pWindow)
+{
+    EyePlaneRay ray = eyePlaneRayFrom(eyeRayThroughWindow(camera, pWindow));
+    ray.origin = glm::dvec3(camera.worldFromEye * glm::dvec4(ray.origin, 1.0));
+    ray.direction = glm::dvec3(camera.worldFromEye * glm::dvec4(ray.direction, 0.0));
+    return ray;
+}
+
+glm::dvec2 windowFromPixelCentre(const Camera& camera, int col, int row)
+{
+    return {col + 0.5, camera.windowYFromImageY(row + 0.5)};
+}
+
+Ray eyeRayThroughWindow(const Camera& camera, const glm::dvec2& pWindow)
+{
+    const glm::dvec4 nearEye = camera.eyeFromClip * clipFromWindow(camera, {pWindow, camera.windowDepthNear()});
+    const glm::dvec4 farEye = camera.eyeFromClip * clipFromWindow(camera, {pWindow, camera.windowDepthFar()});
+    Ray ray;
+    ray.origin = glm::dvec3(nearEye) / nearEye.w;
+    // |w| this small relative to xyz means the far point is at infinity (infinite far plane).
+    if (std::abs(farEye.w) <= 1e-12 * glm::length(glm::dvec3(farEye))) {
+        const glm::dvec3 direction = glm::normalize(glm::dvec3(farEye));
+        // The direction of the point at infinity is fixed up to sign: it points away from the eye.
+        ray.direction = camera.eyeZOf(direction) > 0 ? direction : -direction;
+        ray.tMax = INFINITY;
+    } else {
+        ray.direction = glm::dvec3(farEye) / farEye.w - ray.origin;
+        ray.tMax = 1.0;
+    }
+    return ray;
+}
+
+Ray worldRayThroughWindow(const Camera& camera, const glm::dvec2& pWindow)
+{
+    const Ray rayEye = eyeRayThroughWindow(camera, pWindow);
+    return {glm::dvec3(camera.worldFromEye * glm::dvec4(rayEye.origin, 1.0)),
+            glm::dvec3(camera.worldFromEye * glm::dvec4(rayEye.direction, 0.0)), rayEye.tMax};
+}
+
+glm::dvec3 eyeFromWindow(const Camera& camera, const glm::dvec3& pWindow)
+{
+    const glm::dvec4 pEye = camera.eyeFromClip * clipFromWindow(camera, pWindow);
+    return glm::dvec3(pEye) / pEye.w;
+}
+
+glm::dvec3 windowFromEye(const Camera& camera, const glm::dvec3& pEye)
+{
+    const glm::dvec4 pClip = camera.clipFromEye * glm::dvec4(pEye, 1.0);
+    return glm::dvec3(camera.windowFromNdc * glm::dvec4(glm::dvec3(pClip) / pClip.w, 1.0));
+}
+
+glm::dvec3 windowFromWorld(const Camera& camera, const glm::dvec3& pWorld)
+{
+    return windowFromEye(camera, glm::dvec3(camera.eyeFromWorld * glm::dvec4(pWorld, 1.0)));
+}
+
+double eyeZFromWindowDepth(const Camera& camera, const glm::dvec2& pWindow, double windowDepth)
+{
+    return camera.eyeZOf(eyeFromWindow(camera, {pWindow, windowDepth}));
+}
+
+namespace {
+// The eye point on the ray through pWindow at planar depth eyeZ.
+glm::dvec3 eyePointAtEyeZ(const Camera& camera, const glm::dvec2& pWindow, double eyeZ)
+{
+    const Ray ray = eyeRayThroughWindow(camera, pWindow);
+    const double t = (eyeZ - camera.eyeZOf(ray.origin)) / camera.eyeZOf(ray.direction);
+    return ray.origin + t * ray.direction;
+}
+}  // namespace
+
+double windowDepthFromEyeZ(const Camera& camera, const glm::dvec2& pWindow, double eyeZ)
+{
+    return windowFromEye(camera, eyePointAtEyeZ(camera, pWindow, eyeZ)).z;
+}
+
+double distanceFromEyeZ(const Camera& camera, const glm::dvec2& pWindow, double eyeZ)
+{
+    return distanceOfEyePoint(camera, eyePointAtEyeZ(camera, pWindow, eyeZ));
+}
+
+double eyeZFromDistance(const Camera& camera, const glm::dvec2& pWindow, double distance)
+{
+    const EyePlaneRay ray = eyePlaneRayFrom(eyeRayThroughWindow(camera, pWindow));
+    return camera.eyeZOf(ray.origin + distance * ray.direction);
+}
+
+double distanceOfEyePoint(const Camera& camera, const glm::dvec3& pEye)
+{
+    const glm::dvec3 pWindow = windowFromEye(camera, pEye);
+    return glm::length(pEye - eyePlaneRayFrom(eyeRayThroughWindow(camera, {pWindow.x, pWindow.y})).origin);
+}
+
+}  // namespace zcheck

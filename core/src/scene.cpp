@@ -1,0 +1,44 @@
+#include "zcheck/scene.h"
+
+#include "zcheck/error.h"
+
+#include <cmath>
+
+namespace zcheck {
+
+glm::dvec3 Scene::boundsMin() const
+{
+    glm::dvec3 lo(INFINITY);
+    for (const auto& p : positions) lo = glm::min(lo, glm::dvec3(p));
+    return lo;
+}
+
+glm::dvec3 Scene::boundsMax() const
+{
+    glm::dvec3 hi(-INFINITY);
+    for (const auto& p : positions) hi = glm::max(hi, glm::dvec3(p));
+    return hi;
+}
+
+void Scene::append(const std::vector<glm::vec3>& morePositions, const std::vector<glm::uvec3>& moreTriangles)
+{
+    const auto offset = static_cast<std::uint32_t>(positions.size());
+    positions.insert(positions.end(), morePositions.begin(), morePositions.end());
+    for (const auto& t : moreTriangles) triangles.push_back(t + glm::uvec3(offset));
+}
+
+void validateScene(const Scene& scene)
+{
+    if (scene.triangles.empty()) throw Error("scene '" + scene.name + "' has no triangles");
+    if (scene.triangles.size() >= 0xFFFFFFFFu)
+        throw Error("scene '" + scene.name + "' has more triangles than 32-bit primitive ids can name");
+    for (const auto& p : scene.positions)
+        for (int i = 0; i < 3; ++i)
+            if (!std::isfinite(p[i])) throw Error("scene '" + scene.name + "' has a vertex that is not finite");
+    for (const auto& t : scene.triangles)
+        for (int i = 0; i < 3; ++i)
+            if (t[i] >= scene.positions.size())
+                throw Error("scene '" + scene.name + "' has a vertex index out of range (" + std::to_string(t[i]) + ")");
+}
+
+}  // namespace zcheck

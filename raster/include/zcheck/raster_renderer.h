@@ -1,0 +1,39 @@
+#pragma once
+// The raster route: a software rasterizer that draws the scene forward into a z-buffer.
+//
+// Pipeline, one function per stage:
+//   world → clip (clipFromWorld, double)
+//   → homogeneous clipping against near and far always, and against a guard band of
+//     |x|,|y| ≤ g·w that keeps window coordinates inside ±2^20 pixels (so 16.8 fixed point
+//     and 64-bit edge functions cannot overflow, whatever the input)
+//   → perspective divide → viewport (the camera's windowFromNdc, image rows top-down)
+//   → snapping to 16.8 fixed point (round to nearest)
+//   → scan conversion with integer edge functions and the top-left fill rule, sampled at
+//     pixel centres (a shared edge covers each pixel exactly once)
+//   → window depth interpolated linearly in window space (plane through the snapped
+//     vertices), clamped to the depth range and quantized to the depth format on write
+//   → depth test LESS, or GREATER with reversed-Z; no culling; primitive id per pixel.
+//
+// Parallel and deterministic: triangles are set up in fixed chunks of kChunkTriangles
+// (independent of the thread count) and binned per chunk into 64×64 tiles in submission
+// order; tiles are then drawn in parallel, each walking the chunks in order. The result is
+// bit-identical for any number of threads.
+#include "zcheck/render.h"
+
+namespace zcheck {
+
+class RasterRenderer final : public Renderer {
+public:
+    static constexpr int kSubpixelBits = 8;          // 16.8 fixed point
+    static constexpr int kTileSize = 64;             // pixels per tile side
+    static constexpr int kChunkTriangles = 16384;    // triangles per set-up chunk
+
+    explicit RasterRenderer(const Scene& scene);     // the scene must outlive the renderer
+    std::string name() const override { return "raster"; }
+    RenderResult render(const Camera& camera) const override;
+
+private:
+    const Scene& scene_;
+};
+
+}  // namespace zcheck

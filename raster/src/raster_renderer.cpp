@@ -1,0 +1,226 @@
+// Scan conversion after the classic half-space formulation (Pineda, "A Parallel Algorithm
+// for Polygon Rasterization", SIGGRAPH 1988) with Direct3D's top-left fill convention,
+// binned into tiles as in Abrash's Larrabee rasterizer.
+#include "zcheck/raster_renderer.h"
+
+#include "zcheck/clip.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace zcheck {
+
+namespace {
+
+constexpr std::int64_t kSubpixel = 1 << RasterRenderer::kSubpixelBits;  // fixed-point units per pixel
+constexpr std::int64_t kHalfPixel = kSubpixel / 2;
+constexpr double kMaxImageCoordinate = 1 << 20;  // |window coordinate| after guard-band clipping, pixels
+
+// A triangle ready to scan: edge functions in 16.8 fixed point, depth plane in pixels.
+struct TriangleSetup {
+    // E_i(P) = A_i·P.x + B_i·P.y + C_i for P in fixed point; the pixel is covered iff all
+    // three are ≥ 0 (the top-left rule is folded into C_i as a bias of −1 on other edges).
+    std::int64_t A[3], B[3], C[3];
+    // Window depth at image point (x, y): z0 + dzdx·(x − x0) + dzdy·(y − y0).
+    double x0, y0, z0, dzdx, dzdy;
+    int minCol, maxCol, minRow, maxRow;  // pixel bounding box, inclusive, inside the image
+    std::uint32_t primitive;
+};
+
+struct Chunk {
+    std::vector<TriangleSetup> triangles;
+    std::vector<std::uint32_t> tileStart;   // CSR: triangles of tile t are binned[tileStart[t] .. tileStart[t+1])
+    std::vector<std::uint32_t> binned;      // indices into triangles, submission order per tile
+};
+
+struct Viewport {
+    const Camera& camera;
+    int width, height, tilesX, tilesY;
+    ClipPlanes planes;  // near, far, guard band
+
+    Viewport(const Camera& c) : camera(c), width(c.width()), height(c.height())
+    {
+        tilesX = (width + RasterRenderer::kTileSize - 1) / RasterRenderer::kTileSize;
+        tilesY = (height + RasterRenderer::kTileSize - 1) / RasterRenderer::kTileSize;
+        planes = depthClipPlanes(c.convention().ndcZMin());
+        // |ndc| ≤ guard keeps image coordinates within ±(guard+1)/2·size ≤ 2^20 pixels.
+        addGuardBandPlanes(planes, 2.0 * kMaxImageCoordinate / std::max(width, height) - 1.0);
+    }
+
+    unsigned outcode(const glm::dvec4& pClip) const
+    {
+        unsigned code = 0;
+        for (int p = 0; p < planes.size; ++p)
+            if (glm::dot(planes.plane[p], pClip) < 0) code |= 1u << p;
+        return code;
+    }
+};
+
+// Perspective divide, viewport, image rows top-down, snap. Appends the triangle unless it
+// covers no pixel centre.
+void setupTriangle(const Viewport& vp, const glm::dvec4 (&pClip)[3], std::uint32_t primitive,
+                   std::vector<TriangleSetup>& out)
+{
+    std::int64_t X[3], Y[3];
+    double z[3];
+    for (int k = 0; k < 3; ++k) {
+        const glm::dvec3 pNdc = glm::dvec3(pClip[k]) / pClip[k].w;
+        const glm::dvec3 pWindow(vp.camera.windowFromNdc * glm::dvec4(pNdc, 1.0));
+        X[k] = std::llround(pWindow.x * kSubpixel);
+        Y[k] = std::llround(vp.camera.imageYFromWindowY(pWindow.y) * kSubpixel);
+        z[k] = pWindow.z;
+    }
+    std::int64_t area2 = (X[1] - X[0]) * (Y[2] - Y[0]) - (Y[1] - Y[0]) * (X[2] - X[0]);
+    if (area2 == 0) return;  // covers no sample point
+    if (area2 < 0) {         // no culling: both windings are drawn, normalised to area2 > 0
+        std::swap(X[1], X[2]), std::swap(Y[1], Y[2]), std::swap(z[1], z[2]);
+        area2 = -area2;
+    }
+
+    TriangleSetup t;
+    // Pixel (c, r) samples at fixed point (c·256 + 128, r·256 + 128).
+    auto firstCentre = [](std::int64_t lo) { return int((lo - kHalfPixel + kSubpixel - 1) >> RasterRenderer::kSubpixelBits); };
+    auto lastCentre = [](std::int64_t hi) { return int((hi - kHalfPixel) >> RasterRenderer::kSubpixelBits); };
+    t.minCol = std::max(0, firstCentre(std::min({X[0], X[1], X[2]})));
+    t.maxCol = std::min(vp.width - 1, lastCentre(std::max({X[0], X[1], X[2]})));
+    t.minRow = std::max(0, firstCentre(std::min({Y[0], Y[1], Y[2]})));
+    t.maxRow = std::min(vp.height - 1, lastCentre(std::max({Y[0], Y[1], Y[2]})));
+    if (t.minCol > t.maxCol || t.minRow > t.maxRow) return;
+
+    for (int e = 0; e < 3; ++e) {
+        const int a = e, b = (e + 1) % 3;
+        const std::int64_t dx = X[b] - X[a], dy = Y[b] - Y[a];
+        // Top-left rule (image y points down, area2 > 0): a top edge is horizontal with the
+        // interior below it (dx > 0); a left edge goes up (dy < 0).
+        const bool topLeft = dy < 0 || (dy == 0 && dx > 0);
+        t.A[e] = -dy;
+        t.B[e] = dx;
+        t.C[e] = dy * X[a] - dx * Y[a] - (topLeft ? 0 : 1);
+    }
+    const double x0 = double(X[0]) / kSubpixel, y0 = double(Y[0]) / kSubpixel;
+    const double dx1 = double(X[1] - X[0]) / kSubpixel, dy1 = double(Y[1] - Y[0]) / kSubpixel;
+    const double dx2 = double(X[2] - X[0]) / kSubpixel, dy2 = double(Y[2] - Y[0]) / kSubpixel;
+    const double dz1 = z[1] - z[0], dz2 = z[2] - z[0];
+    const double det = dx1 * dy2 - dx2 * dy1;
+    t.x0 = x0, t.y0 = y0, t.z0 = z[0];
+    t.dzdx = (dz1 * dy2 - dz2 * dy1) / det;
+    t.dzdy = (dx1 * dz2 - dx2 * dz1) / det;
+    t.primitive = primitive;
+    out.push_back(t);
+}
+
+// Clip one world triangle and set up what survives (a fan when clipping made a polygon).
+void setupPrimitive(const Viewport& vp, const glm::dvec4& a, const glm::dvec4& b, const glm::dvec4& c,
+                    std::uint32_t primitive, std::vector<TriangleSetup>& out)
+{
+    const unsigned codeA = vp.outcode(a), codeB = vp.outcode(b), codeC = vp.outcode(c);
+    if (codeA & codeB & codeC) return;  // wholly outside one plane
+    if ((codeA | codeB | codeC) == 0) {
+        const glm::dvec4 triangle[3] = {a, b, c};
+        setupTriangle(vp, triangle, primitive, out);
+        return;
+    }
+    const ClipPolygon polygon = clipTriangle(a, b, c, vp.planes);
+    for (int k = 1; k + 1 < polygon.size; ++k) {
+        const glm::dvec4 triangle[3] = {polygon.pClip[0], polygon.pClip[k], polygon.pClip[k + 1]};
+        setupTriangle(vp, triangle, primitive, out);
+    }
+}
+
+void binChunk(const Viewport& vp, Chunk& chunk)
+{
+    const int tiles = vp.tilesX * vp.tilesY;
+    const int T = RasterRenderer::kTileSize;
+    chunk.tileStart.assign(std::size_t(tiles) + 1, 0);
+    auto forEachTile = [&](const TriangleSetup& t, auto&& visit) {
+        for (int ty = t.minRow / T; ty <= t.maxRow / T; ++ty)
+            for (int tx = t.minCol / T; tx <= t.maxCol / T; ++tx) visit(ty * vp.tilesX + tx);
+    };
+    for (const auto& t : chunk.triangles) forEachTile(t, [&](int tile) { ++chunk.tileStart[std::size_t(tile) + 1]; });
+    for (int tile = 0; tile < tiles; ++tile) chunk.tileStart[tile + 1] += chunk.tileStart[tile];
+    chunk.binned.resize(chunk.tileStart[tiles]);
+    std::vector<std::uint32_t> fill(chunk.tileStart.begin(), chunk.tileStart.end() - 1);
+    for (std::uint32_t index = 0; index < chunk.triangles.size(); ++index)
+        forEachTile(chunk.triangles[index], [&](int tile) { chunk.binned[fill[tile]++] = index; });
+}
+
+// Scan one triangle inside one tile.
+void drawInTile(const Camera& camera, const TriangleSetup& t, int tileCol0, int tileRow0, int tileCol1, int tileRow1,
+                RenderResult& out)
+{
+    const int col0 = std::max(t.minCol, tileCol0), col1 = std::min(t.maxCol, tileCol1);
+    const int row0 = std::max(t.minRow, tileRow0), row1 = std::min(t.maxRow, tileRow1);
+    const DepthSettings& depth = camera.depth();
+    const int W = camera.width();
+    for (int row = row0; row <= row1; ++row) {
+        const std::int64_t py = row * kSubpixel + kHalfPixel, px = col0 * kSubpixel + kHalfPixel;
+        std::int64_t e0 = t.A[0] * px + t.B[0] * py + t.C[0];
+        std::int64_t e1 = t.A[1] * px + t.B[1] * py + t.C[1];
+        std::int64_t e2 = t.A[2] * px + t.B[2] * py + t.C[2];
+        const std::int64_t step0 = t.A[0] * kSubpixel, step1 = t.A[1] * kSubpixel, step2 = t.A[2] * kSubpixel;
+        const double rowDepth = t.z0 + t.dzdy * (row + 0.5 - t.y0);
+        for (int col = col0; col <= col1; ++col, e0 += step0, e1 += step1, e2 += step2) {
+            if ((e0 | e1 | e2) < 0) continue;  // some edge function negative: outside
+            const double windowDepth = std::clamp(rowDepth + t.dzdx * (col + 0.5 - t.x0), depth.rangeMin, depth.rangeMax);
+            const double stored = quantizeDepth(depth.format, windowDepth);
+            const std::size_t i = std::size_t(row) * W + col;
+            if (camera.passesDepthTest(stored, out.windowDepth.value[i])) {
+                out.windowDepth.value[i] = stored;
+                out.primitiveId[i] = t.primitive;
+            }
+        }
+    }
+}
+
+}  // namespace
+
+RasterRenderer::RasterRenderer(const Scene& scene) : scene_(scene) { validateScene(scene); }
+
+RenderResult RasterRenderer::render(const Camera& camera) const
+{
+    const auto start = std::chrono::steady_clock::now();
+    const Viewport vp(camera);
+    const int W = camera.width(), H = camera.height();
+    RenderResult result;
+    result.windowDepth = {W, H, DepthQuantity::Window, std::vector<double>(std::size_t(W) * H, camera.clearDepth())};
+    result.primitiveId.assign(std::size_t(W) * H, kNoPrimitive);
+
+    // Vertices to clip space, in double.
+    std::vector<glm::dvec4> pClip(scene_.positions.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pClip.size(), 4096), [&](const auto& range) {
+        for (std::size_t v = range.begin(); v != range.end(); ++v)
+            pClip[v] = camera.clipFromWorld * glm::dvec4(glm::dvec3(scene_.positions[v]), 1.0);
+    });
+
+    // Set-up and binning, one fixed-size chunk of triangles per task.
+    const std::size_t triangleCount = scene_.triangles.size();
+    std::vector<Chunk> chunks((triangleCount + kChunkTriangles - 1) / kChunkTriangles);
+    tbb::parallel_for(std::size_t(0), chunks.size(), [&](std::size_t c) {
+        Chunk& chunk = chunks[c];
+        const std::size_t first = c * kChunkTriangles, last = std::min(triangleCount, first + kChunkTriangles);
+        chunk.triangles.reserve(last - first);
+        for (std::size_t p = first; p < last; ++p) {
+            const glm::uvec3& tri = scene_.triangles[p];
+            setupPrimitive(vp, pClip[tri[0]], pClip[tri[1]], pClip[tri[2]], std::uint32_t(p), chunk.triangles);
+        }
+        binChunk(vp, chunk);
+    });
+
+    // Tiles in parallel; inside a tile, chunks and their triangles in submission order.
+    tbb::parallel_for(0, vp.tilesX * vp.tilesY, [&](int tile) {
+        const int col0 = (tile % vp.tilesX) * kTileSize, row0 = (tile / vp.tilesX) * kTileSize;
+        const int col1 = std::min(W, col0 + kTileSize) - 1, row1 = std::min(H, row0 + kTileSize) - 1;
+        for (const Chunk& chunk : chunks)
+            for (std::uint32_t k = chunk.tileStart[tile]; k < chunk.tileStart[tile + 1]; ++k)
+                drawInTile(camera, chunk.triangles[chunk.binned[k]], col0, row0, col1, row1, result);
+    });
+    result.renderMilliseconds =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return result;
+}
+
+}  // namespace zcheck

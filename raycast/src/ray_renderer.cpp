@@ -1,0 +1,195 @@
+#include "zcheck/ray_renderer.h"
+
+#include "zcheck/error.h"
+#include "zcheck/inverse_projection.h"
+
+#include <embree3/rtcore.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <xmmintrin.h>
+
+#include <chrono>
+#include <cmath>
+#include <mutex>
+
+namespace zcheck {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double millisecondsSince(Clock::time_point start)
+{
+    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+struct DeviceDeleter {
+    void operator()(RTCDevice device) const { rtcReleaseDevice(device); }
+};
+struct SceneDeleter {
+    void operator()(RTCScene scene) const { rtcReleaseScene(scene); }
+};
+using DeviceHandle = std::unique_ptr<RTCDeviceTy, DeviceDeleter>;
+using SceneHandle = std::unique_ptr<RTCSceneTy, SceneDeleter>;
+
+// The first error Embree reports; checked after every set-up step.
+struct ErrorLog {
+    std::mutex mutex;
+    std::string message;
+};
+
+void recordError(void* userPtr, RTCError code, const char* text)
+{
+    auto* log = static_cast<ErrorLog*>(userPtr);
+    std::lock_guard<std::mutex> lock(log->mutex);
+    if (log->message.empty())
+        log->message = "Embree error " + std::to_string(int(code)) + (text ? std::string(": ") + text : "");
+}
+
+// Flush denormals to zero while tracing (Embree's recommendation); restores the caller's mode.
+class FlushDenormals {
+public:
+    FlushDenormals() : saved_(_mm_getcsr()) { _mm_setcsr(saved_ | 0x8040); }  // FTZ | DAZ
+    ~FlushDenormals() { _mm_setcsr(saved_); }
+
+private:
+    unsigned saved_;
+};
+
+constexpr int kTile = 8;        // 8×8 pixels per tile
+constexpr int kPacketW = 4;     // a packet covers 4×2 pixels
+constexpr int kPacketH = 2;
+
+}  // namespace
+
+struct RayRenderer::Embree {
+    ErrorLog errors;
+    DeviceHandle device;
+    SceneHandle scene;
+
+    void check(const char* step)
+    {
+        std::lock_guard<std::mutex> lock(errors.mutex);
+        if (!errors.message.empty()) throw Error(std::string("Embree failed while ") + step + ": " + errors.message);
+    }
+};
+
+RayRenderer::RayRenderer(const Scene& scene) : embree_(std::make_unique<Embree>()), scene_(scene)
+{
+    validateScene(scene);
+    const auto start = Clock::now();
+    embree_->device.reset(rtcNewDevice(nullptr));
+    if (!embree_->device) throw Error("cannot create an Embree device (error " + std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
+    // Install the error callback first, so every later failure is seen.
+    rtcSetDeviceErrorFunction(embree_->device.get(), recordError, &embree_->errors);
+
+    embree_->scene.reset(rtcNewScene(embree_->device.get()));
+    rtcSetSceneFlags(embree_->scene.get(), RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(embree_->scene.get(), RTC_BUILD_QUALITY_MEDIUM);
+
+    RTCGeometry geometry = rtcNewGeometry(embree_->device.get(), RTC_GEOMETRY_TYPE_TRIANGLE);
+    embree_->check("creating the triangle geometry");
+    // rtcSetNewGeometryBuffer pads the buffers as Embree requires (vertex reads may run 16 bytes past the end).
+    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                                 3 * sizeof(float), scene.positions.size()));
+    auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                   3 * sizeof(unsigned), scene.triangles.size()));
+    if (!vertices || !indices) {
+        rtcReleaseGeometry(geometry);
+        embree_->check("allocating geometry buffers");
+        throw Error("Embree could not allocate geometry buffers");
+    }
+    for (std::size_t v = 0; v < scene.positions.size(); ++v)
+        for (int k = 0; k < 3; ++k) vertices[3 * v + k] = scene.positions[v][k];
+    for (std::size_t t = 0; t < scene.triangles.size(); ++t)
+        for (int k = 0; k < 3; ++k) indices[3 * t + k] = scene.triangles[t][k];
+    rtcCommitGeometry(geometry);  // commit before attaching, or no intersections
+    rtcAttachGeometryByID(embree_->scene.get(), geometry, 0);
+    rtcReleaseGeometry(geometry);
+    rtcCommitScene(embree_->scene.get());
+    embree_->check("building the BVH");
+    buildMilliseconds_ = millisecondsSince(start);
+}
+
+RayRenderer::~RayRenderer() = default;
+
+RenderResult RayRenderer::render(const Camera& camera) const
+{
+    const auto start = Clock::now();
+    const int W = camera.width(), H = camera.height();
+    RenderResult result;
+    result.windowDepth = {W, H, DepthQuantity::Window, std::vector<double>(std::size_t(W) * H, camera.clearDepth())};
+    result.primitiveId.assign(std::size_t(W) * H, kNoPrimitive);
+    result.pEye.assign(std::size_t(W) * H, glm::dvec3(NAN));
+
+    const int tilesX = (W + kTile - 1) / kTile, tilesY = (H + kTile - 1) / kTile;
+    RTCScene rtcScene = embree_->scene.get();
+    const RaySampling fault = sampling;
+
+    tbb::parallel_for(tbb::blocked_range<int>(0, tilesX * tilesY, 4), [&](const tbb::blocked_range<int>& tiles) {
+        FlushDenormals flush;
+        RTCIntersectContext context;
+        rtcInitIntersectContext(&context);
+        context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+        alignas(32) int valid[8];
+        alignas(32) RTCRayHit8 packet;
+        EyePlaneRay rays[8];
+        int pixelOf[8];
+
+        for (int tile = tiles.begin(); tile != tiles.end(); ++tile) {
+            const int tileX = (tile % tilesX) * kTile, tileY = (tile / tilesX) * kTile;
+            for (int py = 0; py < kTile; py += kPacketH) {
+                for (int px = 0; px < kTile; px += kPacketW) {
+                    for (int k = 0; k < 8; ++k) {
+                        const int col = tileX + px + k % kPacketW, row = tileY + py + k / kPacketW;
+                        valid[k] = (col < W && row < H) ? -1 : 0;
+                        pixelOf[k] = row * W + col;
+                        // Every field of every lane is initialised, valid or not.
+                        const int sampleRow = fault.flipRows ? H - 1 - row : row;
+                        const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, sampleRow) + fault.shiftPixels;
+                        rays[k] = valid[k] ? worldEyePlaneRayThroughWindow(camera, pWindow)
+                                           : EyePlaneRay{{0, 0, 0}, {0, 0, 1}, 0, 0};
+                        const EyePlaneRay& r = rays[k];
+                        packet.ray.org_x[k] = float(r.origin.x);
+                        packet.ray.org_y[k] = float(r.origin.y);
+                        packet.ray.org_z[k] = float(r.origin.z);
+                        packet.ray.dir_x[k] = float(r.direction.x);
+                        packet.ray.dir_y[k] = float(r.direction.y);
+                        packet.ray.dir_z[k] = float(r.direction.z);
+                        packet.ray.tnear[k] = float(r.tNear);
+                        packet.ray.tfar[k] = std::isinf(r.tFar) ? INFINITY : float(r.tFar);
+                        packet.ray.time[k] = 0.0f;
+                        packet.ray.mask[k] = 0xFFFFFFFFu;  // Debian's Embree has ray masks on
+                        packet.ray.id[k] = unsigned(k);
+                        packet.ray.flags[k] = 0;
+                        packet.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+                        packet.hit.primID[k] = RTC_INVALID_GEOMETRY_ID;
+                        packet.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+                    }
+                    rtcIntersect8(valid, rtcScene, &context, &packet);
+                    for (int k = 0; k < 8; ++k) {
+                        if (!valid[k] || packet.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) continue;
+                        const std::uint32_t primitive = packet.hit.primID[k];
+                        const glm::uvec3& tri = scene_.triangles[primitive];
+                        const glm::dvec3 a(scene_.positions[tri[0]]), b(scene_.positions[tri[1]]),
+                            c(scene_.positions[tri[2]]);
+                        // The hit again, in double: the ray against the hit triangle's plane.
+                        const EyePlaneRay& r = rays[k];
+                        const glm::dvec3 normal = glm::cross(b - a, c - a);
+                        double t = glm::dot(normal, a - r.origin) / glm::dot(normal, r.direction);
+                        if (!std::isfinite(t)) t = packet.ray.tfar[k];
+                        const glm::dvec3 pWorld = r.origin + t * r.direction;
+                        const glm::dvec3 pEye(camera.eyeFromWorld * glm::dvec4(pWorld, 1.0));
+                        const std::size_t i = std::size_t(pixelOf[k]);
+                        result.primitiveId[i] = primitive;
+                        result.pEye[i] = pEye;
+                        result.windowDepth.value[i] = windowFromEye(camera, pEye).z;
+                    }
+                }
+            }
+        }
+    });
+    result.renderMilliseconds = millisecondsSince(start);
+    return result;
+}
+
+}  // namespace zcheck
