@@ -6,15 +6,204 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 
 namespace zcheck {
+
+namespace {
+
+// PLY files that store triangle strips (`element tristrips` with a `vertex_indices` list,
+// −1 restarting a strip) are read here: assimp 5.2 reads such a file as a single triangle
+// without complaint. ASCII and binary (either byte order) are supported; a malformed file
+// is refused with the reason.
+class PlyStripReader {
+public:
+    explicit PlyStripReader(const std::string& path) : path_(path), in_(path, std::ios::binary) {}
+
+    static bool storesStrips(const std::string& path)
+    {
+        std::ifstream in(path, std::ios::binary);
+        std::string line;
+        if (!std::getline(in, line) || line.rfind("ply", 0) != 0) return false;
+        for (int n = 0; n < 1000 && std::getline(in, line); ++n) {
+            if (line.rfind("end_header", 0) == 0) return false;
+            if (line.rfind("element tristrips", 0) == 0) return true;
+        }
+        return false;
+    }
+
+    Scene read()
+    {
+        readHeader();
+        Scene scene;
+        scene.name = path_;
+        for (const Element& element : elements_) {
+            for (std::uint64_t item = 0; item < element.count; ++item) {
+                glm::vec3 position(0.0f);
+                for (const Property& property : element.properties) {
+                    if (property.isList) {
+                        const auto length = static_cast<std::int64_t>(value(property.countType));
+                        if (length < 0 || length > (1 << 28)) fail("a list has an impossible length");
+                        std::vector<std::int64_t> list(static_cast<std::size_t>(length));
+                        for (auto& index : list) index = static_cast<std::int64_t>(value(property.type));
+                        if (property.name == "vertex_indices" || property.name == "vertex_index")
+                            addPrimitives(scene, element.name, list);
+                    } else {
+                        const double v = value(property.type);
+                        if (element.name == "vertex") {
+                            if (property.name == "x") position.x = float(v);
+                            if (property.name == "y") position.y = float(v);
+                            if (property.name == "z") position.z = float(v);
+                        }
+                    }
+                }
+                if (element.name == "vertex") scene.positions.push_back(position);
+            }
+        }
+        for (const auto& t : scene.triangles)
+            for (int k = 0; k < 3; ++k)
+                if (t[k] >= scene.positions.size()) fail("a vertex index is out of range");
+        return scene;
+    }
+
+private:
+    struct Property {
+        std::string name, type, countType;
+        bool isList = false;
+    };
+    struct Element {
+        std::string name;
+        std::uint64_t count = 0;
+        std::vector<Property> properties;
+    };
+
+    [[noreturn]] void fail(const std::string& why) const
+    {
+        throw Error("cannot load mesh '" + path_ + "': malformed PLY: " + why);
+    }
+
+    void readHeader()
+    {
+        std::string line;
+        std::getline(in_, line);
+        while (std::getline(in_, line)) {
+            if (!line.empty() && line.back() == '\r') line.pop_back();
+            std::istringstream words(line);
+            std::string keyword;
+            words >> keyword;
+            if (keyword == "format") {
+                std::string format;
+                words >> format;
+                if (format == "ascii") ascii_ = true;
+                else if (format == "binary_big_endian") bigEndian_ = true;
+                else if (format != "binary_little_endian") fail("unknown format '" + format + "'");
+            } else if (keyword == "element") {
+                Element element;
+                if (!(words >> element.name >> element.count)) fail("bad element line '" + line + "'");
+                elements_.push_back(element);
+            } else if (keyword == "property") {
+                if (elements_.empty()) fail("a property before any element");
+                Property property;
+                std::string first;
+                words >> first;
+                if (first == "list") {
+                    property.isList = true;
+                    words >> property.countType >> property.type >> property.name;
+                    sizeOf(property.countType);
+                } else {
+                    property.type = first;
+                    words >> property.name;
+                }
+                sizeOf(property.type);
+                elements_.back().properties.push_back(property);
+            } else if (keyword == "end_header") {
+                return;
+            } else if (keyword != "comment" && keyword != "obj_info" && !keyword.empty()) {
+                fail("unknown header line '" + line + "'");
+            }
+        }
+        fail("no end_header");
+    }
+
+    int sizeOf(const std::string& type) const
+    {
+        if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
+        if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
+        if (type == "int" || type == "uint" || type == "int32" || type == "uint32" || type == "float" ||
+            type == "float32")
+            return 4;
+        if (type == "double" || type == "float64") return 8;
+        fail("unknown property type '" + type + "'");
+    }
+
+    double value(const std::string& type)
+    {
+        if (ascii_) {
+            double v;
+            if (!(in_ >> v)) fail("the data ends early or holds a non-number");
+            return v;
+        }
+        unsigned char bytes[8];
+        const int size = sizeOf(type);
+        if (!in_.read(reinterpret_cast<char*>(bytes), size)) fail("the data ends early");
+        if (bigEndian_) std::reverse(bytes, bytes + size);
+        auto as = [&](auto v) {
+            std::memcpy(&v, bytes, sizeof v);
+            return double(v);
+        };
+        if (type == "char" || type == "int8") return as(std::int8_t{});
+        if (type == "uchar" || type == "uint8") return as(std::uint8_t{});
+        if (type == "short" || type == "int16") return as(std::int16_t{});
+        if (type == "ushort" || type == "uint16") return as(std::uint16_t{});
+        if (type == "int" || type == "int32") return as(std::int32_t{});
+        if (type == "uint" || type == "uint32") return as(std::uint32_t{});
+        if (type == "float" || type == "float32") return as(float{});
+        return as(double{});
+    }
+
+    // Faces are fans; strips alternate winding and restart at −1. Triangles that repeat an
+    // index (the joins between strips) have no area and are not geometry: they are skipped.
+    static void addPrimitives(Scene& scene, const std::string& element, const std::vector<std::int64_t>& list)
+    {
+        auto add = [&](std::int64_t a, std::int64_t b, std::int64_t c) {
+            if (a < 0 || b < 0 || c < 0 || a == b || b == c || a == c) return;
+            scene.triangles.push_back({std::uint32_t(a), std::uint32_t(b), std::uint32_t(c)});
+        };
+        if (element == "tristrips") {
+            std::size_t start = 0;
+            for (std::size_t k = 0; k <= list.size(); ++k) {
+                if (k < list.size() && list[k] >= 0) continue;
+                for (std::size_t i = start; i + 2 < k; ++i) {
+                    const bool even = (i - start) % 2 == 0;
+                    add(list[even ? i : i + 1], list[even ? i + 1 : i], list[i + 2]);
+                }
+                start = k + 1;
+            }
+        } else {
+            for (std::size_t i = 1; i + 1 < list.size(); ++i) add(list[0], list[i], list[i + 1]);
+        }
+    }
+
+    std::string path_;
+    std::ifstream in_;
+    std::vector<Element> elements_;
+    bool ascii_ = false, bigEndian_ = false;
+};
+
+Scene framed(Scene scene);
+
+}  // namespace
 
 Scene loadMesh(const std::string& path)
 {
     std::error_code ec;
     if (!std::filesystem::exists(path, ec)) throw Error("cannot read mesh '" + path + "': no such file");
     if (std::filesystem::is_directory(path, ec)) throw Error("cannot read mesh '" + path + "': it is a directory");
+
+    if (PlyStripReader::storesStrips(path)) return framed(PlyStripReader(path).read());
 
     Assimp::Importer importer;
     // Keep every triangle: no degenerate removal, no validation that drops faces.
@@ -44,14 +233,21 @@ Scene loadMesh(const std::string& path)
         }
         scene.append(positions, triangles);
     }
-    if (scene.triangles.empty()) throw Error("cannot load mesh '" + path + "': it holds no triangles");
-    validateScene(scene);
+    return framed(std::move(scene));
+}
 
+namespace {
+// Validates a loaded mesh and gives it a camera that frames its bounding sphere.
+Scene framed(Scene scene)
+{
+    if (scene.triangles.empty()) throw Error("cannot load mesh '" + scene.name + "': it holds no triangles");
+    validateScene(scene);
     const glm::dvec3 lo = scene.boundsMin(), hi = scene.boundsMax();
     const double radius = std::max(glm::length(hi - lo) / 2, 1e-6);
     scene.defaultCamera = framingCameraSpec((lo + hi) / 2.0, radius);
     return scene;
 }
+}  // namespace
 
 Scene loadScene(const std::string& nameOrPath)
 {

@@ -1,0 +1,404 @@
+// Core: conventions, cameras and the inverse-projection module, against textbook matrices,
+// GLM's independent implementations and round trips.
+#include "zcheck/camera.h"
+#include "zcheck/camera_file.h"
+#include "zcheck/clip.h"
+#include "zcheck/error.h"
+#include "zcheck/inverse_projection.h"
+
+#include <catch2/catch.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+
+#include <cmath>
+#include <random>
+
+using namespace zcheck;
+
+namespace {
+
+CameraSpec specWith(const std::string& convention, ProjectionType type, bool reversed = false)
+{
+    CameraSpec spec;
+    spec.convention = Convention::preset(convention);
+    spec.width = 640;
+    spec.height = 480;
+    spec.projection.type = type;
+    spec.projection.fovyDeg = 60;
+    spec.projection.left = -0.3, spec.projection.right = 0.5;
+    spec.projection.bottom = -0.2, spec.projection.top = 0.25;
+    spec.projection.near = 0.5;
+    spec.projection.far = 80;
+    if (type == ProjectionType::Orthographic) {
+        spec.projection.left = -4, spec.projection.right = 5, spec.projection.bottom = -3, spec.projection.top = 3.5;
+    }
+    spec.view = {{1.0, 2.0, 6.0}, {0.2, 0.1, -1.0}, {0.1, 1.0, 0.0}};
+    spec.depth.reversed = reversed;
+    return spec;
+}
+
+void requireMatrixNear(const glm::dmat4& actual, const glm::dmat4& expected, double tolerance = 1e-12)
+{
+    for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 4; ++r) {
+            INFO("row " << r << " column " << c);
+            REQUIRE(actual[c][r] == Approx(expected[c][r]).margin(tolerance).epsilon(tolerance));
+        }
+}
+
+std::vector<CameraSpec> everyConventionAndProjection()
+{
+    std::vector<CameraSpec> specs;
+    for (const auto& convention : Convention::presetNames())
+        for (auto type : {ProjectionType::Perspective, ProjectionType::Frustum, ProjectionType::Orthographic})
+            for (bool reversed : {false, true}) {
+                CameraSpec spec = specWith(convention, type, reversed);
+                spec.depth.rangeMin = 0.1;  // a depth range other than [0,1] too
+                spec.depth.rangeMax = 0.9;
+                specs.push_back(specWith(convention, type, reversed));
+                specs.push_back(spec);
+            }
+    return specs;
+}
+
+std::string describe(const CameraSpec& s)
+{
+    return s.convention.name + " " + toString(s.projection.type) + (s.depth.reversed ? " reversed" : "") + " range [" +
+           std::to_string(s.depth.rangeMin) + "," + std::to_string(s.depth.rangeMax) + "]";
+}
+
+}  // namespace
+
+TEST_CASE("clipFromEye of the opengl preset is the textbook gluPerspective matrix", "[core][textbook]")
+{
+    const Camera camera(specWith("opengl", ProjectionType::Perspective));
+    const double n = 0.5, f = 80, aspect = 640.0 / 480.0, cot = 1.0 / std::tan(glm::radians(60.0) / 2);
+    const double rows[4][4] = {
+        {cot / aspect, 0, 0, 0},
+        {0, cot, 0, 0},
+        {0, 0, (f + n) / (n - f), 2 * f * n / (n - f)},
+        {0, 0, -1, 0},
+    };
+    requireMatrixNear(camera.clipFromEye, matrixFromRows(rows));
+}
+
+TEST_CASE("clipFromEye of the opengl preset is the textbook glFrustum matrix", "[core][textbook]")
+{
+    const Camera camera(specWith("opengl", ProjectionType::Frustum));
+    const double l = -0.3, r = 0.5, b = -0.2, t = 0.25, n = 0.5, f = 80;
+    const double rows[4][4] = {
+        {2 * n / (r - l), 0, (r + l) / (r - l), 0},
+        {0, 2 * n / (t - b), (t + b) / (t - b), 0},
+        {0, 0, -(f + n) / (f - n), -2 * f * n / (f - n)},
+        {0, 0, -1, 0},
+    };
+    requireMatrixNear(camera.clipFromEye, matrixFromRows(rows));
+}
+
+TEST_CASE("clipFromEye of the opengl preset is the textbook glOrtho matrix", "[core][textbook]")
+{
+    const Camera camera(specWith("opengl", ProjectionType::Orthographic));
+    const double l = -4, r = 5, b = -3, t = 3.5, n = 0.5, f = 80;
+    const double rows[4][4] = {
+        {2 / (r - l), 0, 0, -(r + l) / (r - l)},
+        {0, 2 / (t - b), 0, -(t + b) / (t - b)},
+        {0, 0, -2 / (f - n), -(f + n) / (f - n)},
+        {0, 0, 0, 1},
+    };
+    requireMatrixNear(camera.clipFromEye, matrixFromRows(rows));
+}
+
+TEST_CASE("clipFromEye of the direct3d preset is the transposed D3DXMatrixPerspectiveFovLH", "[core][textbook]")
+{
+    // Row-vector form (p' = p·M), left-handed, depth [0,1]: d = 1/tan(α/2), A = f/(f−n), B = −nf/(f−n).
+    const Camera camera(specWith("direct3d", ProjectionType::Perspective));
+    const double n = 0.5, f = 80, aspect = 640.0 / 480.0, d = 1.0 / std::tan(glm::radians(60.0) / 2);
+    const double rowVectorForm[4][4] = {
+        {d / aspect, 0, 0, 0},
+        {0, d, 0, 0},
+        {0, 0, f / (f - n), 1},
+        {0, 0, -n * f / (f - n), 0},
+    };
+    requireMatrixNear(camera.clipFromEye, glm::transpose(matrixFromRows(rowVectorForm)));
+}
+
+TEST_CASE("projection and view agree with GLM's independent implementations", "[core][glm]")
+{
+    const double fovy = glm::radians(60.0), aspect = 640.0 / 480.0, n = 0.5, f = 80;
+    const glm::dvec3 eye(1.0, 2.0, 6.0), target(0.2, 0.1, -1.0), up(0.1, 1.0, 0.0);
+    SECTION("opengl is perspectiveRH_NO and lookAtRH")
+    {
+        const Camera camera(specWith("opengl", ProjectionType::Perspective));
+        requireMatrixNear(camera.clipFromEye, glm::perspectiveRH_NO(fovy, aspect, n, f));
+        requireMatrixNear(camera.eyeFromWorld, glm::lookAtRH(eye, target, up));
+    }
+    SECTION("direct3d is perspectiveLH_ZO; its view is lookAtRH with eye z negated")
+    {
+        // zcheck's world is right-handed in every convention, so that one camera gives one
+        // picture. GLM's lookAtLH (like D3DXMatrixLookAtLH) assumes a left-handed world and
+        // takes x = up × forward: the mirror image, hence its x row negated here.
+        const Camera camera(specWith("direct3d", ProjectionType::Perspective));
+        requireMatrixNear(camera.clipFromEye, glm::perspectiveLH_ZO(fovy, aspect, n, f));
+        const glm::dmat4 negateZ = glm::scale(glm::dmat4(1.0), glm::dvec3(1, 1, -1));
+        const glm::dmat4 negateX = glm::scale(glm::dmat4(1.0), glm::dvec3(-1, 1, 1));
+        requireMatrixNear(camera.eyeFromWorld, negateZ * glm::lookAtRH(eye, target, up));
+        requireMatrixNear(camera.eyeFromWorld, negateX * glm::lookAtLH(eye, target, up));
+    }
+    SECTION("metal is perspectiveRH_ZO; vulkan is perspectiveRH_ZO with clip y negated")
+    {
+        requireMatrixNear(Camera(specWith("metal", ProjectionType::Perspective)).clipFromEye,
+                          glm::perspectiveRH_ZO(fovy, aspect, n, f));
+        glm::dmat4 flipped = glm::perspectiveRH_ZO(fovy, aspect, n, f);
+        flipped[1][1] = -flipped[1][1];
+        requireMatrixNear(Camera(specWith("vulkan", ProjectionType::Perspective)).clipFromEye, flipped);
+    }
+    SECTION("orthographic: orthoRH_NO for opengl, orthoLH_ZO for direct3d")
+    {
+        requireMatrixNear(Camera(specWith("opengl", ProjectionType::Orthographic)).clipFromEye,
+                          glm::orthoRH_NO(-4.0, 5.0, -3.0, 3.5, n, f));
+        requireMatrixNear(Camera(specWith("direct3d", ProjectionType::Orthographic)).clipFromEye,
+                          glm::orthoLH_ZO(-4.0, 5.0, -3.0, 3.5, n, f));
+    }
+    SECTION("frustum: frustumRH_NO for opengl")
+    {
+        requireMatrixNear(Camera(specWith("opengl", ProjectionType::Frustum)).clipFromEye,
+                          glm::frustumRH_NO(-0.3, 0.5, -0.2, 0.25, n, f));
+    }
+}
+
+TEST_CASE("windowFromNdc is the textbook viewport for bottom-left and top-left origins", "[core][textbook]")
+{
+    SECTION("glViewport + glDepthRange(0,1): the [-1,1] depth remap T(0,0,1/2)·S(1,1,1/2)")
+    {
+        const Camera camera(specWith("opengl", ProjectionType::Perspective));
+        const double rows[4][4] = {{320, 0, 0, 320}, {0, 240, 0, 240}, {0, 0, 0.5, 0.5}, {0, 0, 0, 1}};
+        requireMatrixNear(camera.windowFromNdc, matrixFromRows(rows));
+    }
+    SECTION("Direct3D viewport, top-left origin, MinDepth 0.1 / MaxDepth 0.9")
+    {
+        CameraSpec spec = specWith("direct3d", ProjectionType::Perspective);
+        spec.depth.rangeMin = 0.1, spec.depth.rangeMax = 0.9;
+        const Camera camera(spec);
+        const double rows[4][4] = {{320, 0, 0, 320}, {0, -240, 0, 240}, {0, 0, 0.8, 0.1}, {0, 0, 0, 1}};
+        requireMatrixNear(camera.windowFromNdc, matrixFromRows(rows));
+    }
+}
+
+TEST_CASE("the near and far planes map to the ends of the depth range, swapped by reversed-Z", "[core]")
+{
+    for (const CameraSpec& spec : everyConventionAndProjection()) {
+        INFO(describe(spec));
+        const Camera camera(spec);
+        const glm::dvec2 centre(320, 240);
+        for (double eyeZ : {spec.projection.near, spec.projection.far}) {
+            const double expected = (eyeZ == spec.projection.near) != spec.depth.reversed ? spec.depth.rangeMin
+                                                                                            : spec.depth.rangeMax;
+            REQUIRE(windowDepthFromEyeZ(camera, centre, eyeZ) == Approx(expected).margin(1e-12));
+        }
+    }
+}
+
+TEST_CASE("window depth of a perspective camera matches the analytic formula in every convention", "[core]")
+{
+    // Standard: d = f(z − n) / (z (f − n)); reversed: d = n(f − z) / (z (f − n)); then the range.
+    for (const auto& convention : Convention::presetNames())
+        for (bool reversed : {false, true}) {
+            const CameraSpec spec = specWith(convention, ProjectionType::Perspective, reversed);
+            const Camera camera(spec);
+            const double n = spec.projection.near, f = spec.projection.far;
+            for (double z : {0.5, 0.7, 3.0, 41.0, 80.0}) {
+                const double d = reversed ? n * (f - z) / (z * (f - n)) : f * (z - n) / (z * (f - n));
+                INFO(convention << (reversed ? " reversed" : "") << " eye-z " << z);
+                REQUIRE(windowDepthFromEyeZ(camera, {100.5, 33.5}, z) == Approx(d).margin(1e-13));
+            }
+        }
+}
+
+TEST_CASE("every transform round-trips through its inverse in every convention", "[core][property]")
+{
+    std::mt19937_64 random(20261121);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    for (const CameraSpec& spec : everyConventionAndProjection()) {
+        INFO(describe(spec));
+        const Camera camera(spec);
+        const double lo = std::min(camera.windowDepthNear(), camera.windowDepthFar());
+        const double hi = std::max(camera.windowDepthNear(), camera.windowDepthFar());
+        for (int k = 0; k < 200; ++k) {
+            const glm::dvec3 pWindow(unit(random) * 640, unit(random) * 480, lo + (hi - lo) * unit(random));
+            // window → eye → window
+            const glm::dvec3 pEye = eyeFromWindow(camera, pWindow);
+            const glm::dvec3 back = windowFromEye(camera, pEye);
+            REQUIRE(back.x == Approx(pWindow.x).margin(1e-7));
+            REQUIRE(back.y == Approx(pWindow.y).margin(1e-7));
+            REQUIRE(back.z == Approx(pWindow.z).margin(1e-9));
+            // the eye point lies in front, between near and far
+            const double eyeZ = camera.eyeZOf(pEye);
+            REQUIRE(eyeZ >= spec.projection.near * (1 - 1e-9));
+            REQUIRE(eyeZ <= spec.projection.far * (1 + 1e-9));
+            // window depth ↔ eye-z ↔ distance
+            const glm::dvec2 pXY(pWindow);
+            REQUIRE(eyeZFromWindowDepth(camera, pXY, pWindow.z) == Approx(eyeZ).epsilon(1e-9));
+            REQUIRE(windowDepthFromEyeZ(camera, pXY, eyeZ) == Approx(pWindow.z).margin(1e-9));
+            const double distance = distanceFromEyeZ(camera, pXY, eyeZ);
+            REQUIRE(distance >= eyeZ * (1 - 1e-12));
+            REQUIRE(eyeZFromDistance(camera, pXY, distance) == Approx(eyeZ).epsilon(1e-9));
+            // the world ray through the window point passes through the world point
+            const glm::dvec3 pWorld(camera.worldFromEye * glm::dvec4(pEye, 1.0));
+            const EyePlaneRay ray = worldEyePlaneRayThroughWindow(camera, pXY);
+            const double t = glm::dot(pWorld - ray.origin, ray.direction);
+            REQUIRE(glm::length(ray.origin + t * ray.direction - pWorld) <= 1e-9 * (1 + glm::length(pWorld)));
+            REQUIRE(t >= ray.tNear * (1 - 1e-9));
+            REQUIRE(t <= ray.tFar * (1 + 1e-9));
+            REQUIRE(t == Approx(distance).epsilon(1e-9));  // t along the eye-plane ray is the distance
+            // world ↔ eye ↔ clip
+            const glm::dvec4 pClip = camera.clipFromWorld * glm::dvec4(pWorld, 1.0);
+            const glm::dvec4 again = camera.worldFromClip * pClip;
+            REQUIRE(glm::length(glm::dvec3(again) / again.w - pWorld) <= 1e-9 * (1 + glm::length(pWorld)));
+        }
+    }
+}
+
+TEST_CASE("the same camera sees the same picture in every convention", "[core][property]")
+{
+    // A world point lands on the same image position (row 0 at the top) and at the same
+    // eye-z, whatever the convention: conventions change numbers, never the image.
+    std::mt19937_64 random(7);
+    std::uniform_real_distribution<double> unit(-1.0, 1.0);
+    for (auto type : {ProjectionType::Perspective, ProjectionType::Frustum, ProjectionType::Orthographic}) {
+        const Camera reference(specWith("opengl", type));
+        for (int k = 0; k < 100; ++k) {
+            const glm::dvec3 pWorld(unit(random) * 2, unit(random) * 2, unit(random) * 2 - 1);
+            const glm::dvec3 w0 = windowFromWorld(reference, pWorld);
+            const glm::dvec3 pEye0(reference.eyeFromWorld * glm::dvec4(pWorld, 1.0));
+            for (const auto& name : Convention::presetNames()) {
+                const Camera camera(specWith(name, type));
+                const glm::dvec3 w = windowFromWorld(camera, pWorld);
+                INFO(name << " " << toString(type));
+                REQUIRE(w.x == Approx(w0.x).margin(1e-9));
+                REQUIRE(camera.imageYFromWindowY(w.y) == Approx(reference.imageYFromWindowY(w0.y)).margin(1e-9));
+                const glm::dvec3 pEye(camera.eyeFromWorld * glm::dvec4(pWorld, 1.0));
+                REQUIRE(camera.eyeZOf(pEye) == Approx(reference.eyeZOf(pEye0)).margin(1e-12));
+            }
+        }
+    }
+}
+
+TEST_CASE("pixel rays of a perspective camera pass through the hand-computed points", "[core]")
+{
+    // opengl, eye at the origin looking down −z, fovy 90°, square 2×2 image: the centre of
+    // pixel (1,0) (top-right) sits at NDC (0.5, 0.5), so its ray points along (0.5, 0.5, −1).
+    CameraSpec spec = specWith("opengl", ProjectionType::Perspective);
+    spec.width = spec.height = 2;
+    spec.projection.fovyDeg = 90;
+    spec.view = {{0, 0, 0}, {0, 0, -1}, {0, 1, 0}};
+    for (const auto& name : {"opengl", "direct3d", "vulkan", "metal", "opencv"}) {
+        spec.convention = Convention::preset(name);
+        const Camera camera(spec);
+        const EyePlaneRay ray = worldEyePlaneRayThroughWindow(camera, windowFromPixelCentre(camera, 1, 0));
+        INFO(name);
+        REQUIRE(glm::length(ray.origin) <= 1e-15);
+        REQUIRE(glm::length(ray.direction - glm::normalize(glm::dvec3(0.5, 0.5, -1))) <= 1e-12);
+        REQUIRE(ray.tNear == Approx(0.5 * std::sqrt(1.5)).epsilon(1e-12));
+    }
+}
+
+TEST_CASE("storage quanta and quantization follow the formats' definitions", "[core]")
+{
+    REQUIRE(storageQuantum(DepthFormat::Unorm16, 0.3) == 1.0 / 65535);
+    REQUIRE(storageQuantum(DepthFormat::Unorm24, 0.3) == 1.0 / 16777215);
+    REQUIRE(storageQuantum(DepthFormat::Float32, 1.0) == std::ldexp(1.0, -23));
+    REQUIRE(storageQuantum(DepthFormat::Float32, 0.75) == std::ldexp(1.0, -24));
+    REQUIRE(quantizeDepth(DepthFormat::Unorm16, 0.5) == 32768.0 / 65535);  // round(0.5·65535) = 32768
+    REQUIRE(quantizeDepth(DepthFormat::Unorm16, 1.2) == 1.0);
+    REQUIRE(quantizeDepth(DepthFormat::Float32, 0.1) == double(0.1f));
+}
+
+TEST_CASE("clipping a triangle keeps what is inside the near and far planes", "[core]")
+{
+    // ZO volume: 0 ≤ z ≤ w. One vertex behind the near plane.
+    const ClipPlanes planes = depthClipPlanes(0.0);
+    const ClipPolygon polygon = clipTriangle({0, 0, -1, 1}, {1, 0, 0.5, 1}, {0, 1, 0.5, 1}, planes);
+    REQUIRE(polygon.size == 4);
+    for (int i = 0; i < polygon.size; ++i) {
+        REQUIRE(polygon.pClip[i].z >= -1e-15);
+        REQUIRE(polygon.pClip[i].z <= polygon.pClip[i].w);
+    }
+    REQUIRE(clipTriangle({0, 0, -1, 1}, {1, 0, -2, 1}, {0, 1, -0.5, 1}, planes).size == 0);
+}
+
+TEST_CASE("invalid cameras are refused with a message naming the parameter", "[core][validation]")
+{
+    auto refuses = [](CameraSpec spec, const std::string& key) {
+        INFO("expected a complaint about " << key);
+        REQUIRE_THROWS_WITH(Camera(spec), Catch::Contains(key));
+    };
+    CameraSpec good = specWith("opengl", ProjectionType::Perspective);
+    REQUIRE_NOTHROW(Camera(good));
+    CameraSpec s = good;
+    s.projection.near = 0;
+    refuses(s, "projection.near");
+    s = good, s.projection.near = -1;
+    refuses(s, "projection.near");
+    s = good, s.projection.far = 0.5;
+    refuses(s, "projection.far");
+    s = good, s.projection.far = NAN;
+    refuses(s, "projection.far");
+    s = good, s.projection.fovyDeg = NAN;
+    refuses(s, "projection.fovy_deg");
+    s = good, s.projection.fovyDeg = 180;
+    refuses(s, "projection.fovy_deg");
+    s = good, s.width = 0;
+    refuses(s, "image.width");
+    s = good, s.height = 100000;
+    refuses(s, "image.height");
+    s = good, s.view.target = s.view.eye;
+    refuses(s, "view.target");
+    s = good, s.view.up = s.view.target - s.view.eye;
+    refuses(s, "view.up");
+    s = good, s.view.eye.x = NAN;
+    refuses(s, "view.eye");
+    s = good, s.depth.rangeMin = 0.8, s.depth.rangeMax = 0.2;
+    refuses(s, "depth.range");
+    s = specWith("opengl", ProjectionType::Frustum), s.projection.right = s.projection.left;
+    refuses(s, "projection.right");
+    s = specWith("opengl", ProjectionType::Orthographic), s.projection.far = INFINITY;
+    refuses(s, "projection.far");
+}
+
+TEST_CASE("the camera file is read strictly", "[core][validation]")
+{
+    const auto parse = [](const std::string& text) { return cameraSpecFromJson(nlohmann::json::parse(text), "test"); };
+    const std::string projection = R"("projection": {"type": "perspective", "fovy_deg": 60, "near": 0.1, "far": 100})";
+    const std::string view = R"("view": {"eye": [0, 1, 3], "target": [0, 0, 0], "up": [0, 1, 0]})";
+    const CameraSpec spec = parse("{" + projection + "," + view + "}");
+    REQUIRE(spec.convention.name == "opengl");
+    REQUIRE(spec.width == 640);
+    REQUIRE(spec.height == 480);
+    REQUIRE(spec.depth.format == DepthFormat::Float32);
+    REQUIRE_FALSE(spec.depth.reversed);
+    REQUIRE(spec.depth.rangeMin == 0);
+    REQUIRE(spec.depth.rangeMax == 1);
+    // Round trip through toJson.
+    const CameraSpec again = cameraSpecFromJson(toJson(spec), "round trip");
+    REQUIRE(again.view.eye == spec.view.eye);
+    REQUIRE(again.projection.far == spec.projection.far);
+
+    REQUIRE_THROWS_WITH(parse("{" + view + "}"), Catch::Contains("'projection' is missing"));
+    REQUIRE_THROWS_WITH(parse("{" + projection + "," + view + R"(, "colour": 1})"), Catch::Contains("unknown key 'colour'"));
+    REQUIRE_THROWS_WITH(parse(R"({"projection": {"type": "perspective", "fovy_deg": "60", "near": 0.1, "far": 100},)" + view + "}"),
+                        Catch::Contains("'projection.fovy_deg' must be a number"));
+    REQUIRE_THROWS_WITH(parse(R"({"projection": {"type": "perspective", "fov": 60, "near": 0.1, "far": 100},)" + view + "}"),
+                        Catch::Contains("projection.fovy_deg"));
+    REQUIRE_THROWS_WITH(parse(R"({"projection": {"type": "fisheye", "near": 0.1, "far": 100},)" + view + "}"),
+                        Catch::Contains("'projection.type'"));
+    REQUIRE_THROWS_WITH(parse("{" + projection + "," + view + R"(, "convention": "glide"})"),
+                        Catch::Contains("'convention'"));
+    REQUIRE_THROWS_WITH(parse("{" + projection + "," + view + R"(, "depth": {"format": "unorm8"}})"),
+                        Catch::Contains("'depth.format'"));
+    REQUIRE_THROWS_WITH(parse("{" + projection + "," + view + R"(, "image": {"width": 64.5}})"),
+                        Catch::Contains("'image.width' must be an integer"));
+    REQUIRE_THROWS_WITH(parse(R"({"projection": {"type": "perspective", "fovy_deg": 60, "near": 0, "far": 100},)" + view + "}"),
+                        Catch::Contains("projection.near"));
+    REQUIRE_THROWS_WITH(parse(R"({"projection": {"type": "perspective", "fovy_deg": 60, "near": 1, "far": 1},)" + view + "}"),
+                        Catch::Contains("projection.far"));
+    REQUIRE_THROWS_WITH(readCameraFile("/nonexistent/camera.json"), Catch::Contains("cannot read camera file"));
+}

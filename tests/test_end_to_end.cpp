@@ -1,0 +1,154 @@
+// End to end: both routes on real scenes across the whole configuration matrix, and the
+// check's sensitivity to deliberately broken chains.
+#include "check.h"
+
+#include "zcheck/mesh_loader.h"
+
+#include <catch2/catch.hpp>
+
+#include <sstream>
+
+using namespace zcheck;
+
+namespace {
+
+const std::string kModels = ZCHECK_MODELS_DIR;
+
+std::string describe(const CameraSpec& spec, const ComparisonReport& r)
+{
+    std::ostringstream out;
+    out << spec.convention.name << " " << toString(spec.depth.format) << (spec.depth.reversed ? " reversed" : "")
+        << " range [" << spec.depth.rangeMin << "," << spec.depth.rangeMax << "]: both hit " << r.bothHit
+        << ", depth errors " << r.depthErrors << ", unexplained coverage " << r.coverageUnexplained << ", max/tol "
+        << r.maxErrorOverTolerance;
+    if (!r.unexplainedSamples.empty())
+        out << ", first unexplained (" << r.unexplainedSamples[0].col << "," << r.unexplainedSamples[0].row << ") "
+            << toString(r.unexplainedSamples[0].pixelClass);
+    return out.str();
+}
+
+// Every convention × depth format × reversed-Z on/off, plus a narrowed depth range.
+void requireConsistentEverywhere(const std::string& sceneName)
+{
+    const Scene scene = loadScene(sceneName);
+    const RayRenderer rays(scene);
+    const RasterRenderer raster(scene);
+    for (const auto& convention : Convention::presetNames())
+        for (const auto& format : depthFormatNames())
+            for (bool reversed : {false, true})
+                for (auto range : {std::pair{0.0, 1.0}, std::pair{0.2, 0.7}}) {
+                    if (range.first != 0.0 && format != "float32") continue;  // one narrowed range per convention
+                    CameraSpec spec = scene.defaultCamera;
+                    spec.convention = Convention::preset(convention);
+                    spec.depth = {depthFormatFromName(format), reversed, range.first, range.second};
+                    const CheckRun run = runCheck(scene, Camera(spec), rays, raster);
+                    const ComparisonReport& r = run.report.comparison;
+                    INFO(sceneName << " " << describe(spec, r));
+                    REQUIRE(r.bothHit > 1000);  // the camera actually sees the scene
+                    REQUIRE(r.unexplained() == 0);
+                    REQUIRE(r.consistent());
+                }
+}
+
+ComparisonReport checkWithSampling(const Scene& scene, const CameraSpec& spec, const RaySampling& sampling)
+{
+    RayRenderer rays(scene);
+    rays.sampling = sampling;
+    const RasterRenderer raster(scene);
+    return runCheck(scene, Camera(spec), rays, raster).report.comparison;
+}
+
+}  // namespace
+
+TEST_CASE("builtin:default is consistent in every convention, depth format and Z direction", "[e2e]")
+{
+    requireConsistentEverywhere("builtin:default");
+}
+
+TEST_CASE("builtin:near-crossing is consistent in every convention, depth format and Z direction", "[e2e]")
+{
+    requireConsistentEverywhere("builtin:near-crossing");
+}
+
+TEST_CASE("builtin:terrain is consistent in every convention, depth format and Z direction", "[e2e]")
+{
+    requireConsistentEverywhere("builtin:terrain?n=160");
+}
+
+TEST_CASE("stanford-bunny.obj is consistent everywhere", "[e2e][mesh]") { requireConsistentEverywhere(kModels + "/stanford-bunny.obj"); }
+TEST_CASE("nefertiti.obj is consistent everywhere", "[e2e][mesh]") { requireConsistentEverywhere(kModels + "/nefertiti.obj"); }
+TEST_CASE("fandisk.obj is consistent everywhere", "[e2e][mesh]") { requireConsistentEverywhere(kModels + "/fandisk.obj"); }
+TEST_CASE("spot.obj is consistent everywhere", "[e2e][mesh]") { requireConsistentEverywhere(kModels + "/spot.obj"); }
+TEST_CASE("cow.obj is consistent everywhere", "[e2e][mesh]") { requireConsistentEverywhere(kModels + "/cow.obj"); }
+TEST_CASE("teapot.obj is consistent everywhere", "[e2e][mesh]") { requireConsistentEverywhere(kModels + "/teapot.obj"); }
+TEST_CASE("suzanne.obj (quads) is consistent everywhere", "[e2e][mesh]") { requireConsistentEverywhere(kModels + "/suzanne.obj"); }
+TEST_CASE("beast.obj (quads) is consistent everywhere", "[e2e][mesh]") { requireConsistentEverywhere(kModels + "/beast.obj"); }
+TEST_CASE("igea.ply (triangle strips) is consistent everywhere", "[e2e][mesh]") { requireConsistentEverywhere(kModels + "/igea.ply"); }
+
+TEST_CASE("every shared mesh loads with its documented face count", "[mesh]")
+{
+    // Triangles after triangulation: quads become two triangles each.
+    const std::pair<const char*, std::size_t> expected[] = {
+        {"stanford-bunny.obj", 69451}, {"nefertiti.obj", 99938}, {"fandisk.obj", 12946},
+        {"spot.obj", 5856},            {"cow.obj", 5804},        {"teapot.obj", 6320},
+    };
+    for (const auto& [file, triangles] : expected) {
+        INFO(file);
+        REQUIRE(loadMesh(kModels + "/" + file).triangleCount() == triangles);
+    }
+    REQUIRE(loadMesh(kModels + "/suzanne.obj").triangleCount() == 468 * 2 + 32);
+}
+
+TEST_CASE("regression: assimp read igea.ply's triangle strips as a single triangle", "[mesh][regression]")
+{
+    // igea.ply holds 134,345 vertices and one `tristrips` element; assimp 5.2 returned one
+    // triangle without an error. A closed-ish scan of V vertices has about 2V triangles.
+    const Scene igea = loadMesh(kModels + "/igea.ply");
+    REQUIRE(igea.positions.size() == 134345);
+    REQUIRE(igea.triangleCount() > 260000);
+    REQUIRE(igea.triangleCount() < 270000);
+}
+
+TEST_CASE("a y-flipped ray route is reported inconsistent", "[sensitivity]")
+{
+    for (const std::string& name : {std::string("builtin:default"), kModels + "/stanford-bunny.obj"})
+        for (const auto& format : depthFormatNames()) {
+            const Scene scene = loadScene(name);
+            CameraSpec spec = scene.defaultCamera;
+            spec.depth.format = depthFormatFromName(format);
+            RaySampling flipped;
+            flipped.flipRows = true;
+            const ComparisonReport r = checkWithSampling(scene, spec, flipped);
+            INFO(name << " " << describe(spec, r));
+            REQUIRE_FALSE(r.consistent());
+            REQUIRE(r.unexplained() > 1000);
+        }
+}
+
+TEST_CASE("a ray route missing the half-pixel offset is reported inconsistent", "[sensitivity]")
+{
+    for (const std::string& name : {std::string("builtin:default"), std::string("builtin:terrain?n=64"),
+                                   kModels + "/stanford-bunny.obj"})
+        for (const auto& format : depthFormatNames())
+            for (const glm::dvec2 shift : {glm::dvec2(-0.5, 0.0), glm::dvec2(0.0, -0.5), glm::dvec2(-0.5, -0.5)}) {
+                const Scene scene = loadScene(name);
+                CameraSpec spec = scene.defaultCamera;
+                spec.depth.format = depthFormatFromName(format);
+                RaySampling shifted;
+                shifted.shiftPixels = shift;
+                const ComparisonReport r = checkWithSampling(scene, spec, shifted);
+                INFO(name << " shift " << shift.x << "," << shift.y << " " << describe(spec, r));
+                REQUIRE_FALSE(r.consistent());
+                REQUIRE(r.unexplained() > 100);
+            }
+}
+
+TEST_CASE("a ray route shifted by a tenth of a pixel is still caught", "[sensitivity]")
+{
+    const Scene scene = builtinScene("builtin:default");
+    RaySampling shifted;
+    shifted.shiftPixels = {0.1, 0.0};
+    const ComparisonReport r = checkWithSampling(scene, scene.defaultCamera, shifted);
+    INFO(describe(scene.defaultCamera, r));
+    REQUIRE_FALSE(r.consistent());
+}

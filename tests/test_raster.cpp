@@ -1,0 +1,236 @@
+// Rasterizer rules and analytic depths through both routes.
+#include "check.h"
+
+#include "zcheck/inverse_projection.h"
+
+#include <catch2/catch.hpp>
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <random>
+
+using namespace zcheck;
+
+namespace {
+
+Scene sceneOf(std::vector<glm::vec3> positions, std::vector<glm::uvec3> triangles)
+{
+    Scene scene;
+    scene.name = "test";
+    scene.positions = std::move(positions);
+    scene.triangles = std::move(triangles);
+    return scene;
+}
+
+// opengl orthographic camera whose window coordinates equal world x, y (origin bottom-left).
+CameraSpec pixelExactCamera(int size)
+{
+    CameraSpec spec;
+    spec.width = spec.height = size;
+    spec.projection.type = ProjectionType::Orthographic;
+    spec.projection.left = 0, spec.projection.right = size, spec.projection.bottom = 0, spec.projection.top = size;
+    spec.projection.near = 0.5, spec.projection.far = 10;
+    spec.view = {{0, 0, 0}, {0, 0, -1}, {0, 1, 0}};
+    return spec;
+}
+
+// Coverage count per pixel when each triangle of the fan is drawn alone.
+std::vector<int> coverageCounts(const std::vector<glm::vec3>& positions, const std::vector<glm::uvec3>& triangles,
+                                const Camera& camera)
+{
+    std::vector<int> count(std::size_t(camera.width()) * camera.height(), 0);
+    for (const auto& triangle : triangles) {
+        const Scene single = sceneOf(positions, {triangle});
+        const RenderResult image = RasterRenderer(single).render(camera);
+        for (std::size_t i = 0; i < count.size(); ++i) count[i] += image.hit(i) ? 1 : 0;
+    }
+    return count;
+}
+
+double cross2(const glm::dvec2& a, const glm::dvec2& b) { return a.x * b.y - a.y * b.x; }
+
+// Is p strictly inside the star-shaped fan polygon, more than `margin` from its outer boundary?
+bool strictlyInsideFan(const glm::dvec2& p, const glm::dvec2& centre, const std::vector<glm::dvec2>& rim, double margin)
+{
+    bool inside = false;
+    for (std::size_t k = 0; k < rim.size(); ++k) {
+        const glm::dvec2 a = rim[k], b = rim[(k + 1) % rim.size()];
+        const double edgeLength = glm::length(b - a);
+        const double side = cross2(b - a, p - a) / edgeLength;  // signed distance to the rim edge
+        const double s1 = cross2(a - centre, p - centre), s2 = cross2(p - centre, b - centre);
+        if (s1 >= 0 && s2 >= 0 && side > margin) inside = true;
+    }
+    return inside;
+}
+
+void requireFanCoversEachPixelOnce(const glm::dvec2& centre, const std::vector<glm::dvec2>& rim, int size)
+{
+    std::vector<glm::vec3> positions = {glm::vec3(centre, -1.0)};
+    std::vector<glm::uvec3> triangles;
+    for (const auto& p : rim) positions.emplace_back(p, -1.0);
+    for (std::uint32_t k = 0; k < rim.size(); ++k)
+        triangles.push_back({0, 1 + k, 1 + (k + 1) % std::uint32_t(rim.size())});
+    const Camera camera(pixelExactCamera(size));
+    const std::vector<int> count = coverageCounts(positions, triangles, camera);
+    const RenderResult whole = RasterRenderer(sceneOf(positions, triangles)).render(camera);
+    int inside = 0;
+    for (int row = 0; row < size; ++row)
+        for (int col = 0; col < size; ++col) {
+            const std::size_t i = std::size_t(row) * size + col;
+            const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
+            INFO("pixel " << col << ", " << row);
+            REQUIRE(count[i] <= 1);  // never twice
+            if (strictlyInsideFan(pWindow, centre, rim, 1e-6)) {
+                ++inside;
+                REQUIRE(count[i] == 1);  // no gaps
+            }
+            REQUIRE(whole.hit(i) == (count[i] == 1));
+        }
+    REQUIRE(inside > 100);
+}
+
+}  // namespace
+
+TEST_CASE("a fan whose edges run through pixel centres covers each pixel exactly once", "[raster][fill-rule]")
+{
+    const glm::dvec2 centre(32.5, 32.5);  // a pixel centre
+    const std::vector<glm::dvec2> rim = {{52.5, 32.5}, {46.5, 46.5}, {32.5, 52.5}, {18.5, 46.5},
+                                         {12.5, 32.5}, {18.5, 18.5}, {32.5, 12.5}, {46.5, 18.5}};
+    requireFanCoversEachPixelOnce(centre, rim, 64);
+}
+
+TEST_CASE("random fans cover each pixel exactly once", "[raster][fill-rule][property]")
+{
+    std::mt19937_64 random(1988);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    for (int fan = 0; fan < 20; ++fan) {
+        // Vertices on a 1/16-pixel grid: many land exactly on pixel centres and edges.
+        auto grid = [](double v) { return std::round(v * 16) / 16; };
+        const glm::dvec2 centre(grid(20 + 24 * unit(random)), grid(20 + 24 * unit(random)));
+        std::vector<glm::dvec2> rim;
+        const int spokes = 5 + int(unit(random) * 12);
+        for (int k = 0; k < spokes; ++k) {
+            const double angle = 2 * M_PI * (k + 0.8 * unit(random)) / spokes;
+            const double radius = 6 + 12 * unit(random);
+            rim.push_back({grid(centre.x + radius * std::cos(angle)), grid(centre.y + radius * std::sin(angle))});
+        }
+        INFO("fan " << fan);
+        requireFanCoversEachPixelOnce(centre, rim, 64);
+    }
+}
+
+TEST_CASE("a triangle crossing the near plane and lying behind the camera is clipped, not wrapped", "[raster][clipping]")
+{
+    // Eye at the origin looking down −z, fovy 90°, 64×64, near 2, far 50. A floor triangle
+    // at y = −1 with two vertices behind the camera (w < 0 there) and its side edges far
+    // off-screen. The floor is at eye-z 1/|y_ndc|: rows 33..47 see it between near and far;
+    // rows 48..63 would see it in front of the near plane (clipped), row 32 beyond far
+    // (clipped), rows 0..31 look above the horizon. Unclipped, the part behind the camera
+    // would wrap into the upper half.
+    CameraSpec spec;
+    spec.width = spec.height = 64;
+    spec.projection.fovyDeg = 90;
+    spec.projection.near = 2, spec.projection.far = 50;
+    spec.view = {{0, 0, 0}, {0, 0, -1}, {0, 1, 0}};
+    const Scene floor = sceneOf({{-500, -1, 10}, {500, -1, 10}, {0, -1, -500}}, {{0, 1, 2}});
+    for (const auto& name : Convention::presetNames())
+        for (bool reversed : {false, true}) {
+            spec.convention = Convention::preset(name);
+            spec.depth.reversed = reversed;
+            const Camera camera(spec);
+            const RenderResult image = RasterRenderer(floor).render(camera);
+            for (int row = 0; row < 64; ++row)
+                for (int col = 0; col < 64; ++col) {
+                    const std::size_t i = std::size_t(row) * 64 + col;
+                    const double yNdc = 1 - (row + 0.5) / 32;  // image up
+                    INFO(name << (reversed ? " reversed" : "") << " pixel " << col << ", " << row);
+                    REQUIRE(image.hit(i) == (row >= 33 && row <= 47));
+                    if (!image.hit(i)) continue;
+                    const double eyeZ = 1 / -yNdc, n = 2, f = 50;
+                    const double expected = reversed ? n * (f - eyeZ) / (eyeZ * (f - n)) : f * (eyeZ - n) / (eyeZ * (f - n));
+                    // Window depth is affine in y_ndc here, n·f/(f−n) per unit, 1/32 unit per
+                    // row; vertex snapping may move it by up to 2^-8 of that slope.
+                    const double slopePerRow = n * f / (f - n) / 32;
+                    const double bound = 4 * storageQuantum(DepthFormat::Float32, expected) + slopePerRow / 256;
+                    REQUIRE(std::abs(image.windowDepth.value[i] - expected) <= bound);
+                }
+            REQUIRE(runCheck(floor, camera).report.comparison.consistent());
+        }
+}
+
+TEST_CASE("a triangle wholly behind the camera draws nothing", "[raster][clipping]")
+{
+    CameraSpec spec;
+    spec.width = spec.height = 32;
+    spec.view = {{0, 0, 0}, {0, 0, -1}, {0, 1, 0}};
+    const Scene behind = sceneOf({{-5, -5, 3}, {5, -5, 3}, {0, 5, 1}}, {{0, 1, 2}});
+    const RenderResult image = RasterRenderer(behind).render(Camera(spec));
+    for (std::size_t i = 0; i < image.primitiveId.size(); ++i) REQUIRE_FALSE(image.hit(i));
+}
+
+TEST_CASE("the raster result is bit-identical for any number of threads", "[raster][determinism]")
+{
+    const Scene terrain = builtinScene("builtin:terrain?n=300");
+    CameraSpec spec = terrain.defaultCamera;
+    spec.width = 700, spec.height = 500;
+    const Camera camera(spec);
+    const RasterRenderer raster(terrain);
+    RenderResult one, two;
+    {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+        one = raster.render(camera);
+    }
+    {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+        two = raster.render(camera);
+    }
+    REQUIRE(one.primitiveId == two.primitiveId);
+    REQUIRE(one.windowDepth.value == two.windowDepth.value);
+}
+
+TEST_CASE("a plane at a known eye depth yields exactly that depth through each route", "[analytic]")
+{
+    // Eye at the origin looking down −z; a quad at z = −D covers the whole view. The expected
+    // window depth is written out from the textbook mappings, independent of the code.
+    const double D = 7.25, n = 0.5, f = 40;
+    const Scene wall = sceneOf({{-100, -100, float(-D)}, {100, -100, float(-D)}, {100, 100, float(-D)}, {-100, 100, float(-D)}},
+                               {{0, 1, 2}, {0, 2, 3}});
+    const RayRenderer rays(wall);
+    const RasterRenderer raster(wall);
+    for (const auto& name : Convention::presetNames())
+        for (auto type : {ProjectionType::Perspective, ProjectionType::Orthographic})
+            for (const auto& format : depthFormatNames())
+                for (bool reversed : {false, true})
+                    for (auto range : {std::pair{0.0, 1.0}, std::pair{0.25, 0.75}}) {
+                        CameraSpec spec;
+                        spec.convention = Convention::preset(name);
+                        spec.width = 61, spec.height = 47;
+                        spec.projection.type = type;
+                        spec.projection.fovyDeg = 50;
+                        spec.projection.left = -3, spec.projection.right = 4, spec.projection.bottom = -2.5,
+                        spec.projection.top = 2;
+                        spec.projection.near = n, spec.projection.far = f;
+                        spec.view = {{0, 0, 0}, {0, 0, -1}, {0, 1, 0}};
+                        spec.depth = {depthFormatFromName(format), reversed, range.first, range.second};
+                        const Camera camera(spec);
+                        const double unit = type == ProjectionType::Perspective
+                                                ? (reversed ? n * (f - D) / (D * (f - n)) : f * (D - n) / (D * (f - n)))
+                                                : (reversed ? (f - D) / (f - n) : (D - n) / (f - n));
+                        const double expected = range.first + (range.second - range.first) * unit;
+                        const double q = storageQuantum(spec.depth.format, expected);
+                        const RenderResult byRay = rays.render(camera), byRaster = raster.render(camera);
+                        INFO(name << " " << toString(type) << " " << format << (reversed ? " reversed" : "")
+                                  << " range [" << range.first << "," << range.second << "]");
+                        for (std::size_t i = 0; i < byRay.primitiveId.size(); ++i) {
+                            REQUIRE(byRay.hit(i));
+                            REQUIRE(byRaster.hit(i));
+                            REQUIRE(byRay.windowDepth.value[i] == Approx(expected).epsilon(1e-13).margin(1e-15));
+                            REQUIRE(camera.eyeZOf(byRay.pEye[i]) == Approx(D).epsilon(1e-13));
+                            // The stored value is the format's rounding of the exact depth (or
+                            // its neighbour, when the exact depth sits on a rounding boundary).
+                            REQUIRE(std::abs(byRaster.windowDepth.value[i] - quantizeDepth(spec.depth.format, expected)) <=
+                                    (std::abs(quantizeDepth(spec.depth.format, expected * (1 + 1e-12)) -
+                                              quantizeDepth(spec.depth.format, expected * (1 - 1e-12))) > 0 ? q * 1.0001 : 0.0));
+                        }
+                    }
+}
