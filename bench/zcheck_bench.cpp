@@ -1,0 +1,111 @@
+// zcheck_bench — reproducible speed and memory measurements of both routes (not a test).
+//
+// For each named workload: scene load, BVH build, trace (ray generation + Embree + depth
+// in double), raster (transform, clip, bin, scan), compare; each render repeated and the
+// median and best reported. Peak memory is the process's maximum resident set size.
+#include "check.h"
+
+#include "zcheck/error.h"
+#include "zcheck/mesh_loader.h"
+
+#include <CLI/CLI.hpp>
+#include <sys/resource.h>
+#include <tbb/global_control.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <memory>
+
+using namespace zcheck;
+
+namespace {
+
+double peakResidentMiB()
+{
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    return double(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
+}
+
+struct Stats {
+    double median, best;
+};
+
+template <class F>
+Stats timeRepeated(int repeats, F&& run)
+{
+    std::vector<double> ms;
+    for (int k = 0; k < repeats; ++k) ms.push_back(run());
+    std::sort(ms.begin(), ms.end());
+    return {ms[ms.size() / 2], ms.front()};
+}
+
+void runWorkload(const std::string& label, const std::string& sceneName, int width, int height, int repeats)
+{
+    const auto loadStart = std::chrono::steady_clock::now();
+    const Scene scene = loadScene(sceneName);
+    const double loadMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - loadStart).count();
+    CameraSpec spec = scene.defaultCamera;
+    spec.width = width, spec.height = height;
+    const Camera camera(spec);
+
+    const RayRenderer rays(scene);
+    const RasterRenderer raster(scene);
+    RenderResult lastRay, lastRaster;
+    const Stats trace = timeRepeated(repeats, [&] {
+        lastRay = rays.render(camera);
+        return lastRay.renderMilliseconds;
+    });
+    const Stats rasterMs = timeRepeated(repeats, [&] {
+        lastRaster = raster.render(camera);
+        return lastRaster.renderMilliseconds;
+    });
+    bool consistent = false;
+    const Stats compare = timeRepeated(repeats, [&] {
+        const auto start = std::chrono::steady_clock::now();
+        consistent = compareRoutes(scene, camera, lastRay, lastRaster).report.consistent();
+        return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    });
+
+    const double pixels = double(width) * height, triangles = double(scene.triangleCount());
+    std::printf("%-16s %9.0f tris %4dx%-4d load %7.1f ms | BVH %7.1f ms | trace %7.1f ms (best %7.1f) %6.2f Mrays/s"
+                " | raster %7.1f ms (best %7.1f) %6.2f Mtris/s | compare %6.1f ms | peak RSS %6.0f MiB | %s\n",
+                label.c_str(), triangles, width, height, loadMs, rays.buildMilliseconds(), trace.median, trace.best,
+                pixels / trace.median / 1e3, rasterMs.median, rasterMs.best, triangles / rasterMs.median / 1e3,
+                compare.median, peakResidentMiB(), consistent ? "consistent" : "INCONSISTENT");
+    std::fflush(stdout);
+}
+
+}  // namespace
+
+int main(int argc, char** argv)
+{
+    CLI::App app{"zcheck_bench: throughput of the ray and raster routes on named workloads"};
+    int width = 1920, height = 1080, repeats = 5, threads = 0;
+    std::string only;
+    app.add_option("--width", width, "image width")->capture_default_str();
+    app.add_option("--height", height, "image height")->capture_default_str();
+    app.add_option("--repeat", repeats, "renders per measurement (median and best reported)")->capture_default_str();
+    app.add_option("--threads", threads, "worker threads (default: all cores)");
+    app.add_option("--only", only, "run only workloads whose label contains this text");
+    CLI11_PARSE(app, argc, argv);
+
+    std::unique_ptr<tbb::global_control> limit;
+    if (threads > 0)
+        limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+
+    const std::pair<std::string, std::string> workloads[] = {
+        {"terrain-708", "builtin:terrain?n=708"},
+        {"bunny", std::string(ZCHECK_MODELS_DIR) + "/stanford-bunny.obj"},
+        {"default", "builtin:default"},
+    };
+    try {
+        for (const auto& [label, scene] : workloads)
+            if (only.empty() || label.find(only) != std::string::npos) runWorkload(label, scene, width, height, std::max(1, repeats));
+    } catch (const Error& e) {
+        std::fprintf(stderr, "zcheck_bench: error: %s\n", e.what());
+        return 2;
+    }
+    return 0;
+}

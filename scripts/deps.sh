@@ -1,0 +1,17 @@
+#!/usr/bin/env bash
+# Installs zcheck's build and test dependencies from the Debian 12 archive (idempotent).
+set -euo pipefail
+packages=(cmake ninja-build g++ pkg-config python3
+          libembree-dev libglm-dev libopenimageio-dev openimageio-tools catch2 libtbb-dev
+          libassimp-dev libcli11-dev nlohmann-json3-dev)
+missing=()
+for p in "${packages[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+    sudo=""
+    [[ $(id -u) -eq 0 ]] || sudo=sudo
+    echo "installing: ${missing[*]}"
+    $sudo apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
