@@ -113,6 +113,14 @@ int main(int argc, char** argv)
                              "write ray_depth.exr, raster_depth.exr, error_heatmap.png, coverage_classes.png "
                              "and report.json into this directory");
     checkCommand->add_flag("--json", check.json, "print the report as JSON instead of the summary");
+    checkCommand->footer(
+        "Examples:\n"
+        "  zcheck check                                      the built-in default scene, its own camera\n"
+        "  zcheck check --scene bunny.obj --convention direct3d --reversed-z --depth-format unorm24\n"
+        "  zcheck check --camera examples/frustum.json --out results/   camera file; images + report.json\n"
+        "  zcheck check --scene 'builtin:terrain?n=708' --width 1920 --height 1080 --json\n"
+        "Depths are compared as window depth (the depth-buffer value) per pixel; the tolerance is\n"
+        "C*q + S*m (q: storage quantum, m: depth slope per pixel, S = 2^-8 px). See README.md.");
     checkCommand->add_option("--threads", check.threads, "worker threads (default: all cores)")
         ->check(CLI::Range(1, 1024));
 

@@ -17,6 +17,7 @@ std::string toString(PixelClass pixelClass)
     case PixelClass::DepthError: return "depth-error";
     case PixelClass::RayOnlyEdge: return "ray-only-edge";
     case PixelClass::RasterOnlyEdge: return "raster-only-edge";
+    case PixelClass::RayOnlyAtClear: return "ray-only-at-clear";
     case PixelClass::RayOnly: return "ray-only";
     case PixelClass::RasterOnly: return "raster-only";
     }
@@ -190,9 +191,17 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
                 }
             } else if (rayHit) {
                 ++r.rayOnly;
-                const bool edge = triangles.nearEdge(camera, f.rayPrimitive, pWindow, S);
-                f.pixelClass = edge ? PixelClass::RayOnlyEdge : PixelClass::RayOnly;
-                edge ? ++r.coverageExplained : ++r.coverageUnexplained;
+                const double distanceToClear = std::abs(f.rayWindowDepth - camera.clearDepth());
+                const double q = storageQuantum(format, f.rayWindowDepth);
+                if (triangles.nearEdge(camera, f.rayPrimitive, pWindow, S)) {
+                    f.pixelClass = PixelClass::RayOnlyEdge;
+                } else if (distanceToClear <= C * q + S * triangles.slope(camera, f.rayPrimitive)) {
+                    f.pixelClass = PixelClass::RayOnlyAtClear;
+                    ++r.lostAtClearValue;
+                } else {
+                    f.pixelClass = PixelClass::RayOnly;
+                }
+                f.pixelClass == PixelClass::RayOnly ? ++r.coverageUnexplained : ++r.coverageExplained;
             } else {
                 ++r.rasterOnly;
                 const bool edge = triangles.nearEdge(camera, f.rasterPrimitive, pWindow, S);

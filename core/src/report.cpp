@@ -66,6 +66,7 @@ nlohmann::json toJson(const CheckReport& report)
           {"edge_surface", c.edgeSurface},
           {"depth_errors", c.depthErrors},
           {"coverage_explained", c.coverageExplained},
+          {"lost_at_clear_value", c.lostAtClearValue},
           {"coverage_unexplained", c.coverageUnexplained}}},
         {"depth_error",
          {{"max_quanta", c.maxErrorQuanta},
@@ -112,7 +113,8 @@ std::string formatSummary(const CheckReport& report)
     row("both miss", c.bothMiss, total);
     row("ray only", c.rayOnly, total);
     row("raster only", c.rasterOnly, total);
-    row("  explained (at an edge)", c.coverageExplained, total);
+    row("  explained (at an edge)", c.coverageExplained - c.lostAtClearValue, total);
+    row("  explained (at clear value)", c.lostAtClearValue, total);
     row("  UNEXPLAINED", c.coverageUnexplained, total);
 
     out << "\ndepth error over compared pixels (both hit, same surface or within tolerance)\n";
@@ -139,6 +141,13 @@ std::string formatSummary(const CheckReport& report)
                           toString(f.pixelClass).c_str(), f.rayWindowDepth, f.rasterWindowDepth);
             out << line;
         }
+    }
+    if (c.lostAtClearValue > 0) {
+        std::snprintf(line, sizeof line,
+                      "\nnote: %lld pixels see surfaces whose depth rounds to the clear value in %s, so no depth test\n"
+                      "      can pass there: raise near or use a finer depth format to see them in a real depth buffer\n",
+                      static_cast<long long>(c.lostAtClearValue), toString(cam.depth.format).c_str());
+        out << line;
     }
     std::snprintf(line, sizeof line, "\ntimings    BVH build %.1f ms, trace %.1f ms, raster %.1f ms, compare %.1f ms\n",
                   report.timings.bvhBuildMs, report.timings.traceMs, report.timings.rasterMs,

@@ -13,8 +13,11 @@
 // the sum of both surfaces' tolerances, 2·C·q + S·(m_ray + m_raster).
 // Otherwise a mismatch is *explained* only when the pixel centre lies within S pixels of an
 // edge of a triangle involved (as drawn: clipped to the near and far planes), i.e. where
-// vertex snapping can move the edge across the sample point. Everything else is an
-// unexplained mismatch; a half-pixel or one-row shift can never hide among edge pixels.
+// vertex snapping can move the edge across the sample point, or when only the ray hits a
+// surface whose depth lies within its tolerance of the clear value (stored, it would equal
+// the clear value and fail the strict LESS/GREATER test: the far end of a unorm16 buffer
+// with a tiny near plane). Everything else is an unexplained mismatch; a half-pixel or
+// one-row shift can never hide among edge pixels.
 //
 // Verdict: consistent ⇔ no unexplained coverage mismatch and no depth error.
 #include "zcheck/camera.h"
@@ -33,6 +36,9 @@ enum class PixelClass : std::uint8_t {
     DepthError,          // both hit, depths disagree beyond tolerance, unexplained
     RayOnlyEdge,         // only the ray hits, pixel centre at an edge: explained
     RasterOnlyEdge,      // only the raster hits, pixel centre at an edge: explained
+    RayOnlyAtClear,      // only the ray hits a surface whose depth is within tolerance of the clear
+                         // value: quantized, it cannot pass the strict depth test (a precision
+                         // limit of the camera and format, not a chain error): explained
     RayOnly,             // only the ray hits, unexplained
     RasterOnly,          // only the raster hits, unexplained
 };
@@ -70,7 +76,8 @@ struct ComparisonReport {
     std::int64_t edgeSurface = 0;   // different surfaces beyond tolerance at an edge (explained)
     std::int64_t depthErrors = 0;   // beyond tolerance, unexplained
     // Coverage mismatches split; explained + unexplained = rayOnly + rasterOnly.
-    std::int64_t coverageExplained = 0;    // pixel centre within S of an edge
+    std::int64_t coverageExplained = 0;    // pixel centre within S of an edge, or depth at the clear value
+    std::int64_t lostAtClearValue = 0;     // of those: ray-only surfaces whose depth quantizes to the clear value
     std::int64_t coverageUnexplained = 0;  // anything else
     // Over the both-hit pixels compared on depth (agree + depthErrors):
     double maxErrorQuanta = 0;      // max |d_raster − d_ray| / q
