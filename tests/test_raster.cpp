@@ -6,6 +6,7 @@
 #include <catch2/catch.hpp>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -97,6 +98,31 @@ TEST_CASE("a fan whose edges run through pixel centres covers each pixel exactly
     const std::vector<glm::dvec2> rim = {{52.5, 32.5}, {46.5, 46.5}, {32.5, 52.5}, {18.5, 46.5},
                                          {12.5, 32.5}, {18.5, 18.5}, {32.5, 12.5}, {46.5, 18.5}};
     requireFanCoversEachPixelOnce(centre, rim, 64);
+}
+
+TEST_CASE("the top-left rule: centres on top and left edges are covered, on bottom and right edges not", "[raster][fill-rule]")
+{
+    // A square whose edges run exactly through pixel centres: image x and y in [10.5, 20.5],
+    // i.e. columns and rows 10..20 lie on its boundary. With the top-left rule it covers
+    // columns 10..19 and rows 10..19: the left column and top row, not the right and bottom.
+    const int size = 32;
+    const Camera camera(pixelExactCamera(size));  // opengl: image y = size − world y
+    auto at = [&](double xImage, double yImage) { return glm::vec3(xImage, size - yImage, -1.0); };
+    for (bool otherDiagonal : {false, true})
+        for (bool reverseWinding : {false, true}) {
+            std::vector<glm::vec3> corners = {at(10.5, 10.5), at(20.5, 10.5), at(20.5, 20.5), at(10.5, 20.5)};
+            if (otherDiagonal) std::rotate(corners.begin(), corners.begin() + 1, corners.end());
+            std::vector<glm::uvec3> triangles = {{0, 1, 2}, {0, 2, 3}};
+            if (reverseWinding)
+                for (auto& t : triangles) std::swap(t[1], t[2]);
+            const RenderResult image = RasterRenderer(sceneOf(corners, triangles)).render(camera);
+            for (int row = 0; row < size; ++row)
+                for (int col = 0; col < size; ++col) {
+                    INFO("pixel " << col << ", " << row << (otherDiagonal ? ", other diagonal" : "")
+                                  << (reverseWinding ? ", reversed winding" : ""));
+                    REQUIRE(image.hit(std::size_t(row) * size + col) == (col >= 10 && col <= 19 && row >= 10 && row <= 19));
+                }
+        }
 }
 
 TEST_CASE("random fans cover each pixel exactly once", "[raster][fill-rule][property]")
