@@ -72,6 +72,7 @@ expect_usage_error "width"                   check --width 0
 expect_usage_error "height"                  check --height -5
 expect_usage_error "width"                   check --width 20000
 expect_usage_error "width"                   check --width abc
+expect_usage_error "more than .* pixels"     check --width 16384 --height 16384
 expect_usage_error "unknown convention"      check --convention opengl2
 expect_usage_error "unknown depth format"    check --depth-format unorm8
 expect_usage_error "unknown built-in scene"  check --scene builtin:nothing

@@ -109,38 +109,40 @@ TEST_CASE("regression: assimp read igea.ply's triangle strips as a single triang
     REQUIRE(igea.triangleCount() < 270000);
 }
 
+namespace {
+// The check must call a ray route that samples the wrong place inconsistent, loudly.
+void requireCaught(const std::string& sceneName, const RaySampling& fault, std::int64_t minimumUnexplained)
+{
+    const Scene scene = loadScene(sceneName);
+    for (const auto& format : depthFormatNames()) {
+        CameraSpec spec = scene.defaultCamera;
+        spec.depth.format = depthFormatFromName(format);
+        const ComparisonReport r = checkWithSampling(scene, spec, fault);
+        INFO(sceneName << " shift " << fault.shiftPixels.x << "," << fault.shiftPixels.y
+                       << (fault.flipRows ? " flipped" : "") << " " << describe(spec, r));
+        REQUIRE_FALSE(r.consistent());
+        REQUIRE(r.unexplained() > minimumUnexplained);
+    }
+}
+}  // namespace
+
 TEST_CASE("a y-flipped ray route is reported inconsistent", "[sensitivity]")
 {
+    RaySampling flipped;
+    flipped.flipRows = true;
     for (const std::string& name : {std::string("builtin:default"), kModels + "/stanford-bunny.obj"})
-        for (const auto& format : depthFormatNames()) {
-            const Scene scene = loadScene(name);
-            CameraSpec spec = scene.defaultCamera;
-            spec.depth.format = depthFormatFromName(format);
-            RaySampling flipped;
-            flipped.flipRows = true;
-            const ComparisonReport r = checkWithSampling(scene, spec, flipped);
-            INFO(name << " " << describe(spec, r));
-            REQUIRE_FALSE(r.consistent());
-            REQUIRE(r.unexplained() > 1000);
-        }
+        requireCaught(name, flipped, 1000);
 }
 
 TEST_CASE("a ray route missing the half-pixel offset is reported inconsistent", "[sensitivity]")
 {
     for (const std::string& name : {std::string("builtin:default"), std::string("builtin:terrain?n=64"),
-                                   kModels + "/stanford-bunny.obj"})
-        for (const auto& format : depthFormatNames())
-            for (const glm::dvec2 shift : {glm::dvec2(-0.5, 0.0), glm::dvec2(0.0, -0.5), glm::dvec2(-0.5, -0.5)}) {
-                const Scene scene = loadScene(name);
-                CameraSpec spec = scene.defaultCamera;
-                spec.depth.format = depthFormatFromName(format);
-                RaySampling shifted;
-                shifted.shiftPixels = shift;
-                const ComparisonReport r = checkWithSampling(scene, spec, shifted);
-                INFO(name << " shift " << shift.x << "," << shift.y << " " << describe(spec, r));
-                REQUIRE_FALSE(r.consistent());
-                REQUIRE(r.unexplained() > 100);
-            }
+                                    kModels + "/stanford-bunny.obj"})
+        for (const glm::dvec2 shift : {glm::dvec2(-0.5, 0.0), glm::dvec2(0.0, -0.5), glm::dvec2(-0.5, -0.5)}) {
+            RaySampling shifted;
+            shifted.shiftPixels = shift;
+            requireCaught(name, shifted, 100);
+        }
 }
 
 TEST_CASE("a ray route shifted by a tenth of a pixel is still caught", "[sensitivity]")
@@ -190,4 +192,15 @@ TEST_CASE("odd image sizes and extreme near/far ratios are consistent", "[e2e]")
                                     << " " << describe(spec, r));
                     REQUIRE(r.consistent());
                 }
+}
+
+TEST_CASE("glTF files load with their node transforms applied", "[mesh]")
+{
+    // tests/data_quad.gltf: a 2×2 quad (two triangles) in x ∈ [−1,1], y ∈ [0,2], z = 0,
+    // placed by its node at translation (10, 0, −5).
+    const Scene quad = loadMesh(std::string(ZCHECK_TESTS_DIR) + "/data_quad.gltf");
+    REQUIRE(quad.triangleCount() == 2);
+    REQUIRE(quad.boundsMin() == glm::dvec3(9, 0, -5));
+    REQUIRE(quad.boundsMax() == glm::dvec3(11, 2, -5));
+    REQUIRE(runCheck(quad, Camera(quad.defaultCamera)).report.comparison.consistent());
 }

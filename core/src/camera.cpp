@@ -27,6 +27,9 @@ glm::dmat4 matrixFromRows(const double rows[4][4])
 namespace {
 
 constexpr int kMaxImageSide = 16384;
+// About 40 bytes per pixel across both routes and the comparison: 2^26 pixels (8192²) stay
+// within ~3 GiB; more would risk the machine's memory instead of failing cleanly.
+constexpr long long kMaxImagePixels = 1LL << 26;
 
 void requireFinite(double value, const std::string& name)
 {
@@ -125,6 +128,9 @@ void validate(const CameraSpec& spec)
         if (value < 1 || value > kMaxImageSide)
             throw Error(std::string("'") + name + "' must be in 1.." + std::to_string(kMaxImageSide) + " pixels, got " +
                         std::to_string(value));
+    if (static_cast<long long>(spec.width) * spec.height > kMaxImagePixels)
+        throw Error("image " + std::to_string(spec.width) + "x" + std::to_string(spec.height) + " has more than " +
+                    std::to_string(kMaxImagePixels) + " pixels (8192x8192)");
     validateProjection(spec);
     requireFinite(spec.view.eye, "view.eye");
     requireFinite(spec.view.target, "view.target");

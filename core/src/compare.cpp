@@ -100,13 +100,18 @@ double percentile99(std::vector<double>& values)
 
 struct TriangleView {
     const Scene& scene;
+    mutable std::vector<double> slopeCache;  // per primitive, NaN until computed
+
     glm::dvec3 vertex(std::uint32_t primitive, int corner) const
     {
         return glm::dvec3(scene.positions[scene.triangles[primitive][corner]]);
     }
+    // m is a property of the triangle's plane, the same at every pixel: computed once.
     double slope(const Camera& camera, std::uint32_t primitive) const
     {
-        return windowDepthSlope(camera, vertex(primitive, 0), vertex(primitive, 1), vertex(primitive, 2));
+        double& m = slopeCache[primitive];
+        if (std::isnan(m)) m = windowDepthSlope(camera, vertex(primitive, 0), vertex(primitive, 1), vertex(primitive, 2));
+        return m;
     }
     bool nearEdge(const Camera& camera, std::uint32_t primitive, const glm::dvec2& pWindow, double radius) const
     {
@@ -133,7 +138,7 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
     out.pixelClass.assign(std::size_t(W) * H, PixelClass::BothMiss);
     out.errorOverTolerance.assign(std::size_t(W) * H, 0.0f);
 
-    const TriangleView triangles{scene};
+    const TriangleView triangles{scene, std::vector<double>(scene.triangleCount(), NAN)};
     const DepthFormat format = camera.depth().format;
     const double C = ToleranceModel::constantQuanta(camera.depth());
     const double S = tolerance.snapPixels();
@@ -180,7 +185,8 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
                     f.pixelClass == PixelClass::Agree ? ++r.agree : ++r.depthErrors;
                     out.errorOverTolerance[i] = static_cast<float>(ratio);
                     errorQuanta.push_back(f.errorQuanta);
-                    const double eyeZRay = eyeZFromWindowDepth(camera, pWindow, f.rayWindowDepth);
+                    const double eyeZRay = ray.pEye.empty() ? eyeZFromWindowDepth(camera, pWindow, f.rayWindowDepth)
+                                                            : camera.eyeZOf(ray.pEye[i]);
                     const double eyeZRaster = eyeZFromWindowDepth(camera, pWindow, f.rasterWindowDepth);
                     relativeEyeZ.push_back(std::abs(eyeZRaster - eyeZRay) / std::abs(eyeZRay));
                     r.maxErrorQuanta = std::max(r.maxErrorQuanta, f.errorQuanta);

@@ -114,10 +114,11 @@ void setupTriangle(const Viewport& vp, const glm::dvec4 (&pClip)[3], std::uint32
 }
 
 // Clip one world triangle and set up what survives (a fan when clipping made a polygon).
+// codeX: the vertex's outcode, one bit per clip plane it lies outside.
 void setupPrimitive(const Viewport& vp, const glm::dvec4& a, const glm::dvec4& b, const glm::dvec4& c,
-                    std::uint32_t primitive, std::vector<TriangleSetup>& out)
+                    unsigned codeA, unsigned codeB, unsigned codeC, std::uint32_t primitive,
+                    std::vector<TriangleSetup>& out)
 {
-    const unsigned codeA = vp.outcode(a), codeB = vp.outcode(b), codeC = vp.outcode(c);
     if (codeA & codeB & codeC) return;  // wholly outside one plane
     if ((codeA | codeB | codeC) == 0) {
         const glm::dvec4 triangle[3] = {a, b, c};
@@ -189,11 +190,14 @@ RenderResult RasterRenderer::render(const Camera& camera) const
     result.windowDepth = {W, H, DepthQuantity::Window, std::vector<double>(std::size_t(W) * H, camera.clearDepth())};
     result.primitiveId.assign(std::size_t(W) * H, kNoPrimitive);
 
-    // Vertices to clip space, in double.
+    // Vertices to clip space, in double, with their outcodes.
     std::vector<glm::dvec4> pClip(scene_.positions.size());
+    std::vector<unsigned char> outcode(scene_.positions.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pClip.size(), 4096), [&](const auto& range) {
-        for (std::size_t v = range.begin(); v != range.end(); ++v)
+        for (std::size_t v = range.begin(); v != range.end(); ++v) {
             pClip[v] = camera.clipFromWorld * glm::dvec4(glm::dvec3(scene_.positions[v]), 1.0);
+            outcode[v] = static_cast<unsigned char>(vp.outcode(pClip[v]));
+        }
     });
 
     // Set-up and binning, one fixed-size chunk of triangles per task.
@@ -205,7 +209,8 @@ RenderResult RasterRenderer::render(const Camera& camera) const
         chunk.triangles.reserve(last - first);
         for (std::size_t p = first; p < last; ++p) {
             const glm::uvec3& tri = scene_.triangles[p];
-            setupPrimitive(vp, pClip[tri[0]], pClip[tri[1]], pClip[tri[2]], std::uint32_t(p), chunk.triangles);
+            setupPrimitive(vp, pClip[tri[0]], pClip[tri[1]], pClip[tri[2]], outcode[tri[0]], outcode[tri[1]],
+                           outcode[tri[2]], std::uint32_t(p), chunk.triangles);
         }
         binChunk(vp, chunk);
     });

@@ -26,7 +26,7 @@ struct RaySampling {
 
 class RayRenderer final : public Renderer {
 public:
-    explicit RayRenderer(const Scene& scene);  // builds the BVH (timed); throws Error
+    explicit RayRenderer(const Scene& scene);  // builds the BVH (timed); throws Error; `scene` must outlive it
     ~RayRenderer() override;
     RayRenderer(const RayRenderer&) = delete;
     RayRenderer& operator=(const RayRenderer&) = delete;
