@@ -101,9 +101,9 @@ std::string formatSummary(const CheckReport& report)
     std::snprintf(line, sizeof line, "depth      %s%s, range [%g, %g]; tolerance C = %g q, S = 2^-%d px\n",
                   toString(cam.depth.format).c_str(), cam.depth.reversed ? ", reversed-Z" : "", cam.depth.rangeMin,
                   cam.depth.rangeMax, ToleranceModel::constantQuanta(cam.depth), report.tolerance.subpixelBits);
-    out << line << "\npixels                      count\n";
+    out << line << "\npixels                             count\n";
     auto row = [&](const char* label, std::int64_t n, std::int64_t of) {
-        std::snprintf(line, sizeof line, "  %-24s %9lld  %s\n", label, static_cast<long long>(n), percent(n, of).c_str());
+        std::snprintf(line, sizeof line, "  %-28s %9lld  %s\n", label, static_cast<long long>(n), percent(n, of).c_str());
         out << line;
     };
     row("both hit", c.bothHit, total);
