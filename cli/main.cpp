@@ -53,7 +53,7 @@ void writeOutputs(const std::string& dir, const CheckRun& run)
     writeExr(path("raster_depth.exr"), W, H, {"Z"}, asFloats(run.raster.windowDepth));
     writePng8(path("error_heatmap.png"), W, H, errorHeatmapRgb(run.comparison));
     writePng8(path("coverage_classes.png"), W, H, pixelClassRgb(run.comparison));
-    writeTextFileAtomically(path("report.json"), toJson(run.report).dump(2) + "\n");
+    writeTextFileAtomically(path("report.json"), toJson(run.report).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
 }
 
 int runCheckCommand(const CheckOptions& options)
@@ -75,7 +75,7 @@ int runCheckCommand(const CheckOptions& options)
     const RasterRenderer raster(scene);
     const CheckRun run = runCheck(scene, camera, rays, raster);
     if (options.json)
-        std::cout << toJson(run.report).dump(2) << "\n";
+        std::cout << toJson(run.report).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
     else
         std::cout << formatSummary(run.report);
     if (!options.outDir.empty()) writeOutputs(options.outDir, run);

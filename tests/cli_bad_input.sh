@@ -52,6 +52,12 @@ printf 'v 0 0 0\nv 1 0 0\nf 1 2 9\n' > "$tmp/badindex.obj"
 printf 'this is not a mesh\n' > "$tmp/garbage.obj"
 printf 'ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement tristrips 1\nproperty list int int vertex_indices\nend_header\n' > "$tmp/truncated.ply"
 : > "$tmp/empty.obj"
+ply_header='ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n'
+printf "${ply_header}element tristrips 1\nproperty list int int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 4294967296\n" > "$tmp/bigindex.ply"
+printf "${ply_header}element tristrips 1\nproperty list int int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n268435456 0 1 2\n" > "$tmp/biglist.ply"
+printf "${ply_header}element tristrips 5000000000\nproperty list int int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n" > "$tmp/bigcount.ply"
+printf "${ply_header}element junk 18446744073709551615\nelement tristrips 1\nproperty list int int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n" > "$tmp/noprops.ply"
+printf "${ply_header}element tristrips 1\nproperty list int float vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 nan\n" > "$tmp/nanindex.ply"
 
 expect_usage_error "no such file"            check --camera "$tmp/missing.json"
 expect_usage_error "not valid JSON"          check --camera "$tmp/truncated.json"
@@ -72,7 +78,7 @@ expect_usage_error "width"                   check --width 0
 expect_usage_error "height"                  check --height -5
 expect_usage_error "width"                   check --width 20000
 expect_usage_error "width"                   check --width abc
-expect_usage_error "more than .* pixels"     check --width 16384 --height 16384
+expect_usage_error "more than .* pixels"     check --width 8193 --height 4096
 expect_usage_error "unknown convention"      check --convention opengl2
 expect_usage_error "unknown depth format"    check --depth-format unorm8
 expect_usage_error "unknown built-in scene"  check --scene builtin:nothing
@@ -84,6 +90,12 @@ expect_usage_error "out of range|cannot load" check --scene "$tmp/badindex.obj"
 expect_usage_error "cannot load"             check --scene "$tmp/garbage.obj"
 expect_usage_error "cannot load"             check --scene "$tmp/empty.obj"
 expect_usage_error "ends early|malformed"    check --scene "$tmp/truncated.ply"
+expect_usage_error "out of range"            check --scene "$tmp/bigindex.ply"
+expect_usage_error "more than the file"      check --scene "$tmp/biglist.ply"
+expect_usage_error "more than the file"      check --scene "$tmp/bigcount.ply"
+expect_usage_error "no properties"           check --scene "$tmp/noprops.ply"
+expect_usage_error "whole number|non-number" check --scene "$tmp/nanindex.ply"
+expect_usage_error "not a regular file"      check --scene /dev/zero
 expect_usage_error "directory"               check --scene "$tmp"
 expect_usage_error "not a directory"         check --out "$tmp/good.json"
 expect_usage_error "extraneous|not expected|unknown|following argument" check --frobnicate

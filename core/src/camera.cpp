@@ -27,9 +27,10 @@ glm::dmat4 matrixFromRows(const double rows[4][4])
 namespace {
 
 constexpr int kMaxImageSide = 16384;
-// About 40 bytes per pixel across both routes and the comparison: 2^26 pixels (8192²) stay
-// within ~3 GiB; more would risk the machine's memory instead of failing cleanly.
-constexpr long long kMaxImagePixels = 1LL << 26;
+// About 85 bytes per pixel across both routes, the comparison and --out: 2^25 pixels
+// (8192×4096) stay within ~3 GiB; more would risk the machine's memory instead of failing
+// cleanly.
+constexpr long long kMaxImagePixels = 1LL << 25;
 
 void requireFinite(double value, const std::string& name)
 {
@@ -130,7 +131,7 @@ void validate(const CameraSpec& spec)
                         std::to_string(value));
     if (static_cast<long long>(spec.width) * spec.height > kMaxImagePixels)
         throw Error("image " + std::to_string(spec.width) + "x" + std::to_string(spec.height) + " has more than " +
-                    std::to_string(kMaxImagePixels) + " pixels (8192x8192)");
+                    std::to_string(kMaxImagePixels) + " pixels (8192x4096)");
     validateProjection(spec);
     requireFinite(spec.view.eye, "view.eye");
     requireFinite(spec.view.target, "view.target");

@@ -26,6 +26,9 @@ ClipPolygon clipTriangle(const glm::dvec4& a, const glm::dvec4& b, const glm::dv
     for (int p = 0; p < planes.size && polygon.size > 0; ++p) {
         const glm::dvec4& plane = planes.plane[p];
         ClipPolygon out;
+        // Exactly, each plane adds at most one vertex; rounding with vertices on several
+        // planes at once could add more. Never write past the array: drop such a sliver.
+        if (polygon.size + 1 > ClipPolygon::kMaxVertices) return ClipPolygon{};
         for (int i = 0; i < polygon.size; ++i) {
             const glm::dvec4& current = polygon.pClip[i];
             const glm::dvec4& next = polygon.pClip[(i + 1) % polygon.size];

@@ -18,6 +18,7 @@ std::string toString(PixelClass pixelClass)
     case PixelClass::RayOnlyEdge: return "ray-only-edge";
     case PixelClass::RasterOnlyEdge: return "raster-only-edge";
     case PixelClass::RayOnlyAtClear: return "ray-only-at-clear";
+    case PixelClass::AtClipPlane: return "at-clip-plane";
     case PixelClass::RayOnly: return "ray-only";
     case PixelClass::RasterOnly: return "raster-only";
     }
@@ -113,6 +114,18 @@ struct TriangleView {
         if (std::isnan(m)) m = windowDepthSlope(camera, vertex(primitive, 0), vertex(primitive, 1), vertex(primitive, 2));
         return m;
     }
+    // Does the primitive's plane cross the pixel's ray at the near or far plane, to within
+    // binary32 rounding (2^-20 relative) of the distances where the routes clip?
+    bool atClipPlane(const Camera& camera, std::uint32_t primitive, const glm::dvec2& pWindow) const
+    {
+        const EyePlaneRay ray = worldEyePlaneRayThroughWindow(camera, pWindow);
+        const glm::dvec3 a = vertex(primitive, 0);
+        const glm::dvec3 normal = glm::cross(vertex(primitive, 1) - a, vertex(primitive, 2) - a);
+        const double t = glm::dot(normal, a - ray.origin) / glm::dot(normal, ray.direction);
+        const double epsilon = std::ldexp(1.0, -20);
+        return std::isfinite(t) && (std::abs(t - ray.tNear) <= epsilon * std::abs(ray.tNear) ||
+                                    std::abs(t - ray.tFar) <= epsilon * std::abs(ray.tFar));
+    }
     bool nearEdge(const Camera& camera, std::uint32_t primitive, const glm::dvec2& pWindow, double radius) const
     {
         if (primitive == kNoPrimitive) return false;
@@ -142,6 +155,7 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
     const DepthFormat format = camera.depth().format;
     const double C = ToleranceModel::constantQuanta(camera.depth());
     const double S = tolerance.snapPixels();
+    const double E = 16 * std::ldexp(1.0, -52) * std::max(std::abs(camera.depth().rangeMin), std::abs(camera.depth().rangeMax));
     std::vector<double> errorQuanta, relativeEyeZ;
 
     for (int row = 0; row < H; ++row) {
@@ -166,15 +180,17 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
                 const bool samePrimitive = f.rayPrimitive == f.rasterPrimitive;
                 const double mRay = triangles.slope(camera, f.rayPrimitive);
                 const double bound = samePrimitive
-                                         ? C * q + S * mRay
-                                         : 2 * C * q + S * (mRay + triangles.slope(camera, f.rasterPrimitive));
+                                         ? C * q + S * mRay + E
+                                         : 2 * (C * q + E) + S * (mRay + triangles.slope(camera, f.rasterPrimitive));
                 f.errorQuanta = error / q;
                 f.toleranceQuanta = bound / q;
                 const double ratio = bound > 0 ? error / bound : (error > 0 ? INFINITY : 0.0);
                 if (error <= bound) {
                     f.pixelClass = PixelClass::Agree;
                 } else if (!samePrimitive && (triangles.nearEdge(camera, f.rayPrimitive, pWindow, S) ||
-                                              triangles.nearEdge(camera, f.rasterPrimitive, pWindow, S))) {
+                                              triangles.nearEdge(camera, f.rasterPrimitive, pWindow, S) ||
+                                              triangles.atClipPlane(camera, f.rayPrimitive, pWindow) ||
+                                              triangles.atClipPlane(camera, f.rasterPrimitive, pWindow))) {
                     f.pixelClass = PixelClass::EdgeSurface;
                 } else {
                     f.pixelClass = PixelClass::DepthError;
@@ -201,18 +217,27 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
                 const double q = storageQuantum(format, f.rayWindowDepth);
                 if (triangles.nearEdge(camera, f.rayPrimitive, pWindow, S)) {
                     f.pixelClass = PixelClass::RayOnlyEdge;
-                } else if (distanceToClear <= C * q + S * triangles.slope(camera, f.rayPrimitive)) {
+                } else if (distanceToClear <= C * q + S * triangles.slope(camera, f.rayPrimitive) + E) {
                     f.pixelClass = PixelClass::RayOnlyAtClear;
                     ++r.lostAtClearValue;
+                } else if (triangles.atClipPlane(camera, f.rayPrimitive, pWindow)) {
+                    f.pixelClass = PixelClass::AtClipPlane;
+                    ++r.atClipPlane;
                 } else {
                     f.pixelClass = PixelClass::RayOnly;
                 }
                 f.pixelClass == PixelClass::RayOnly ? ++r.coverageUnexplained : ++r.coverageExplained;
             } else {
                 ++r.rasterOnly;
-                const bool edge = triangles.nearEdge(camera, f.rasterPrimitive, pWindow, S);
-                f.pixelClass = edge ? PixelClass::RasterOnlyEdge : PixelClass::RasterOnly;
-                edge ? ++r.coverageExplained : ++r.coverageUnexplained;
+                if (triangles.nearEdge(camera, f.rasterPrimitive, pWindow, S)) {
+                    f.pixelClass = PixelClass::RasterOnlyEdge;
+                } else if (triangles.atClipPlane(camera, f.rasterPrimitive, pWindow)) {
+                    f.pixelClass = PixelClass::AtClipPlane;
+                    ++r.atClipPlane;
+                } else {
+                    f.pixelClass = PixelClass::RasterOnly;
+                }
+                f.pixelClass == PixelClass::RasterOnly ? ++r.coverageUnexplained : ++r.coverageExplained;
             }
 
             out.pixelClass[i] = f.pixelClass;

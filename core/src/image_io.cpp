@@ -54,6 +54,7 @@ Rgb classColour(PixelClass c)
     case PixelClass::RayOnlyEdge: return {220, 200, 60};
     case PixelClass::RasterOnlyEdge: return {60, 200, 200};
     case PixelClass::RayOnlyAtClear: return {120, 80, 160};
+    case PixelClass::AtClipPlane: return {150, 110, 60};
     case PixelClass::RayOnly: return {255, 0, 255};
     case PixelClass::RasterOnly: return {255, 140, 0};
     }

@@ -46,8 +46,8 @@ Ray eyeRayThroughWindow(const Camera& camera, const glm::dvec2& pWindow)
     const glm::dvec4 farEye = camera.eyeFromClip * clipFromWindow(camera, {pWindow, camera.windowDepthFar()});
     Ray ray;
     ray.origin = glm::dvec3(nearEye) / nearEye.w;
-    // |w| this small relative to xyz means the far point is at infinity (infinite far plane).
-    if (std::abs(farEye.w) <= 1e-12 * glm::length(glm::dvec3(farEye))) {
+    // With an infinite far plane the far point has w = 0 (up to rounding): a direction.
+    if (std::isinf(camera.spec().projection.far)) {
         const glm::dvec3 direction = glm::normalize(glm::dvec3(farEye));
         // The direction of the point at infinity is fixed up to sign: it points away from the eye.
         ray.direction = camera.eyeZOf(direction) > 0 ? direction : -direction;

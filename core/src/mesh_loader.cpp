@@ -6,6 +6,7 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -25,32 +26,49 @@ public:
 
     static bool storesStrips(const std::string& path)
     {
+        // Look only at the first 64 KiB: a header is short, and the file may be anything.
         std::ifstream in(path, std::ios::binary);
-        std::string line;
-        if (!std::getline(in, line) || line.rfind("ply", 0) != 0) return false;
-        for (int n = 0; n < 1000 && std::getline(in, line); ++n) {
-            if (line.rfind("end_header", 0) == 0) return false;
-            if (line.rfind("element tristrips", 0) == 0) return true;
-        }
-        return false;
+        std::string head(65536, '\0');
+        in.read(head.data(), std::streamsize(head.size()));
+        head.resize(std::size_t(in.gcount()));
+        if (head.rfind("ply", 0) != 0) return false;
+        const std::size_t end = head.find("end_header");
+        return head.find("\nelement tristrips") < end;
     }
 
     Scene read()
     {
+        in_.seekg(0, std::ios::end);
+        fileSize_ = static_cast<std::uint64_t>(in_.tellg());
+        in_.seekg(0);
         readHeader();
         Scene scene;
         scene.name = path_;
         for (const Element& element : elements_) {
+            // Refuse counts the file cannot hold before allocating or looping for them.
+            std::uint64_t minimumBytes = 0;
+            for (const Property& property : element.properties)
+                minimumBytes += ascii_ ? 2 : std::uint64_t(sizeOf(property.isList ? property.countType : property.type));
+            if (element.count > 0 && minimumBytes == 0) fail("element '" + element.name + "' has no properties");
+            if (minimumBytes > 0 && element.count > remainingBytes() / minimumBytes)
+                fail("element '" + element.name + "' declares " + std::to_string(element.count) +
+                     " items, more than the file can hold");
+            if (element.name == "vertex" && element.count >= 0xFFFFFFFFull) fail("too many vertices");
             for (std::uint64_t item = 0; item < element.count; ++item) {
                 glm::vec3 position(0.0f);
                 for (const Property& property : element.properties) {
                     if (property.isList) {
-                        const auto length = static_cast<std::int64_t>(value(property.countType));
-                        if (length < 0 || length > (1 << 28)) fail("a list has an impossible length");
-                        std::vector<std::int64_t> list(static_cast<std::size_t>(length));
-                        for (auto& index : list) index = static_cast<std::int64_t>(value(property.type));
-                        if (property.name == "vertex_indices" || property.name == "vertex_index")
-                            addPrimitives(scene, element.name, list);
+                        const double length = value(property.countType);
+                        const std::uint64_t itemBytes = ascii_ ? 2 : std::uint64_t(sizeOf(property.type));
+                        if (!(length >= 0) || length != std::floor(length) || length > double(remainingBytes() / itemBytes))
+                            fail("a list declares " + formatNumber(length) + " entries, more than the file can hold");
+                        const bool indices = property.name == "vertex_indices" || property.name == "vertex_index";
+                        std::vector<std::int64_t> list;
+                        for (std::uint64_t k = 0; k < std::uint64_t(length); ++k) {
+                            const double v = value(property.type);  // other lists are read past
+                            if (indices) list.push_back(vertexIndex(v, property.type));
+                        }
+                        if (indices) addPrimitives(scene, element.name, list);
                     } else {
                         const double v = value(property.type);
                         if (element.name == "vertex") {
@@ -79,6 +97,23 @@ private:
         std::uint64_t count = 0;
         std::vector<Property> properties;
     };
+
+    std::uint64_t remainingBytes()
+    {
+        const auto position = in_.tellg();
+        return position < 0 ? 0 : fileSize_ - std::min(fileSize_, static_cast<std::uint64_t>(position));
+    }
+
+    // A vertex index as read: a whole number in [0, 2^32 − 2], or −1 (a strip restart; for
+    // unsigned index types the all-ones value is the restart).
+    std::int64_t vertexIndex(double v, const std::string& type) const
+    {
+        if (!std::isfinite(v) || v != std::floor(v)) fail("a vertex index is not a whole number");
+        const bool isUnsigned = type[0] == 'u';
+        if (isUnsigned && v == std::ldexp(1.0, 8 * sizeOf(type)) - 1) return -1;
+        if (v < -1 || v > 4294967294.0) fail("a vertex index is out of range (" + formatNumber(v) + ")");
+        return static_cast<std::int64_t>(v);
+    }
 
     [[noreturn]] void fail(const std::string& why) const
     {
@@ -191,6 +226,7 @@ private:
     std::ifstream in_;
     std::vector<Element> elements_;
     bool ascii_ = false, bigEndian_ = false;
+    std::uint64_t fileSize_ = 0;
 };
 
 Scene framed(Scene scene);
@@ -202,6 +238,7 @@ Scene loadMesh(const std::string& path)
     std::error_code ec;
     if (!std::filesystem::exists(path, ec)) throw Error("cannot read mesh '" + path + "': no such file");
     if (std::filesystem::is_directory(path, ec)) throw Error("cannot read mesh '" + path + "': it is a directory");
+    if (!std::filesystem::is_regular_file(path, ec)) throw Error("cannot read mesh '" + path + "': not a regular file");
 
     if (PlyStripReader::storesStrips(path)) return framed(PlyStripReader(path).read());
 

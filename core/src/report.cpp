@@ -67,6 +67,7 @@ nlohmann::json toJson(const CheckReport& report)
           {"depth_errors", c.depthErrors},
           {"coverage_explained", c.coverageExplained},
           {"lost_at_clear_value", c.lostAtClearValue},
+          {"at_clip_plane", c.atClipPlane},
           {"coverage_unexplained", c.coverageUnexplained}}},
         {"depth_error",
          {{"max_quanta", c.maxErrorQuanta},
@@ -113,8 +114,9 @@ std::string formatSummary(const CheckReport& report)
     row("both miss", c.bothMiss, total);
     row("ray only", c.rayOnly, total);
     row("raster only", c.rasterOnly, total);
-    row("  explained (at an edge)", c.coverageExplained - c.lostAtClearValue, total);
+    row("  explained (at an edge)", c.coverageExplained - c.lostAtClearValue - c.atClipPlane, total);
     row("  explained (at clear value)", c.lostAtClearValue, total);
+    row("  explained (on near/far)", c.atClipPlane, total);
     row("  UNEXPLAINED", c.coverageUnexplained, total);
 
     out << "\ndepth error over compared pixels (both hit, same surface or within tolerance)\n";

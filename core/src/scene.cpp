@@ -33,8 +33,13 @@ void validateScene(const Scene& scene)
     if (scene.triangles.size() >= 0xFFFFFFFFu)
         throw Error("scene '" + scene.name + "' has more triangles than 32-bit primitive ids can name");
     for (const auto& p : scene.positions)
-        for (int i = 0; i < 3; ++i)
+        for (int i = 0; i < 3; ++i) {
             if (!std::isfinite(p[i])) throw Error("scene '" + scene.name + "' has a vertex that is not finite");
+            // binary32 ray tracing needs headroom: squares of coordinates must stay finite.
+            if (std::abs(p[i]) > 1e18f)
+                throw Error("scene '" + scene.name + "' has a vertex coordinate beyond ±1e18 (" +
+                            formatNumber(p[i]) + ")");
+        }
     for (const auto& t : scene.triangles)
         for (int i = 0; i < 3; ++i)
             if (t[i] >= scene.positions.size())

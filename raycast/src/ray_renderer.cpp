@@ -62,6 +62,10 @@ constexpr int kPacketH = 2;
 }  // namespace
 
 struct RayRenderer::Embree {
+    // Embree works in binary32 in a frame centred on the scene: world − frameOrigin. Rounding
+    // a ray origin then errs by ~6e-8 of its distance to the scene, not of its distance to
+    // the world origin (a mesh at x = 1000 would otherwise see its edges move by pixels).
+    glm::dvec3 frameOrigin{0.0};
     ErrorLog errors;
     DeviceHandle device;
     SceneHandle scene;
@@ -98,8 +102,10 @@ RayRenderer::RayRenderer(const Scene& scene) : embree_(std::make_unique<Embree>(
         embree_->check("allocating geometry buffers");
         throw Error("Embree could not allocate geometry buffers");
     }
+    embree_->frameOrigin = glm::dvec3(glm::vec3((scene.boundsMin() + scene.boundsMax()) / 2.0));
     for (std::size_t v = 0; v < scene.positions.size(); ++v)
-        for (int k = 0; k < 3; ++k) vertices[3 * v + k] = scene.positions[v][k];
+        for (int k = 0; k < 3; ++k)
+            vertices[3 * v + k] = float(double(scene.positions[v][k]) - embree_->frameOrigin[k]);
     for (std::size_t t = 0; t < scene.triangles.size(); ++t)
         for (int k = 0; k < 3; ++k) indices[3 * t + k] = scene.triangles[t][k];
     rtcCommitGeometry(geometry);  // commit before attaching, or no intersections
@@ -124,6 +130,7 @@ RenderResult RayRenderer::render(const Camera& camera) const
     const int tilesX = (W + kTile - 1) / kTile, tilesY = (H + kTile - 1) / kTile;
     RTCScene rtcScene = embree_->scene.get();
     const RaySampling fault = sampling;
+    const glm::dvec3 frameOrigin = embree_->frameOrigin;
 
     tbb::parallel_for(tbb::blocked_range<int>(0, tilesX * tilesY, 4), [&](const tbb::blocked_range<int>& tiles) {
         FlushDenormals flush;
@@ -149,9 +156,9 @@ RenderResult RayRenderer::render(const Camera& camera) const
                         rays[k] = valid[k] ? worldEyePlaneRayThroughWindow(camera, pWindow)
                                            : EyePlaneRay{{0, 0, 0}, {0, 0, 1}, 0, 0};
                         const EyePlaneRay& r = rays[k];
-                        packet.ray.org_x[k] = float(r.origin.x);
-                        packet.ray.org_y[k] = float(r.origin.y);
-                        packet.ray.org_z[k] = float(r.origin.z);
+                        packet.ray.org_x[k] = float(r.origin.x - frameOrigin.x);
+                        packet.ray.org_y[k] = float(r.origin.y - frameOrigin.y);
+                        packet.ray.org_z[k] = float(r.origin.z - frameOrigin.z);
                         packet.ray.dir_x[k] = float(r.direction.x);
                         packet.ray.dir_y[k] = float(r.direction.y);
                         packet.ray.dir_z[k] = float(r.direction.z);

@@ -18,7 +18,7 @@
 // positive distances along the viewing direction (eye-z).
 //
 // Cameras are built by a validating constructor: a NaN, a degenerate view, near ≤ 0,
-// far ≤ near, an empty frustum or an image outside 1…16384 pixels per side (or over 2^26
+// far ≤ near, an empty frustum or an image outside 1…16384 pixels per side (or over 2^25
 // pixels in all) throws Error
 // naming the parameter. Nothing is silently repaired.
 #include "zcheck/convention.h"

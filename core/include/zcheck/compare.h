@@ -16,8 +16,14 @@
 // vertex snapping can move the edge across the sample point, or when only the ray hits a
 // surface whose depth lies within its tolerance of the clear value (stored, it would equal
 // the clear value and fail the strict LESS/GREATER test: the far end of a unorm16 buffer
-// with a tiny near plane). Everything else is an unexplained mismatch; a half-pixel or
+// with a tiny near plane), or when the surface involved lies on the near or far plane to
+// within 2^-20 of its distance (Embree's binary32 tNear/tFar and the rasterizer's clipping
+// round differently there). Everything else is an unexplained mismatch; a half-pixel or
 // one-row shift can never hide among edge pixels.
+//
+// Every tolerance also carries E = 16·2^-52·max(|rangeMin|, |rangeMax|), the rounding of
+// the double-precision forward chain itself; it matters only where binary32 ulps are finer
+// still (reversed-Z float32 at the far plane, where window depth is ~0).
 //
 // Verdict: consistent ⇔ no unexplained coverage mismatch and no depth error.
 #include "zcheck/camera.h"
@@ -32,13 +38,16 @@ namespace zcheck {
 enum class PixelClass : std::uint8_t {
     BothMiss,            // neither route sees a surface
     Agree,               // both hit, depths agree within tolerance
-    EdgeSurface,         // both hit different surfaces beyond tolerance, pixel centre at an edge: explained
+    EdgeSurface,         // both hit different surfaces beyond tolerance, the pixel centre at an
+                         // edge of one of them or one of them on the near/far plane: explained
     DepthError,          // both hit, depths disagree beyond tolerance, unexplained
     RayOnlyEdge,         // only the ray hits, pixel centre at an edge: explained
     RasterOnlyEdge,      // only the raster hits, pixel centre at an edge: explained
     RayOnlyAtClear,      // only the ray hits a surface whose depth is within tolerance of the clear
                          // value: quantized, it cannot pass the strict depth test (a precision
                          // limit of the camera and format, not a chain error): explained
+    AtClipPlane,         // only one route hits, and the surface lies on the near or far plane
+                         // within binary32 rounding of where the routes clip: explained
     RayOnly,             // only the ray hits, unexplained
     RasterOnly,          // only the raster hits, unexplained
 };
@@ -73,11 +82,12 @@ struct ComparisonReport {
     std::int64_t rasterOnly = 0;    // the raster hits, the ray does not
     // Both-hit pixels split by outcome; agree + edgeSurface + depthErrors = bothHit.
     std::int64_t agree = 0;         // depths within tolerance
-    std::int64_t edgeSurface = 0;   // different surfaces beyond tolerance at an edge (explained)
+    std::int64_t edgeSurface = 0;   // different surfaces beyond tolerance at an edge or clip plane (explained)
     std::int64_t depthErrors = 0;   // beyond tolerance, unexplained
     // Coverage mismatches split; explained + unexplained = rayOnly + rasterOnly.
     std::int64_t coverageExplained = 0;    // pixel centre within S of an edge, or depth at the clear value
     std::int64_t lostAtClearValue = 0;     // of those: ray-only surfaces whose depth quantizes to the clear value
+    std::int64_t atClipPlane = 0;          // of those: a surface on the near or far plane
     std::int64_t coverageUnexplained = 0;  // anything else
     // Over the both-hit pixels compared on depth (agree + depthErrors):
     double maxErrorQuanta = 0;      // max |d_raster − d_ray| / q
