@@ -224,7 +224,8 @@ TEST_CASE("a plane at a known eye depth yields exactly that depth through each r
     const RayRenderer rays(wall);
     const RasterRenderer raster(wall);
     for (const auto& name : Convention::presetNames())
-        for (auto type : {ProjectionType::Perspective, ProjectionType::Orthographic})
+        for (auto [type, far] : {std::pair{ProjectionType::Perspective, f}, std::pair{ProjectionType::Perspective, double(INFINITY)},
+                                 std::pair{ProjectionType::Orthographic, f}})
             for (const auto& format : depthFormatNames())
                 for (bool reversed : {false, true})
                     for (auto range : {std::pair{0.0, 1.0}, std::pair{0.25, 0.75}}) {
@@ -235,17 +236,20 @@ TEST_CASE("a plane at a known eye depth yields exactly that depth through each r
                         spec.projection.fovyDeg = 50;
                         spec.projection.left = -3, spec.projection.right = 4, spec.projection.bottom = -2.5,
                         spec.projection.top = 2;
-                        spec.projection.near = n, spec.projection.far = f;
+                        spec.projection.near = n, spec.projection.far = far;
                         spec.view = {{0, 0, 0}, {0, 0, -1}, {0, 1, 0}};
                         spec.depth = {depthFormatFromName(format), reversed, range.first, range.second};
                         const Camera camera(spec);
-                        const double unit = type == ProjectionType::Perspective
-                                                ? (reversed ? n * (f - D) / (D * (f - n)) : f * (D - n) / (D * (f - n)))
-                                                : (reversed ? (f - D) / (f - n) : (D - n) / (f - n));
+                        // Infinite far plane: the limits f → ∞ of the perspective formulas.
+                        const double unit = type == ProjectionType::Orthographic
+                                                ? (reversed ? (f - D) / (f - n) : (D - n) / (f - n))
+                                            : std::isinf(far)
+                                                ? (reversed ? n / D : (D - n) / D)
+                                                : (reversed ? n * (f - D) / (D * (f - n)) : f * (D - n) / (D * (f - n)));
                         const double expected = range.first + (range.second - range.first) * unit;
                         const double q = storageQuantum(spec.depth.format, expected);
                         const RenderResult byRay = rays.render(camera), byRaster = raster.render(camera);
-                        INFO(name << " " << toString(type) << " " << format << (reversed ? " reversed" : "")
+                        INFO(name << " " << toString(type) << " far " << far << " " << format << (reversed ? " reversed" : "")
                                   << " range [" << range.first << "," << range.second << "]");
                         for (std::size_t i = 0; i < byRay.primitiveId.size(); ++i) {
                             REQUIRE(byRay.hit(i));

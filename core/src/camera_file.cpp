@@ -194,7 +194,7 @@ CameraSpec readCameraFile(const std::string& path)
     json document;
     try {
         document = json::parse(in);
-    } catch (const json::parse_error& e) {
+    } catch (const json::exception& e) {  // syntax errors, and numbers out of range such as 1e400
         std::string what = e.what();
         throw Error("camera file '" + path + "' is not valid JSON: " + what.substr(what.find(']') + 2));
     }
