@@ -211,33 +211,26 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
                         r.worst = f;
                     }
                 }
-            } else if (rayHit) {
-                ++r.rayOnly;
-                const double distanceToClear = std::abs(f.rayWindowDepth - camera.clearDepth());
-                const double q = storageQuantum(format, f.rayWindowDepth);
-                if (triangles.nearEdge(camera, f.rayPrimitive, pWindow, S)) {
-                    f.pixelClass = PixelClass::RayOnlyEdge;
-                } else if (distanceToClear <= C * q + S * triangles.slope(camera, f.rayPrimitive) + E) {
+            } else {
+                // Coverage mismatch: only one route sees a surface. Explained at an edge of its
+                // triangle, (ray route only) at the clear value, or on the near/far plane.
+                rayHit ? ++r.rayOnly : ++r.rasterOnly;
+                const std::uint32_t primitive = rayHit ? f.rayPrimitive : f.rasterPrimitive;
+                const bool atClear =
+                    rayHit && std::abs(f.rayWindowDepth - camera.clearDepth()) <=
+                                  C * storageQuantum(format, f.rayWindowDepth) + S * triangles.slope(camera, primitive) + E;
+                if (triangles.nearEdge(camera, primitive, pWindow, S)) {
+                    f.pixelClass = rayHit ? PixelClass::RayOnlyEdge : PixelClass::RasterOnlyEdge;
+                } else if (atClear) {
                     f.pixelClass = PixelClass::RayOnlyAtClear;
                     ++r.lostAtClearValue;
-                } else if (triangles.atClipPlane(camera, f.rayPrimitive, pWindow)) {
+                } else if (triangles.atClipPlane(camera, primitive, pWindow)) {
                     f.pixelClass = PixelClass::AtClipPlane;
                     ++r.atClipPlane;
                 } else {
-                    f.pixelClass = PixelClass::RayOnly;
+                    f.pixelClass = rayHit ? PixelClass::RayOnly : PixelClass::RasterOnly;
                 }
-                f.pixelClass == PixelClass::RayOnly ? ++r.coverageUnexplained : ++r.coverageExplained;
-            } else {
-                ++r.rasterOnly;
-                if (triangles.nearEdge(camera, f.rasterPrimitive, pWindow, S)) {
-                    f.pixelClass = PixelClass::RasterOnlyEdge;
-                } else if (triangles.atClipPlane(camera, f.rasterPrimitive, pWindow)) {
-                    f.pixelClass = PixelClass::AtClipPlane;
-                    ++r.atClipPlane;
-                } else {
-                    f.pixelClass = PixelClass::RasterOnly;
-                }
-                f.pixelClass == PixelClass::RasterOnly ? ++r.coverageUnexplained : ++r.coverageExplained;
+                isUnexplained(f.pixelClass) ? ++r.coverageUnexplained : ++r.coverageExplained;
             }
 
             out.pixelClass[i] = f.pixelClass;
