@@ -31,7 +31,7 @@ CameraSpec specWith(const std::string& convention, ProjectionType type, bool rev
     if (type == ProjectionType::Orthographic) {
         spec.projection.left = -4, spec.projection.right = 5, spec.projection.bottom = -3, spec.projection.top = 3.5;
     }
-    spec.view = {{1.0, 2.0, 6.0}, {0.2, 0.1, -1.0}, {0.1, 1.0, 0.0}};
+    spec.view = View::lookAt({1.0, 2.0, 6.0}, {0.2, 0.1, -1.0}, {0.1, 1.0, 0.0});
     spec.depth.reversed = reversed;
     return spec;
 }
@@ -289,7 +289,7 @@ TEST_CASE("pixel rays of a perspective camera pass through the hand-computed poi
     CameraSpec spec = specWith("opengl", ProjectionType::Perspective);
     spec.width = spec.height = 2;
     spec.projection.fovyDeg = 90;
-    spec.view = {{0, 0, 0}, {0, 0, -1}, {0, 1, 0}};
+    spec.view = View::lookAt({0, 0, 0}, {0, 0, -1}, {0, 1, 0});
     for (const auto& name : {"opengl", "direct3d", "vulkan", "metal", "opencv"}) {
         spec.convention = Convention::preset(name);
         const Camera camera(spec);

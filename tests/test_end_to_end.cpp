@@ -228,7 +228,7 @@ TEST_CASE("regression: surfaces lying exactly on the near or far plane gave unex
                 spec.convention = Convention::preset(convention);
                 spec.width = 160, spec.height = 120;
                 spec.projection.near = n, spec.projection.far = f;
-                spec.view = {{0, 0, 0}, {0, 0, -1}, {0, 1, 0}};
+                spec.view = View::lookAt({0, 0, 0}, {0, 0, -1}, {0, 1, 0});
                 spec.depth.format = depthFormatFromName(format);
                 spec.depth.reversed = reversed;
                 const ComparisonReport r = runCheck(planes, Camera(spec)).report.comparison;

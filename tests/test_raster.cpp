@@ -31,7 +31,7 @@ CameraSpec pixelExactCamera(int size)
     spec.projection.type = ProjectionType::Orthographic;
     spec.projection.left = 0, spec.projection.right = size, spec.projection.bottom = 0, spec.projection.top = size;
     spec.projection.near = 0.5, spec.projection.far = 10;
-    spec.view = {{0, 0, 0}, {0, 0, -1}, {0, 1, 0}};
+    spec.view = View::lookAt({0, 0, 0}, {0, 0, -1}, {0, 1, 0});
     return spec;
 }
 
@@ -157,7 +157,7 @@ TEST_CASE("a triangle crossing the near plane and lying behind the camera is cli
     spec.width = spec.height = 64;
     spec.projection.fovyDeg = 90;
     spec.projection.near = 2, spec.projection.far = 50;
-    spec.view = {{0, 0, 0}, {0, 0, -1}, {0, 1, 0}};
+    spec.view = View::lookAt({0, 0, 0}, {0, 0, -1}, {0, 1, 0});
     const Scene floor = sceneOf({{-500, -1, 10}, {500, -1, 10}, {0, -1, -500}}, {{0, 1, 2}});
     for (const auto& name : Convention::presetNames())
         for (bool reversed : {false, true}) {
@@ -188,7 +188,7 @@ TEST_CASE("a triangle wholly behind the camera draws nothing", "[raster][clippin
 {
     CameraSpec spec;
     spec.width = spec.height = 32;
-    spec.view = {{0, 0, 0}, {0, 0, -1}, {0, 1, 0}};
+    spec.view = View::lookAt({0, 0, 0}, {0, 0, -1}, {0, 1, 0});
     const Scene behind = sceneOf({{-5, -5, 3}, {5, -5, 3}, {0, 5, 1}}, {{0, 1, 2}});
     const RenderResult image = RasterRenderer(behind).render(Camera(spec));
     for (std::size_t i = 0; i < image.primitiveId.size(); ++i) REQUIRE_FALSE(image.hit(i));
@@ -237,7 +237,7 @@ TEST_CASE("a plane at a known eye depth yields exactly that depth through each r
                         spec.projection.left = -3, spec.projection.right = 4, spec.projection.bottom = -2.5,
                         spec.projection.top = 2;
                         spec.projection.near = n, spec.projection.far = far;
-                        spec.view = {{0, 0, 0}, {0, 0, -1}, {0, 1, 0}};
+                        spec.view = View::lookAt({0, 0, 0}, {0, 0, -1}, {0, 1, 0});
                         spec.depth = {depthFormatFromName(format), reversed, range.first, range.second};
                         const Camera camera(spec);
                         // Infinite far plane: the limits f → ∞ of the perspective formulas.

@@ -109,8 +109,8 @@ Scene defaultScene()
     s.quad({-1.0, 2.5, -4.002}, {0.8, 2.5, -4.002}, {0.8, 3.9, -4.002}, {-1.0, 3.9, -4.002});
 
     CameraSpec camera;
-    camera.projection = {ProjectionType::Perspective, 55.0, 0.0, 0, 0, 0, 0, 0.1, 100.0};
-    camera.view = {{1.2, 2.4, 5.5}, {-0.3, 0.9, -4.0}, {0.0, 1.0, 0.0}};
+    camera.projection = Projection::perspective(55.0, 0.1, 100.0);
+    camera.view = View::lookAt({1.2, 2.4, 5.5}, {-0.3, 0.9, -4.0}, {0.0, 1.0, 0.0});
     return sceneFrom("builtin:default", std::move(s), camera);
 }
 
@@ -125,8 +125,8 @@ Scene terrainScene(const std::string& name, int n)
     CameraSpec camera;
     camera.width = 640;
     camera.height = 480;
-    camera.projection = {ProjectionType::Perspective, 50.0, 0.0, 0, 0, 0, 0, 0.5, 200.0};
-    camera.view = {{-35.0, 14.0, 42.0}, {8.0, -2.0, -10.0}, {0.0, 1.0, 0.0}};
+    camera.projection = Projection::perspective(50.0, 0.5, 200.0);
+    camera.view = View::lookAt({-35.0, 14.0, 42.0}, {8.0, -2.0, -10.0}, {0.0, 1.0, 0.0});
     return sceneFrom(name, std::move(s), camera);
 }
 
@@ -147,8 +147,8 @@ Scene nearCrossingScene()
     s.sphere({1.0, 0.0, -3.0}, 0.6);
 
     CameraSpec camera;
-    camera.projection = {ProjectionType::Perspective, 70.0, 0.0, 0, 0, 0, 0, 0.5, 50.0};
-    camera.view = {{0.0, 0.0, 0.0}, {0.0, 0.0, -1.0}, {0.0, 1.0, 0.0}};
+    camera.projection = Projection::perspective(70.0, 0.5, 50.0);
+    camera.view = View::lookAt({0.0, 0.0, 0.0}, {0.0, 0.0, -1.0}, {0.0, 1.0, 0.0});
     return sceneFrom("builtin:near-crossing", std::move(s), camera);
 }
 

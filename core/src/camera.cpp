@@ -12,8 +12,38 @@ std::string toString(ProjectionType type)
     case ProjectionType::Perspective: return "perspective";
     case ProjectionType::Frustum: return "frustum";
     case ProjectionType::Orthographic: return "orthographic";
+    case ProjectionType::Oblique: return "oblique";
+    case ProjectionType::Pinhole: return "pinhole";
+    case ProjectionType::Lens: return "lens";
+    case ProjectionType::Matrix: return "matrix";
     }
     return "?";
+}
+
+bool Projection::isPerspective() const
+{
+    if (type == ProjectionType::Matrix)  // w depends on eye z: a centre of projection
+        return clipFromEye[2][3] != 0.0 || clipFromEye[0][3] != 0.0 || clipFromEye[1][3] != 0.0;
+    return type != ProjectionType::Orthographic && type != ProjectionType::Oblique;
+}
+
+View View::axonometricView(const std::string& kind, const glm::dvec3& target, double distance, double azimuthDeg,
+                           double elevationDeg)
+{
+    if (kind != "isometric" && kind != "dimetric" && kind != "trimetric")
+        throw Error("unknown axonometric view '" + kind + "' (expected isometric, dimetric or trimetric)");
+    if (!std::isfinite(distance) || !(distance > 0))
+        throw Error("'view.distance' must be > 0, got " + formatNumber(distance));
+    if (!std::isfinite(azimuthDeg) || !std::isfinite(elevationDeg) || !(std::abs(elevationDeg) < 90))
+        throw Error("'view.elevation_deg' must be in (-90, 90) and 'view.azimuth_deg' finite");
+    View view;
+    const double a = glm::radians(azimuthDeg), e = glm::radians(elevationDeg);
+    view.eye = target + distance * glm::dvec3(std::cos(e) * std::sin(a), std::sin(e), std::cos(e) * std::cos(a));
+    view.target = target;
+    view.up = {0.0, 1.0, 0.0};
+    view.axonometric = kind;
+    view.distance = distance, view.azimuthDeg = azimuthDeg, view.elevationDeg = elevationDeg;
+    return view;
 }
 
 glm::dmat4 matrixFromRows(const double rows[4][4])
@@ -91,27 +121,57 @@ glm::dmat4 clipGlFromEyeGl(const Projection& projection, double l, double r, dou
     return matrixFromRows(rows);
 }
 
-void validateProjection(const CameraSpec& spec)
+void validateNearFar(const Projection& p)
 {
-    const Projection& p = spec.projection;
     requireFinite(p.near, "projection.near");
     if (!(p.near > 0)) throw Error("'projection.near' must be > 0, got " + formatNumber(p.near));
     if (std::isnan(p.far)) throw Error("'projection.far' must be a number, got nan");
     if (std::isinf(p.far) && !(p.far > 0 && p.isPerspective()))
-        throw Error("'projection.far' must be finite for an orthographic projection");
+        throw Error("'projection.far' must be finite for a parallel projection");
     if (!(p.far > p.near))
         throw Error("'projection.far' must be > projection.near (" + formatNumber(p.near) + "), got " +
                     formatNumber(p.far));
     if (!std::isinf(p.far) && !(p.far / p.near < 1e12))
         throw Error("'projection.far' / 'projection.near' = " + formatNumber(p.far / p.near) +
                     " exceeds 1e12: depth cannot be resolved");
-    if (p.type == ProjectionType::Perspective) {
+}
+
+void requirePositive(double value, const std::string& name)
+{
+    requireFinite(value, name);
+    if (!(value > 0)) throw Error("'" + name + "' must be > 0, got " + formatNumber(value));
+}
+
+void validateProjection(const CameraSpec& spec)
+{
+    const Projection& p = spec.projection;
+    switch (p.type) {
+    case ProjectionType::Matrix: requireMatrixFinite(p.clipFromEye, "projection.clip_from_eye"); return;
+    case ProjectionType::Perspective:
         requireFinite(p.fovyDeg, "projection.fovy_deg");
         if (!(p.fovyDeg > 0 && p.fovyDeg < 180))
             throw Error("'projection.fovy_deg' must be in (0, 180) degrees, got " + formatNumber(p.fovyDeg));
         requireFinite(p.aspect, "projection.aspect");
         if (p.aspect < 0) throw Error("'projection.aspect' must be > 0, got " + formatNumber(p.aspect));
-    } else {
+        break;
+    case ProjectionType::Pinhole:
+        requirePositive(p.fx, "projection.fx");
+        requirePositive(p.fy, "projection.fy");
+        requireFinite(p.cx, "projection.cx");
+        requireFinite(p.cy, "projection.cy");
+        break;
+    case ProjectionType::Lens:
+        requirePositive(p.focalMm, "projection.focal_mm");
+        requirePositive(p.sensorWidthMm, "projection.sensor_width_mm");
+        break;
+    case ProjectionType::Oblique:
+        requireFinite(p.angleDeg, "projection.angle_deg");
+        requireFinite(p.foreshortening, "projection.foreshortening");
+        if (p.foreshortening < 0)
+            throw Error("'projection.foreshortening' must be >= 0, got " + formatNumber(p.foreshortening));
+        [[fallthrough]];
+    case ProjectionType::Frustum:
+    case ProjectionType::Orthographic:
         for (auto [value, name] : {std::pair{p.left, "left"}, {p.right, "right"}, {p.bottom, "bottom"}, {p.top, "top"}})
             requireFinite(value, std::string("projection.") + name);
         if (!(p.right > p.left))
@@ -120,8 +180,12 @@ void validateProjection(const CameraSpec& spec)
         if (!(p.top > p.bottom))
             throw Error("'projection.top' must be > projection.bottom (" + formatNumber(p.bottom) + "), got " +
                         formatNumber(p.top));
+        break;
     }
+    validateNearFar(p);
 }
+
+void validateLookAt(const CameraSpec& spec);
 
 void validate(const CameraSpec& spec)
 {
@@ -133,6 +197,33 @@ void validate(const CameraSpec& spec)
         throw Error("image " + std::to_string(spec.width) + "x" + std::to_string(spec.height) + " has more than " +
                     std::to_string(kMaxImagePixels) + " pixels (8192x4096)");
     validateProjection(spec);
+    if (spec.view.hasMatrix) {
+        // A view is a rigid motion (a rotation, possibly with a reflection between
+        // handedness conventions, and a translation): eye-z must be a world distance.
+        const glm::dmat4& m = spec.view.eyeFromWorld;
+        requireMatrixFinite(m, "view.eye_from_world");
+        const glm::dmat3 rotation(m);
+        const glm::dmat3 gram = glm::transpose(rotation) * rotation;
+        for (int c = 0; c < 3; ++c)
+            for (int r = 0; r < 3; ++r)
+                if (std::abs(gram[c][r] - (c == r ? 1.0 : 0.0)) > 1e-6)
+                    throw Error("camera matrix 'view.eye_from_world' is not rigid (its 3x3 part is not orthonormal: "
+                                "scale or shear)");
+        if (m[0][3] != 0 || m[1][3] != 0 || m[2][3] != 0 || m[3][3] != 1)
+            throw Error("camera matrix 'view.eye_from_world' must have the last row 0 0 0 1 (for column vectors)");
+    } else {
+        validateLookAt(spec);
+    }
+    const DepthSettings& d = spec.depth;
+    requireFinite(d.rangeMin, "depth.range[0]");
+    requireFinite(d.rangeMax, "depth.range[1]");
+    if (!(d.rangeMin >= 0 && d.rangeMax <= 1 && d.rangeMin < d.rangeMax))
+        throw Error("'depth.range' must satisfy 0 <= min < max <= 1, got [" + formatNumber(d.rangeMin) + ", " +
+                    formatNumber(d.rangeMax) + "] (reversed-Z is 'depth.reversed', not a reversed range)");
+}
+
+void validateLookAt(const CameraSpec& spec)
+{
     requireFinite(spec.view.eye, "view.eye");
     requireFinite(spec.view.target, "view.target");
     requireFinite(spec.view.up, "view.up");
@@ -142,12 +233,53 @@ void validate(const CameraSpec& spec)
     if (!(glm::length(spec.view.up) > 0)) throw Error("'view.up' must not be the zero vector");
     const double sine = glm::length(glm::cross(forward / forwardLength, glm::normalize(spec.view.up)));
     if (!(sine > 1e-9)) throw Error("'view.up' must not be parallel to the viewing direction (view.target - view.eye)");
-    const DepthSettings& d = spec.depth;
-    requireFinite(d.rangeMin, "depth.range[0]");
-    requireFinite(d.rangeMax, "depth.range[1]");
-    if (!(d.rangeMin >= 0 && d.rangeMax <= 1 && d.rangeMin < d.rangeMax))
-        throw Error("'depth.range' must satisfy 0 <= min < max <= 1, got [" + formatNumber(d.rangeMin) + ", " +
-                    formatNumber(d.rangeMax) + "] (reversed-Z is 'depth.reversed', not a reversed range)");
+}
+
+}  // namespace
+
+namespace {
+
+// The near-plane window (perspective types) or view box (parallel types) as seen in the image.
+struct Window {
+    double left, right, bottom, top;
+};
+
+Window imageWindow(const CameraSpec& spec, double aspect)
+{
+    const Projection& p = spec.projection;
+    const double n = p.near;
+    switch (p.type) {
+    case ProjectionType::Perspective: {
+        const double top = n * std::tan(glm::radians(p.fovyDeg) / 2);
+        return {-top * aspect, top * aspect, -top, top};
+    }
+    case ProjectionType::Pinhole: {
+        // OpenCV: u = fx·X/Z + cx with u = 0 at the centre of the leftmost pixel, so the
+        // image's left edge is u = −½ and its right edge u = width − ½ (likewise v, downwards).
+        const double W = spec.width, H = spec.height;
+        return {n * (-0.5 - p.cx) / p.fx, n * (W - 0.5 - p.cx) / p.fx, -n * (H - 0.5 - p.cy) / p.fy,
+                n * (p.cy + 0.5) / p.fy};
+    }
+    case ProjectionType::Lens: {
+        const double right = n * p.sensorWidthMm / (2 * p.focalMm);
+        const double top = right * spec.height / spec.width;
+        return {-right, right, -top, top};
+    }
+    default: return {p.left, p.right, p.bottom, p.top};
+    }
+}
+
+// Oblique shear in OpenGL's eye space: depth d = −z_gl behind the near plane moves a point by
+// λ·(d − near)·(cos a, sin a), so x' = x − λ·cos a·(z_gl + near), likewise y.
+glm::dmat4 obliqueShear(const Projection& p)
+{
+    glm::dmat4 shear(1.0);
+    if (p.type != ProjectionType::Oblique) return shear;
+    const double sx = p.foreshortening * std::cos(glm::radians(p.angleDeg));
+    const double sy = p.foreshortening * std::sin(glm::radians(p.angleDeg));
+    shear[2][0] = -sx, shear[3][0] = -sx * p.near;
+    shear[2][1] = -sy, shear[3][1] = -sy * p.near;
+    return shear;
 }
 
 }  // namespace
@@ -156,33 +288,38 @@ Camera::Camera(const CameraSpec& spec) : spec_(spec)
 {
     validate(spec_);
     const Projection& p = spec_.projection;
-    if (p.type == ProjectionType::Perspective) {
-        top_ = p.near * std::tan(glm::radians(p.fovyDeg) / 2);
-        bottom_ = -top_;
-        right_ = top_ * aspect();
-        left_ = -right_;
-    } else {
-        left_ = p.left, right_ = p.right, bottom_ = p.bottom, top_ = p.top;
-    }
-
-    // View: look-at, with the eye axes the convention asks for.
     const Convention& c = spec_.convention;
-    const glm::dvec3 forward = glm::normalize(spec_.view.target - spec_.view.eye);
-    const glm::dvec3 rightAxis = glm::normalize(glm::cross(forward, spec_.view.up));
-    const glm::dvec3 upAxis = glm::cross(rightAxis, forward);
-    const glm::dvec3 axes[3] = {rightAxis, double(c.eyeUpY) * upAxis, double(c.eyeForwardZ) * forward};
-    eyeFromWorld = glm::dmat4(1.0);
-    for (int row = 0; row < 3; ++row) {
-        for (int col = 0; col < 3; ++col) eyeFromWorld[col][row] = axes[row][col];
-        eyeFromWorld[3][row] = -glm::dot(axes[row], spec_.view.eye);
+
+    // View: a raw matrix, or a look-at with the eye axes the convention asks for.
+    if (spec_.view.hasMatrix) {
+        eyeFromWorld = spec_.view.eyeFromWorld;
+    } else {
+        const glm::dvec3 forward = glm::normalize(spec_.view.target - spec_.view.eye);
+        const glm::dvec3 rightAxis = glm::normalize(glm::cross(forward, spec_.view.up));
+        const glm::dvec3 upAxis = glm::cross(rightAxis, forward);
+        const glm::dvec3 axes[3] = {rightAxis, double(c.eyeUpY) * upAxis, double(c.eyeForwardZ) * forward};
+        eyeFromWorld = glm::dmat4(1.0);
+        for (int row = 0; row < 3; ++row) {
+            for (int col = 0; col < 3; ++col) eyeFromWorld[col][row] = axes[row][col];
+            eyeFromWorld[3][row] = -glm::dot(axes[row], spec_.view.eye);
+        }
     }
     worldFromEye = glm::inverse(eyeFromWorld);
 
-    // Projection: the canonical (OpenGL eye) matrix between the convention's axis changes.
-    glm::dmat4 clipFromClipGl(1.0);
-    clipFromClipGl[1][1] = c.ndcUpY;
-    clipFromEye = clipFromClipGl * clipGlFromEyeGl(p, left_, right_, bottom_, top_, ndcZNear(), ndcZFar()) *
-                  eyeGlFromEye(c);
+    // Projection: a raw matrix, or the canonical (OpenGL eye) matrix between the
+    // convention's axis changes.
+    if (p.type == ProjectionType::Matrix) {
+        clipFromEye = p.clipFromEye;
+    } else {
+        const Window w = imageWindow(spec_, aspect());
+        left_ = w.left, right_ = w.right, bottom_ = w.bottom, top_ = w.top;
+        glm::dmat4 clipFromClipGl(1.0);
+        clipFromClipGl[1][1] = c.ndcUpY;
+        clipFromEye = clipFromClipGl * clipGlFromEyeGl(p, left_, right_, bottom_, top_, ndcZNear(), ndcZFar()) *
+                      obliqueShear(p) * eyeGlFromEye(c);
+    }
+    if (std::abs(glm::determinant(clipFromEye)) < 1e-300 || !std::isfinite(glm::determinant(clipFromEye)))
+        throw Error("camera matrix 'clip_from_eye' is singular");
     eyeFromClip = glm::inverse(clipFromEye);
     clipFromWorld = clipFromEye * eyeFromWorld;
     worldFromClip = worldFromEye * eyeFromClip;
@@ -204,6 +341,26 @@ Camera::Camera(const CameraSpec& spec) : spec_(spec)
     for (auto [m, name] : {std::pair{&eyeFromWorld, "eye_from_world"}, {&worldFromEye, "world_from_eye"},
                            {&clipFromEye, "clip_from_eye"}, {&eyeFromClip, "eye_from_clip"}})
         requireMatrixFinite(*m, name);
+
+    // Near and far as eye-z distances: given, or read off a raw matrix by unprojecting the
+    // ends of the NDC depth range on the viewing axis.
+    if (p.type != ProjectionType::Matrix) {
+        near_ = p.near, far_ = p.far;
+        return;
+    }
+    auto eyePointAt = [&](double zNdc) { return eyeFromClip * glm::dvec4(0.0, 0.0, zNdc, 1.0); };
+    const glm::dvec4 nearPoint = eyePointAt(ndcZNear()), farPoint = eyePointAt(ndcZFar());
+    near_ = eyeZOf(glm::dvec3(nearPoint) / nearPoint.w);
+    // w ≈ 0: the far end of the depth range is at infinity (an infinite far plane).
+    far_ = std::abs(farPoint.w) <= 1e-9 * glm::length(glm::dvec3(farPoint)) ? INFINITY
+                                                                              : eyeZOf(glm::dvec3(farPoint) / farPoint.w);
+    const std::string hint = " (is 'convention' or 'depth.reversed' right for this matrix?)";
+    if (!(near_ > 0))
+        throw Error("camera matrix 'projection.clip_from_eye' puts the near plane at eye-z " + formatNumber(near_) +
+                    ", not in front of the eye" + hint);
+    if (!(far_ > near_))
+        throw Error("camera matrix 'projection.clip_from_eye' puts the far plane (eye-z " + formatNumber(far_) +
+                    ") before the near plane (eye-z " + formatNumber(near_) + ")" + hint);
 }
 
 double Camera::aspect() const

@@ -47,7 +47,7 @@ Ray eyeRayThroughWindow(const Camera& camera, const glm::dvec2& pWindow)
     Ray ray;
     ray.origin = glm::dvec3(nearEye) / nearEye.w;
     // With an infinite far plane the far point has w = 0 (up to rounding): a direction.
-    if (std::isinf(camera.spec().projection.far)) {
+    if (camera.farIsInfinite()) {
         const glm::dvec3 direction = glm::normalize(glm::dvec3(farEye));
         // The direction of the point at infinity is fixed up to sign: it points away from the eye.
         ray.direction = camera.eyeZOf(direction) > 0 ? direction : -direction;

@@ -25,6 +25,7 @@
 
 #include <glm/glm.hpp>
 
+#include <cmath>
 #include <string>
 
 namespace zcheck {
@@ -33,6 +34,10 @@ enum class ProjectionType {
     Perspective,   // gluPerspective: fovy_deg, aspect, near, far
     Frustum,       // glFrustum: left, right, bottom, top on the near plane, near, far
     Orthographic,  // glOrtho: left, right, bottom, top, near, far
+    Oblique,       // the orthographic box sheared: cavalier (λ = 1), cabinet (λ = ½)
+    Pinhole,       // OpenCV intrinsics fx, fy, cx, cy in pixels, near, far
+    Lens,          // physical lens: focal_mm on a sensor sensor_width_mm wide (horizontal fit)
+    Matrix,        // a raw clipFromEye matrix
 };
 
 std::string toString(ProjectionType type);
@@ -41,27 +46,71 @@ struct Projection {
     ProjectionType type = ProjectionType::Perspective;
     double fovyDeg = 60.0;  // perspective: full vertical field of view, degrees, in (0, 180)
     double aspect = 0.0;    // perspective: width / height of the view; 0 = the image's
-    // frustum: extents of the near-plane window; orthographic: extents of the view box.
+    // frustum: extents of the near-plane window; orthographic and oblique: the view box.
     // As seen in the image (right = image right, top = image top), in eye units.
     double left = 0.0, right = 0.0, bottom = 0.0, top = 0.0;
-    double near = 0.1;      // > 0
-    double far = 100.0;     // > near
+    // oblique: a point at depth d behind the near plane moves by λ·d·(cos a, sin a) in the
+    // image plane (x right, y up) before the orthographic mapping; the near plane stays put.
+    double angleDeg = 45.0;       // a
+    double foreshortening = 0.5;  // λ ≥ 0: 1 cavalier, ½ cabinet, 0 orthographic
+    // pinhole: focal lengths and principal point in pixels; cx, cy in OpenCV pixel
+    // coordinates, where the centre of the top-left pixel is (0, 0) and y grows downwards,
+    // so a centred camera has cx = (width − 1)/2, cy = (height − 1)/2.
+    double fx = 0.0, fy = 0.0, cx = 0.0, cy = 0.0;
+    // lens: focal length and sensor width in millimetres; the sensor width spans the image
+    // width (horizontal fit): horizontal fov = 2·atan(sensor / (2·focal)).
+    double focalMm = 50.0, sensorWidthMm = 36.0;
+    // matrix: the convention's clip space from the convention's eye space, p' = M·p.
+    glm::dmat4 clipFromEye{1.0};
+    double near = 0.1;      // > 0 (not used by matrix: derived from it)
+    double far = 100.0;     // > near, or +inf for the perspective types (infinite far plane)
 
-    bool isPerspective() const { return type != ProjectionType::Orthographic; }
+    // Rays meet at a centre of projection (perspective, frustum, pinhole, lens; a matrix
+    // whose w depends on z) rather than running parallel.
+    bool isPerspective() const;
+
+    static Projection perspective(double fovyDeg, double near, double far)
+    {
+        Projection p;
+        p.type = ProjectionType::Perspective;
+        p.fovyDeg = fovyDeg, p.near = near, p.far = far;
+        return p;
+    }
 };
 
-struct LookAt {
+// The view: a look-at, or a raw eyeFromWorld matrix. Axonometric views are a look-at
+// whose eye is placed by angles (kept for printing).
+struct View {
     glm::dvec3 eye{0.0, 1.0, 3.0};
     glm::dvec3 target{0.0, 0.0, 0.0};
     glm::dvec3 up{0.0, 1.0, 0.0};
+    // Axonometric: "isometric", "dimetric", "trimetric" or empty. The eye stands at
+    // target + distance·(cos e·sin a, sin e, cos e·cos a) for azimuth a (about world +y,
+    // from +z towards +x) and elevation e (above the horizontal plane).
+    std::string axonometric;
+    double distance = 0.0, azimuthDeg = 0.0, elevationDeg = 0.0;
+    // A raw view matrix: the convention's eye space from world, p' = M·p; rigid.
+    bool hasMatrix = false;
+    glm::dmat4 eyeFromWorld{1.0};
+
+    static View lookAt(const glm::dvec3& eye, const glm::dvec3& target, const glm::dvec3& up)
+    {
+        View view;
+        view.eye = eye, view.target = target, view.up = up;
+        return view;
+    }
+    // Places the eye of an axonometric view; throws Error for an unknown kind.
+    static View axonometricView(const std::string& kind, const glm::dvec3& target, double distance,
+                                double azimuthDeg, double elevationDeg);
 };
+using LookAt = View;
 
 struct CameraSpec {
     Convention convention = Convention::preset("opengl");
     int width = 640;   // pixels, 1…16384
     int height = 480;  // pixels, 1…16384
     Projection projection;
-    LookAt view;
+    View view;
     DepthSettings depth;
 };
 
@@ -81,6 +130,11 @@ public:
     double right() const { return right_; }
     double bottom() const { return bottom_; }
     double top() const { return top_; }
+    // Near and far distances along the viewing direction (eye-z), derived from the matrix
+    // for a raw matrix; far is +inf for an infinite far plane.
+    double nearDistance() const { return near_; }
+    double farDistance() const { return far_; }
+    bool farIsInfinite() const { return std::isinf(far_); }
 
     glm::dmat4 eyeFromWorld, worldFromEye;
     glm::dmat4 clipFromEye, eyeFromClip;
@@ -115,6 +169,7 @@ public:
 private:
     CameraSpec spec_;
     double left_ = 0, right_ = 0, bottom_ = 0, top_ = 0;
+    double near_ = 0, far_ = 0;
 };
 
 // A camera that sees a bounding sphere (centre, radius) whole, looking at it from the front
