@@ -53,7 +53,7 @@ void writeOutputs(const std::string& dir, const CheckRun& run)
     writeExr(path("raster_depth.exr"), W, H, {"Z"}, asFloats(run.raster.windowDepth));
     writePng8(path("error_heatmap.png"), W, H, errorHeatmapRgb(run.comparison));
     writePng8(path("coverage_classes.png"), W, H, pixelClassRgb(run.comparison));
-    writeTextFileAtomically(path("report.json"), toJson(run.report).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
+    writeTextFileAtomically(path("report.json"), prettyJson(toJson(run.report)) + "\n");
 }
 
 int runCheckCommand(const CheckOptions& options)
@@ -75,11 +75,25 @@ int runCheckCommand(const CheckOptions& options)
     const RasterRenderer raster(scene);
     const CheckRun run = runCheck(scene, camera, rays, raster);
     if (options.json)
-        std::cout << toJson(run.report).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
+        std::cout << prettyJson(toJson(run.report)) << "\n";
     else
         std::cout << formatSummary(run.report);
     if (!options.outDir.empty()) writeOutputs(options.outDir, run);
     return run.report.comparison.consistent() ? kExitConsistent : kExitInconsistent;
+}
+
+CameraSpec cameraSpecFrom(const std::string& cameraFile, const std::string& convention)
+{
+    CameraSpec spec = readCameraFile(cameraFile);
+    if (!convention.empty()) spec.convention = Convention::preset(convention);
+    return spec;
+}
+
+int runMatricesCommand(const std::string& cameraFile, const std::string& convention)
+{
+    const Camera camera(cameraSpecFrom(cameraFile, convention));
+    std::cout << prettyJson(matricesJson(camera)) << "\n";
+    return kExitConsistent;
 }
 
 }  // namespace
@@ -124,6 +138,15 @@ int main(int argc, char** argv)
     checkCommand->add_option("--threads", check.threads, "worker threads (default: all cores)")
         ->check(CLI::Range(1, 1024));
 
+    std::string matricesCamera, matricesConvention;
+    CLI::App* matricesCommand = app.add_subcommand(
+        "matrices", "Print a camera's transforms as JSON: eye_from_world, world_from_eye, clip_from_eye,\n"
+                    "eye_from_clip, clip_from_world, window_from_ndc, ndc_from_window (4 rows of 4, column\n"
+                    "vectors p' = M·p), and a 'native' block in the convention's own form (row vectors for\n"
+                    "direct3d).");
+    matricesCommand->add_option("--camera", matricesCamera, "camera file (JSON, see README)")->required();
+    matricesCommand->add_option("--convention", matricesConvention, "override the convention");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -139,6 +162,7 @@ int main(int argc, char** argv)
 
     try {
         if (checkCommand->parsed()) return runCheckCommand(check);
+        if (matricesCommand->parsed()) return runMatricesCommand(matricesCamera, matricesConvention);
     } catch (const zcheck::Error& e) {
         std::cerr << "zcheck: error: " << e.what() << "\n";
         return kExitUsage;

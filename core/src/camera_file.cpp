@@ -111,11 +111,48 @@ private:
     std::vector<std::string> consumed_;
 };
 
+// 16 numbers as a column-vector matrix (p' = M·p). "layout" says how the list is ordered
+// (row-major: row by row as written on paper; column-major: as OpenGL/GLM store it);
+// "vectors" says which side the engine multiplies on (row vectors, p' = p·M, as Direct3D
+// writes it, is the transpose).
+glm::dmat4 readMatrix(ObjectReader& object, const std::string& key)
+{
+    const std::vector<double> v = object.numbers(key, 16);
+    const std::string layout = object.string("layout", "");
+    const std::string vectors = object.string("vectors", "");
+    if (layout != "row-major" && layout != "column-major")
+        object.failKey("layout", "must be \"row-major\" or \"column-major\" (how the 16 numbers of '" + key + "' are ordered)");
+    if (vectors != "column" && vectors != "row")
+        object.failKey("vectors", "must be \"column\" (p' = M·p) or \"row\" (p' = p·M, Direct3D style)");
+    double rows[4][4];
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) rows[r][c] = layout == "row-major" ? v[std::size_t(4 * r + c)] : v[std::size_t(4 * c + r)];
+    const glm::dmat4 m = matrixFromRows(rows);
+    return vectors == "column" ? m : glm::transpose(m);
+}
+
+// "far": a number, or "inf" for an infinite far plane.
+double readFar(ObjectReader& projection)
+{
+    if (projection.has("far") && projection.at("far").is_string()) {
+        if (projection.string("far", "") != "inf") projection.failKey("far", "must be a number or \"inf\"");
+        return INFINITY;
+    }
+    return projection.number("far");
+}
+
 Projection readProjection(ObjectReader projection)
 {
     Projection p;
     const std::string type = projection.string("type", "");
-    if (type.empty()) projection.failKey("type", "is missing (perspective, frustum or orthographic)");
+    const std::string types = "perspective, frustum, orthographic, oblique, pinhole, lens or matrix";
+    if (type.empty()) projection.failKey("type", "is missing (" + types + ")");
+    auto box = [&] {
+        p.left = projection.number("left");
+        p.right = projection.number("right");
+        p.bottom = projection.number("bottom");
+        p.top = projection.number("top");
+    };
     if (type == "perspective") {
         p.type = ProjectionType::Perspective;
         p.fovyDeg = projection.number("fovy_deg");
@@ -123,17 +160,73 @@ Projection readProjection(ObjectReader projection)
         if (projection.has("aspect") && !(p.aspect > 0)) projection.failKey("aspect", "must be > 0");
     } else if (type == "frustum" || type == "orthographic") {
         p.type = type == "frustum" ? ProjectionType::Frustum : ProjectionType::Orthographic;
-        p.left = projection.number("left");
-        p.right = projection.number("right");
-        p.bottom = projection.number("bottom");
-        p.top = projection.number("top");
+        box();
+    } else if (type == "oblique") {
+        p.type = ProjectionType::Oblique;
+        box();
+        p.angleDeg = projection.number("angle_deg");
+        p.foreshortening = projection.number("foreshortening");
+    } else if (type == "pinhole") {
+        p.type = ProjectionType::Pinhole;
+        p.fx = projection.number("fx");
+        p.fy = projection.number("fy");
+        p.cx = projection.number("cx");
+        p.cy = projection.number("cy");
+    } else if (type == "lens") {
+        p.type = ProjectionType::Lens;
+        p.focalMm = projection.number("focal_mm");
+        p.sensorWidthMm = projection.number("sensor_width_mm", 36.0);
+    } else if (type == "matrix") {
+        p.type = ProjectionType::Matrix;
+        p.clipFromEye = readMatrix(projection, "clip_from_eye");
+        projection.finish();
+        return p;
     } else {
-        projection.failKey("type", "must be perspective, frustum or orthographic, got '" + type + "'");
+        projection.failKey("type", "must be " + types + ", got '" + type + "'");
     }
     p.near = projection.number("near");
-    p.far = projection.number("far");
+    p.far = readFar(projection);
     projection.finish();
     return p;
+}
+
+View readView(ObjectReader view)
+{
+    View v;
+    if (view.has("eye_from_world") || view.has("world_from_eye")) {
+        if (view.has("eye_from_world") && view.has("world_from_eye"))
+            view.fail("takes one of 'eye_from_world' and 'world_from_eye', not both");
+        const bool eyeFromWorld = view.has("eye_from_world");
+        const glm::dmat4 m = readMatrix(view, eyeFromWorld ? "eye_from_world" : "world_from_eye");
+        if (!(std::abs(glm::determinant(m)) > 1e-12))
+            view.failKey(eyeFromWorld ? "eye_from_world" : "world_from_eye", "is singular");
+        v.hasMatrix = true;
+        v.eyeFromWorld = eyeFromWorld ? m : glm::inverse(m);
+    } else if (view.has("axonometric")) {
+        const std::string kind = view.string("axonometric", "");
+        const glm::dvec3 target = view.vec3("target");
+        const double distance = view.number("distance");
+        double azimuth = 45.0, elevation = glm::degrees(std::atan(1.0 / std::sqrt(2.0)));  // isometric
+        if (kind == "dimetric") {
+            elevation = view.number("elevation_deg", 30.0);
+        } else if (kind == "trimetric") {
+            azimuth = view.number("azimuth_deg");
+            elevation = view.number("elevation_deg");
+        } else if (kind != "isometric") {
+            view.failKey("axonometric", "must be isometric, dimetric or trimetric, got '" + kind + "'");
+        }
+        try {
+            v = View::axonometricView(kind, target, distance, azimuth, elevation);
+        } catch (const Error& e) {
+            view.fail(e.what());
+        }
+    } else {
+        v.eye = view.vec3("eye");
+        v.target = view.vec3("target");
+        v.up = view.has("up") ? view.vec3("up") : glm::dvec3(0, 1, 0);
+    }
+    view.finish();
+    return v;
 }
 
 }  // namespace
@@ -155,13 +248,7 @@ CameraSpec cameraSpecFromJson(const json& document, const std::string& source)
         image.finish();
     }
     spec.projection = readProjection(root.child("projection"));
-    {
-        ObjectReader view = root.child("view");
-        spec.view.eye = view.vec3("eye");
-        spec.view.target = view.vec3("target");
-        spec.view.up = view.has("up") ? view.vec3("up") : glm::dvec3(0, 1, 0);
-        view.finish();
-    }
+    spec.view = readView(root.child("view"));
     if (root.has("depth")) {
         ObjectReader depth = root.child("depth");
         const std::string format = depth.string("format", "float32");
@@ -201,32 +288,104 @@ CameraSpec readCameraFile(const std::string& path)
     return cameraSpecFromJson(document, "camera file '" + path + "'");
 }
 
+namespace {
+json matrixJson(const glm::dmat4& m)
+{
+    json rows = json::array();
+    auto clean = [](double v) { return v == 0.0 ? 0.0 : v; };  // no "-0.0" in print
+    for (int r = 0; r < 4; ++r)
+        rows.push_back(json::array({clean(m[0][r]), clean(m[1][r]), clean(m[2][r]), clean(m[3][r])}));
+    return rows;
+}
+json flatRowMajor(const glm::dmat4& m)
+{
+    json numbers = json::array();
+    for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) numbers.push_back(m[c][r]);
+    return numbers;
+}
+}  // namespace
+
 json toJson(const CameraSpec& spec)
 {
+    const Projection& p = spec.projection;
     json projection;
-    projection["type"] = toString(spec.projection.type);
-    if (spec.projection.type == ProjectionType::Perspective) {
-        projection["fovy_deg"] = spec.projection.fovyDeg;
-        if (spec.projection.aspect > 0) projection["aspect"] = spec.projection.aspect;
-    } else {
-        projection["left"] = spec.projection.left;
-        projection["right"] = spec.projection.right;
-        projection["bottom"] = spec.projection.bottom;
-        projection["top"] = spec.projection.top;
+    projection["type"] = toString(p.type);
+    switch (p.type) {
+    case ProjectionType::Perspective:
+        projection["fovy_deg"] = p.fovyDeg;
+        if (p.aspect > 0) projection["aspect"] = p.aspect;
+        break;
+    case ProjectionType::Pinhole:
+        projection["fx"] = p.fx, projection["fy"] = p.fy, projection["cx"] = p.cx, projection["cy"] = p.cy;
+        break;
+    case ProjectionType::Lens:
+        projection["focal_mm"] = p.focalMm, projection["sensor_width_mm"] = p.sensorWidthMm;
+        break;
+    case ProjectionType::Matrix:
+        projection["clip_from_eye"] = flatRowMajor(p.clipFromEye);
+        projection["layout"] = "row-major";
+        projection["vectors"] = "column";
+        break;
+    case ProjectionType::Oblique:
+        projection["angle_deg"] = p.angleDeg, projection["foreshortening"] = p.foreshortening;
+        [[fallthrough]];
+    default:
+        projection["left"] = p.left, projection["right"] = p.right;
+        projection["bottom"] = p.bottom, projection["top"] = p.top;
     }
-    projection["near"] = spec.projection.near;
-    projection["far"] = spec.projection.far;
+    if (p.type != ProjectionType::Matrix) {
+        projection["near"] = p.near;
+        projection["far"] = std::isinf(p.far) ? json("inf") : json(p.far);
+    }
     auto array3 = [](const glm::dvec3& v) { return json::array({v.x, v.y, v.z}); };
+    json view;
+    const View& v = spec.view;
+    if (v.hasMatrix) {
+        view = {{"eye_from_world", flatRowMajor(v.eyeFromWorld)}, {"layout", "row-major"}, {"vectors", "column"}};
+    } else if (!v.axonometric.empty()) {
+        view = {{"axonometric", v.axonometric}, {"target", array3(v.target)}, {"distance", v.distance}};
+        if (v.axonometric != "isometric") view["elevation_deg"] = v.elevationDeg;
+        if (v.axonometric == "trimetric") view["azimuth_deg"] = v.azimuthDeg;
+    } else {
+        view = {{"eye", array3(v.eye)}, {"target", array3(v.target)}, {"up", array3(v.up)}};
+    }
     return json{
         {"convention", spec.convention.name},
         {"image", {{"width", spec.width}, {"height", spec.height}}},
         {"projection", projection},
-        {"view", {{"eye", array3(spec.view.eye)}, {"target", array3(spec.view.target)}, {"up", array3(spec.view.up)}}},
+        {"view", view},
         {"depth",
          {{"format", toString(spec.depth.format)},
           {"reversed", spec.depth.reversed},
           {"range", json::array({spec.depth.rangeMin, spec.depth.rangeMax})}}},
     };
+}
+
+json matricesJson(const Camera& camera)
+{
+    json out = {
+        {"vectors", "column (p' = M·p), rows as printed"},
+        {"eye_from_world", matrixJson(camera.eyeFromWorld)},
+        {"world_from_eye", matrixJson(camera.worldFromEye)},
+        {"clip_from_eye", matrixJson(camera.clipFromEye)},
+        {"eye_from_clip", matrixJson(camera.eyeFromClip)},
+        {"clip_from_world", matrixJson(camera.clipFromWorld)},
+        {"window_from_ndc", matrixJson(camera.windowFromNdc)},
+        {"ndc_from_window", matrixJson(camera.ndcFromWindow)},
+        {"near", camera.nearDistance()},
+        {"far", camera.farIsInfinite() ? json("inf") : json(camera.farDistance())},
+    };
+    const bool rows = camera.convention().rowVectors;
+    auto native = [&](const glm::dmat4& m) { return matrixJson(rows ? glm::transpose(m) : m); };
+    out["native"] = {
+        {"convention", camera.convention().name},
+        {"vectors", rows ? "row (p' = p·M): the transposes of the above" : "column (p' = M·p)"},
+        {"eye_from_world", native(camera.eyeFromWorld)},
+        {"clip_from_eye", native(camera.clipFromEye)},
+        {"window_from_ndc", native(camera.windowFromNdc)},
+    };
+    return out;
 }
 
 }  // namespace zcheck

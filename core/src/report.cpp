@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <regex>
 #include <sstream>
 
 namespace zcheck {
@@ -35,6 +36,26 @@ std::string percent(std::int64_t part, std::int64_t whole)
 }
 
 }  // namespace
+
+std::string prettyJson(const nlohmann::json& document)
+{
+    const std::string text = document.dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
+    // An array whose elements are all numbers (or null) is folded onto one line.
+    static const std::regex numberArray(R"(\[(\s*(-?[0-9][0-9.eE+-]*|null)\s*,)*\s*(-?[0-9][0-9.eE+-]*|null)\s*\])");
+    static const std::regex space(R"(\s+)");
+    std::string out;
+    auto last = text.cbegin();
+    for (std::sregex_iterator it(text.begin(), text.end(), numberArray), end; it != end; ++it) {
+        out.append(last, text.cbegin() + it->position());
+        std::string folded = std::regex_replace(it->str(), space, "");
+        std::string spaced;
+        for (char c : folded) spaced += c == ',' ? std::string(", ") : std::string(1, c);
+        out += spaced;
+        last = text.cbegin() + it->position() + it->length();
+    }
+    out.append(last, text.cend());
+    return out;
+}
 
 nlohmann::json toJson(const CheckReport& report)
 {

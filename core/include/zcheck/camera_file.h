@@ -5,10 +5,14 @@
 //     "projection": {"type": "perspective", "fovy_deg": 60, "near": 0.1, "far": 100},
 //     "view": {"eye": [0, 1, 3], "target": [0, 0, 0], "up": [0, 1, 0]},
 //     "depth": {"format": "float32", "reversed": false, "range": [0, 1]} }
-// "frustum" and "orthographic" take left, right, bottom, top, near, far instead of fovy_deg
-// (perspective also takes an optional "aspect"). Every key but "projection" and "view" has
-// the default shown. Unknown keys, wrong types and invalid values throw Error naming the
-// file and the key.
+// Projection types: perspective (fovy_deg, optional aspect), frustum and orthographic (left,
+// right, bottom, top), oblique (the orthographic box + angle_deg, foreshortening), pinhole
+// (fx, fy, cx, cy), lens (focal_mm, sensor_width_mm = 36), all with near and far ("inf" for
+// the perspective types); matrix (clip_from_eye: 16 numbers, layout, vectors).
+// Views: eye/target/up; axonometric (isometric | dimetric | trimetric, target, distance,
+// elevation_deg, azimuth_deg); or eye_from_world | world_from_eye (16 numbers, layout, vectors).
+// Every key but "projection" and "view" has the default shown. Unknown keys, wrong types
+// and invalid values throw Error naming the file and the key.
 #include "zcheck/camera.h"
 
 #include <nlohmann/json.hpp>
@@ -20,5 +24,9 @@ namespace zcheck {
 CameraSpec cameraSpecFromJson(const nlohmann::json& document, const std::string& source);
 CameraSpec readCameraFile(const std::string& path);
 nlohmann::json toJson(const CameraSpec& spec);
+
+// Every transform of a camera as 4 rows of 4 numbers for column vectors (p' = M·p), plus a
+// "native" block in the convention's own form (row vectors for direct3d).
+nlohmann::json matricesJson(const Camera& camera);
 
 }  // namespace zcheck

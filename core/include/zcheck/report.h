@@ -26,6 +26,10 @@ struct CheckReport {
 };
 
 nlohmann::json toJson(const CheckReport& report);
+// JSON indented for people: arrays of numbers (matrix rows, vectors) stay on one line.
+// Invalid UTF-8 in strings (file names) is replaced, never thrown over.
+std::string prettyJson(const nlohmann::json& document);
+
 // The human-readable summary `zcheck check` prints.
 std::string formatSummary(const CheckReport& report);
 
