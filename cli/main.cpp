@@ -7,10 +7,13 @@
 #include "zcheck/error.h"
 #include "zcheck/image_io.h"
 #include "zcheck/mesh_loader.h"
+#include "zcheck/precision.h"
 
 #include <CLI/CLI.hpp>
 #include <tbb/global_control.h>
 
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -96,6 +99,75 @@ int runMatricesCommand(const std::string& cameraFile, const std::string& convent
     return kExitConsistent;
 }
 
+std::vector<double> parseNumberList(const std::string& text, const std::string& option)
+{
+    std::vector<double> values;
+    std::size_t start = 0;
+    while (start <= text.size() && !text.empty()) {
+        const std::size_t end = std::min(text.find(',', start), text.size());
+        const std::string item = text.substr(start, end - start);
+        char* stop = nullptr;
+        const double value = std::strtod(item.c_str(), &stop);
+        if (item.empty() || *stop != '\0' || !std::isfinite(value))
+            throw Error(option + ": '" + item + "' is not a number (expected a comma-separated list)");
+        values.push_back(value);
+        start = end + 1;
+    }
+    return values;
+}
+
+int runPrecisionCommand(const std::string& cameraFile, const std::string& convention, const std::string& at, bool json)
+{
+    const CameraSpec spec = cameraSpecFrom(cameraFile, convention);
+    const PrecisionTable table = depthPrecision(spec, parseNumberList(at, "--at"));
+    if (json) {
+        nlohmann::json layouts = nlohmann::json::array();
+        for (std::size_t k = 0; k < table.layouts.size(); ++k) {
+            nlohmann::json steps = nlohmann::json::array();
+            for (double step : table.step[k]) steps.push_back(std::isfinite(step) ? nlohmann::json(step) : nlohmann::json(nullptr));
+            layouts.push_back({{"format", toString(table.layouts[k].format)},
+                               {"mapping", toString(table.layouts[k].mapping)},
+                               {"eye_z_step", steps}});
+        }
+        const PrecisionLayout& best = table.layouts[table.best];
+        std::cout << prettyJson({{"camera", toJson(spec)},
+                                 {"distances", table.distances},
+                                 {"definition", "eye_z_step: eye-z between the stored value at that distance and the next "
+                                                "representable value farther away; null: unresolvable"},
+                                 {"layouts", layouts},
+                                 {"best", {{"format", toString(best.format)}, {"mapping", toString(best.mapping)},
+                                           {"worst_relative_step", table.bestWorstRelativeStep}}}})
+                  << "\n";
+        return kExitConsistent;
+    }
+    const Camera camera(spec);
+    std::printf("depth precision: %s camera, near %g, far %g, %s convention\n", toString(spec.projection.type).c_str(),
+                camera.nearDistance(), camera.farDistance(), spec.convention.name.c_str());
+    std::printf("smallest resolvable eye-z step at eye-z d (scene units; '-' = cannot be told from the far end)\n");
+    for (DepthFormat format : {DepthFormat::Unorm16, DepthFormat::Unorm24, DepthFormat::Float32}) {
+        std::printf("\n%-8s %12s", toString(format).c_str(), "eye-z d");
+        for (const auto& layout : table.layouts)
+            if (layout.format == format) std::printf(" %24s", toString(layout.mapping).c_str());
+        std::printf("\n");
+        for (std::size_t i = 0; i < table.distances.size(); ++i) {
+            std::printf("%-8s %12.6g", "", table.distances[i]);
+            for (std::size_t k = 0; k < table.layouts.size(); ++k)
+                if (table.layouts[k].format == format) {
+                    const double step = table.step[k][i];
+                    if (std::isfinite(step))
+                        std::printf(" %13.3g (%8.2g%%)", step, 100 * step / table.distances[i]);
+                    else
+                        std::printf(" %24s", "-");
+                }
+            std::printf("\n");
+        }
+    }
+    const PrecisionLayout& best = table.layouts[table.best];
+    std::printf("\nbest for this camera: %s, %s (worst relative step %.3g over these distances)\n",
+                toString(best.format).c_str(), toString(best.mapping).c_str(), table.bestWorstRelativeStep);
+    return kExitConsistent;
+}
+
 }  // namespace
 
 int main(int argc, char** argv)
@@ -147,6 +219,17 @@ int main(int argc, char** argv)
     matricesCommand->add_option("--camera", matricesCamera, "camera file (JSON, see README)")->required();
     matricesCommand->add_option("--convention", matricesConvention, "override the convention");
 
+    std::string precisionCamera, precisionConvention, precisionAt;
+    bool precisionJson = false;
+    CLI::App* precisionCommand = app.add_subcommand(
+        "precision", "How finely each depth layout (unorm16, unorm24, float32 x standard, reversed, infinite far)\n"
+                     "resolves eye depth for a camera's near/far: the eye-z step between neighbouring stored\n"
+                     "values at each distance, and which layout is best.");
+    precisionCommand->add_option("--camera", precisionCamera, "camera file (JSON, see README)")->required();
+    precisionCommand->add_option("--at", precisionAt, "eye-z distances, comma-separated (default: 9 log-spaced from near to far)");
+    precisionCommand->add_option("--convention", precisionConvention, "override the convention");
+    precisionCommand->add_flag("--json", precisionJson, "print JSON instead of tables");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -163,6 +246,8 @@ int main(int argc, char** argv)
     try {
         if (checkCommand->parsed()) return runCheckCommand(check);
         if (matricesCommand->parsed()) return runMatricesCommand(matricesCamera, matricesConvention);
+        if (precisionCommand->parsed())
+            return runPrecisionCommand(precisionCamera, precisionConvention, precisionAt, precisionJson);
     } catch (const zcheck::Error& e) {
         std::cerr << "zcheck: error: " << e.what() << "\n";
         return kExitUsage;

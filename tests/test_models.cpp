@@ -3,6 +3,7 @@
 #include "zcheck/camera_file.h"
 #include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
+#include "zcheck/precision.h"
 
 #include <catch2/catch.hpp>
 #include <glm/gtc/matrix_transform.hpp>
@@ -289,4 +290,67 @@ TEST_CASE("zcheck matrices prints the textbook matrices", "[models][matrices]")
         const double viewport[4][4] = {{320, 0, 0, 0}, {0, -240, 0, 0}, {0, 0, 1, 0}, {320, 240, 0, 1}};
         requireMatrixNear(rowsOf(m["native"]["window_from_ndc"]), matrixFromRows(viewport));
     }
+}
+
+TEST_CASE("precision steps equal direct evaluation of neighbouring representable values", "[precision]")
+{
+    // Steps are differences of nearly equal eye-z values (a 2e-6 step at z = 80), so double
+    // cancellation limits agreement to ~1e-6 relative: compared at 1e-5.
+    // Perspective, near n, far f. Standard: w = f(z − n)/(z(f − n)), so z(w) = f·n/(f − w(f − n)).
+    // Reversed: w = n(f − z)/(z(f − n)), so z(w) = n·f/(n + w(f − n)).
+    const double n = 0.1, f = 100;
+    const CameraSpec base = parse(R"({"projection": {"type": "perspective", "fovy_deg": 60, "near": 0.1, "far": 100}, )" + kView + "}");
+    for (double z : {0.3, 2.0, 17.0, 80.0}) {
+        const double wStandard = f * (z - n) / (z * (f - n)), wReversed = n * (f - z) / (z * (f - n));
+        auto zStandard = [&](double w) { return f * n / (f - w * (f - n)); };
+        auto zReversed = [&](double w) { return n * f / (n + w * (f - n)); };
+        for (auto [format, bits] : {std::pair{DepthFormat::Unorm16, 16}, std::pair{DepthFormat::Unorm24, 24}}) {
+            const double maxCode = std::ldexp(1.0, bits) - 1;
+            const double s = std::round(wStandard * maxCode) / maxCode, r = std::round(wReversed * maxCode) / maxCode;
+            CameraSpec standard = base, reversed = base;
+            standard.depth.format = reversed.depth.format = format;
+            reversed.depth.reversed = true;
+            INFO("eye-z " << z << " unorm" << bits);
+            REQUIRE(resolvableEyeZStep(Camera(standard), z) ==
+                    Approx(zStandard(s + 1 / maxCode) - zStandard(s)).epsilon(1e-5));
+            REQUIRE(resolvableEyeZStep(Camera(reversed), z) ==
+                    Approx(zReversed(r - 1 / maxCode) - zReversed(r)).epsilon(1e-5));
+        }
+        CameraSpec standard = base, reversed = base;
+        reversed.depth.reversed = true;
+        const float s = float(wStandard), r = float(wReversed);
+        INFO("eye-z " << z << " float32");
+        REQUIRE(resolvableEyeZStep(Camera(standard), z) ==
+                Approx(zStandard(std::nextafter(s, 2.0f)) - zStandard(s)).epsilon(1e-5));
+        REQUIRE(resolvableEyeZStep(Camera(reversed), z) ==
+                Approx(zReversed(std::nextafter(r, -1.0f)) - zReversed(r)).epsilon(1e-5));
+    }
+    // Beyond what unorm16 resolves near the far plane, the step is unresolvable.
+    CameraSpec coarse = base;
+    coarse.depth.format = DepthFormat::Unorm16;
+    REQUIRE(std::isinf(resolvableEyeZStep(Camera(coarse), 99.99)));
+}
+
+TEST_CASE("the precision table recommends reversed float32 for a deep perspective camera", "[precision]")
+{
+    const CameraSpec spec = parse(R"({"projection": {"type": "perspective", "fovy_deg": 60, "near": 0.01, "far": 10000}, )" + kView + "}");
+    const PrecisionTable table = depthPrecision(spec);
+    REQUIRE(table.layouts.size() == 12);  // 3 formats × standard, reversed, infinite, infinite reversed
+    REQUIRE(table.distances.size() == 9);
+    REQUIRE(table.distances.front() == Approx(0.01));
+    const PrecisionLayout& best = table.layouts[table.best];
+    REQUIRE(best.format == DepthFormat::Float32);
+    REQUIRE((best.mapping == DepthMapping::Reversed || best.mapping == DepthMapping::InfiniteReversed));
+    // Standard float32 is far worse than reversed at the far end: the lesson of reversed-Z.
+    std::size_t standard = 0, reversed = 0;
+    for (std::size_t k = 0; k < table.layouts.size(); ++k) {
+        if (table.layouts[k].format != DepthFormat::Float32) continue;
+        if (table.layouts[k].mapping == DepthMapping::Standard) standard = k;
+        if (table.layouts[k].mapping == DepthMapping::Reversed) reversed = k;
+    }
+    REQUIRE(table.step[standard].back() > 100 * table.step[reversed].back());
+    // Parallel projections have no infinite-far layouts; a distance outside [near, far] is refused.
+    const CameraSpec ortho = parse(R"({"projection": {"type": "orthographic", "left": -1, "right": 1, "bottom": -1, "top": 1, "near": 1, "far": 50}, )" + kView + "}");
+    REQUIRE(depthPrecision(ortho).layouts.size() == 6);
+    REQUIRE_THROWS_WITH(depthPrecision(ortho, {0.5}), Catch::Contains("outside the camera's depth range"));
 }
