@@ -6,7 +6,9 @@
 #include "zcheck/camera_file.h"
 #include "zcheck/error.h"
 #include "zcheck/image_io.h"
+#include "zcheck/inverse_projection.h"
 #include "zcheck/mesh_loader.h"
+#include "zcheck/point_cloud.h"
 #include "zcheck/precision.h"
 
 #include <CLI/CLI.hpp>
@@ -168,6 +170,91 @@ int runPrecisionCommand(const std::string& cameraFile, const std::string& conven
     return kExitConsistent;
 }
 
+struct UnprojectOptions {
+    std::string cameraFile, convention, pixel, depthMap, quantity = "window", output, space = "world";
+    std::optional<double> depth;
+    double scale = 0;
+    int stride = 1;
+    bool ascii = false;
+};
+
+glm::ivec2 parsePixel(const std::string& text, const Camera& camera)
+{
+    const std::vector<double> v = parseNumberList(text, "--pixel");
+    if (v.size() != 2 || v[0] != std::floor(v[0]) || v[1] != std::floor(v[1]))
+        throw Error("--pixel: expected COL,ROW as two whole numbers, got '" + text + "'");
+    if (v[0] < 0 || v[0] >= camera.width() || v[1] < 0 || v[1] >= camera.height())
+        throw Error("--pixel " + text + " is outside the " + std::to_string(camera.width()) + "x" +
+                    std::to_string(camera.height()) + " image");
+    return {int(v[0]), int(v[1])};
+}
+
+nlohmann::json vec3Json(const glm::dvec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); }
+
+int runUnprojectCommand(const UnprojectOptions& o)
+{
+    if (o.space != "eye" && o.space != "world") throw Error("--space must be eye or world, got '" + o.space + "'");
+    const DepthQuantity quantity = depthQuantityFromName(o.quantity);
+    const Camera camera(cameraSpecFrom(o.cameraFile, o.convention));
+    auto toWorld = [&](const glm::dvec3& pEye) { return glm::dvec3(camera.worldFromEye * glm::dvec4(pEye, 1.0)); };
+
+    if (!o.pixel.empty()) {
+        const glm::ivec2 pixel = parsePixel(o.pixel, camera);
+        const glm::dvec2 pWindow = windowFromPixelCentre(camera, pixel.x, pixel.y);
+        nlohmann::json out = {{"pixel", {pixel.x, pixel.y}}, {"window", {pWindow.x, pWindow.y}}};
+        if (!o.depth) {
+            const EyePlaneRay rayEye = eyePlaneRayFrom(eyeRayThroughWindow(camera, pWindow));
+            const EyePlaneRay rayWorld = worldEyePlaneRayThroughWindow(camera, pWindow);
+            auto rayJson = [](const EyePlaneRay& r) {
+                return nlohmann::json{{"origin", vec3Json(r.origin)},
+                                      {"direction", vec3Json(r.direction)},
+                                      {"t_near", r.tNear},
+                                      {"t_far", std::isinf(r.tFar) ? nlohmann::json("inf") : nlohmann::json(r.tFar)}};
+            };
+            out["ray"] = {{"definition", "points origin + t·direction, t in [t_near, t_far] between the near and far "
+                                         "planes; origin on the eye plane (the centre of projection for perspective)"}};
+            if (o.space == "eye") out["ray"]["eye"] = rayJson(rayEye);
+            out["ray"]["world"] = rayJson(rayWorld);
+            out["ray"]["eye"] = rayJson(rayEye);
+        } else {
+            const auto pEye = eyePointFromDepth(camera, pWindow, *o.depth, quantity);
+            if (!pEye) throw Error("--depth " + formatNumber(*o.depth) + " is a miss for quantity " + o.quantity);
+            out["point"] = {{"eye", vec3Json(*pEye)}, {"world", vec3Json(toWorld(*pEye))},
+                            {"eye_z", camera.eyeZOf(*pEye)}, {"distance", distanceOfEyePoint(camera, *pEye)}};
+        }
+        std::cout << prettyJson(out) << "\n";
+        return kExitConsistent;
+    }
+
+    if (o.depthMap.empty()) throw Error("unproject needs --pixel COL,ROW or --depth-map FILE");
+    if (o.output.empty()) throw Error("--depth-map needs -o FILE.ply");
+    if (o.stride < 1) throw Error("--stride must be >= 1");
+    const DepthMapFile map = readDepthMap(o.depthMap, o.quantity, o.scale);
+    if (map.width != camera.width() || map.height != camera.height())
+        throw Error("depth map '" + o.depthMap + "' is " + std::to_string(map.width) + "x" + std::to_string(map.height) +
+                    " but the camera's image is " + std::to_string(camera.width()) + "x" + std::to_string(camera.height()));
+    std::vector<glm::dvec3> points;
+    std::size_t misses = 0;
+    for (int row = 0; row < map.height; row += o.stride)
+        for (int col = 0; col < map.width; col += o.stride) {
+            const double value = map.value[std::size_t(row) * map.width + col];
+            const auto pEye = eyePointFromDepth(camera, windowFromPixelCentre(camera, col, row), value, quantity);
+            if (!pEye) {
+                ++misses;
+                continue;
+            }
+            points.push_back(o.space == "eye" ? *pEye : toWorld(*pEye));
+        }
+    writePointCloudPly(o.output, points, !o.ascii,
+                       {"zcheck unproject of " + std::filesystem::path(o.depthMap).filename().string() + " (" +
+                            o.quantity + ", channel " + map.channel + ")",
+                        std::string("space ") + o.space + (o.space == "eye" ? " (" + camera.convention().name + " eye axes)" : "")});
+    std::cout << prettyJson({{"points", points.size()}, {"misses", misses}, {"channel", map.channel},
+                             {"quantity", o.quantity}, {"space", o.space}, {"output", o.output}})
+              << "\n";
+    return kExitConsistent;
+}
+
 }  // namespace
 
 int main(int argc, char** argv)
@@ -230,6 +317,23 @@ int main(int argc, char** argv)
     precisionCommand->add_option("--convention", precisionConvention, "override the convention");
     precisionCommand->add_flag("--json", precisionJson, "print JSON instead of tables");
 
+    UnprojectOptions unproject;
+    CLI::App* unprojectCommand = app.add_subcommand(
+        "unproject", "The inverse projection: the ray through a pixel centre, the point at a depth value, or a\n"
+                     "whole depth map (EXR, PFM, TIFF, 16-bit PNG with --scale) as a PLY point cloud, misses skipped.");
+    unprojectCommand->add_option("--camera", unproject.cameraFile, "camera file (JSON, see README)")->required();
+    unprojectCommand->add_option("--convention", unproject.convention, "override the convention");
+    unprojectCommand->add_option("--pixel", unproject.pixel, "COL,ROW (row 0 at the top): print the ray through its centre");
+    unprojectCommand->add_option("--depth", unproject.depth, "with --pixel: print the point at this depth value");
+    unprojectCommand->add_option("--quantity", unproject.quantity, "what --depth / the map holds: window | ndc | eye-z | distance")
+        ->capture_default_str();
+    unprojectCommand->add_option("--depth-map", unproject.depthMap, "a depth map to turn into a point cloud");
+    unprojectCommand->add_option("--scale", unproject.scale, "stored value = depth x scale (required for 16-bit PNG)");
+    unprojectCommand->add_option("-o,--output", unproject.output, "the PLY file to write (atomically)");
+    unprojectCommand->add_option("--space", unproject.space, "eye | world coordinates for points")->capture_default_str();
+    unprojectCommand->add_option("--stride", unproject.stride, "use every K-th pixel in x and y")->capture_default_str();
+    unprojectCommand->add_flag("--ascii", unproject.ascii, "write ASCII PLY instead of binary little-endian");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -246,6 +350,7 @@ int main(int argc, char** argv)
     try {
         if (checkCommand->parsed()) return runCheckCommand(check);
         if (matricesCommand->parsed()) return runMatricesCommand(matricesCamera, matricesConvention);
+        if (unprojectCommand->parsed()) return runUnprojectCommand(unproject);
         if (precisionCommand->parsed())
             return runPrecisionCommand(precisionCamera, precisionConvention, precisionAt, precisionJson);
     } catch (const zcheck::Error& e) {

@@ -1,6 +1,7 @@
 #include "zcheck/compare.h"
 
 #include "zcheck/clip.h"
+#include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
 
 #include <algorithm>
@@ -34,6 +35,13 @@ std::string toString(DepthQuantity quantity)
     case DepthQuantity::Distance: return "distance";
     }
     return "?";
+}
+
+DepthQuantity depthQuantityFromName(const std::string& name)
+{
+    for (DepthQuantity q : {DepthQuantity::Window, DepthQuantity::Ndc, DepthQuantity::EyeZ, DepthQuantity::Distance})
+        if (toString(q) == name) return q;
+    throw Error("unknown depth quantity '" + name + "' (expected window, ndc, eye-z or distance)");
 }
 
 double ToleranceModel::constantQuanta(const DepthSettings& depth)

@@ -5,6 +5,8 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <cmath>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -38,6 +40,50 @@ void writePng8(const std::string& path, int width, int height, const std::vector
 {
     OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
     writeImage(path, spec, rgb.data());
+}
+
+DepthMapFile readDepthMap(const std::string& path, const std::string& preferredChannel, double scale)
+{
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) {
+        std::string reason = OIIO::geterror();
+        for (char& c : reason)
+            if (c == '\n') c = ' ';
+        throw Error("cannot read depth map '" + path + "': " + (reason.empty() ? "unreadable" : reason));
+    }
+    const OIIO::ImageSpec& spec = in->spec();
+    if (spec.width < 1 || spec.height < 1 || spec.depth > 1)
+        throw Error("cannot read depth map '" + path + "': not a 2-D image");
+    int channel = 0;
+    for (const std::string& name : {preferredChannel, std::string("Z")}) {
+        const int found = spec.channelindex(name);
+        if (found >= 0) {
+            channel = found;
+            break;
+        }
+    }
+    const bool integer = !spec.format.is_floating_point();
+    if (integer && !(scale > 0))
+        throw Error("depth map '" + path + "' stores integers (" + std::string(spec.format.c_str()) +
+                    "): give --scale (stored value = depth × scale, e.g. 1000 for millimetres)");
+    DepthMapFile map;
+    map.width = spec.width, map.height = spec.height;
+    map.channel = spec.channelnames.empty() ? "0" : spec.channelnames[std::size_t(channel)];
+    std::vector<double> pixels(std::size_t(spec.width) * spec.height);
+    if (!in->read_image(0, 0, channel, channel + 1, OIIO::TypeDesc::DOUBLE, pixels.data()))
+        throw Error("cannot read depth map '" + path + "': " + in->geterror());
+    if (integer) {
+        // read_image scales integers to [0,1]; undo it to get the stored code.
+        const double maxCode = std::pow(2.0, double(spec.format.size() * 8)) - 1;
+        for (double& v : pixels) {
+            const double code = std::round(v * maxCode);
+            v = code == 0 ? NAN : code / scale;
+        }
+    } else if (scale > 0) {
+        for (double& v : pixels) v /= scale;
+    }
+    map.value = std::move(pixels);
+    return map;
 }
 
 namespace {

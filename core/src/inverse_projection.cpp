@@ -114,6 +114,27 @@ double eyeZFromDistance(const Camera& camera, const glm::dvec2& pWindow, double 
     return camera.eyeZOf(ray.origin + distance * ray.direction);
 }
 
+std::optional<glm::dvec3> eyePointFromDepth(const Camera& camera, const glm::dvec2& pWindow, double value,
+                                            DepthQuantity quantity)
+{
+    if (!std::isfinite(value)) return std::nullopt;
+    switch (quantity) {
+    case DepthQuantity::Ndc: value = camera.windowDepthFromNdcZ(value); [[fallthrough]];
+    case DepthQuantity::Window:
+        if (value == camera.clearDepth() || value == camera.windowDepthFar()) return std::nullopt;
+        return eyeFromWindow(camera, {pWindow, value});
+    case DepthQuantity::EyeZ:
+        if (!(value > 0)) return std::nullopt;
+        return eyePointAtEyeZ(camera, pWindow, value);
+    case DepthQuantity::Distance: {
+        if (!(value > 0)) return std::nullopt;
+        const EyePlaneRay ray = eyePlaneRayFrom(eyeRayThroughWindow(camera, pWindow));
+        return ray.origin + value * ray.direction;
+    }
+    }
+    return std::nullopt;
+}
+
 double distanceOfEyePoint(const Camera& camera, const glm::dvec3& pEye)
 {
     const glm::dvec3 pWindow = windowFromEye(camera, pEye);

@@ -18,6 +18,18 @@ void writeExr(const std::string& path, int width, int height, const std::vector<
 // An 8-bit RGB PNG; `rgb` holds width·height·3 bytes.
 void writePng8(const std::string& path, int width, int height, const std::vector<std::uint8_t>& rgb);
 
+// A depth map read from a file (EXR, PFM, TIFF, PNG, anything OpenImageIO reads), row 0 at
+// the top as seen (OpenImageIO returns PFM's bottom-to-top rows flipped).
+struct DepthMapFile {
+    int width = 0, height = 0;
+    std::string channel;          // the channel read
+    std::vector<double> value;    // width·height; NaN where an integer file stores 0 (a miss)
+};
+// The channel named `preferredChannel` if there is one, else "Z", else the first. Integer
+// files (16-bit PNG) need `scale`: value = stored / scale, 0 = miss. Float files are divided
+// by `scale` when it is given. Throws Error naming the file.
+DepthMapFile readDepthMap(const std::string& path, const std::string& preferredChannel, double scale);
+
 // The check's pictures:
 //   error heatmap — |Δ| / tolerance on both-hit pixels: black 0, through blue and green to
 //                   yellow at 1 (the tolerance), red above; unexplained coverage magenta;

@@ -10,6 +10,9 @@
 // Consumes window coordinates (see camera.h; pixel centres at +0.5) and depth values as
 // stored in the depth buffer (window depth); produces eye- or world-space points and rays.
 #include "zcheck/camera.h"
+#include "zcheck/render.h"
+
+#include <optional>
 
 #include <glm/glm.hpp>
 
@@ -58,6 +61,12 @@ double eyeZFromWindowDepth(const Camera& camera, const glm::dvec2& pWindow, doub
 double windowDepthFromEyeZ(const Camera& camera, const glm::dvec2& pWindow, double eyeZ);
 double distanceFromEyeZ(const Camera& camera, const glm::dvec2& pWindow, double eyeZ);
 double eyeZFromDistance(const Camera& camera, const glm::dvec2& pWindow, double distance);
+
+// The eye-space point at window point (x, y) whose depth, as `quantity`, is `value`
+// (window: depth-buffer value; ndc: z_ndc; eye-z; distance). Empty for a miss: a value that
+// is not finite, the clear value (window, ndc), or not positive (eye-z, distance).
+std::optional<glm::dvec3> eyePointFromDepth(const Camera& camera, const glm::dvec2& pWindow, double value,
+                                            DepthQuantity quantity);
 
 // Range of an eye-space point from the centre of projection (or from the eye plane, along
 // the viewing ray, for parallel projections).

@@ -21,6 +21,7 @@ enum class DepthQuantity {
     Distance,  // Euclidean range from the centre of projection, scene units
 };
 std::string toString(DepthQuantity quantity);
+DepthQuantity depthQuantityFromName(const std::string& name);  // throws Error naming the value
 
 struct DepthImage {
     int width = 0;
