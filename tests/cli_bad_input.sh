@@ -52,6 +52,7 @@ printf 'v 0 0 0\nv 1 0 0\nf 1 2 9\n' > "$tmp/badindex.obj"
 printf 'this is not a mesh\n' > "$tmp/garbage.obj"
 printf 'ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement tristrips 1\nproperty list int int vertex_indices\nend_header\n' > "$tmp/truncated.ply"
 : > "$tmp/empty.obj"
+printf '{"projection": {"type": "matrix", "clip_from_eye": [0,0,0,0, 0,0,0,0, 0,0,0,0, 0,0,0,0], "layout": "row-major", "vectors": "column"}, "view": {"eye": [0, 1, 3], "target": [0, 0, 0]}}' > "$tmp/singular.json"
 ply_header='ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n'
 printf "${ply_header}element tristrips 1\nproperty list int int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 4294967296\n" > "$tmp/bigindex.ply"
 printf "${ply_header}element tristrips 1\nproperty list int int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n268435456 0 1 2\n" > "$tmp/biglist.ply"
@@ -101,6 +102,16 @@ expect_usage_error "not a directory"         check --out "$tmp/good.json"
 expect_usage_error "extraneous|not expected|unknown|following argument" check --frobnicate
 expect_usage_error "subcommand"              
 expect_usage_error "subcommand|not expected|extraneous|following argument" fly
+
+# The other commands.
+expect_usage_error "camera.*required|--camera"  matrices
+expect_usage_error "no such file"            matrices --camera "$tmp/missing.json"
+expect_usage_error "singular"                matrices --camera "$tmp/singular.json"
+expect_usage_error "not a number"            precision --camera "$tmp/good.json" --at 1,abc
+expect_usage_error "outside the camera"      precision --camera "$tmp/good.json" --at 0.01
+expect_usage_error "unknown depth quantity"  unproject --camera "$tmp/good.json" --pixel 1,1 --depth 0.5 --quantity z
+expect_usage_error "whole numbers"           unproject --camera "$tmp/good.json" --pixel 1.5,2
+expect_usage_error "--space"                 unproject --camera "$tmp/good.json" --pixel 1,1 --space clip
 
 echo "cli_bad_input: $passed passed, $failures failed"
 [[ $failures -eq 0 ]]
