@@ -5,6 +5,7 @@
 #include "zcheck/atomic_file.h"
 #include "zcheck/camera_file.h"
 #include "zcheck/error.h"
+#include "zcheck/export.h"
 #include "zcheck/image_io.h"
 #include "zcheck/inverse_projection.h"
 #include "zcheck/mesh_loader.h"
@@ -54,8 +55,8 @@ void writeOutputs(const std::string& dir, const CheckRun& run)
     if (!fs::is_directory(dir)) throw Error("cannot write to --out '" + dir + "': not a directory");
     const int W = run.comparison.report.width, H = run.comparison.report.height;
     const auto path = [&](const char* name) { return (fs::path(dir) / name).string(); };
-    writeExr(path("ray_depth.exr"), W, H, {"Z"}, asFloats(run.ray.windowDepth));
-    writeExr(path("raster_depth.exr"), W, H, {"Z"}, asFloats(run.raster.windowDepth));
+    writeExr(path("ray_depth.exr"), W, H, {"window"}, asFloats(run.ray.windowDepth));
+    writeExr(path("raster_depth.exr"), W, H, {"window"}, asFloats(run.raster.windowDepth));
     writePng8(path("error_heatmap.png"), W, H, errorHeatmapRgb(run.comparison));
     writePng8(path("coverage_classes.png"), W, H, pixelClassRgb(run.comparison));
     writeTextFileAtomically(path("report.json"), prettyJson(toJson(run.report)) + "\n");
@@ -229,7 +230,7 @@ int runUnprojectCommand(const UnprojectOptions& o)
     if (o.depthMap.empty()) throw Error("unproject needs --pixel COL,ROW or --depth-map FILE");
     if (o.output.empty()) throw Error("--depth-map needs -o FILE.ply");
     if (o.stride < 1) throw Error("--stride must be >= 1");
-    const DepthMapFile map = readDepthMap(o.depthMap, o.quantity, o.scale);
+    const DepthMapFile map = readDepthMap(o.depthMap, channelNameOf(exportQuantitiesFromList(o.quantity).front()), o.scale);
     if (map.width != camera.width() || map.height != camera.height())
         throw Error("depth map '" + o.depthMap + "' is " + std::to_string(map.width) + "x" + std::to_string(map.height) +
                     " but the camera's image is " + std::to_string(camera.width()) + "x" + std::to_string(camera.height()));
@@ -251,6 +252,78 @@ int runUnprojectCommand(const UnprojectOptions& o)
                         std::string("space ") + o.space + (o.space == "eye" ? " (" + camera.convention().name + " eye axes)" : "")});
     std::cout << prettyJson({{"points", points.size()}, {"misses", misses}, {"channel", map.channel},
                              {"quantity", o.quantity}, {"space", o.space}, {"output", o.output}})
+              << "\n";
+    return kExitConsistent;
+}
+
+struct ExportOptions {
+    std::string backend = "ray", quantities = "eye-z", scene = "builtin:default", cameraFile, convention, output,
+                preview;
+    double scale = 0;
+    int threads = 0;
+};
+
+nlohmann::json numberOrName(double v)
+{
+    if (std::isnan(v)) return "nan";
+    if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+    return v;
+}
+
+int runExportCommand(const ExportOptions& o)
+{
+    if (o.backend != "ray" && o.backend != "raster") throw Error("--backend must be ray or raster, got '" + o.backend + "'");
+    if (o.output.empty()) throw Error("export needs -o FILE (.exr, .pfm, .tif or .png)");
+    const std::vector<ExportQuantity> quantities = exportQuantitiesFromList(o.quantities);
+    const Scene scene = loadScene(o.scene);
+    CameraSpec spec = o.cameraFile.empty() ? scene.defaultCamera : readCameraFile(o.cameraFile);
+    if (!o.convention.empty()) spec.convention = Convention::preset(o.convention);
+    const Camera camera(spec);
+    const RenderResult route = o.backend == "ray" ? RayRenderer(scene).render(camera) : RasterRenderer(scene).render(camera);
+    std::vector<QuantityImage> images;
+    for (ExportQuantity q : quantities) images.push_back(quantityImage(scene, camera, route, q));
+    const std::string format = writeQuantityFile(o.output, images, o.scale);
+
+    nlohmann::json channels = nlohmann::json::array();
+    for (const auto& image : images)
+        for (const auto& name : image.channels) {
+            nlohmann::json channel = {{"name", name},
+                                      {"quantity", toString(image.quantity)},
+                                      {"unit", image.unit},
+                                      {"type", format == "png" ? "uint16" : image.quantity == ExportQuantity::PrimitiveId ? "uint32" : "float32"},
+                                      {"miss_value", format == "png" ? nlohmann::json(0) : numberOrName(image.missValue)}};
+            if (format == "png") channel["stored_as"] = "round(value * scale); 0 = miss";
+            channels.push_back(channel);
+        }
+    const std::string orientation =
+        format == "pfm" ? "row 0 is the top row of the picture as a standard reader returns it; the file stores rows "
+                          "bottom to top, as the PFM specification says"
+                        : "row 0 (the first row stored and read) is the top row of the picture";
+    nlohmann::json sidecar = {
+        {"zcheck_version", ZCHECK_VERSION},
+        {"file", std::filesystem::path(o.output).filename().string()},
+        {"format", format},
+        {"width", camera.width()},
+        {"height", camera.height()},
+        {"orientation", orientation},
+        {"pixel_centres", "pixel (col,row) samples window point (col + 0.5, row + 0.5) from the top-left corner"},
+        {"channels", channels},
+        {"scale", format == "png" ? nlohmann::json(o.scale) : nlohmann::json(nullptr)},
+        {"backend", o.backend},
+        {"scene", scene.name},
+        {"convention", spec.convention.name},
+        {"depth", {{"format", toString(spec.depth.format)}, {"reversed", spec.depth.reversed},
+                   {"range", {spec.depth.rangeMin, spec.depth.rangeMax}}, {"clear_value", camera.clearDepth()}}},
+        {"camera", toJson(spec)},
+        {"matrices", matricesJson(camera)},
+    };
+    writeTextFileAtomically(o.output + ".json", prettyJson(sidecar) + "\n");
+    if (!o.preview.empty()) writePng8(o.preview, camera.width(), camera.height(), previewRgb(images.front()));
+    std::size_t hits = 0;
+    for (std::size_t i = 0; i < route.primitiveId.size(); ++i) hits += route.hit(i) ? 1 : 0;
+    std::cout << prettyJson({{"output", o.output}, {"sidecar", o.output + ".json"}, {"format", format},
+                             {"quantities", o.quantities}, {"backend", o.backend}, {"covered_pixels", hits},
+                             {"pixels", route.primitiveId.size()}})
               << "\n";
     return kExitConsistent;
 }
@@ -334,6 +407,23 @@ int main(int argc, char** argv)
     unprojectCommand->add_option("--stride", unproject.stride, "use every K-th pixel in x and y")->capture_default_str();
     unprojectCommand->add_flag("--ascii", unproject.ascii, "write ASCII PLY instead of binary little-endian");
 
+    ExportOptions exportOptions;
+    CLI::App* exportCommand = app.add_subcommand(
+        "export", "Render depth with one route and write it as EXR, PFM, TIFF or 16-bit PNG, with a JSON sidecar\n"
+                  "(FILE.json) that says everything needed to read it: quantity, unit, miss value, orientation,\n"
+                  "camera and matrices.");
+    exportCommand->add_option("--backend", exportOptions.backend, "ray | raster")->capture_default_str();
+    exportCommand->add_option("--quantity", exportOptions.quantities,
+                              "comma-separated: window, ndc, eye-z, distance, position-eye, position-world, normal, "
+                              "primitive-id (several only into .exr)")
+        ->capture_default_str();
+    exportCommand->add_option("--scene", exportOptions.scene, "as for check")->capture_default_str();
+    exportCommand->add_option("--camera", exportOptions.cameraFile, "camera file; default: the scene's own camera");
+    exportCommand->add_option("--convention", exportOptions.convention, "override the convention");
+    exportCommand->add_option("-o,--output", exportOptions.output, "FILE.exr | .pfm | .tif | .png (written atomically)");
+    exportCommand->add_option("--scale", exportOptions.scale, "16-bit PNG: stored = value x scale (e.g. 1000 = millimetres)");
+    exportCommand->add_option("--preview", exportOptions.preview, "also write an 8-bit colour-mapped PNG of the first quantity");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -351,6 +441,7 @@ int main(int argc, char** argv)
         if (checkCommand->parsed()) return runCheckCommand(check);
         if (matricesCommand->parsed()) return runMatricesCommand(matricesCamera, matricesConvention);
         if (unprojectCommand->parsed()) return runUnprojectCommand(unproject);
+        if (exportCommand->parsed()) return runExportCommand(exportOptions);
         if (precisionCommand->parsed())
             return runPrecisionCommand(precisionCamera, precisionConvention, precisionAt, precisionJson);
     } catch (const zcheck::Error& e) {

@@ -2,6 +2,7 @@
 // Image files (library zcheck_imageio, the only place OpenImageIO is used). All writes are
 // atomic (atomic_file.h). Row 0 of every image is the top row as seen.
 #include "zcheck/compare.h"
+#include "zcheck/export.h"
 #include "zcheck/render.h"
 
 #include <cstdint>
@@ -25,10 +26,25 @@ struct DepthMapFile {
     std::string channel;          // the channel read
     std::vector<double> value;    // width·height; NaN where an integer file stores 0 (a miss)
 };
-// The channel named `preferredChannel` if there is one, else "Z", else the first. Integer
+// The channel named `preferredChannel` if there is one, else the first. Integer
 // files (16-bit PNG) need `scale`: value = stored / scale, 0 = miss. Float files are divided
 // by `scale` when it is given. Throws Error naming the file.
 DepthMapFile readDepthMap(const std::string& path, const std::string& preferredChannel, double scale);
+
+// Writes exported quantities by the file's extension, atomically:
+//   .exr  any quantities, one channel each (names in export.h), float32 (id: uint32), ZIP
+//   .pfm  one quantity of 1 or 3 float channels; rows stored bottom to top as PFM specifies
+//         (written by zcheck: OpenImageIO 2.4 reads PFM but cannot write it)
+//   .tif  one quantity, float32 (id: uint32)
+//   .png  one of window, ndc, eye-z, distance as 16-bit unsigned: round(value × scale),
+//         0 = miss; `scale` is required, and a value that does not fit in 1..65535 is an
+//         error naming the largest depth and the largest scale that would fit.
+// Returns the format's name ("exr", "pfm", "tiff", "png"). Throws Error naming the file.
+std::string writeQuantityFile(const std::string& path, const std::vector<QuantityImage>& images, double scale);
+
+// An 8-bit picture of one quantity for a person: depths through the viridis colour map
+// (near dark blue, far yellow), normals as RGB = (n + 1)/2, ids hashed to colours; misses black.
+std::vector<std::uint8_t> previewRgb(const QuantityImage& image);
 
 // The check's pictures:
 //   error heatmap — |Δ| / tolerance on both-hit pixels: black 0, through blue and green to

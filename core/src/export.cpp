@@ -1,0 +1,141 @@
+#include "zcheck/export.h"
+
+#include "zcheck/error.h"
+#include "zcheck/inverse_projection.h"
+
+#include <cmath>
+
+namespace zcheck {
+
+namespace {
+const ExportQuantity kAll[] = {ExportQuantity::Window,      ExportQuantity::Ndc,           ExportQuantity::EyeZ,
+                               ExportQuantity::Distance,    ExportQuantity::PositionEye,   ExportQuantity::PositionWorld,
+                               ExportQuantity::Normal,      ExportQuantity::PrimitiveId};
+}
+
+std::string toString(ExportQuantity quantity)
+{
+    switch (quantity) {
+    case ExportQuantity::Window: return "window";
+    case ExportQuantity::Ndc: return "ndc";
+    case ExportQuantity::EyeZ: return "eye-z";
+    case ExportQuantity::Distance: return "distance";
+    case ExportQuantity::PositionEye: return "position-eye";
+    case ExportQuantity::PositionWorld: return "position-world";
+    case ExportQuantity::Normal: return "normal";
+    case ExportQuantity::PrimitiveId: return "primitive-id";
+    }
+    return "?";
+}
+
+const std::vector<std::string>& exportQuantityNames()
+{
+    static const std::vector<std::string> names = [] {
+        std::vector<std::string> all;
+        for (ExportQuantity q : kAll) all.push_back(toString(q));
+        return all;
+    }();
+    return names;
+}
+
+std::vector<ExportQuantity> exportQuantitiesFromList(const std::string& text)
+{
+    std::vector<ExportQuantity> out;
+    std::size_t start = 0;
+    while (start <= text.size()) {
+        const std::size_t end = std::min(text.find(',', start), text.size());
+        const std::string name = text.substr(start, end - start);
+        bool found = false;
+        for (ExportQuantity q : kAll)
+            if (toString(q) == name) {
+                for (ExportQuantity seen : out)
+                    if (seen == q) throw Error("--quantity lists '" + name + "' twice");
+                out.push_back(q), found = true;
+            }
+        if (!found) {
+            std::string known;
+            for (const auto& n : exportQuantityNames()) known += (known.empty() ? "" : ", ") + n;
+            throw Error("unknown quantity '" + name + "' (expected one or more of " + known + ", comma-separated)");
+        }
+        start = end + 1;
+    }
+    return out;
+}
+
+std::string channelNameOf(ExportQuantity quantity)
+{
+    switch (quantity) {
+    case ExportQuantity::Window: return "window";
+    case ExportQuantity::Ndc: return "ndc";
+    case ExportQuantity::EyeZ: return "Z";
+    case ExportQuantity::Distance: return "distance";
+    default: return toString(quantity);
+    }
+}
+
+bool QuantityImage::isMiss(std::size_t pixel) const
+{
+    if (quantity == ExportQuantity::PrimitiveId) return id[pixel] == kNoPrimitive;
+    const double v = value[pixel * channels.size()];
+    return std::isnan(missValue) ? std::isnan(v) : v == missValue;
+}
+
+QuantityImage quantityImage(const Scene& scene, const Camera& camera, const RenderResult& route, ExportQuantity quantity)
+{
+    QuantityImage image;
+    image.quantity = quantity;
+    image.width = camera.width(), image.height = camera.height();
+    const std::size_t pixels = std::size_t(image.width) * image.height;
+    switch (quantity) {
+    case ExportQuantity::Window: image.channels = {channelNameOf(quantity)}, image.unit = "depth-buffer value", image.missValue = camera.clearDepth(); break;
+    case ExportQuantity::Ndc: image.channels = {channelNameOf(quantity)}, image.unit = "NDC z", image.missValue = camera.ndcZFar(); break;
+    case ExportQuantity::EyeZ: image.channels = {channelNameOf(quantity)}, image.unit = "scene units (planar depth)", image.missValue = INFINITY; break;
+    case ExportQuantity::Distance: image.channels = {channelNameOf(quantity)}, image.unit = "scene units (range)", image.missValue = INFINITY; break;
+    case ExportQuantity::PositionEye: image.channels = {"P.X", "P.Y", "P.Z"}, image.unit = "scene units, eye space", image.missValue = NAN; break;
+    case ExportQuantity::PositionWorld: image.channels = {"Pw.X", "Pw.Y", "Pw.Z"}, image.unit = "scene units, world space", image.missValue = NAN; break;
+    case ExportQuantity::Normal: image.channels = {"N.X", "N.Y", "N.Z"}, image.unit = "unit vector, world space, facing the camera", image.missValue = NAN; break;
+    case ExportQuantity::PrimitiveId: image.channels = {"id"}, image.unit = "triangle index (uint32)", image.missValue = double(kNoPrimitive); break;
+    }
+    const std::size_t C = image.channels.size();
+    if (quantity == ExportQuantity::PrimitiveId) {
+        image.id = route.primitiveId;
+        return image;
+    }
+    image.value.assign(pixels * C, image.missValue);
+    for (int row = 0; row < image.height; ++row)
+        for (int col = 0; col < image.width; ++col) {
+            const std::size_t i = std::size_t(row) * image.width + col;
+            if (!route.hit(i)) continue;
+            const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
+            const double windowDepth = route.windowDepth.value[i];
+            // The ray route carries the exact hit; the raster route its stored depth.
+            const glm::dvec3 pEye = route.pEye.empty() ? eyeFromWindow(camera, {pWindow, windowDepth}) : route.pEye[i];
+            double* out = &image.value[i * C];
+            switch (quantity) {
+            case ExportQuantity::Window: out[0] = windowDepth; break;
+            case ExportQuantity::Ndc: out[0] = camera.ndcZFromWindowDepth(windowDepth); break;
+            case ExportQuantity::EyeZ: out[0] = camera.eyeZOf(pEye); break;
+            case ExportQuantity::Distance: out[0] = distanceOfEyePoint(camera, pEye); break;
+            case ExportQuantity::PositionEye: out[0] = pEye.x, out[1] = pEye.y, out[2] = pEye.z; break;
+            case ExportQuantity::PositionWorld: {
+                const glm::dvec3 pWorld(camera.worldFromEye * glm::dvec4(pEye, 1.0));
+                out[0] = pWorld.x, out[1] = pWorld.y, out[2] = pWorld.z;
+                break;
+            }
+            case ExportQuantity::Normal: {
+                const glm::uvec3 t = scene.triangles[route.primitiveId[i]];
+                const glm::dvec3 a(scene.positions[t[0]]), b(scene.positions[t[1]]), c(scene.positions[t[2]]);
+                glm::dvec3 n = glm::normalize(glm::cross(b - a, c - a));
+                // Face the viewer: against the viewing ray (for parallel projections too).
+                const glm::dvec3 rayDirection = worldEyePlaneRayThroughWindow(camera, pWindow).direction;
+                if (glm::dot(n, rayDirection) > 0) n = -n;
+                out[0] = n.x, out[1] = n.y, out[2] = n.z;
+                break;
+            }
+            case ExportQuantity::PrimitiveId: break;
+            }
+        }
+    return image;
+}
+
+}  // namespace zcheck
