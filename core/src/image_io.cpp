@@ -238,6 +238,11 @@ std::vector<std::uint8_t> previewRgb(const QuantityImage& image)
     if (C == 1 && image.quantity != ExportQuantity::PrimitiveId)
         for (std::size_t i = 0; i < pixels; ++i)
             if (!image.isMiss(i)) lo = std::min(lo, image.value[i]), hi = std::max(hi, image.value[i]);
+    double boxLo[3] = {INFINITY, INFINITY, INFINITY}, boxHi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    if (C == 3)
+        for (std::size_t i = 0; i < pixels; ++i)
+            for (int k = 0; k < 3 && !image.isMiss(i); ++k)
+                boxLo[k] = std::min(boxLo[k], image.value[i * 3 + k]), boxHi[k] = std::max(boxHi[k], image.value[i * 3 + k]);
     for (std::size_t i = 0; i < pixels; ++i) {
         if (image.isMiss(i)) continue;
         Rgb c{};
@@ -245,8 +250,14 @@ std::vector<std::uint8_t> previewRgb(const QuantityImage& image)
             std::uint32_t h = image.id[i] * 2654435761u;  // Knuth's multiplicative hash
             c = {std::uint8_t(64 + (h >> 24) % 192), std::uint8_t(64 + (h >> 16) % 192), std::uint8_t(64 + (h >> 8) % 192)};
         } else if (C == 3) {
-            // Positions are shown like normals, scaled to their bounding box elsewhere; here as (v+1)/2 clamped.
-            for (int k = 0; k < 3; ++k) c[k] = std::uint8_t(std::lround(255 * std::clamp((image.value[i * 3 + k] + 1) / 2, 0.0, 1.0)));
+            // Normals as (n + 1)/2; positions scaled per axis to their bounding box.
+            for (int k = 0; k < 3; ++k) {
+                const double v = image.value[i * 3 + k];
+                const double t = image.quantity == ExportQuantity::Normal ? (v + 1) / 2
+                                 : boxHi[k] > boxLo[k]                    ? (v - boxLo[k]) / (boxHi[k] - boxLo[k])
+                                                                          : 0.5;
+                c[k] = std::uint8_t(std::lround(255 * std::clamp(t, 0.0, 1.0)));
+            }
         } else {
             c = viridis(hi > lo ? (image.value[i] - lo) / (hi - lo) : 0.5);
         }
