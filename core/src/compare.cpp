@@ -165,6 +165,8 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
     const double S = tolerance.snapPixels();
     const double E = 16 * std::ldexp(1.0, -52) * std::max(std::abs(camera.depth().rangeMin), std::abs(camera.depth().rangeMax));
     std::vector<double> errorQuanta, relativeEyeZ;
+    double signedErrorSum = 0;
+    std::int64_t quarterCounts[4] = {0, 0, 0, 0};
 
     for (int row = 0; row < H; ++row) {
         for (int col = 0; col < W; ++col) {
@@ -193,6 +195,13 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
                 f.errorQuanta = error / q;
                 f.toleranceQuanta = bound / q;
                 const double ratio = bound > 0 ? error / bound : (error > 0 ? INFINITY : 0.0);
+                if (samePrimitive && S * mRay <= 0.1 * q) {
+                    // Quantization dominates here: feed the bias test.
+                    signedErrorSum += (f.rasterWindowDepth - f.rayWindowDepth) / q;
+                    const double position = f.rayWindowDepth / q;
+                    ++quarterCounts[std::clamp(int(4 * (position - std::floor(position))), 0, 3)];
+                    ++r.biasSamples;
+                }
                 if (error <= bound) {
                     f.pixelClass = PixelClass::Agree;
                 } else if (!samePrimitive && (triangles.nearEdge(camera, f.rayPrimitive, pWindow, S) ||
@@ -257,6 +266,10 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
     }
     for (double v : relativeEyeZ) r.maxRelativeEyeZError = std::max(r.maxRelativeEyeZError, v);
     r.p99ErrorQuanta = percentile99(errorQuanta);
+    if (r.biasSamples > 0) r.meanSignedErrorQuanta = signedErrorSum / double(r.biasSamples);
+    const bool spread = std::all_of(std::begin(quarterCounts), std::end(quarterCounts),
+                                    [&](std::int64_t n) { return n >= r.biasSamples / 10; });
+    r.depthBias = r.biasSamples >= 1000 && spread && std::abs(r.meanSignedErrorQuanta) > 0.25;
     r.p99RelativeEyeZError = percentile99(relativeEyeZ);
     return out;
 }

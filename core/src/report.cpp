@@ -96,6 +96,9 @@ nlohmann::json toJson(const CheckReport& report)
           {"max_over_tolerance", c.maxErrorOverTolerance},
           {"max_relative_eye_z", c.maxRelativeEyeZError},
           {"p99_relative_eye_z", c.p99RelativeEyeZError},
+          {"bias_samples", c.biasSamples},
+          {"mean_signed_error_quanta", c.meanSignedErrorQuanta},
+          {"depth_bias", c.depthBias},
           {"worst_pixel", toJson(c.worst)}}},
         {"unexplained", {{"count", c.unexplained()}, {"bounding_box", box}, {"samples", unexplained}}},
         {"timings_ms",
@@ -147,6 +150,12 @@ std::string formatSummary(const CheckReport& report)
     std::snprintf(line, sizeof line, "  relative eye-z error: max %.3g, p99 %.3g\n", c.maxRelativeEyeZError,
                   c.p99RelativeEyeZError);
     out << line;
+    if (c.biasSamples > 0) {
+        std::snprintf(line, sizeof line, "  mean signed error %+.3f q over %lld quantization-bound pixels%s\n",
+                      c.meanSignedErrorQuanta, static_cast<long long>(c.biasSamples),
+                      c.depthBias ? "  <- SYSTEMATIC BIAS (rounding is not to nearest)" : "");
+        out << line;
+    }
     if (c.agree + c.depthErrors > 0) {
         std::snprintf(line, sizeof line, "  worst pixel (%d, %d): ray %.10g, raster %.10g, %.3g q (tolerance %.3g q)\n",
                       c.worst.col, c.worst.row, c.worst.rayWindowDepth, c.worst.rasterWindowDepth,

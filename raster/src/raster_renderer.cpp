@@ -4,6 +4,7 @@
 #include "zcheck/raster_renderer.h"
 
 #include "zcheck/clip.h"
+#include "zcheck/inverse_projection.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -39,16 +40,28 @@ struct Chunk {
 
 struct Viewport {
     const Camera& camera;
+    const RasterFaults& faults;
     int width, height, tilesX, tilesY;
     ClipPlanes planes;  // near, far, guard band
+    glm::dmat4 clipFromWorld, windowFromNdc;
+    bool pixelFaults;   // a fault that changes the per-pixel depth computation
 
-    Viewport(const Camera& c) : camera(c), width(c.width()), height(c.height())
+    Viewport(const Camera& c, const RasterFaults& f) : camera(c), faults(f), width(c.width()), height(c.height())
     {
         tilesX = (width + RasterRenderer::kTileSize - 1) / RasterRenderer::kTileSize;
         tilesY = (height + RasterRenderer::kTileSize - 1) / RasterRenderer::kTileSize;
-        planes = depthClipPlanes(c.convention().ndcZMin());
+        const ClipPlanes depthPlanes = depthClipPlanes(c.convention().ndcZMin());
+        planes = depthPlanes;
+        if (f.noNearClip) planes.size = 0, planes.plane[planes.size++] = depthPlanes.plane[1];  // far only
         // |ndc| ≤ guard keeps image coordinates within ±(guard+1)/2·size ≤ 2^20 pixels.
         addGuardBandPlanes(planes, 2.0 * kMaxImageCoordinate / std::max(width, height) - 1.0);
+        clipFromWorld = f.overrideClipFromWorld ? f.clipFromWorld : c.clipFromWorld;
+        windowFromNdc = c.windowFromNdc;
+        if (f.viewportMinusOne) {
+            windowFromNdc[0][0] *= double(width - 1) / width, windowFromNdc[3][0] *= double(width - 1) / width;
+            windowFromNdc[1][1] *= double(height - 1) / height, windowFromNdc[3][1] *= double(height - 1) / height;
+        }
+        pixelFaults = f.screenLinearEyeZ || f.truncateUnorm || f.storeLinearEyeZ;
     }
 
     unsigned outcode(const glm::dvec4& pClip) const
@@ -69,10 +82,16 @@ void setupTriangle(const Viewport& vp, const glm::dvec4 (&pClip)[3], std::uint32
     double z[3];
     for (int k = 0; k < 3; ++k) {
         const glm::dvec3 pNdc = glm::dvec3(pClip[k]) / pClip[k].w;
-        const glm::dvec3 pWindow(vp.camera.windowFromNdc * glm::dvec4(pNdc, 1.0));
+        const glm::dvec3 pWindow(vp.windowFromNdc * glm::dvec4(pNdc, 1.0));
+        const double yImage = vp.camera.imageYFromWindowY(pWindow.y);
+        // Only a fault (no near clipping) can bring w ≤ 0 here: skip what cannot be snapped.
+        if (!(std::abs(pWindow.x) < 2 * kMaxImageCoordinate) || !(std::abs(yImage) < 2 * kMaxImageCoordinate)) return;
         X[k] = std::llround(pWindow.x * kSubpixel);
-        Y[k] = std::llround(vp.camera.imageYFromWindowY(pWindow.y) * kSubpixel);
-        z[k] = pWindow.z;
+        Y[k] = std::llround(yImage * kSubpixel);
+        // The fault "eye-z interpolated in screen space" interpolates eye-z instead of depth.
+        z[k] = vp.faults.screenLinearEyeZ ? vp.camera.eyeZOf(glm::dvec3(vp.camera.eyeFromClip * pClip[k]) /
+                                                             (vp.camera.eyeFromClip * pClip[k]).w)
+                                          : pWindow.z;
     }
     std::int64_t area2 = (X[1] - X[0]) * (Y[2] - Y[0]) - (Y[1] - Y[0]) * (X[2] - X[0]);
     if (area2 == 0) return;  // covers no sample point
@@ -149,10 +168,31 @@ void binChunk(const Viewport& vp, Chunk& chunk)
         forEachTile(chunk.triangles[index], [&](int tile) { chunk.binned[fill[tile]++] = index; });
 }
 
+// The stored value under the pixel faults (never called for a clean chain).
+double faultyStoredDepth(const Viewport& vp, double interpolated, int col, int row)
+{
+    const Camera& camera = vp.camera;
+    const DepthSettings& depth = camera.depth();
+    const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
+    double windowDepth = vp.faults.screenLinearEyeZ ? windowDepthFromEyeZ(camera, pWindow, interpolated) : interpolated;
+    if (vp.faults.storeLinearEyeZ) {
+        const double eyeZ = eyeZFromWindowDepth(camera, pWindow, windowDepth);
+        windowDepth = depth.rangeMin + (depth.rangeMax - depth.rangeMin) * (eyeZ - camera.nearDistance()) /
+                                           (camera.farDistance() - camera.nearDistance());
+    }
+    windowDepth = std::clamp(windowDepth, depth.rangeMin, depth.rangeMax);
+    if (vp.faults.truncateUnorm && depth.format != DepthFormat::Float32) {
+        const double maxCode = 1.0 / storageQuantum(depth.format, windowDepth);
+        return std::floor(windowDepth * maxCode) / maxCode;
+    }
+    return quantizeDepth(depth.format, windowDepth);
+}
+
 // Scan one triangle inside one tile.
-void drawInTile(const Camera& camera, const TriangleSetup& t, int tileCol0, int tileRow0, int tileCol1, int tileRow1,
+void drawInTile(const Viewport& vp, const TriangleSetup& t, int tileCol0, int tileRow0, int tileCol1, int tileRow1,
                 RenderResult& out)
 {
+    const Camera& camera = vp.camera;
     const int col0 = std::max(t.minCol, tileCol0), col1 = std::min(t.maxCol, tileCol1);
     const int row0 = std::max(t.minRow, tileRow0), row1 = std::min(t.maxRow, tileRow1);
     const DepthSettings& depth = camera.depth();
@@ -166,8 +206,9 @@ void drawInTile(const Camera& camera, const TriangleSetup& t, int tileCol0, int 
         const double rowDepth = t.z0 + t.dzdy * (row + 0.5 - t.y0);
         for (int col = col0; col <= col1; ++col, e0 += step0, e1 += step1, e2 += step2) {
             if ((e0 | e1 | e2) < 0) continue;  // some edge function negative: outside
-            const double windowDepth = std::clamp(rowDepth + t.dzdx * (col + 0.5 - t.x0), depth.rangeMin, depth.rangeMax);
-            const double stored = quantizeDepth(depth.format, windowDepth);
+            const double interpolated = rowDepth + t.dzdx * (col + 0.5 - t.x0);
+            const double stored = vp.pixelFaults ? faultyStoredDepth(vp, interpolated, col, row)
+                                                 : quantizeDepth(depth.format, std::clamp(interpolated, depth.rangeMin, depth.rangeMax));
             const std::size_t i = std::size_t(row) * W + col;
             if (camera.passesDepthTest(stored, out.windowDepth.value[i])) {
                 out.windowDepth.value[i] = stored;
@@ -184,7 +225,7 @@ RasterRenderer::RasterRenderer(const Scene& scene) : scene_(scene) { validateSce
 RenderResult RasterRenderer::render(const Camera& camera) const
 {
     const auto start = std::chrono::steady_clock::now();
-    const Viewport vp(camera);
+    const Viewport vp(camera, faults);
     const int W = camera.width(), H = camera.height();
     RenderResult result;
     result.windowDepth = {W, H, DepthQuantity::Window, std::vector<double>(std::size_t(W) * H, camera.clearDepth())};
@@ -195,7 +236,7 @@ RenderResult RasterRenderer::render(const Camera& camera) const
     std::vector<unsigned char> outcode(scene_.positions.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pClip.size(), 4096), [&](const auto& range) {
         for (std::size_t v = range.begin(); v != range.end(); ++v) {
-            pClip[v] = camera.clipFromWorld * glm::dvec4(glm::dvec3(scene_.positions[v]), 1.0);
+            pClip[v] = vp.clipFromWorld * glm::dvec4(glm::dvec3(scene_.positions[v]), 1.0);
             outcode[v] = static_cast<unsigned char>(vp.outcode(pClip[v]));
         }
     });
@@ -221,7 +262,7 @@ RenderResult RasterRenderer::render(const Camera& camera) const
         const int col1 = std::min(W, col0 + kTileSize) - 1, row1 = std::min(H, row0 + kTileSize) - 1;
         for (const Chunk& chunk : chunks)
             for (std::uint32_t k = chunk.tileStart[tile]; k < chunk.tileStart[tile + 1]; ++k)
-                drawInTile(camera, chunk.triangles[chunk.binned[k]], col0, row0, col1, row1, result);
+                drawInTile(vp, chunk.triangles[chunk.binned[k]], col0, row0, col1, row1, result);
     });
     result.renderMilliseconds =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

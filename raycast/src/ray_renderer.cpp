@@ -129,7 +129,7 @@ RenderResult RayRenderer::render(const Camera& camera) const
 
     const int tilesX = (W + kTile - 1) / kTile, tilesY = (H + kTile - 1) / kTile;
     RTCScene rtcScene = embree_->scene.get();
-    const RaySampling fault = sampling;
+    const RayFaults fault = sampling;
     const glm::dvec3 frameOrigin = embree_->frameOrigin;
 
     tbb::parallel_for(tbb::blocked_range<int>(0, tilesX * tilesY, 4), [&](const tbb::blocked_range<int>& tiles) {
@@ -152,7 +152,8 @@ RenderResult RayRenderer::render(const Camera& camera) const
                         pixelOf[k] = row * W + col;
                         // Every field of every lane is initialised, valid or not.
                         const int sampleRow = fault.flipRows ? H - 1 - row : row;
-                        const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, sampleRow) + fault.shiftPixels;
+                        const int sampleCol = fault.flipCols ? W - 1 - col : col;
+                        const glm::dvec2 pWindow = windowFromPixelCentre(camera, sampleCol, sampleRow) + fault.shiftPixels;
                         rays[k] = valid[k] ? worldEyePlaneRayThroughWindow(camera, pWindow)
                                            : EyePlaneRay{{0, 0, 0}, {0, 0, 1}, 0, 0};
                         const EyePlaneRay& r = rays[k];
@@ -190,6 +191,11 @@ RenderResult RayRenderer::render(const Camera& camera) const
                         result.primitiveId[i] = primitive;
                         result.pEye[i] = pEye;
                         result.windowDepth.value[i] = windowFromEye(camera, pEye).z;
+                        if (fault.distanceAsEyeZ) {
+                            const glm::dvec3 pHitWindow = windowFromEye(camera, pEye);
+                            result.windowDepth.value[i] =
+                                windowDepthFromEyeZ(camera, {pHitWindow.x, pHitWindow.y}, distanceOfEyePoint(camera, pEye));
+                        }
                     }
                 }
             }

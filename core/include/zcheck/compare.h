@@ -25,7 +25,13 @@
 // the double-precision forward chain itself; it matters only where binary32 ulps are finer
 // still (reversed-Z float32 at the far plane, where window depth is ~0).
 //
-// Verdict: consistent ⇔ no unexplained coverage mismatch and no depth error.
+// Systematic bias: over both-hit pixels on one triangle where quantization dominates
+// (S·m ≤ 0.1·q), a correct buffer rounds to nearest, so the mean signed error is ~0 q;
+// truncation (or any one-sided rounding) drifts towards ±½ q while staying inside C·q at
+// every pixel. With ≥ 1000 such pixels whose exact depths fall in every quarter of the
+// quantum (so a constant-depth wall cannot fake it), |mean| > ¼ q is a depth bias.
+//
+// Verdict: consistent ⇔ no unexplained coverage mismatch, no depth error and no bias.
 #include "zcheck/camera.h"
 #include "zcheck/render.h"
 #include "zcheck/scene.h"
@@ -101,8 +107,13 @@ struct ComparisonReport {
     std::vector<PixelFinding> unexplainedSamples;
     int unexplainedMinCol = 0, unexplainedMinRow = 0, unexplainedMaxCol = -1, unexplainedMaxRow = -1;
 
+    // The bias test (see above):
+    std::int64_t biasSamples = 0;          // pixels where quantization dominates
+    double meanSignedErrorQuanta = 0;      // mean of (d_raster − d_ray) / q over them
+    bool depthBias = false;                // a systematic rounding bias was found
+
     std::int64_t unexplained() const { return depthErrors + coverageUnexplained; }
-    bool consistent() const { return unexplained() == 0; }
+    bool consistent() const { return unexplained() == 0 && !depthBias; }
 };
 
 struct Comparison {

@@ -22,6 +22,18 @@
 
 namespace zcheck {
 
+// Classic mistakes injected into the raster route (the fault catalogue uses them; the
+// defaults are the correct chain).
+struct RasterFaults {
+    bool overrideClipFromWorld = false;  // draw with `clipFromWorld` instead of the camera's
+    glm::dmat4 clipFromWorld{1.0};       // (a wrong projection or view matrix)
+    bool noNearClip = false;             // clip against the far plane and guard band only
+    bool screenLinearEyeZ = false;       // interpolate eye-z linearly in screen space, then map it to depth
+    bool viewportMinusOne = false;       // viewport scaled by (width − 1, height − 1)
+    bool truncateUnorm = false;          // unorm-N stores floor(d·(2^N − 1)) instead of rounding
+    bool storeLinearEyeZ = false;        // store (eye-z − near)/(far − near) as the window depth
+};
+
 class RasterRenderer final : public Renderer {
 public:
     static constexpr int kSubpixelBits = 8;          // 16.8 fixed point
@@ -31,6 +43,8 @@ public:
     explicit RasterRenderer(const Scene& scene);     // the scene must outlive the renderer
     std::string name() const override { return "raster"; }
     RenderResult render(const Camera& camera) const override;
+
+    RasterFaults faults;  // injected faults; default: none
 
 private:
     const Scene& scene_;

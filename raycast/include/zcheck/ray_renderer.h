@@ -17,12 +17,15 @@
 
 namespace zcheck {
 
-// Where a ray samples pixel (col,row). Correct is the pixel centre; tests inject the
-// classic mistakes here (a missing half-pixel offset, a y-flip) and expect them caught.
-struct RaySampling {
+// Classic mistakes injected into the ray route (the fault catalogue and tests use them; the
+// defaults are the correct chain).
+struct RayFaults {
     glm::dvec2 shiftPixels{0.0, 0.0};  // added to the window position of the pixel centre
     bool flipRows = false;             // sample row H−1−row instead of row
+    bool flipCols = false;             // sample column W−1−col instead of col
+    bool distanceAsEyeZ = false;       // the hit's ray distance turned into depth as if it were eye-z
 };
+using RaySampling = RayFaults;
 
 class RayRenderer final : public Renderer {
 public:
@@ -35,7 +38,7 @@ public:
     RenderResult render(const Camera& camera) const override;
 
     double buildMilliseconds() const { return buildMilliseconds_; }
-    RaySampling sampling;
+    RayFaults sampling;  // injected faults; default: none
 
 private:
     struct Embree;
