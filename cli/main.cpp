@@ -1,6 +1,7 @@
 // zcheck — the command line. Thin: parse, call the libraries, print.
 // Exit status: 0 consistent, 1 inconsistent, 2 usage or input error (one line on stderr).
 #include "check.h"
+#include "suite.h"
 
 #include "zcheck/atomic_file.h"
 #include "zcheck/camera_file.h"
@@ -13,11 +14,14 @@
 #include "zcheck/precision.h"
 
 #include <CLI/CLI.hpp>
+#include <unistd.h>
 #include <tbb/global_control.h>
 
 #include <cmath>
 #include <cstdio>
+#include <chrono>
 #include <filesystem>
+#include <sstream>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -328,6 +332,150 @@ int runExportCommand(const ExportOptions& o)
     return kExitConsistent;
 }
 
+struct SuiteOptions {
+    bool quick = false;
+    std::string filter, jsonFile, htmlFile, modelsDir = ZCHECK_MODELS_DIR;
+    int threads = 0;
+};
+
+std::string htmlEscape(const std::string& text)
+{
+    std::string out;
+    for (char c : text) out += c == '<' ? "&lt;" : c == '>' ? "&gt;" : c == '&' ? "&amp;" : std::string(1, c);
+    return out;
+}
+
+// Detected / applicable per fault over the whole run.
+struct FaultTally {
+    int detected = 0, missed = 0, notApplicable = 0, meaningless = 0;
+};
+
+std::vector<FaultTally> tallyFaults(const SuiteResult& result)
+{
+    std::vector<FaultTally> tally(faultCatalogue().size());
+    for (const auto& outcome : result.outcomes)
+        for (std::size_t k = 0; k < outcome.faults.size(); ++k) switch (outcome.faults[k]) {
+            case FaultResult::Detected: ++tally[k].detected; break;
+            case FaultResult::Missed: ++tally[k].missed; break;
+            case FaultResult::NotApplicable: ++tally[k].notApplicable; break;
+            case FaultResult::Meaningless: ++tally[k].meaningless; break;
+            }
+    return tally;
+}
+
+std::string suiteTable(const SuiteResult& result)
+{
+    std::ostringstream out;
+    const auto tally = tallyFaults(result);
+    const int clean = int(result.outcomes.size());
+    char line[256];
+    std::snprintf(line, sizeof line, "clean configurations: %d consistent of %d (false positives: %d)\n\n",
+                  clean - result.falsePositives, clean, result.falsePositives);
+    out << line;
+    std::snprintf(line, sizeof line, "%-22s %-7s %10s %14s %9s  %s\n", "fault", "route", "detected", "not applicable",
+                  "n/a", "");
+    out << line;
+    for (std::size_t k = 0; k < tally.size(); ++k) {
+        const Fault& fault = faultCatalogue()[k];
+        const int applicable = tally[k].detected + tally[k].missed;
+        std::snprintf(line, sizeof line, "%-22s %-7s %4d / %-4d %14d %9d  %s\n", fault.name.c_str(), fault.route.c_str(),
+                      tally[k].detected, applicable, tally[k].notApplicable, tally[k].meaningless,
+                      tally[k].missed ? "<- MISSED" : "");
+        out << line;
+    }
+    out << "\n(detected / applicable; not applicable: the fault leaves that picture unchanged within the tolerance\n"
+           " model, e.g. truncating a float buffer; n/a: the mistake has no meaning there, e.g. a field-of-view\n"
+           " mistake on an orthographic camera)\n";
+    return out.str();
+}
+
+int runSuiteCommand(const SuiteOptions& o)
+{
+    std::unique_ptr<tbb::global_control> threadLimit;
+    if (o.threads > 0)
+        threadLimit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, std::size_t(o.threads));
+    std::vector<SuiteConfig> configs;
+    for (auto& config : suiteConfigurations(o.quick, o.modelsDir))
+        if (o.filter.empty() || config.label().find(o.filter) != std::string::npos) configs.push_back(config);
+    if (configs.empty()) throw Error("--filter '" + o.filter + "' matches no configuration");
+    const bool terminal = ::isatty(2);
+    const auto start = std::chrono::steady_clock::now();
+    int failuresSoFar = 0;
+    const SuiteResult result = runSuite(configs, [&](std::size_t done, std::size_t total, const ConfigOutcome& outcome) {
+        for (FaultResult r : outcome.faults) failuresSoFar += r == FaultResult::Missed ? 1 : 0;
+        failuresSoFar += outcome.clean.consistent() ? 0 : 1;
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (terminal || done == total || done % 25 == 0)
+            std::fprintf(stderr, "%s[%zu/%zu] %.0f s, failures %d: %-70.70s%s", terminal ? "\r" : "", done, total,
+                         seconds, failuresSoFar, outcome.config.label().c_str(), terminal && done < total ? "" : "\n");
+    });
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::cout << "zcheck suite" << (o.quick ? " --quick" : "") << ": " << configs.size() << " configurations x "
+              << faultCatalogue().size() << " faults in " << std::lround(seconds) << " s\n\n"
+              << suiteTable(result) << "\nverdict    " << (result.passed() ? "PASSED" : "FAILED") << "\n";
+
+    if (!o.jsonFile.empty()) {
+        nlohmann::json configsJson = nlohmann::json::array();
+        for (const auto& outcome : result.outcomes) {
+            nlohmann::json faults;
+            for (std::size_t k = 0; k < outcome.faults.size(); ++k) faults[faultCatalogue()[k].name] = toString(outcome.faults[k]);
+            configsJson.push_back({{"label", outcome.config.label()},
+                                   {"scene", outcome.config.scene},
+                                   {"model", outcome.config.model},
+                                   {"camera", toJson(outcome.config.spec)},
+                                   {"clean", {{"consistent", outcome.clean.consistent()},
+                                              {"unexplained", outcome.clean.unexplained()},
+                                              {"max_over_tolerance", outcome.clean.maxErrorOverTolerance},
+                                              {"mean_signed_error_quanta", outcome.clean.meanSignedErrorQuanta}}},
+                                   {"faults", faults},
+                                   {"milliseconds", outcome.milliseconds}});
+        }
+        nlohmann::json table = nlohmann::json::object();
+        const auto tally = tallyFaults(result);
+        for (std::size_t k = 0; k < tally.size(); ++k)
+            table[faultCatalogue()[k].name] = {{"description", faultCatalogue()[k].description},
+                                               {"route", faultCatalogue()[k].route},
+                                               {"detected", tally[k].detected},
+                                               {"applicable", tally[k].detected + tally[k].missed},
+                                               {"not_applicable", tally[k].notApplicable},
+                                               {"meaningless", tally[k].meaningless}};
+        writeTextFileAtomically(o.jsonFile, prettyJson({{"zcheck_version", ZCHECK_VERSION},
+                                                        {"quick", o.quick},
+                                                        {"configurations", configsJson},
+                                                        {"detection", table},
+                                                        {"false_positives", result.falsePositives},
+                                                        {"missed_faults", result.missedFaults},
+                                                        {"passed", result.passed()},
+                                                        {"seconds", seconds}}) + "\n");
+    }
+    if (!o.htmlFile.empty()) {
+        std::ostringstream html;
+        html << "<!doctype html><html><head><meta charset=\"utf-8\"><title>zcheck suite</title><style>"
+                "body{font-family:sans-serif;margin:2em}pre{background:#f4f4f4;padding:1em}"
+                "img{image-rendering:pixelated;width:320px;margin-right:8px;border:1px solid #ccc}"
+                ".failure{margin-bottom:2em}</style></head><body>"
+             << "<h1>zcheck suite: " << (result.passed() ? "PASSED" : "FAILED") << "</h1><p>" << configs.size()
+             << " configurations &times; " << faultCatalogue().size() << " faults, " << std::lround(seconds)
+             << " s.</p><pre>" << htmlEscape(suiteTable(result)) << "</pre>";
+        html << "<h2>Failures" << (result.failures.empty() ? ": none" : "") << "</h2>";
+        for (const auto& failure : result.failures) {
+            const Comparison& c = failure.run.comparison;
+            QuantityImage depth;
+            depth.quantity = ExportQuantity::Window, depth.width = c.report.width, depth.height = c.report.height;
+            depth.channels = {"window"}, depth.value = failure.run.raster.windowDepth.value;
+            depth.missValue = failure.run.raster.windowDepth.value.empty() ? 0 : NAN;
+            html << "<div class=\"failure\"><h3>" << htmlEscape(failure.label) << "</h3><p>" << htmlEscape(failure.what)
+                 << "</p><img title=\"raster depth\" src=\"" << pngDataUri(depth.width, depth.height, previewRgb(depth))
+                 << "\"><img title=\"error heatmap\" src=\"" << pngDataUri(depth.width, depth.height, errorHeatmapRgb(c))
+                 << "\"><img title=\"coverage classes\" src=\"" << pngDataUri(depth.width, depth.height, pixelClassRgb(c))
+                 << "\"><pre>" << htmlEscape(formatSummary(failure.run.report)) << "</pre></div>";
+        }
+        html << "</body></html>\n";
+        writeTextFileAtomically(o.htmlFile, html.str());
+    }
+    return result.passed() ? kExitConsistent : kExitInconsistent;
+}
+
 }  // namespace
 
 int main(int argc, char** argv)
@@ -424,6 +572,18 @@ int main(int argc, char** argv)
     exportCommand->add_option("--scale", exportOptions.scale, "16-bit PNG: stored = value x scale (e.g. 1000 = millimetres)");
     exportCommand->add_option("--preview", exportOptions.preview, "also write an 8-bit colour-mapped PNG of the first quantity");
 
+    SuiteOptions suite;
+    CLI::App* suiteCommand = app.add_subcommand(
+        "suite", "Run the consistency suite: every configuration clean (no false positive allowed) and with each\n"
+                 "fault of the catalogue injected into one route (each applicable fault must be detected).\n"
+                 "Exit status 0 only when both hold.");
+    suiteCommand->add_flag("--quick", suite.quick, "a representative subset (what CTest runs)");
+    suiteCommand->add_option("--filter", suite.filter, "only configurations whose label contains TEXT");
+    suiteCommand->add_option("--json", suite.jsonFile, "write the results as JSON");
+    suiteCommand->add_option("--html", suite.htmlFile, "write a self-contained HTML report with images of every failure");
+    suiteCommand->add_option("--models", suite.modelsDir, "folder of the shared meshes")->capture_default_str();
+    suiteCommand->add_option("--threads", suite.threads, "worker threads (default: all cores)");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -442,6 +602,7 @@ int main(int argc, char** argv)
         if (matricesCommand->parsed()) return runMatricesCommand(matricesCamera, matricesConvention);
         if (unprojectCommand->parsed()) return runUnprojectCommand(unproject);
         if (exportCommand->parsed()) return runExportCommand(exportOptions);
+        if (suiteCommand->parsed()) return runSuiteCommand(suite);
         if (precisionCommand->parsed())
             return runPrecisionCommand(precisionCamera, precisionConvention, precisionAt, precisionJson);
     } catch (const zcheck::Error& e) {

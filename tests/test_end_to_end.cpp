@@ -287,3 +287,25 @@ TEST_CASE("PLY triangle strips: restarts, alternating winding, unsigned restarts
     }
     (void)dir;
 }
+
+TEST_CASE("regression: with an infinite far plane every coverage mismatch was explained as lying on the far plane", "[e2e][regression]")
+{
+    // |t − tFar| ≤ ε·tFar with tFar = +inf is inf ≤ inf: every ray-only pixel counted as
+    // "on the far plane". Found by the suite: with far = inf, a raster that draws nothing at
+    // all looked consistent.
+    const Scene scene = builtinScene("builtin:default");
+    CameraSpec spec = scene.defaultCamera;
+    spec.projection.far = INFINITY;
+    for (bool reversed : {false, true}) {
+        spec.depth.reversed = reversed;
+        const Camera camera(spec);
+        const RenderResult ray = RayRenderer(scene).render(camera);
+        RenderResult empty = ray;  // the same size, nothing drawn
+        std::fill(empty.primitiveId.begin(), empty.primitiveId.end(), kNoPrimitive);
+        std::fill(empty.windowDepth.value.begin(), empty.windowDepth.value.end(), camera.clearDepth());
+        const ComparisonReport r = compareRoutes(scene, camera, ray, empty).report;
+        INFO(describe(spec, r));
+        REQUIRE(r.coverageUnexplained > 10000);
+        REQUIRE_FALSE(r.consistent());
+    }
+}

@@ -2,6 +2,7 @@
 // float32 and unorm24, standard and reversed (and with an infinite far plane where it
 // applies), on built-in scenes and the shared meshes.
 #include "check.h"
+#include "suite.h"
 
 #include "zcheck/mesh_loader.h"
 
@@ -15,84 +16,12 @@ namespace {
 
 const std::string kModels = ZCHECK_MODELS_DIR;
 
-struct NamedCamera {
-    std::string name;
-    CameraSpec spec;
-};
-
-// The models, all framing what the scene's own (perspective) camera frames.
-std::vector<NamedCamera> cameraModels(const Scene& scene)
-{
-    CameraSpec base = scene.defaultCamera;
-    base.width = 320, base.height = 240;
-    const Camera reference(base);
-    const double n = base.projection.near, f = base.projection.far;
-    const double distance = glm::length(base.view.target - base.view.eye);
-    const double tanHalf = std::tan(glm::radians(base.projection.fovyDeg) / 2), aspect = 320.0 / 240.0;
-    std::vector<NamedCamera> out;
-    auto add = [&](const std::string& name, CameraSpec spec) { out.push_back({name, spec}); };
-
-    add("perspective", base);
-    CameraSpec infinite = base;
-    infinite.projection.far = INFINITY;
-    add("perspective far=inf", infinite);
-
-    CameraSpec frustum = base;
-    frustum.projection.type = ProjectionType::Frustum;
-    frustum.projection.left = -0.6 * n * tanHalf * aspect, frustum.projection.right = 1.1 * n * tanHalf * aspect;
-    frustum.projection.bottom = -0.9 * n * tanHalf, frustum.projection.top = 0.7 * n * tanHalf;
-    add("frustum (off-axis)", frustum);
-
-    CameraSpec pinhole = base;
-    pinhole.projection.type = ProjectionType::Pinhole;
-    pinhole.projection.fx = 120.0 / tanHalf * 1.02, pinhole.projection.fy = 120.0 / tanHalf;
-    pinhole.projection.cx = (320 - 1) / 2.0 + 13.5, pinhole.projection.cy = (240 - 1) / 2.0 - 7.25;
-    add("pinhole", pinhole);
-
-    CameraSpec lens = base;
-    lens.projection.type = ProjectionType::Lens;
-    lens.projection.focalMm = 18.0 / (tanHalf * aspect);
-    add("lens", lens);
-
-    CameraSpec ortho = base;
-    ortho.projection.type = ProjectionType::Orthographic;
-    const double halfHeight = distance * tanHalf;
-    ortho.projection.left = -halfHeight * aspect, ortho.projection.right = halfHeight * aspect * 0.9;
-    ortho.projection.bottom = -halfHeight * 1.1, ortho.projection.top = halfHeight;
-    add("orthographic", ortho);
-
-    for (auto [name, lambda, angle] : {std::tuple{"oblique cavalier", 1.0, 45.0}, std::tuple{"oblique cabinet", 0.5, 63.4}}) {
-        CameraSpec oblique = ortho;
-        oblique.projection.type = ProjectionType::Oblique;
-        oblique.projection.foreshortening = lambda, oblique.projection.angleDeg = angle;
-        // Keep the sheared depth range short so that the scene stays in view.
-        oblique.projection.near = std::max(n, distance * 0.5), oblique.projection.far = distance * 1.6;
-        add(name, oblique);
-    }
-    for (auto [kind, azimuth, elevation] : {std::tuple{"isometric", 45.0, 35.2643896827547}, std::tuple{"dimetric", 45.0, 30.0},
-                                            std::tuple{"trimetric", 25.0, 20.0}}) {
-        CameraSpec axonometric = ortho;
-        axonometric.view = View::axonometricView(kind, base.view.target, distance, azimuth, elevation);
-        axonometric.projection.near = distance * 0.05, axonometric.projection.far = distance * 3;
-        add(std::string("axonometric ") + kind, axonometric);
-    }
-
-    CameraSpec matrix = base;  // the perspective camera's own matrices, pasted raw
-    matrix.projection.type = ProjectionType::Matrix;
-    matrix.projection.clipFromEye = reference.clipFromEye;
-    matrix.view.hasMatrix = true;
-    matrix.view.eyeFromWorld = reference.eyeFromWorld;
-    add("matrix", matrix);
-    (void)f;
-    return out;
-}
-
 void requireEveryModelConsistent(const std::string& sceneName)
 {
     const Scene scene = loadScene(sceneName);
     const RayRenderer rays(scene);
     const RasterRenderer raster(scene);
-    for (const NamedCamera& model : cameraModels(scene))
+    for (const NamedCamera& model : cameraModels(scene, 320, 240))
         for (const auto& convention : Convention::presetNames())
             for (DepthFormat format : {DepthFormat::Float32, DepthFormat::Unorm24})
                 for (bool reversed : {false, true}) {

@@ -131,8 +131,9 @@ struct TriangleView {
         const glm::dvec3 normal = glm::cross(vertex(primitive, 1) - a, vertex(primitive, 2) - a);
         const double t = glm::dot(normal, a - ray.origin) / glm::dot(normal, ray.direction);
         const double epsilon = std::ldexp(1.0, -20);
+        // An infinite far plane has no surface to lie on (inf <= inf must not explain anything).
         return std::isfinite(t) && (std::abs(t - ray.tNear) <= epsilon * std::abs(ray.tNear) ||
-                                    std::abs(t - ray.tFar) <= epsilon * std::abs(ray.tFar));
+                                    (std::isfinite(ray.tFar) && std::abs(t - ray.tFar) <= epsilon * ray.tFar));
     }
     bool nearEdge(const Camera& camera, std::uint32_t primitive, const glm::dvec2& pWindow, double radius) const
     {

@@ -12,7 +12,9 @@
 #include <cctype>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
+#include <unistd.h>
 
 namespace zcheck {
 
@@ -43,6 +45,29 @@ void writePng8(const std::string& path, int width, int height, const std::vector
 {
     OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
     writeImage(path, spec, rgb.data());
+}
+
+std::string pngDataUri(int width, int height, const std::vector<std::uint8_t>& rgb)
+{
+    const std::filesystem::path file = std::filesystem::temp_directory_path() /
+                                       ("zcheck-" + std::to_string(::getpid()) + "-inline.png");
+    writePng8(file.string(), width, height, rgb);
+    std::ifstream in(file, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::error_code ignored;
+    std::filesystem::remove(file, ignored);
+    static const char digits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out = "data:image/png;base64,";
+    for (std::size_t i = 0; i < bytes.size(); i += 3) {
+        const std::uint32_t n = (std::uint32_t(std::uint8_t(bytes[i])) << 16) |
+                                (i + 1 < bytes.size() ? std::uint32_t(std::uint8_t(bytes[i + 1])) << 8 : 0) |
+                                (i + 2 < bytes.size() ? std::uint32_t(std::uint8_t(bytes[i + 2])) : 0);
+        out += digits[(n >> 18) & 63];
+        out += digits[(n >> 12) & 63];
+        out += i + 1 < bytes.size() ? digits[(n >> 6) & 63] : '=';
+        out += i + 2 < bytes.size() ? digits[n & 63] : '=';
+    }
+    return out;
 }
 
 DepthMapFile readDepthMap(const std::string& path, const std::string& preferredChannel, double scale)

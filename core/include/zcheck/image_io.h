@@ -46,6 +46,9 @@ std::string writeQuantityFile(const std::string& path, const std::vector<Quantit
 // (near dark blue, far yellow), normals as RGB = (n + 1)/2, ids hashed to colours; misses black.
 std::vector<std::uint8_t> previewRgb(const QuantityImage& image);
 
+// An 8-bit RGB PNG as a data: URI (base64), for self-contained HTML reports.
+std::string pngDataUri(int width, int height, const std::vector<std::uint8_t>& rgb);
+
 // The check's pictures:
 //   error heatmap — |Δ| / tolerance on both-hit pixels: black 0, through blue and green to
 //                   yellow at 1 (the tolerance), red above; unexplained coverage magenta;

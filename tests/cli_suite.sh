@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# zcheck suite --quick: every clean configuration consistent, every applicable fault
+# detected, JSON and a self-contained HTML report written.
+set -eu
+zcheck=$1
+models=$2
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+"$zcheck" suite --quick --models "$models" --json "$tmp/suite.json" --html "$tmp/suite.html" > "$tmp/table.txt"
+grep -q "verdict    PASSED" "$tmp/table.txt"
+python3 - "$tmp" <<'PY'
+import json, sys
+tmp = sys.argv[1]
+r = json.load(open(f"{tmp}/suite.json"))
+assert r["passed"] is True and r["false_positives"] == 0 and r["missed_faults"] == 0, r["detection"]
+assert len(r["configurations"]) >= 10
+assert len(r["detection"]) == 16
+for name, row in r["detection"].items():
+    assert row["detected"] == row["applicable"], (name, row)
+# Every fault is applicable somewhere even in the quick subset.
+assert all(row["applicable"] > 0 for row in r["detection"].values()), r["detection"]
+html = open(f"{tmp}/suite.html").read()
+assert "<h1>zcheck suite: PASSED</h1>" in html and "http" not in html.replace("charset", "")
+PY
+# --filter narrows the matrix; a filter matching nothing is a usage error.
+"$zcheck" suite --quick --models "$models" --filter "pinhole" > "$tmp/pinhole.txt"
+grep -q "configurations x 16 faults" "$tmp/pinhole.txt"
+set +e
+"$zcheck" suite --quick --models "$models" --filter "no such configuration" > /dev/null 2>&1
+status=$?
+set -e
+[[ $status -eq 2 ]]
+echo "cli_suite: 1 passed, 0 failed"
