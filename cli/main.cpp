@@ -2,6 +2,7 @@
 // Exit status: 0 consistent, 1 inconsistent, 2 usage or input error (one line on stderr).
 #include "check.h"
 #include "suite.h"
+#include "verify.h"
 
 #include "zcheck/atomic_file.h"
 #include "zcheck/camera_file.h"
@@ -51,7 +52,7 @@ std::vector<float> asFloats(const DepthImage& image)
     return std::vector<float>(image.value.begin(), image.value.end());
 }
 
-void writeOutputs(const std::string& dir, const CheckRun& run)
+void writeOutputs(const std::string& dir, const CheckRun& run, const char* rasterName = "raster_depth.exr")
 {
     namespace fs = std::filesystem;
     std::error_code ec;
@@ -60,7 +61,7 @@ void writeOutputs(const std::string& dir, const CheckRun& run)
     const int W = run.comparison.report.width, H = run.comparison.report.height;
     const auto path = [&](const char* name) { return (fs::path(dir) / name).string(); };
     writeExr(path("ray_depth.exr"), W, H, {"window"}, asFloats(run.ray.windowDepth));
-    writeExr(path("raster_depth.exr"), W, H, {"window"}, asFloats(run.raster.windowDepth));
+    writeExr(path(rasterName), W, H, {"window"}, asFloats(run.raster.windowDepth));
     writePng8(path("error_heatmap.png"), W, H, errorHeatmapRgb(run.comparison));
     writePng8(path("coverage_classes.png"), W, H, pixelClassRgb(run.comparison));
     writeTextFileAtomically(path("report.json"), prettyJson(toJson(run.report)) + "\n");
@@ -332,6 +333,72 @@ int runExportCommand(const ExportOptions& o)
     return kExitConsistent;
 }
 
+struct VerifyOptions {
+    std::string scene = "builtin:default", cameraFile, convention, depthMap, quantity = "window", outDir;
+    double scale = 0;
+    bool diagnose = false, json = false;
+};
+
+int runVerifyCommand(const VerifyOptions& o)
+{
+    const DepthQuantity quantity = depthQuantityFromName(o.quantity);
+    const Scene scene = loadScene(o.scene);
+    CameraSpec spec = o.cameraFile.empty() ? scene.defaultCamera : readCameraFile(o.cameraFile);
+    if (!o.convention.empty()) spec.convention = Convention::preset(o.convention);
+    const Camera camera(spec);
+    const DepthMapFile file = readDepthMap(o.depthMap, channelNameOf(exportQuantitiesFromList(o.quantity).front()), o.scale);
+    if (file.width != camera.width() || file.height != camera.height())
+        throw Error("depth map '" + o.depthMap + "' is " + std::to_string(file.width) + "x" + std::to_string(file.height) +
+                    " but the camera's image is " + std::to_string(camera.width()) + "x" + std::to_string(camera.height()));
+    ExternalDepthMap map{file.width, file.height, quantity, file.value, o.scale > 0 ? 1.0 / o.scale : 0.0};
+    RayRenderer rays(scene);
+    const VerifyRun run = verifyDepthMap(scene, camera, map, rays);
+    nlohmann::json report = toJson(run.report);
+    report["depth_map"] = {{"file", o.depthMap}, {"quantity", o.quantity}, {"channel", file.channel}, {"scale", o.scale}};
+    std::vector<Hypothesis> hypotheses;
+    if (o.diagnose && !run.comparison.report.consistent()) {
+        hypotheses = diagnoseDepthMap(scene, camera, map, rays);
+        nlohmann::json list = nlohmann::json::array();
+        for (const auto& h : hypotheses)
+            list.push_back({{"hypothesis", h.name}, {"explanation", h.explanation}, {"consistent", h.consistent},
+                            {"unexplained", h.unexplained}});
+        report["diagnosis"] = list;
+    }
+    if (o.json) {
+        std::cout << prettyJson(report) << "\n";
+    } else {
+        std::string summary = formatSummary(run.report);
+        const std::string from = "ray route (Embree) vs raster route (z-buffer)";
+        summary.replace(summary.find(from), from.size(), "ground truth (Embree) vs depth map '" + o.depthMap + "' (" + o.quantity + ")");
+        std::cout << summary;
+        if (o.diagnose && !run.comparison.report.consistent()) {
+            const Hypothesis* best = nullptr;
+            for (const auto& h : hypotheses)
+                if (h.consistent) {
+                    best = &h;
+                    break;
+                }
+            std::cout << "\ndiagnosis  ";
+            if (best) {
+                std::cout << best->explanation << "\n";
+            } else {
+                const Hypothesis* closest = &hypotheses.front();
+                for (const auto& h : hypotheses)
+                    if (h.unexplained < closest->unexplained) closest = &h;
+                std::cout << "none of the " << hypotheses.size() << " hypotheses makes the map consistent (closest: "
+                          << closest->name << ", " << closest->unexplained << " unexplained pixels)\n";
+            }
+        }
+    }
+    if (!o.outDir.empty()) {
+        CheckRun asCheck;
+        asCheck.ray = run.truth, asCheck.raster = run.map, asCheck.comparison = run.comparison, asCheck.report = run.report;
+        writeOutputs(o.outDir, asCheck, "map_depth.exr");
+        writeTextFileAtomically((std::filesystem::path(o.outDir) / "report.json").string(), prettyJson(report) + "\n");
+    }
+    return run.comparison.report.consistent() ? kExitConsistent : kExitInconsistent;
+}
+
 struct SuiteOptions {
     bool quick = false;
     std::string filter, jsonFile, htmlFile, modelsDir = ZCHECK_MODELS_DIR;
@@ -572,6 +639,22 @@ int main(int argc, char** argv)
     exportCommand->add_option("--scale", exportOptions.scale, "16-bit PNG: stored = value x scale (e.g. 1000 = millimetres)");
     exportCommand->add_option("--preview", exportOptions.preview, "also write an 8-bit colour-mapped PNG of the first quantity");
 
+    VerifyOptions verify;
+    CLI::App* verifyCommand = app.add_subcommand(
+        "verify", "Compare a depth map rendered elsewhere (a GPU, an engine, Blender, a simulator) against Embree's\n"
+                  "ground truth for the same scene and camera, with the same tolerance model, report and exit codes\n"
+                  "as check; --diagnose names the classic mistake that explains an inconsistent map.");
+    verifyCommand->add_option("--scene", verify.scene, "as for check")->capture_default_str();
+    verifyCommand->add_option("--camera", verify.cameraFile, "camera file the map was rendered with; default: the scene's");
+    verifyCommand->add_option("--convention", verify.convention, "override the convention");
+    verifyCommand->add_option("--depth-map", verify.depthMap, "EXR, PFM, TIFF, or 16-bit PNG with --scale")->required();
+    verifyCommand->add_option("--quantity", verify.quantity, "what the map holds: window | ndc | eye-z | distance")
+        ->capture_default_str();
+    verifyCommand->add_option("--scale", verify.scale, "stored value = depth x scale (required for integer files)");
+    verifyCommand->add_flag("--diagnose", verify.diagnose, "when inconsistent, test the classic hypotheses and name the one that fits");
+    verifyCommand->add_option("--out", verify.outDir, "write truth and map depth EXRs, heatmap, classes and report.json");
+    verifyCommand->add_flag("--json", verify.json, "print the report as JSON");
+
     SuiteOptions suite;
     CLI::App* suiteCommand = app.add_subcommand(
         "suite", "Run the consistency suite: every configuration clean (no false positive allowed) and with each\n"
@@ -603,6 +686,7 @@ int main(int argc, char** argv)
         if (unprojectCommand->parsed()) return runUnprojectCommand(unproject);
         if (exportCommand->parsed()) return runExportCommand(exportOptions);
         if (suiteCommand->parsed()) return runSuiteCommand(suite);
+        if (verifyCommand->parsed()) return runVerifyCommand(verify);
         if (precisionCommand->parsed())
             return runPrecisionCommand(precisionCamera, precisionConvention, precisionAt, precisionJson);
     } catch (const zcheck::Error& e) {

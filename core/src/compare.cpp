@@ -115,9 +115,11 @@ struct TriangleView {
     {
         return glm::dvec3(scene.positions[scene.triangles[primitive][corner]]);
     }
+    bool known(std::uint32_t primitive) const { return primitive < scene.triangles.size(); }
     // m is a property of the triangle's plane, the same at every pixel: computed once.
     double slope(const Camera& camera, std::uint32_t primitive) const
     {
+        if (!known(primitive)) return 0.0;
         double& m = slopeCache[primitive];
         if (std::isnan(m)) m = windowDepthSlope(camera, vertex(primitive, 0), vertex(primitive, 1), vertex(primitive, 2));
         return m;
@@ -126,6 +128,7 @@ struct TriangleView {
     // binary32 rounding (2^-20 relative) of the distances where the routes clip?
     bool atClipPlane(const Camera& camera, std::uint32_t primitive, const glm::dvec2& pWindow) const
     {
+        if (!known(primitive)) return false;
         const EyePlaneRay ray = worldEyePlaneRayThroughWindow(camera, pWindow);
         const glm::dvec3 a = vertex(primitive, 0);
         const glm::dvec3 normal = glm::cross(vertex(primitive, 1) - a, vertex(primitive, 2) - a);
@@ -137,7 +140,7 @@ struct TriangleView {
     }
     bool nearEdge(const Camera& camera, std::uint32_t primitive, const glm::dvec2& pWindow, double radius) const
     {
-        if (primitive == kNoPrimitive) return false;
+        if (!known(primitive)) return false;
         return distanceToDrawnEdge(camera, vertex(primitive, 0), vertex(primitive, 1), vertex(primitive, 2),
                                    pWindow) <= radius;
     }
@@ -151,7 +154,8 @@ bool isUnexplained(PixelClass c)
 }  // namespace
 
 Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderResult& ray,
-                         const RenderResult& raster, const ToleranceModel& tolerance)
+                         const RenderResult& raster, const ToleranceModel& tolerance,
+                         const std::vector<double>* rasterQuantum)
 {
     const int W = camera.width(), H = camera.height();
     Comparison out;
@@ -186,7 +190,7 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
                 f.pixelClass = PixelClass::BothMiss;
             } else if (rayHit && rasterHit) {
                 ++r.bothHit;
-                const double q = storageQuantum(format, f.rayWindowDepth);
+                const double q = rasterQuantum ? (*rasterQuantum)[i] : storageQuantum(format, f.rayWindowDepth);
                 const double error = std::abs(f.rasterWindowDepth - f.rayWindowDepth);
                 const bool samePrimitive = f.rayPrimitive == f.rasterPrimitive;
                 const double mRay = triangles.slope(camera, f.rayPrimitive);
@@ -234,9 +238,9 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
                 // triangle, (ray route only) at the clear value, or on the near/far plane.
                 rayHit ? ++r.rayOnly : ++r.rasterOnly;
                 const std::uint32_t primitive = rayHit ? f.rayPrimitive : f.rasterPrimitive;
+                const double q = rasterQuantum ? (*rasterQuantum)[i] : storageQuantum(format, f.rayWindowDepth);
                 const bool atClear =
-                    rayHit && std::abs(f.rayWindowDepth - camera.clearDepth()) <=
-                                  C * storageQuantum(format, f.rayWindowDepth) + S * triangles.slope(camera, primitive) + E;
+                    rayHit && std::abs(f.rayWindowDepth - camera.clearDepth()) <= C * q + S * triangles.slope(camera, primitive) + E;
                 if (triangles.nearEdge(camera, primitive, pWindow, S)) {
                     f.pixelClass = rayHit ? PixelClass::RayOnlyEdge : PixelClass::RasterOnlyEdge;
                 } else if (atClear) {

@@ -123,9 +123,15 @@ struct Comparison {
 };
 
 // Compares two renders of `scene` through `camera`. `ray` must carry exact depths (the ray
-// route); `raster` holds stored depth-buffer values.
+// route); `raster` holds stored depth-buffer values. `rasterQuantum`, when given, is the
+// storage quantum of each raster pixel in window-depth units (a map stored as eye-z or
+// distance, or as scaled integers); otherwise q comes from the camera's depth format.
+// A raster primitive id that is not a triangle of the scene (kUnknownPrimitive) marks a hit
+// whose surface is unknown: it earns no edge or clip-plane explanation and no slope credit.
+constexpr std::uint32_t kUnknownPrimitive = 0xFFFFFFFEu;
 Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderResult& ray,
-                         const RenderResult& raster, const ToleranceModel& tolerance = {});
+                         const RenderResult& raster, const ToleranceModel& tolerance = {},
+                         const std::vector<double>* rasterQuantum = nullptr);
 
 // Window-depth slope m of a world-space triangle's plane, per pixel (may be +inf for a plane
 // seen edge-on).

@@ -1,0 +1,49 @@
+#pragma once
+// Verifying a depth map rendered elsewhere (a GPU, an engine, Blender, a simulator) against
+// Embree's ground truth for the same scene and camera, with the same tolerance model, and
+// diagnosing a failure by testing the classic hypotheses.
+#include "check.h"
+
+#include <string>
+#include <vector>
+
+namespace zcheck {
+
+struct ExternalDepthMap {
+    int width = 0, height = 0;
+    DepthQuantity quantity = DepthQuantity::Window;
+    std::vector<double> value;   // row 0 at the top; misses as eyePointFromDepth defines them
+    double valueQuantum = 0;     // the storage step of `value` (1/scale for integer files); 0: binary32
+};
+
+// The map as the raster side of a comparison: window depth per pixel, a hit where the value is
+// not a miss. The map does not say which surface it saw: each hit takes the ground-truth
+// triangle, at the pixel or one of its 8 neighbours, whose plane at this pixel is closest to
+// the map's depth (kUnknownPrimitive if there is none). `quantum` receives each pixel's
+// storage step in window units.
+RenderResult renderResultFromMap(const Scene& scene, const Camera& camera, const ExternalDepthMap& map,
+                                 const RenderResult& truth, std::vector<double>& quantum);
+
+struct VerifyRun {
+    RenderResult truth;       // the ray route
+    RenderResult map;         // the external map as a render result
+    Comparison comparison;
+    CheckReport report;
+};
+VerifyRun verifyDepthMap(const Scene& scene, const Camera& camera, const ExternalDepthMap& map, RayRenderer& rays);
+
+struct Hypothesis {
+    std::string name;         // e.g. "distance-as-eye-z"
+    std::string explanation;  // "consistent if read as ray distance instead of eye-z"
+    bool consistent = false;
+    std::int64_t unexplained = 0;
+};
+
+// Tests each classic hypothesis (flips, half-pixel shifts, the other NDC depth range,
+// reversed, linear or eye-z depth passed as window depth, distance vs eye-z, transposed or
+// other-handed matrix, small field-of-view and aspect errors) by re-reading the map or
+// re-rendering the ground truth under it; returns them all, in order of simplicity.
+std::vector<Hypothesis> diagnoseDepthMap(const Scene& scene, const Camera& camera, const ExternalDepthMap& map,
+                                         RayRenderer& rays);
+
+}  // namespace zcheck
