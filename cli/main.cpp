@@ -450,9 +450,9 @@ std::string suiteTable(const SuiteResult& result)
                       tally[k].missed ? "<- MISSED" : "");
         out << line;
     }
-    out << "\n(detected / applicable; not applicable: the fault leaves that picture unchanged within the tolerance\n"
-           " model, e.g. truncating a float buffer; n/a: the mistake has no meaning there, e.g. a field-of-view\n"
-           " mistake on an orthographic camera)\n";
+    out << "\n(detected / applicable. Not applicable: the fault leaves that picture visibly unchanged - the same\n"
+           " coverage, depth within twice the snapping noise - e.g. no near clipping where nothing crosses the near\n"
+           " plane. n/a: the mistake has no meaning there, e.g. a field-of-view mistake on an orthographic camera.)\n";
     return out.str();
 }
 

@@ -2,7 +2,10 @@
 
 #include "zcheck/inverse_projection.h"
 
+#include <algorithm>
 #include <chrono>
+#include <memory>
+#include <unordered_map>
 #include <cmath>
 #include <functional>
 
@@ -24,19 +27,62 @@ double windowDepthOfValue(const Camera& camera, const glm::dvec2& pWindow, doubl
 }  // namespace
 
 // Window depth of a triangle's plane where the pixel's ray meets it (NaN if it does not).
-double planeWindowDepth(const Scene& scene, const Camera& camera, std::uint32_t primitive, const glm::dvec2& pWindow)
+double planeWindowDepth(const Scene& scene, const Camera& camera, std::uint32_t primitive, const EyePlaneRay& ray)
 {
     const glm::uvec3 t = scene.triangles[primitive];
     const glm::dvec3 a(scene.positions[t[0]]), b(scene.positions[t[1]]), c(scene.positions[t[2]]);
     const glm::dvec3 normal = glm::cross(b - a, c - a);
-    const EyePlaneRay ray = worldEyePlaneRayThroughWindow(camera, pWindow);
     const double s = glm::dot(normal, a - ray.origin) / glm::dot(normal, ray.direction);
     return std::isfinite(s) ? windowFromWorld(camera, ray.origin + s * ray.direction).z : NAN;
 }
 
+namespace {
+
+// Triangles around each vertex position (positions, not indices: loaders duplicate vertices).
+class VertexNeighbours {
+public:
+    explicit VertexNeighbours(const Scene& scene) : scene_(scene)
+    {
+        for (std::uint32_t t = 0; t < scene.triangles.size(); ++t)
+            for (int k = 0; k < 3; ++k) around_[key(scene.positions[scene.triangles[t][k]])].push_back(t);
+    }
+    // `primitive` and every triangle that shares a vertex position with it.
+    template <class Visit>
+    void forEachNeighbour(std::uint32_t primitive, Visit&& visit) const
+    {
+        for (int k = 0; k < 3; ++k) {
+            const auto found = around_.find(key(scene_.positions[scene_.triangles[primitive][k]]));
+            for (std::uint32_t t : found->second) visit(t);
+        }
+    }
+
+private:
+    static std::string key(const glm::vec3& p) { return std::string(reinterpret_cast<const char*>(&p), sizeof p); }
+    const Scene& scene_;
+    std::unordered_map<std::string, std::vector<std::uint32_t>> around_;
+};
+
+}  // namespace
+
+namespace {
+// Built once per scene: verifying and diagnosing compare one scene many times.
+const VertexNeighbours& neighboursOf(const Scene& scene)
+{
+    static const Scene* cachedScene = nullptr;
+    static std::size_t cachedTriangles = 0;
+    static std::unique_ptr<VertexNeighbours> cached;
+    if (cachedScene != &scene || cachedTriangles != scene.triangles.size() || !cached) {
+        cached = std::make_unique<VertexNeighbours>(scene);
+        cachedScene = &scene, cachedTriangles = scene.triangles.size();
+    }
+    return *cached;
+}
+}  // namespace
+
 RenderResult renderResultFromMap(const Scene& scene, const Camera& camera, const ExternalDepthMap& map,
                                  const RenderResult& truth, std::vector<double>& quantum)
 {
+    const VertexNeighbours& neighbours = neighboursOf(scene);
     const int W = camera.width(), H = camera.height();
     RenderResult out;
     out.windowDepth = {W, H, DepthQuantity::Window, std::vector<double>(std::size_t(W) * H, camera.clearDepth())};
@@ -63,18 +109,43 @@ RenderResult renderResultFromMap(const Scene& scene, const Camera& camera, const
             }
             if (!std::isfinite(depth)) continue;
             out.windowDepth.value[i] = depth;
-            // Which surface did the map see? The ground-truth triangle here or next door whose
-            // plane is closest to the map's depth at this pixel.
+            // Which surface did the map see? Among the ground-truth triangles within 2 pixels and
+            // their mesh neighbours, the one whose plane is closest to the map's depth here.
+            // Preference: a plane within the tolerance model of the map's depth whose drawn region
+            // holds (or nearly holds) the pixel centre; then simply the closest plane.
             std::uint32_t primitive = kUnknownPrimitive;
-            double closest = INFINITY;
-            for (int dy = -1; dy <= 1; ++dy)
-                for (int dx = -1; dx <= 1; ++dx) {
+            double closest = INFINITY, bestReach = INFINITY;
+            const EyePlaneRay ray = worldEyePlaneRayThroughWindow(camera, pWindow);
+            std::vector<std::uint32_t> considered;
+            auto consider = [&](std::uint32_t candidate) {
+                if (std::find(considered.begin(), considered.end(), candidate) != considered.end()) return;
+                considered.push_back(candidate);
+                const double gap = std::abs(planeWindowDepth(scene, camera, candidate, ray) - depth);
+                const glm::uvec3 t = scene.triangles[candidate];
+                const glm::dvec3 a(scene.positions[t[0]]), b(scene.positions[t[1]]), c(scene.positions[t[2]]);
+                double reach = INFINITY;  // 0 inside the drawn triangle, else the distance to it
+                if (gap <= 8 * quantum[i] + ToleranceModel{}.snapPixels() * windowDepthSlope(camera, a, b, c))
+                    reach = insideDrawnTriangle(camera, a, b, c, pWindow) ? 0.0 : distanceToDrawnEdge(camera, a, b, c, pWindow);
+                if (reach < bestReach || (reach == bestReach && gap < closest))
+                    bestReach = reach, closest = gap, primitive = candidate;
+            };
+            const std::uint32_t here = truth.primitiveId[i];
+            if (here != kNoPrimitive) {
+                consider(here);  // ties go to the surface the ground truth sees
+                if (bestReach == 0 && closest <= 4 * quantum[i]) {  // the common case: the same surface
+                    out.primitiveId[i] = here;
+                    continue;
+                }
+            }
+            std::vector<std::uint32_t> seen;
+            for (int dy = -2; dy <= 2; ++dy)
+                for (int dx = -2; dx <= 2; ++dx) {
                     const int c = col + dx, r = row + dy;
                     if (c < 0 || c >= W || r < 0 || r >= H) continue;
-                    const std::uint32_t candidate = truth.primitiveId[std::size_t(r) * W + c];
-                    if (candidate == kNoPrimitive || candidate == primitive) continue;
-                    const double gap = std::abs(planeWindowDepth(scene, camera, candidate, pWindow) - depth);
-                    if (gap < closest || (gap == closest && (dx | dy) == 0)) closest = gap, primitive = candidate;
+                    const std::uint32_t nearby = truth.primitiveId[std::size_t(r) * W + c];
+                    if (nearby == kNoPrimitive || std::find(seen.begin(), seen.end(), nearby) != seen.end()) continue;
+                    seen.push_back(nearby);
+                    neighbours.forEachNeighbour(nearby, consider);
                 }
             out.primitiveId[i] = primitive;
         }

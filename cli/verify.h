@@ -17,9 +17,9 @@ struct ExternalDepthMap {
 };
 
 // The map as the raster side of a comparison: window depth per pixel, a hit where the value is
-// not a miss. The map does not say which surface it saw: each hit takes the ground-truth
-// triangle, at the pixel or one of its 8 neighbours, whose plane at this pixel is closest to
-// the map's depth (kUnknownPrimitive if there is none). `quantum` receives each pixel's
+// not a miss. The map does not say which surface it saw: each hit takes, among the
+// ground-truth triangles within 2 pixels and the triangles sharing a vertex with them, the one
+// whose plane at this pixel is closest to the map's depth (kUnknownPrimitive if none). `quantum` receives each pixel's
 // storage step in window units.
 RenderResult renderResultFromMap(const Scene& scene, const Camera& camera, const ExternalDepthMap& map,
                                  const RenderResult& truth, std::vector<double>& quantum);
