@@ -47,6 +47,24 @@ struct CheckOptions {
     int threads = 0;
 };
 
+// The camera a command uses: the camera file, or the scene's own camera; then --convention.
+CameraSpec cameraSpecFor(const Scene& scene, const std::string& cameraFile, const std::string& convention)
+{
+    CameraSpec spec = cameraFile.empty() ? scene.defaultCamera : readCameraFile(cameraFile);
+    if (!convention.empty()) spec.convention = Convention::preset(convention);
+    return spec;
+}
+
+// --scene, --camera and --convention, as check, export and verify take them.
+void addSceneAndCameraOptions(CLI::App* command, std::string& scene, std::string& cameraFile, std::string& convention)
+{
+    command->add_option("--scene", scene,
+                        "builtin:default | builtin:terrain[?n=N] | builtin:near-crossing | a mesh file (OBJ, PLY, glTF/glb)")
+        ->capture_default_str();
+    command->add_option("--camera", cameraFile, "camera file (JSON, see README); default: the scene's own camera");
+    command->add_option("--convention", convention, "override the convention: opengl | direct3d | vulkan | metal | opencv");
+}
+
 std::vector<float> asFloats(const DepthImage& image)
 {
     return std::vector<float>(image.value.begin(), image.value.end());
@@ -74,8 +92,7 @@ int runCheckCommand(const CheckOptions& options)
         threadLimit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
                                                             std::size_t(options.threads));
     const Scene scene = loadScene(options.scene);
-    CameraSpec spec = options.cameraFile.empty() ? scene.defaultCamera : readCameraFile(options.cameraFile);
-    if (!options.convention.empty()) spec.convention = Convention::preset(options.convention);
+    CameraSpec spec = cameraSpecFor(scene, options.cameraFile, options.convention);
     if (options.width) spec.width = *options.width;
     if (options.height) spec.height = *options.height;
     if (!options.depthFormat.empty()) spec.depth.format = depthFormatFromName(options.depthFormat);
@@ -281,8 +298,7 @@ int runExportCommand(const ExportOptions& o)
     if (o.output.empty()) throw Error("export needs -o FILE (.exr, .pfm, .tif or .png)");
     const std::vector<ExportQuantity> quantities = exportQuantitiesFromList(o.quantities);
     const Scene scene = loadScene(o.scene);
-    CameraSpec spec = o.cameraFile.empty() ? scene.defaultCamera : readCameraFile(o.cameraFile);
-    if (!o.convention.empty()) spec.convention = Convention::preset(o.convention);
+    CameraSpec spec = cameraSpecFor(scene, o.cameraFile, o.convention);
     const Camera camera(spec);
     const RenderResult route = o.backend == "ray" ? RayRenderer(scene).render(camera) : RasterRenderer(scene).render(camera);
     std::vector<QuantityImage> images;
@@ -343,8 +359,7 @@ int runVerifyCommand(const VerifyOptions& o)
 {
     const DepthQuantity quantity = depthQuantityFromName(o.quantity);
     const Scene scene = loadScene(o.scene);
-    CameraSpec spec = o.cameraFile.empty() ? scene.defaultCamera : readCameraFile(o.cameraFile);
-    if (!o.convention.empty()) spec.convention = Convention::preset(o.convention);
+    CameraSpec spec = cameraSpecFor(scene, o.cameraFile, o.convention);
     const Camera camera(spec);
     const DepthMapFile file = readDepthMap(o.depthMap, channelNameOf(exportQuantitiesFromList(o.quantity).front()), o.scale);
     if (file.width != camera.width() || file.height != camera.height())
@@ -524,7 +539,11 @@ int runSuiteCommand(const SuiteOptions& o)
              << "<h1>zcheck suite: " << (result.passed() ? "PASSED" : "FAILED") << "</h1><p>" << configs.size()
              << " configurations &times; " << faultCatalogue().size() << " faults, " << std::lround(seconds)
              << " s.</p><pre>" << htmlEscape(suiteTable(result)) << "</pre>";
-        html << "<h2>Failures" << (result.failures.empty() ? ": none" : "") << "</h2>";
+        const int allFailures = result.falsePositives + result.missedFaults;
+        html << "<h2>Failures" << (allFailures == 0 ? ": none" : "") << "</h2>";
+        if (allFailures > int(result.failures.size()))
+            html << "<p>Showing the first " << result.failures.size() << " of " << allFailures
+                 << " failures with images; the JSON report lists every configuration.</p>";
         for (const auto& failure : result.failures) {
             const Comparison& c = failure.run.comparison;
             QuantityImage depth;
@@ -558,14 +577,7 @@ int main(int argc, char** argv)
     CLI::App* checkCommand = app.add_subcommand(
         "check", "Check one scene through one camera: ray route vs raster route, per pixel.\n"
                  "Exit status 0 consistent, 1 inconsistent, 2 usage or input error.");
-    checkCommand->add_option("--scene", check.scene,
-                             "builtin:default | builtin:terrain[?n=N] | builtin:near-crossing | a mesh file "
-                             "(OBJ, PLY, glTF/glb)")
-        ->capture_default_str();
-    checkCommand->add_option("--camera", check.cameraFile,
-                             "camera file (JSON, see README); default: the scene's own camera");
-    checkCommand->add_option("--convention", check.convention,
-                             "override the convention: opengl | direct3d | vulkan | metal | opencv");
+    addSceneAndCameraOptions(checkCommand, check.scene, check.cameraFile, check.convention);
     checkCommand->add_option("--width", check.width, "override the image width in pixels (1..16384)");
     checkCommand->add_option("--height", check.height, "override the image height in pixels (1..16384)");
     checkCommand->add_option("--depth-format", check.depthFormat, "override the depth format: float32 | unorm24 | unorm16");
@@ -632,9 +644,7 @@ int main(int argc, char** argv)
                               "comma-separated: window, ndc, eye-z, distance, position-eye, position-world, normal, "
                               "primitive-id (several only into .exr)")
         ->capture_default_str();
-    exportCommand->add_option("--scene", exportOptions.scene, "as for check")->capture_default_str();
-    exportCommand->add_option("--camera", exportOptions.cameraFile, "camera file; default: the scene's own camera");
-    exportCommand->add_option("--convention", exportOptions.convention, "override the convention");
+    addSceneAndCameraOptions(exportCommand, exportOptions.scene, exportOptions.cameraFile, exportOptions.convention);
     exportCommand->add_option("-o,--output", exportOptions.output, "FILE.exr | .pfm | .tif | .png (written atomically)");
     exportCommand->add_option("--scale", exportOptions.scale, "16-bit PNG: stored = value x scale (e.g. 1000 = millimetres)");
     exportCommand->add_option("--preview", exportOptions.preview, "also write an 8-bit colour-mapped PNG of the first quantity");
@@ -644,9 +654,7 @@ int main(int argc, char** argv)
         "verify", "Compare a depth map rendered elsewhere (a GPU, an engine, Blender, a simulator) against Embree's\n"
                   "ground truth for the same scene and camera, with the same tolerance model, report and exit codes\n"
                   "as check; --diagnose names the classic mistake that explains an inconsistent map.");
-    verifyCommand->add_option("--scene", verify.scene, "as for check")->capture_default_str();
-    verifyCommand->add_option("--camera", verify.cameraFile, "camera file the map was rendered with; default: the scene's");
-    verifyCommand->add_option("--convention", verify.convention, "override the convention");
+    addSceneAndCameraOptions(verifyCommand, verify.scene, verify.cameraFile, verify.convention);
     verifyCommand->add_option("--depth-map", verify.depthMap, "EXR, PFM, TIFF, or 16-bit PNG with --scale")->required();
     verifyCommand->add_option("--quantity", verify.quantity, "what the map holds: window | ndc | eye-z | distance")
         ->capture_default_str();
