@@ -382,10 +382,7 @@ int runVerifyCommand(const VerifyOptions& o)
     if (o.json) {
         std::cout << prettyJson(report) << "\n";
     } else {
-        std::string summary = formatSummary(run.report);
-        const std::string from = "ray route (Embree) vs raster route (z-buffer)";
-        summary.replace(summary.find(from), from.size(), "ground truth (Embree) vs depth map '" + o.depthMap + "' (" + o.quantity + ")");
-        std::cout << summary;
+        std::cout << formatSummary(run.report, "ground truth (Embree) vs depth map '" + o.depthMap + "' (" + o.quantity + ")");
         if (o.diagnose && !run.comparison.report.consistent()) {
             const Hypothesis* best = nullptr;
             for (const auto& h : hypotheses)

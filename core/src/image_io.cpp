@@ -20,12 +20,15 @@ namespace zcheck {
 
 namespace {
 
-void writeImage(const std::string& path, const OIIO::ImageSpec& spec, const void* pixels)
+// `pixelFormat`: the buffer's format; UNKNOWN means each channel in spec.channelformats.
+void writeImage(const std::string& path, const OIIO::ImageSpec& spec, const void* pixels,
+                OIIO::TypeDesc pixelFormat = OIIO::TypeDesc::UNKNOWN)
 {
+    if (spec.channelformats.empty() && pixelFormat == OIIO::TypeDesc::UNKNOWN) pixelFormat = spec.format;
     writeAtomically(path, [&](const std::string& temporary) {
         auto out = OIIO::ImageOutput::create(temporary);
         if (!out) throw Error("cannot write '" + path + "': " + OIIO::geterror());
-        if (!out->open(temporary, spec) || !out->write_image(spec.format, pixels) || !out->close())
+        if (!out->open(temporary, spec) || !out->write_image(pixelFormat, pixels) || !out->close())
             throw Error("cannot write '" + path + "': " + out->geterror());
     });
 }
@@ -225,13 +228,7 @@ std::string writeQuantityFile(const std::string& path, const std::vector<Quantit
     spec.channelnames = names;
     if (mixed) spec.channelformats = formats;
     if (format == "exr") spec.attribute("compression", "zip");
-    writeAtomically(path, [&](const std::string& temporary) {
-        auto out = OIIO::ImageOutput::create(temporary);
-        if (!out) throw Error("cannot write '" + path + "': " + OIIO::geterror());
-        if (!out->open(temporary, spec) ||
-            !out->write_image(mixed ? OIIO::TypeDesc::UNKNOWN : spec.format, words.data()) || !out->close())
-            throw Error("cannot write '" + path + "': " + out->geterror());
-    });
+    writeImage(path, spec, words.data());
     return format;
 }
 

@@ -110,14 +110,14 @@ nlohmann::json toJson(const CheckReport& report)
     };
 }
 
-std::string formatSummary(const CheckReport& report)
+std::string formatSummary(const CheckReport& report, const std::string& comparing)
 {
     const ComparisonReport& c = report.comparison;
     const CameraSpec& cam = report.camera;
     const std::int64_t total = std::int64_t(c.width) * c.height;
     std::ostringstream out;
     char line[256];
-    out << "zcheck " << ZCHECK_VERSION << " — ray route (Embree) vs raster route (z-buffer)\n";
+    out << "zcheck " << ZCHECK_VERSION << " — " << comparing << "\n";
     out << "scene      " << report.scene << "  (" << report.triangles << " triangles)\n";
     std::snprintf(line, sizeof line, "camera     %s, %s, %dx%d, near %g, far %g\n", cam.convention.name.c_str(),
                   toString(cam.projection.type).c_str(), cam.width, cam.height, cam.projection.near,

@@ -89,9 +89,12 @@ void setupTriangle(const Viewport& vp, const glm::dvec4 (&pClip)[3], std::uint32
         X[k] = std::llround(pWindow.x * kSubpixel);
         Y[k] = std::llround(yImage * kSubpixel);
         // The fault "eye-z interpolated in screen space" interpolates eye-z instead of depth.
-        z[k] = vp.faults.screenLinearEyeZ ? vp.camera.eyeZOf(glm::dvec3(vp.camera.eyeFromClip * pClip[k]) /
-                                                             (vp.camera.eyeFromClip * pClip[k]).w)
-                                          : pWindow.z;
+        if (vp.faults.screenLinearEyeZ) {
+            const glm::dvec4 pEye = vp.camera.eyeFromClip * pClip[k];
+            z[k] = vp.camera.eyeZOf(glm::dvec3(pEye) / pEye.w);
+        } else {
+            z[k] = pWindow.z;
+        }
     }
     std::int64_t area2 = (X[1] - X[0]) * (Y[2] - Y[0]) - (Y[1] - Y[0]) * (X[2] - X[0]);
     if (area2 == 0) return;  // covers no sample point

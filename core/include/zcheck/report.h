@@ -30,7 +30,8 @@ nlohmann::json toJson(const CheckReport& report);
 // Invalid UTF-8 in strings (file names) is replaced, never thrown over.
 std::string prettyJson(const nlohmann::json& document);
 
-// The human-readable summary `zcheck check` prints.
-std::string formatSummary(const CheckReport& report);
+// The human-readable summary `zcheck check` prints; `comparing` names the two sides.
+std::string formatSummary(const CheckReport& report,
+                          const std::string& comparing = "ray route (Embree) vs raster route (z-buffer)");
 
 }  // namespace zcheck
