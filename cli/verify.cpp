@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <memory>
 #include <unordered_map>
 #include <cmath>
 #include <functional>
@@ -36,53 +35,19 @@ double planeWindowDepth(const Scene& scene, const Camera& camera, std::uint32_t 
     return std::isfinite(s) ? windowFromWorld(camera, ray.origin + s * ray.direction).z : NAN;
 }
 
-namespace {
 
-// Triangles around each vertex position (positions, not indices: loaders duplicate vertices).
-class VertexNeighbours {
-public:
-    explicit VertexNeighbours(const Scene& scene) : scene_(scene)
-    {
-        for (std::uint32_t t = 0; t < scene.triangles.size(); ++t)
-            for (int k = 0; k < 3; ++k) around_[key(scene.positions[scene.triangles[t][k]])].push_back(t);
-    }
-    // `primitive` and every triangle that shares a vertex position with it.
-    template <class Visit>
-    void forEachNeighbour(std::uint32_t primitive, Visit&& visit) const
-    {
-        for (int k = 0; k < 3; ++k) {
-            const auto found = around_.find(key(scene_.positions[scene_.triangles[primitive][k]]));
-            for (std::uint32_t t : found->second) visit(t);
-        }
-    }
-
-private:
-    static std::string key(const glm::vec3& p) { return std::string(reinterpret_cast<const char*>(&p), sizeof p); }
-    const Scene& scene_;
-    std::unordered_map<std::string, std::vector<std::uint32_t>> around_;
-};
-
-}  // namespace
-
-namespace {
-// Built once per scene: verifying and diagnosing compare one scene many times.
-const VertexNeighbours& neighboursOf(const Scene& scene)
+VertexNeighbours::VertexNeighbours(const Scene& scene) : scene_(scene)
 {
-    static const Scene* cachedScene = nullptr;
-    static std::size_t cachedTriangles = 0;
-    static std::unique_ptr<VertexNeighbours> cached;
-    if (cachedScene != &scene || cachedTriangles != scene.triangles.size() || !cached) {
-        cached = std::make_unique<VertexNeighbours>(scene);
-        cachedScene = &scene, cachedTriangles = scene.triangles.size();
-    }
-    return *cached;
+    for (std::uint32_t t = 0; t < scene.triangles.size(); ++t)
+        for (int k = 0; k < 3; ++k) around_[key(scene.positions[scene.triangles[t][k]])].push_back(t);
 }
-}  // namespace
+
+std::string VertexNeighbours::key(const glm::vec3& p) { return std::string(reinterpret_cast<const char*>(&p), sizeof p); }
 
 RenderResult renderResultFromMap(const Scene& scene, const Camera& camera, const ExternalDepthMap& map,
-                                 const RenderResult& truth, std::vector<double>& quantum)
+                                 const RenderResult& truth, const VertexNeighbours& neighbours,
+                                 std::vector<double>& quantum)
 {
-    const VertexNeighbours& neighbours = neighboursOf(scene);
     const int W = camera.width(), H = camera.height();
     RenderResult out;
     out.windowDepth = {W, H, DepthQuantity::Window, std::vector<double>(std::size_t(W) * H, camera.clearDepth())};
@@ -154,10 +119,16 @@ RenderResult renderResultFromMap(const Scene& scene, const Camera& camera, const
 
 VerifyRun verifyDepthMap(const Scene& scene, const Camera& camera, const ExternalDepthMap& map, RayRenderer& rays)
 {
+    return verifyDepthMap(scene, camera, map, rays, VertexNeighbours(scene));
+}
+
+VerifyRun verifyDepthMap(const Scene& scene, const Camera& camera, const ExternalDepthMap& map, RayRenderer& rays,
+                         const VertexNeighbours& neighbours)
+{
     VerifyRun run;
     run.truth = rays.render(camera);
     std::vector<double> quantum;
-    run.map = renderResultFromMap(scene, camera, map, run.truth, quantum);
+    run.map = renderResultFromMap(scene, camera, map, run.truth, neighbours, quantum);
     const auto start = std::chrono::steady_clock::now();
     run.comparison = compareRoutes(scene, camera, run.truth, run.map, {}, &quantum);
     run.report.timings.compareMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -175,10 +146,11 @@ std::vector<Hypothesis> diagnoseDepthMap(const Scene& scene, const Camera& camer
 {
     std::vector<Hypothesis> out;
     const int W = camera.width(), H = camera.height();
+    const VertexNeighbours neighbours(scene);  // one scene, many comparisons: built once
     auto test = [&](const std::string& name, const std::string& explanation, const Camera& hypothesisCamera,
                     const ExternalDepthMap& hypothesisMap, const RayFaults& sampling = {}) {
         rays.sampling = sampling;
-        const VerifyRun run = verifyDepthMap(scene, hypothesisCamera, hypothesisMap, rays);
+        const VerifyRun run = verifyDepthMap(scene, hypothesisCamera, hypothesisMap, rays, neighbours);
         rays.sampling = RayFaults{};
         out.push_back({name, explanation, run.comparison.report.consistent(), run.comparison.report.unexplained()});
     };

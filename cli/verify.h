@@ -5,6 +5,7 @@
 #include "check.h"
 
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 namespace zcheck {
@@ -16,13 +17,33 @@ struct ExternalDepthMap {
     double valueQuantum = 0;     // the storage step of `value` (1/scale for integer files); 0: binary32
 };
 
+// Triangles around each vertex position (positions, not indices: loaders duplicate vertices),
+// for guessing which surface a map saw. Holds a reference to the scene.
+class VertexNeighbours {
+public:
+    explicit VertexNeighbours(const Scene& scene);
+    // `primitive` and every triangle that shares a vertex position with it.
+    template <class Visit>
+    void forEachNeighbour(std::uint32_t primitive, Visit&& visit) const
+    {
+        for (int k = 0; k < 3; ++k)
+            for (std::uint32_t t : around_.at(key(scene_.positions[scene_.triangles[primitive][k]]))) visit(t);
+    }
+
+private:
+    static std::string key(const glm::vec3& p);
+    const Scene& scene_;
+    std::unordered_map<std::string, std::vector<std::uint32_t>> around_;
+};
+
 // The map as the raster side of a comparison: window depth per pixel, a hit where the value is
 // not a miss. The map does not say which surface it saw: each hit takes, among the
 // ground-truth triangles within 2 pixels and the triangles sharing a vertex with them, the one
 // whose plane at this pixel is closest to the map's depth (kUnknownPrimitive if none). `quantum` receives each pixel's
 // storage step in window units.
 RenderResult renderResultFromMap(const Scene& scene, const Camera& camera, const ExternalDepthMap& map,
-                                 const RenderResult& truth, std::vector<double>& quantum);
+                                 const RenderResult& truth, const VertexNeighbours& neighbours,
+                                 std::vector<double>& quantum);
 
 struct VerifyRun {
     RenderResult truth;       // the ray route
@@ -31,6 +52,9 @@ struct VerifyRun {
     CheckReport report;
 };
 VerifyRun verifyDepthMap(const Scene& scene, const Camera& camera, const ExternalDepthMap& map, RayRenderer& rays);
+// The same with the scene's vertex index built once by the caller (for many comparisons).
+VerifyRun verifyDepthMap(const Scene& scene, const Camera& camera, const ExternalDepthMap& map, RayRenderer& rays,
+                         const VertexNeighbours& neighbours);
 
 struct Hypothesis {
     std::string name;         // e.g. "distance-as-eye-z"
