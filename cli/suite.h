@@ -33,6 +33,10 @@ struct NamedCamera {
 // matrices pasted raw. Conventions and depth settings are the base camera's.
 std::vector<NamedCamera> cameraModels(const Scene& scene, int width, int height);
 
+// `spec` in another convention and depth mapping; a raw-matrix camera gets the matrices of
+// the scene's own camera in that convention and mapping (raw matrices belong to both).
+CameraSpec withDepthAndConvention(CameraSpec spec, const Scene& scene, const Convention& convention, DepthSettings depth);
+
 struct SuiteConfig {
     std::string scenePath;  // as loadScene takes it
     std::string scene;      // for people: builtin name or file name

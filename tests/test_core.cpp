@@ -6,6 +6,8 @@
 #include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
 
+#include "matrix_assert.h"
+
 #include <catch2/catch.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -34,15 +36,6 @@ CameraSpec specWith(const std::string& convention, ProjectionType type, bool rev
     spec.view = View::lookAt({1.0, 2.0, 6.0}, {0.2, 0.1, -1.0}, {0.1, 1.0, 0.0});
     spec.depth.reversed = reversed;
     return spec;
-}
-
-void requireMatrixNear(const glm::dmat4& actual, const glm::dmat4& expected, double tolerance = 1e-12)
-{
-    for (int c = 0; c < 4; ++c)
-        for (int r = 0; r < 4; ++r) {
-            INFO("row " << r << " column " << c);
-            REQUIRE(actual[c][r] == Approx(expected[c][r]).margin(tolerance).epsilon(tolerance));
-        }
 }
 
 std::vector<CameraSpec> everyConventionAndProjection()

@@ -5,6 +5,8 @@
 #include "zcheck/inverse_projection.h"
 #include "zcheck/precision.h"
 
+#include "matrix_assert.h"
+
 #include <catch2/catch.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -18,15 +20,6 @@ namespace {
 CameraSpec parse(const std::string& text) { return cameraSpecFromJson(json::parse(text), "test"); }
 
 const std::string kView = R"("view": {"eye": [0, 0, 0], "target": [0, 0, -1], "up": [0, 1, 0]})";
-
-void requireMatrixNear(const glm::dmat4& actual, const glm::dmat4& expected, double tolerance = 1e-12)
-{
-    for (int c = 0; c < 4; ++c)
-        for (int r = 0; r < 4; ++r) {
-            INFO("row " << r << " column " << c);
-            REQUIRE(actual[c][r] == Approx(expected[c][r]).margin(tolerance));
-        }
-}
 
 glm::dmat4 rowsOf(const json& rows)
 {

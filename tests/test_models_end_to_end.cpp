@@ -25,19 +25,9 @@ void requireEveryModelConsistent(const std::string& sceneName)
         for (const auto& convention : Convention::presetNames())
             for (DepthFormat format : {DepthFormat::Float32, DepthFormat::Unorm24})
                 for (bool reversed : {false, true}) {
-                    CameraSpec spec = model.spec;
-                    spec.convention = Convention::preset(convention);
-                    spec.depth.format = format;
-                    spec.depth.reversed = reversed;
-                    if (spec.projection.type == ProjectionType::Matrix) {
-                        // The raw matrices must be the ones of this convention and depth mapping.
-                        CameraSpec perspective = scene.defaultCamera;
-                        perspective.width = 320, perspective.height = 240;
-                        perspective.convention = spec.convention, perspective.depth = spec.depth;
-                        const Camera source(perspective);
-                        spec.projection.clipFromEye = source.clipFromEye;
-                        spec.view.eyeFromWorld = source.eyeFromWorld;
-                    }
+                    DepthSettings depth;
+                    depth.format = format, depth.reversed = reversed;
+                    const CameraSpec spec = withDepthAndConvention(model.spec, scene, Convention::preset(convention), depth);
                     const ComparisonReport r = runCheck(scene, Camera(spec), rays, raster).report.comparison;
                     INFO(sceneName << ": " << model.name << ", " << convention << ", " << toString(format)
                                    << (reversed ? ", reversed" : "") << ": both hit " << r.bothHit << ", depth errors "
