@@ -53,6 +53,7 @@ RenderResult renderResultFromMap(const Scene& scene, const Camera& camera, const
     out.windowDepth = {W, H, DepthQuantity::Window, std::vector<double>(std::size_t(W) * H, camera.clearDepth())};
     out.primitiveId.assign(std::size_t(W) * H, kNoPrimitive);
     quantum.assign(std::size_t(W) * H, 0.0);
+    const PixelJudge judge(scene, camera);
     for (int row = 0; row < H; ++row)
         for (int col = 0; col < W; ++col) {
             const std::size_t i = std::size_t(row) * W + col;
@@ -74,34 +75,49 @@ RenderResult renderResultFromMap(const Scene& scene, const Camera& camera, const
             }
             if (!std::isfinite(depth)) continue;
             out.windowDepth.value[i] = depth;
-            // Which surface did the map see? Among the ground-truth triangles within 2 pixels and
-            // their mesh neighbours, the one whose plane is closest to the map's depth here.
-            // Preference: a plane within the tolerance model of the map's depth whose drawn region
-            // holds (or nearly holds) the pixel centre; then simply the closest plane.
-            std::uint32_t primitive = kUnknownPrimitive;
-            double closest = INFINITY, bestReach = INFINITY;
+            // Which surface did the map see? The comparison's own rule decides (PixelJudge): the
+            // truth's surface if the map's depth agrees with it; otherwise a surface drawn within S
+            // of the pixel centre whose tolerance interval, joined with the truth's, holds the
+            // map's depth, and under which the comparison explains the pixel. Every accepted set
+            // is then an interval around the true depth, so a map nearer to the truth never fails
+            // where a farther one passes (the regression "verify rejected a correct map at a
+            // sliver's edge" in tests/test_verify.cpp).
+            const std::uint32_t here = truth.primitiveId[i];
+            const double q = quantum[i];
+            const double truthDepth = truth.windowDepth.value[i];
+            double bound = 0;
+            if (here != kNoPrimitive &&
+                judge.bothHit(truthDepth, here, depth, here, q, pWindow, bound) == PixelClass::Agree) {
+                out.primitiveId[i] = here;
+                continue;
+            }
+            std::uint32_t primitive = here != kNoPrimitive ? here : kUnknownPrimitive;
+            double closest = INFINITY;
             const EyePlaneRay ray = worldEyePlaneRayThroughWindow(camera, pWindow);
             std::vector<std::uint32_t> considered;
             auto consider = [&](std::uint32_t candidate) {
-                if (std::find(considered.begin(), considered.end(), candidate) != considered.end()) return;
+                if (candidate == here || std::find(considered.begin(), considered.end(), candidate) != considered.end())
+                    return;
                 considered.push_back(candidate);
-                const double gap = std::abs(planeWindowDepth(scene, camera, candidate, ray) - depth);
+                const double plane = planeWindowDepth(scene, camera, candidate, ray);
+                if (!std::isfinite(plane)) return;
+                const double tolerance = judge.surfaceTolerance(candidate, q);
+                double lo = plane - tolerance, hi = plane + tolerance;
+                if (here != kNoPrimitive) {
+                    const double truthTolerance = judge.surfaceTolerance(here, q);
+                    lo = std::min(lo, truthDepth - truthTolerance), hi = std::max(hi, truthDepth + truthTolerance);
+                }
+                const double gap = std::abs(plane - depth);
+                if (!(depth >= lo && depth <= hi) || gap >= closest) return;
                 const glm::uvec3 t = scene.triangles[candidate];
                 const glm::dvec3 a(scene.positions[t[0]]), b(scene.positions[t[1]]), c(scene.positions[t[2]]);
-                double reach = INFINITY;  // 0 inside the drawn triangle, else the distance to it
-                if (gap <= 8 * quantum[i] + ToleranceModel{}.snapPixels() * windowDepthSlope(camera, a, b, c))
-                    reach = insideDrawnTriangle(camera, a, b, c, pWindow) ? 0.0 : distanceToDrawnEdge(camera, a, b, c, pWindow);
-                if (reach < bestReach || (reach == bestReach && gap < closest))
-                    bestReach = reach, closest = gap, primitive = candidate;
+                if (!insideDrawnTriangle(camera, a, b, c, pWindow) && !judge.nearEdge(candidate, pWindow)) return;
+                const bool explained = here != kNoPrimitive
+                                           ? judge.bothHit(truthDepth, here, depth, candidate, q, pWindow, bound) !=
+                                                 PixelClass::DepthError
+                                           : judge.nearEdge(candidate, pWindow) || judge.atClipPlane(candidate, pWindow);
+                if (explained) closest = gap, primitive = candidate;
             };
-            const std::uint32_t here = truth.primitiveId[i];
-            if (here != kNoPrimitive) {
-                consider(here);  // ties go to the surface the ground truth sees
-                if (bestReach == 0 && closest <= 4 * quantum[i]) {  // the common case: the same surface
-                    out.primitiveId[i] = here;
-                    continue;
-                }
-            }
             std::vector<std::uint32_t> seen;
             for (int dy = -2; dy <= 2; ++dy)
                 for (int dx = -2; dx <= 2; ++dx) {

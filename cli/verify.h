@@ -37,10 +37,12 @@ private:
 };
 
 // The map as the raster side of a comparison: window depth per pixel, a hit where the value is
-// not a miss. The map does not say which surface it saw: each hit takes, among the
-// ground-truth triangles within 2 pixels and the triangles sharing a vertex with them, the one
-// whose plane at this pixel is closest to the map's depth (kUnknownPrimitive if none). `quantum` receives each pixel's
-// storage step in window units.
+// not a miss. The map does not say which surface it saw: each hit takes the ground truth's
+// surface when the comparison's rule (PixelJudge) accepts the map's depth on it; otherwise,
+// among the triangles within 2 pixels and those sharing a vertex with them, one drawn within S
+// of the pixel centre whose tolerance interval joined with the truth's holds the depth and
+// under which the comparison explains the pixel; otherwise the truth's surface (a depth error)
+// or kUnknownPrimitive. `quantum` receives each pixel's storage step in window units.
 RenderResult renderResultFromMap(const Scene& scene, const Camera& camera, const ExternalDepthMap& map,
                                  const RenderResult& truth, const VertexNeighbours& neighbours,
                                  std::vector<double>& quantum);

@@ -131,3 +131,113 @@ TEST_CASE("a map that no hypothesis explains is diagnosed as such", "[verify][di
     REQUIRE(diagnosis(s.scene, camera, noise, rays).empty());
 }
 
+
+namespace {
+
+// Two triangles sharing the vertical edge x = xEdge, seen straight on by an orthographic
+// OpenGL camera over [-1,1]² at 100×100 pixels (0.02 units a pixel), near 1, far 3, so
+// window depth is (eye-z − 1)/2. A faces the camera at eye-z 2; B is tilted in x by `tilt`
+// (eye-z grows by tilt per unit of x beyond the edge).
+struct SharedEdge {
+    Scene scene;
+    Camera camera;
+    double xEdge;
+    static Camera orthographicCamera()
+    {
+        CameraSpec spec;
+        spec.width = spec.height = 100;
+        spec.projection.type = ProjectionType::Orthographic;
+        spec.projection.left = spec.projection.bottom = -1;
+        spec.projection.right = spec.projection.top = 1;
+        spec.projection.near = 1, spec.projection.far = 3;
+        spec.view = View::lookAt({0, 0, 0}, {0, 0, -1}, {0, 1, 0});
+        return Camera(spec);
+    }
+    SharedEdge(double xEdge, double tilt) : camera(orthographicCamera()), xEdge(xEdge)
+    {
+        const float e = float(xEdge);
+        scene.name = "shared-edge";
+        scene.positions = {{-1.5f, -1.5f, -2.0f}, {e, -1.5f, -2.0f}, {e, 1.5f, -2.0f},
+                           {1.5f, -1.5f, float(-2.0 - tilt * (1.5 - xEdge))}};
+        scene.triangles = {{0, 1, 2}, {1, 3, 2}};
+    }
+    // Window depth of B's plane at window x (B's plane extended past its edge).
+    double windowDepthOfB(double tilt, double xWindow) const
+    {
+        const double xWorld = -1 + xWindow * 0.02;
+        return (2.0 + tilt * (xWorld - double(float(xEdge))) - 1) / 2;
+    }
+};
+
+}  // namespace
+
+TEST_CASE("regression: verify rejected a correct map whose sample landed across a shared edge", "[verify][regression]")
+{
+    // Pixel (50, 50) has its centre at window x 50.5, world x 0.01; the shared edge lies
+    // 0.002 px to its right (within S = 2^-8 px), so the truth sees A there. A renderer whose
+    // sample landed just across the edge stored B's depth. The old surface guess accepted A
+    // within 8·q + S·m, then judged the pixel against A's own tolerance 4·q + S·m: a map
+    // 6 q from A's depth failed, while one farther away (beyond the 8 q gate, so matched
+    // to B at the edge) passed.
+    const double float32QuantumAtHalf = std::ldexp(1.0, -24);
+    const double pixel = 0.02, across = 0.002;
+    // B's depth at the pixel centre differs from A's by tilt/2·(across·pixel) in window units:
+    // choose the tilt that makes it 6 q.
+    const double tilt = -2 * 6 * float32QuantumAtHalf / (across * pixel);  // B rises towards the camera
+    const SharedEdge s(0.01 + across * pixel, tilt);
+    RayRenderer rays(s.scene);
+    const RenderResult truth = rays.render(s.camera);
+    const std::size_t centre = 50 * 100 + 50;
+    REQUIRE(truth.primitiveId[centre] == 0);  // the truth sees A at this pixel
+    ExternalDepthMap map;
+    map.width = map.height = 100;
+    map.quantity = DepthQuantity::Window;
+    map.value.resize(truth.windowDepth.value.size());
+    for (std::size_t i = 0; i < map.value.size(); ++i)
+        map.value[i] = truth.hit(i) ? double(float(truth.windowDepth.value[i])) : INFINITY;
+    const double onB = double(float(s.windowDepthOfB(tilt, 50.5)));
+    const double gapQuanta = (onB - truth.windowDepth.value[centre]) / float32QuantumAtHalf;
+    REQUIRE(gapQuanta > 5);  // beyond A's own tolerance (4 q, A faces the camera: m = 0) ...
+    REQUIRE(gapQuanta < 7);  // ... and within the old 8 q gate
+    map.value[centre] = onB;
+    const VerifyRun run = verifyDepthMap(s.scene, s.camera, map, rays);
+    INFO("unexplained " << run.comparison.report.unexplained());
+    REQUIRE(run.comparison.report.consistent());
+    REQUIRE(run.comparison.pixelClass[centre] == PixelClass::Agree);
+
+    // Monotonic: between the truth and B's depth, and beyond it towards B's far side, no map
+    // nearer to the truth fails where a farther one passes.
+    bool failedNearer = false;
+    for (double k = 0; k <= 40; k += 0.5) {
+        map.value[centre] = truth.windowDepth.value[centre] + k * float32QuantumAtHalf;
+        const bool passes = verifyDepthMap(s.scene, s.camera, map, rays).comparison.report.consistent();
+        INFO("offset " << k << " q");
+        REQUIRE_FALSE((passes && failedNearer));
+        failedNearer = failedNearer || !passes;
+    }
+    REQUIRE(failedNearer);  // far enough from both surfaces the map is rejected
+}
+
+TEST_CASE("the comparison accepts a depth exactly at its tolerance and rejects the next value", "[compare]")
+{
+    const SharedEdge s(0.5, 0.0);  // both triangles face the camera: m = 0
+    const PixelJudge judge(s.scene, s.camera);
+    const double q = std::ldexp(1.0, -24), truth = 0.5;
+    // C·q + E for float32: 4·2^-24 + 16·2^-52·1, exactly representable beside 0.5.
+    const double tolerance = 4 * q + 16 * std::ldexp(1.0, -52);
+    REQUIRE(judge.surfaceTolerance(0, q) == tolerance);
+    const glm::dvec2 pWindow(20.5, 50.5);  // inside A, far from every edge
+    for (double sign : {-1.0, 1.0}) {
+        double bound = 0;
+        const double atTolerance = truth + sign * tolerance;
+        REQUIRE(std::abs(atTolerance - truth) == tolerance);
+        REQUIRE(judge.bothHit(truth, 0, atTolerance, 0, q, pWindow, bound) == PixelClass::Agree);
+        REQUIRE(bound == tolerance);
+        const double beyond = std::nextafter(atTolerance, sign * INFINITY);
+        REQUIRE(judge.bothHit(truth, 0, beyond, 0, q, pWindow, bound) == PixelClass::DepthError);
+        // Another surface: both tolerances add up, and nothing more.
+        REQUIRE(judge.bothHit(truth, 0, truth + sign * 2 * tolerance, 1, q, pWindow, bound) == PixelClass::Agree);
+        REQUIRE(judge.bothHit(truth, 0, std::nextafter(truth + sign * 2 * tolerance, sign * INFINITY), 1, q, pWindow,
+                              bound) == PixelClass::DepthError);
+    }
+}

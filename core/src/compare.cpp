@@ -132,44 +132,71 @@ double percentile99(std::vector<double>& values)
     return values[k];
 }
 
-struct TriangleView {
-    const Scene& scene;
-    mutable std::vector<double> slopeCache;  // per primitive, NaN until computed
+}  // namespace
 
-    glm::dvec3 vertex(std::uint32_t primitive, int corner) const
-    {
-        return glm::dvec3(scene.positions[scene.triangles[primitive][corner]]);
-    }
-    bool known(std::uint32_t primitive) const { return primitive < scene.triangles.size(); }
-    // m is a property of the triangle's plane, the same at every pixel: computed once.
-    double slope(const Camera& camera, std::uint32_t primitive) const
-    {
-        if (!known(primitive)) return 0.0;
-        double& m = slopeCache[primitive];
-        if (std::isnan(m)) m = windowDepthSlope(camera, vertex(primitive, 0), vertex(primitive, 1), vertex(primitive, 2));
-        return m;
-    }
-    // Does the primitive's plane cross the pixel's ray at the near or far plane, to within
-    // binary32 rounding (2^-20 relative) of the distances where the routes clip?
-    bool atClipPlane(const Camera& camera, std::uint32_t primitive, const glm::dvec2& pWindow) const
-    {
-        if (!known(primitive)) return false;
-        const EyePlaneRay ray = worldEyePlaneRayThroughWindow(camera, pWindow);
-        const glm::dvec3 a = vertex(primitive, 0);
-        const glm::dvec3 normal = glm::cross(vertex(primitive, 1) - a, vertex(primitive, 2) - a);
-        const double t = glm::dot(normal, a - ray.origin) / glm::dot(normal, ray.direction);
-        const double epsilon = std::ldexp(1.0, -20);
-        // An infinite far plane has no surface to lie on (inf <= inf must not explain anything).
-        return std::isfinite(t) && (std::abs(t - ray.tNear) <= epsilon * std::abs(ray.tNear) ||
-                                    (std::isfinite(ray.tFar) && std::abs(t - ray.tFar) <= epsilon * ray.tFar));
-    }
-    bool nearEdge(const Camera& camera, std::uint32_t primitive, const glm::dvec2& pWindow, double radius) const
-    {
-        if (!known(primitive)) return false;
-        return distanceToDrawnEdge(camera, vertex(primitive, 0), vertex(primitive, 1), vertex(primitive, 2),
-                                   pWindow) <= radius;
-    }
-};
+PixelJudge::PixelJudge(const Scene& scene, const Camera& camera, const ToleranceModel& tolerance)
+    : scene_(scene),
+      camera_(camera),
+      C_(ToleranceModel::constantQuanta(camera.depth())),
+      S_(tolerance.snapPixels()),
+      E_(16 * std::ldexp(1.0, -52) * std::max(std::abs(camera.depth().rangeMin), std::abs(camera.depth().rangeMax))),
+      slopeCache_(scene.triangleCount(), NAN)
+{
+}
+
+glm::dvec3 PixelJudge::vertex(std::uint32_t primitive, int corner) const
+{
+    return glm::dvec3(scene_.positions[scene_.triangles[primitive][corner]]);
+}
+
+// m is a property of the triangle's plane, the same at every pixel: computed once.
+double PixelJudge::slope(std::uint32_t primitive) const
+{
+    if (!known(primitive)) return 0.0;
+    double& m = slopeCache_[primitive];
+    if (std::isnan(m)) m = windowDepthSlope(camera_, vertex(primitive, 0), vertex(primitive, 1), vertex(primitive, 2));
+    return m;
+}
+
+double PixelJudge::surfaceTolerance(std::uint32_t primitive, double q) const { return C_ * q + S_ * slope(primitive) + E_; }
+
+// Does the primitive's plane cross the pixel's ray at the near or far plane, to within
+// binary32 rounding (2^-20 relative) of the distances where the routes clip?
+bool PixelJudge::atClipPlane(std::uint32_t primitive, const glm::dvec2& pWindow) const
+{
+    if (!known(primitive)) return false;
+    const EyePlaneRay ray = worldEyePlaneRayThroughWindow(camera_, pWindow);
+    const glm::dvec3 a = vertex(primitive, 0);
+    const glm::dvec3 normal = glm::cross(vertex(primitive, 1) - a, vertex(primitive, 2) - a);
+    const double t = glm::dot(normal, a - ray.origin) / glm::dot(normal, ray.direction);
+    const double epsilon = std::ldexp(1.0, -20);
+    // An infinite far plane has no surface to lie on (inf <= inf must not explain anything).
+    return std::isfinite(t) && (std::abs(t - ray.tNear) <= epsilon * std::abs(ray.tNear) ||
+                                (std::isfinite(ray.tFar) && std::abs(t - ray.tFar) <= epsilon * ray.tFar));
+}
+
+bool PixelJudge::nearEdge(std::uint32_t primitive, const glm::dvec2& pWindow) const
+{
+    if (!known(primitive)) return false;
+    return distanceToDrawnEdge(camera_, vertex(primitive, 0), vertex(primitive, 1), vertex(primitive, 2), pWindow) <= S_;
+}
+
+PixelClass PixelJudge::bothHit(double rayDepth, std::uint32_t rayPrimitive, double rasterDepth,
+                               std::uint32_t rasterPrimitive, double q, const glm::dvec2& pWindow, double& bound) const
+{
+    const double error = std::abs(rasterDepth - rayDepth);
+    // Different surfaces: the raster's may legitimately win where the two lie within both
+    // tolerances of each other, so the bound is their sum.
+    const bool samePrimitive = rayPrimitive == rasterPrimitive;
+    bound = surfaceTolerance(rayPrimitive, q) + (samePrimitive ? 0.0 : surfaceTolerance(rasterPrimitive, q));
+    if (error <= bound) return PixelClass::Agree;
+    if (!samePrimitive && (nearEdge(rayPrimitive, pWindow) || nearEdge(rasterPrimitive, pWindow) ||
+                           atClipPlane(rayPrimitive, pWindow) || atClipPlane(rasterPrimitive, pWindow)))
+        return PixelClass::EdgeSurface;
+    return PixelClass::DepthError;
+}
+
+namespace {
 
 bool isUnexplained(PixelClass c)
 {
@@ -189,11 +216,9 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
     out.pixelClass.assign(std::size_t(W) * H, PixelClass::BothMiss);
     out.errorOverTolerance.assign(std::size_t(W) * H, 0.0f);
 
-    const TriangleView triangles{scene, std::vector<double>(scene.triangleCount(), NAN)};
+    const PixelJudge judge(scene, camera, tolerance);
     const DepthFormat format = camera.depth().format;
-    const double C = ToleranceModel::constantQuanta(camera.depth());
     const double S = tolerance.snapPixels();
-    const double E = 16 * std::ldexp(1.0, -52) * std::max(std::abs(camera.depth().rangeMin), std::abs(camera.depth().rangeMax));
     std::vector<double> errorQuanta, relativeEyeZ;
     double signedErrorSum = 0;
     std::int64_t quarterCounts[4] = {0, 0, 0, 0};
@@ -218,29 +243,18 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
                 const double q = rasterQuantum ? (*rasterQuantum)[i] : storageQuantum(format, f.rayWindowDepth);
                 const double error = std::abs(f.rasterWindowDepth - f.rayWindowDepth);
                 const bool samePrimitive = f.rayPrimitive == f.rasterPrimitive;
-                const double mRay = triangles.slope(camera, f.rayPrimitive);
-                const double bound = samePrimitive
-                                         ? C * q + S * mRay + E
-                                         : 2 * (C * q + E) + S * (mRay + triangles.slope(camera, f.rasterPrimitive));
+                double bound = 0;
+                f.pixelClass = judge.bothHit(f.rayWindowDepth, f.rayPrimitive, f.rasterWindowDepth, f.rasterPrimitive, q,
+                                             pWindow, bound);
                 f.errorQuanta = error / q;
                 f.toleranceQuanta = bound / q;
                 const double ratio = bound > 0 ? error / bound : (error > 0 ? INFINITY : 0.0);
-                if (samePrimitive && S * mRay <= 0.1 * q) {
+                if (samePrimitive && S * judge.slope(f.rayPrimitive) <= 0.1 * q) {
                     // Quantization dominates here: feed the bias test.
                     signedErrorSum += (f.rasterWindowDepth - f.rayWindowDepth) / q;
                     const double position = f.rayWindowDepth / q;
                     ++quarterCounts[std::clamp(int(4 * (position - std::floor(position))), 0, 3)];
                     ++r.biasSamples;
-                }
-                if (error <= bound) {
-                    f.pixelClass = PixelClass::Agree;
-                } else if (!samePrimitive && (triangles.nearEdge(camera, f.rayPrimitive, pWindow, S) ||
-                                              triangles.nearEdge(camera, f.rasterPrimitive, pWindow, S) ||
-                                              triangles.atClipPlane(camera, f.rayPrimitive, pWindow) ||
-                                              triangles.atClipPlane(camera, f.rasterPrimitive, pWindow))) {
-                    f.pixelClass = PixelClass::EdgeSurface;
-                } else {
-                    f.pixelClass = PixelClass::DepthError;
                 }
                 if (f.pixelClass == PixelClass::EdgeSurface) {
                     ++r.edgeSurface;
@@ -265,13 +279,13 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
                 const std::uint32_t primitive = rayHit ? f.rayPrimitive : f.rasterPrimitive;
                 const double q = rasterQuantum ? (*rasterQuantum)[i] : storageQuantum(format, f.rayWindowDepth);
                 const bool atClear =
-                    rayHit && std::abs(f.rayWindowDepth - camera.clearDepth()) <= C * q + S * triangles.slope(camera, primitive) + E;
-                if (triangles.nearEdge(camera, primitive, pWindow, S)) {
+                    rayHit && std::abs(f.rayWindowDepth - camera.clearDepth()) <= judge.surfaceTolerance(primitive, q);
+                if (judge.nearEdge(primitive, pWindow)) {
                     f.pixelClass = rayHit ? PixelClass::RayOnlyEdge : PixelClass::RasterOnlyEdge;
                 } else if (atClear) {
                     f.pixelClass = PixelClass::RayOnlyAtClear;
                     ++r.lostAtClearValue;
-                } else if (triangles.atClipPlane(camera, primitive, pWindow)) {
+                } else if (judge.atClipPlane(primitive, pWindow)) {
                     f.pixelClass = PixelClass::AtClipPlane;
                     ++r.atClipPlane;
                 } else {

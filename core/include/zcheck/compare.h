@@ -122,6 +122,38 @@ struct Comparison {
     std::vector<float> errorOverTolerance;   // per pixel: |Δ| / tolerance for both-hit, 0 elsewhere
 };
 
+// The per-pixel rule above, in one place: the comparison applies it to the raster's surface,
+// and `verify` (which must guess the surface a map saw) applies it to every candidate surface,
+// so that which surfaces a pixel may show and whether its depth agrees are one decision.
+// Not thread-safe (it caches each triangle's slope); one per thread.
+class PixelJudge {
+public:
+    PixelJudge(const Scene& scene, const Camera& camera, const ToleranceModel& tolerance = {});
+
+    // One surface's tolerance at depth-storage quantum q, in window-depth units:
+    // C·q + S·m + E (m = 0 for kUnknownPrimitive, which earns no slope credit).
+    double surfaceTolerance(std::uint32_t primitive, double q) const;
+    // Both routes hit: d_ray on `rayPrimitive`, d_raster on `rasterPrimitive`, at window point
+    // pWindow. Returns Agree, EdgeSurface or DepthError; `bound` receives the tolerance used.
+    PixelClass bothHit(double rayDepth, std::uint32_t rayPrimitive, double rasterDepth,
+                       std::uint32_t rasterPrimitive, double q, const glm::dvec2& pWindow, double& bound) const;
+    // Whether pWindow lies within S pixels of the primitive's edge as drawn.
+    bool nearEdge(std::uint32_t primitive, const glm::dvec2& pWindow) const;
+    // Whether the primitive's plane meets the pixel's ray on the near or far plane.
+    bool atClipPlane(std::uint32_t primitive, const glm::dvec2& pWindow) const;
+    double slope(std::uint32_t primitive) const;
+    double snapPixels() const { return S_; }
+
+private:
+    bool known(std::uint32_t primitive) const { return primitive < scene_.triangles.size(); }
+    glm::dvec3 vertex(std::uint32_t primitive, int corner) const;
+
+    const Scene& scene_;
+    const Camera& camera_;
+    double C_, S_, E_;
+    mutable std::vector<double> slopeCache_;  // per primitive, NaN until computed
+};
+
 // Compares two renders of `scene` through `camera`. `ray` must carry exact depths (the ray
 // route); `raster` holds stored depth-buffer values. `rasterQuantum`, when given, is the
 // storage quantum of each raster pixel in window-depth units (a map stored as eye-z or
