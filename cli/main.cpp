@@ -1,5 +1,6 @@
 // zcheck — the command line. Thin: parse, call the libraries, print.
-// Exit status: 0 consistent, 1 inconsistent, 2 usage or input error (one line on stderr).
+// Exit status: 0 consistent, 1 inconsistent, 2 usage or input error, 3 internal failure (out
+// of memory, a library error); errors are one line on stderr.
 #include "check.h"
 #include "suite.h"
 #include "verify.h"
@@ -33,7 +34,39 @@ using namespace zcheck;
 
 constexpr int kExitConsistent = 0;
 constexpr int kExitInconsistent = 1;
-constexpr int kExitUsage = 2;
+constexpr int kExitUsage = 2;     // bad input: a file, key, option or value (one line names it)
+constexpr int kExitInternal = 3;  // zcheck itself failed: out of memory, a library or internal error
+
+// Option validators, the same in every subcommand.
+const CLI::Validator kNonEmptyPath(
+    [](std::string& value) { return value.empty() ? std::string("the path is empty") : std::string(); }, "PATH");
+const CLI::Validator kPositiveFinite(
+    [](std::string& value) {
+        char* end = nullptr;
+        const double v = std::strtod(value.c_str(), &end);
+        if (value.empty() || *end != '\0') return "'" + value + "' is not a number";
+        if (!std::isfinite(v) || !(v > 0)) return "must be a positive finite number, got '" + value + "'";
+        return std::string();
+    },
+    "NUMBER > 0");
+const auto kThreadRange = CLI::Range(1, 1024);
+const auto kImageSideRange = CLI::Range(1, 16384);
+
+// At most `threads` worker threads (0: all cores) for the lifetime of the object.
+std::unique_ptr<tbb::global_control> limitThreads(int threads)
+{
+    if (threads <= 0) return nullptr;
+    return std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+}
+
+// Refuses a comparison with nothing in it: a camera that sees no geometry proves nothing,
+// and must not be reported CONSISTENT.
+void requireSomethingCompared(const ComparisonReport& report, const std::string& scene)
+{
+    if (report.bothHit + report.rayOnly + report.rasterOnly == 0)
+        throw Error("nothing to compare: neither route sees any surface of '" + scene +
+                    "' through this camera (is it pointing away, or are near/far wrong?)");
+}
 
 struct CheckOptions {
     std::string scene = "builtin:default";
@@ -59,9 +92,11 @@ CameraSpec cameraSpecFor(const Scene& scene, const std::string& cameraFile, cons
 void addSceneAndCameraOptions(CLI::App* command, std::string& scene, std::string& cameraFile, std::string& convention)
 {
     command->add_option("--scene", scene,
-                        "builtin:default | builtin:terrain[?n=N] | builtin:near-crossing | a mesh file (OBJ, PLY, glTF/glb)")
-        ->capture_default_str();
-    command->add_option("--camera", cameraFile, "camera file (JSON, see README); default: the scene's own camera");
+                        "builtin:default | builtin:terrain[?n=N] | builtin:near-crossing | a mesh file (OBJ, PLY, STL, glTF/glb)")
+        ->capture_default_str()
+        ->check(kNonEmptyPath);
+    command->add_option("--camera", cameraFile, "camera file (JSON, see README); default: the scene's own camera")
+        ->check(kNonEmptyPath);
     command->add_option("--convention", convention, "override the convention: opengl | direct3d | vulkan | metal | opencv");
 }
 
@@ -70,27 +105,40 @@ std::vector<float> asFloats(const DepthImage& image)
     return std::vector<float>(image.value.begin(), image.value.end());
 }
 
-void writeOutputs(const std::string& dir, const CheckRun& run, const char* rasterName = "raster_depth.exr")
-{
-    namespace fs = std::filesystem;
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-    if (!fs::is_directory(dir)) throw Error("cannot write to --out '" + dir + "': not a directory");
-    const int W = run.comparison.report.width, H = run.comparison.report.height;
-    const auto path = [&](const char* name) { return (fs::path(dir) / name).string(); };
-    writeExr(path("ray_depth.exr"), W, H, {"window"}, asFloats(run.ray.windowDepth));
-    writeExr(path(rasterName), W, H, {"window"}, asFloats(run.raster.windowDepth));
-    writePng8(path("error_heatmap.png"), W, H, errorHeatmapRgb(run.comparison));
-    writePng8(path("coverage_classes.png"), W, H, pixelClassRgb(run.comparison));
-    writeTextFileAtomically(path("report.json"), prettyJson(toJson(run.report)) + "\n");
-}
+// check --out / verify --out: the images and report.json of one run, registered before it.
+struct RunFolder {
+    std::string dir, rasterName;
+    std::string path(const char* name) const { return (std::filesystem::path(dir) / name).string(); }
+    std::vector<std::string> files() const
+    {
+        return {path("ray_depth.exr"), path(rasterName.c_str()), path("error_heatmap.png"), path("coverage_classes.png"),
+                path("report.json")};
+    }
+    void plan(OutputFiles& outputs) const
+    {
+        outputs.addFolder(dir, "--out");
+        for (const std::string& file : files()) outputs.add(file, "--out");
+    }
+    void write(OutputFiles& outputs, const CheckRun& run, const nlohmann::json& report) const
+    {
+        const int W = run.comparison.report.width, H = run.comparison.report.height;
+        outputs.write(path("ray_depth.exr"), [&](const std::string& t) { writeExr(t, W, H, {"window"}, asFloats(run.ray.windowDepth)); });
+        outputs.write(path(rasterName.c_str()),
+                      [&](const std::string& t) { writeExr(t, W, H, {"window"}, asFloats(run.raster.windowDepth)); });
+        outputs.write(path("error_heatmap.png"), [&](const std::string& t) { writePng8(t, W, H, errorHeatmapRgb(run.comparison)); });
+        outputs.write(path("coverage_classes.png"), [&](const std::string& t) { writePng8(t, W, H, pixelClassRgb(run.comparison)); });
+        outputs.writeText(path("report.json"), prettyJson(report) + "\n");
+    }
+};
 
 int runCheckCommand(const CheckOptions& options)
 {
-    std::unique_ptr<tbb::global_control> threadLimit;
-    if (options.threads > 0)
-        threadLimit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                            std::size_t(options.threads));
+    const auto threadLimit = limitThreads(options.threads);
+    OutputFiles outputs;
+    outputs.addInput(options.scene);
+    outputs.addInput(options.cameraFile);
+    const RunFolder folder{options.outDir, "raster_depth.exr"};
+    if (!options.outDir.empty()) folder.plan(outputs);
     const Scene scene = loadScene(options.scene);
     CameraSpec spec = cameraSpecFor(scene, options.cameraFile, options.convention);
     if (options.width) spec.width = *options.width;
@@ -102,11 +150,15 @@ int runCheckCommand(const CheckOptions& options)
     const RayRenderer rays(scene);
     const RasterRenderer raster(scene);
     const CheckRun run = runCheck(scene, camera, rays, raster);
+    requireSomethingCompared(run.report.comparison, scene.name);
+    if (!options.outDir.empty()) {
+        folder.write(outputs, run, toJson(run.report));
+        outputs.commit();
+    }
     if (options.json)
         std::cout << prettyJson(toJson(run.report)) << "\n";
     else
         std::cout << formatSummary(run.report);
-    if (!options.outDir.empty()) writeOutputs(options.outDir, run);
     return run.report.comparison.consistent() ? kExitConsistent : kExitInconsistent;
 }
 
@@ -212,6 +264,24 @@ glm::ivec2 parsePixel(const std::string& text, const Camera& camera)
     return {int(v[0]), int(v[1])};
 }
 
+// A depth value the camera can produce: window depth within the depth range, z_ndc within the
+// convention's NDC range, eye-z and distance in front of the eye.
+void requireDepthValueInRange(const Camera& camera, DepthQuantity quantity, double value)
+{
+    const std::string given = "--depth " + formatNumber(value) + " (" + toString(quantity) + ")";
+    if (!std::isfinite(value)) throw Error(given + " must be a finite number");
+    const double lo = quantity == DepthQuantity::Window ? camera.depth().rangeMin
+                      : quantity == DepthQuantity::Ndc  ? camera.convention().ndcZMin()
+                                                        : 0.0;
+    const double hi = quantity == DepthQuantity::Window ? camera.depth().rangeMax : quantity == DepthQuantity::Ndc ? 1.0 : INFINITY;
+    const bool inside = quantity == DepthQuantity::Window || quantity == DepthQuantity::Ndc ? value >= lo && value <= hi : value > 0;
+    if (!inside)
+        throw Error(given + (quantity == DepthQuantity::EyeZ || quantity == DepthQuantity::Distance
+                                 ? " must be > 0: the point must lie in front of the eye"
+                                 : " must lie in [" + formatNumber(lo) + ", " + formatNumber(hi) + "], the camera's " +
+                                       (quantity == DepthQuantity::Window ? "depth range" : "NDC depth range")));
+}
+
 nlohmann::json vec3Json(const glm::dvec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); }
 
 int runUnprojectCommand(const UnprojectOptions& o)
@@ -240,6 +310,7 @@ int runUnprojectCommand(const UnprojectOptions& o)
             out["ray"]["world"] = rayJson(rayWorld);
             out["ray"]["eye"] = rayJson(rayEye);
         } else {
+            requireDepthValueInRange(camera, quantity, *o.depth);
             const auto pEye = eyePointFromDepth(camera, pWindow, *o.depth, quantity);
             if (!pEye) throw Error("--depth " + formatNumber(*o.depth) + " is a miss for quantity " + o.quantity);
             out["point"] = {{"eye", vec3Json(*pEye)}, {"world", vec3Json(toWorld(*pEye))},
@@ -251,11 +322,12 @@ int runUnprojectCommand(const UnprojectOptions& o)
 
     if (o.depthMap.empty()) throw Error("unproject needs --pixel COL,ROW or --depth-map FILE");
     if (o.output.empty()) throw Error("--depth-map needs -o FILE.ply");
-    if (o.stride < 1) throw Error("--stride must be >= 1");
-    const DepthMapFile map = readDepthMap(o.depthMap, channelNameOf(exportQuantitiesFromList(o.quantity).front()), o.scale);
-    if (map.width != camera.width() || map.height != camera.height())
-        throw Error("depth map '" + o.depthMap + "' is " + std::to_string(map.width) + "x" + std::to_string(map.height) +
-                    " but the camera's image is " + std::to_string(camera.width()) + "x" + std::to_string(camera.height()));
+    OutputFiles outputs;
+    outputs.addInput(o.cameraFile);
+    outputs.addInput(o.depthMap);
+    outputs.add(o.output, "-o");
+    const DepthMapFile map = readDepthMap(o.depthMap, channelNameOf(exportQuantitiesFromList(o.quantity).front()), o.scale,
+                                          camera.width(), camera.height());
     std::vector<glm::dvec3> points;
     std::size_t misses = 0;
     for (int row = 0; row < map.height; row += o.stride)
@@ -268,10 +340,14 @@ int runUnprojectCommand(const UnprojectOptions& o)
             }
             points.push_back(o.space == "eye" ? *pEye : toWorld(*pEye));
         }
-    writePointCloudPly(o.output, points, !o.ascii,
-                       {"zcheck unproject of " + std::filesystem::path(o.depthMap).filename().string() + " (" +
-                            o.quantity + ", channel " + map.channel + ")",
-                        std::string("space ") + o.space + (o.space == "eye" ? " (" + camera.convention().name + " eye axes)" : "")});
+    outputs.write(o.output, [&](const std::string& temporary) {
+        writePointCloudPly(temporary, points, !o.ascii,
+                           {"zcheck unproject of " + std::filesystem::path(o.depthMap).filename().string() + " (" +
+                                o.quantity + ", channel " + map.channel + ")",
+                            std::string("space ") + o.space +
+                                (o.space == "eye" ? " (" + camera.convention().name + " eye axes)" : "")});
+    });
+    outputs.commit();
     std::cout << prettyJson({{"points", points.size()}, {"misses", misses}, {"channel", map.channel},
                              {"quantity", o.quantity}, {"space", o.space}, {"output", o.output}})
               << "\n";
@@ -297,13 +373,21 @@ int runExportCommand(const ExportOptions& o)
     if (o.backend != "ray" && o.backend != "raster") throw Error("--backend must be ray or raster, got '" + o.backend + "'");
     if (o.output.empty()) throw Error("export needs -o FILE (.exr, .pfm, .tif or .png)");
     const std::vector<ExportQuantity> quantities = exportQuantitiesFromList(o.quantities);
+    const auto threadLimit = limitThreads(o.threads);
+    OutputFiles outputs;
+    outputs.addInput(o.scene);
+    outputs.addInput(o.cameraFile);
+    outputs.add(o.output, "-o");
+    outputs.add(o.output + ".json", "the sidecar of -o");
+    if (!o.preview.empty()) outputs.add(o.preview, "--preview");
     const Scene scene = loadScene(o.scene);
     CameraSpec spec = cameraSpecFor(scene, o.cameraFile, o.convention);
     const Camera camera(spec);
     const RenderResult route = o.backend == "ray" ? RayRenderer(scene).render(camera) : RasterRenderer(scene).render(camera);
     std::vector<QuantityImage> images;
     for (ExportQuantity q : quantities) images.push_back(quantityImage(scene, camera, route, q));
-    const std::string format = writeQuantityFile(o.output, images, o.scale);
+    std::string format;
+    outputs.write(o.output, [&](const std::string& temporary) { format = writeQuantityFile(temporary, images, o.scale); });
 
     nlohmann::json channels = nlohmann::json::array();
     for (const auto& image : images)
@@ -338,8 +422,12 @@ int runExportCommand(const ExportOptions& o)
         {"camera", toJson(spec)},
         {"matrices", matricesJson(camera)},
     };
-    writeTextFileAtomically(o.output + ".json", prettyJson(sidecar) + "\n");
-    if (!o.preview.empty()) writePng8(o.preview, camera.width(), camera.height(), previewRgb(images.front()));
+    outputs.writeText(o.output + ".json", prettyJson(sidecar) + "\n");
+    if (!o.preview.empty())
+        outputs.write(o.preview, [&](const std::string& temporary) {
+            writePng8(temporary, camera.width(), camera.height(), previewRgb(images.front()));
+        });
+    outputs.commit();
     std::size_t hits = 0;
     for (std::size_t i = 0; i < route.primitiveId.size(); ++i) hits += route.hit(i) ? 1 : 0;
     std::cout << prettyJson({{"output", o.output}, {"sidecar", o.output + ".json"}, {"format", format},
@@ -353,21 +441,28 @@ struct VerifyOptions {
     std::string scene = "builtin:default", cameraFile, convention, depthMap, quantity = "window", outDir;
     double scale = 0;
     bool diagnose = false, json = false;
+    int threads = 0;
 };
 
 int runVerifyCommand(const VerifyOptions& o)
 {
     const DepthQuantity quantity = depthQuantityFromName(o.quantity);
+    const auto threadLimit = limitThreads(o.threads);
+    OutputFiles outputs;
+    outputs.addInput(o.scene);
+    outputs.addInput(o.cameraFile);
+    outputs.addInput(o.depthMap);
+    const RunFolder folder{o.outDir, "map_depth.exr"};
+    if (!o.outDir.empty()) folder.plan(outputs);
     const Scene scene = loadScene(o.scene);
     CameraSpec spec = cameraSpecFor(scene, o.cameraFile, o.convention);
     const Camera camera(spec);
-    const DepthMapFile file = readDepthMap(o.depthMap, channelNameOf(exportQuantitiesFromList(o.quantity).front()), o.scale);
-    if (file.width != camera.width() || file.height != camera.height())
-        throw Error("depth map '" + o.depthMap + "' is " + std::to_string(file.width) + "x" + std::to_string(file.height) +
-                    " but the camera's image is " + std::to_string(camera.width()) + "x" + std::to_string(camera.height()));
+    const DepthMapFile file = readDepthMap(o.depthMap, channelNameOf(exportQuantitiesFromList(o.quantity).front()), o.scale,
+                                           camera.width(), camera.height());
     ExternalDepthMap map{file.width, file.height, quantity, file.value, o.scale > 0 ? 1.0 / o.scale : 0.0};
     RayRenderer rays(scene);
     const VerifyRun run = verifyDepthMap(scene, camera, map, rays);
+    requireSomethingCompared(run.comparison.report, scene.name);
     nlohmann::json report = toJson(run.report);
     report["depth_map"] = {{"file", o.depthMap}, {"quantity", o.quantity}, {"channel", file.channel}, {"scale", o.scale}};
     std::vector<Hypothesis> hypotheses;
@@ -378,6 +473,12 @@ int runVerifyCommand(const VerifyOptions& o)
             list.push_back({{"hypothesis", h.name}, {"explanation", h.explanation}, {"consistent", h.consistent},
                             {"unexplained", h.unexplained}});
         report["diagnosis"] = list;
+    }
+    if (!o.outDir.empty()) {
+        CheckRun asCheck;
+        asCheck.ray = run.truth, asCheck.raster = run.map, asCheck.comparison = run.comparison, asCheck.report = run.report;
+        folder.write(outputs, asCheck, report);
+        outputs.commit();
     }
     if (o.json) {
         std::cout << prettyJson(report) << "\n";
@@ -401,12 +502,6 @@ int runVerifyCommand(const VerifyOptions& o)
                           << closest->name << ", " << closest->unexplained << " unexplained pixels)\n";
             }
         }
-    }
-    if (!o.outDir.empty()) {
-        CheckRun asCheck;
-        asCheck.ray = run.truth, asCheck.raster = run.map, asCheck.comparison = run.comparison, asCheck.report = run.report;
-        writeOutputs(o.outDir, asCheck, "map_depth.exr");
-        writeTextFileAtomically((std::filesystem::path(o.outDir) / "report.json").string(), prettyJson(report) + "\n");
     }
     return run.comparison.report.consistent() ? kExitConsistent : kExitInconsistent;
 }
@@ -470,9 +565,10 @@ std::string suiteTable(const SuiteResult& result)
 
 int runSuiteCommand(const SuiteOptions& o)
 {
-    std::unique_ptr<tbb::global_control> threadLimit;
-    if (o.threads > 0)
-        threadLimit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, std::size_t(o.threads));
+    const auto threadLimit = limitThreads(o.threads);
+    OutputFiles outputs;  // validated now, not after a long run
+    if (!o.jsonFile.empty()) outputs.add(o.jsonFile, "--json");
+    if (!o.htmlFile.empty()) outputs.add(o.htmlFile, "--html");
     std::vector<SuiteConfig> configs;
     for (auto& config : suiteConfigurations(o.quick, o.modelsDir))
         if (o.filter.empty() || config.label().find(o.filter) != std::string::npos) configs.push_back(config);
@@ -518,7 +614,7 @@ int runSuiteCommand(const SuiteOptions& o)
                                                {"applicable", tally[k].detected + tally[k].missed},
                                                {"not_applicable", tally[k].notApplicable},
                                                {"meaningless", tally[k].meaningless}};
-        writeTextFileAtomically(o.jsonFile, prettyJson({{"zcheck_version", ZCHECK_VERSION},
+        outputs.writeText(o.jsonFile, prettyJson({{"zcheck_version", ZCHECK_VERSION},
                                                         {"quick", o.quick},
                                                         {"configurations", configsJson},
                                                         {"detection", table},
@@ -554,8 +650,9 @@ int runSuiteCommand(const SuiteOptions& o)
                  << "\"><pre>" << htmlEscape(formatSummary(failure.run.report)) << "</pre></div>";
         }
         html << "</body></html>\n";
-        writeTextFileAtomically(o.htmlFile, html.str());
+        outputs.writeText(o.htmlFile, html.str());
     }
+    outputs.commit();
     return result.passed() ? kExitConsistent : kExitInconsistent;
 }
 
@@ -575,13 +672,14 @@ int main(int argc, char** argv)
         "check", "Check one scene through one camera: ray route vs raster route, per pixel.\n"
                  "Exit status 0 consistent, 1 inconsistent, 2 usage or input error.");
     addSceneAndCameraOptions(checkCommand, check.scene, check.cameraFile, check.convention);
-    checkCommand->add_option("--width", check.width, "override the image width in pixels (1..16384)");
-    checkCommand->add_option("--height", check.height, "override the image height in pixels (1..16384)");
+    checkCommand->add_option("--width", check.width, "override the image width in pixels (1..16384)")->check(kImageSideRange);
+    checkCommand->add_option("--height", check.height, "override the image height in pixels (1..16384)")->check(kImageSideRange);
     checkCommand->add_option("--depth-format", check.depthFormat, "override the depth format: float32 | unorm24 | unorm16");
     checkCommand->add_flag("--reversed-z", check.reversedZ, "use reversed-Z (near -> far end of the range, test GREATER)");
     checkCommand->add_option("--out", check.outDir,
                              "write ray_depth.exr, raster_depth.exr, error_heatmap.png, coverage_classes.png "
-                             "and report.json into this directory");
+                             "and report.json into this directory (all or none of them: see README)")
+        ->check(kNonEmptyPath);
     checkCommand->add_flag("--json", check.json, "print the report as JSON instead of the summary");
     checkCommand->footer(
         "Examples:\n"
@@ -591,8 +689,7 @@ int main(int argc, char** argv)
         "  zcheck check --scene 'builtin:terrain?n=708' --width 1920 --height 1080 --json\n"
         "Depths are compared as window depth (the depth-buffer value) per pixel; the tolerance is\n"
         "C*q + S*m (q: storage quantum, m: depth slope per pixel, S = 2^-8 px). See README.md.");
-    checkCommand->add_option("--threads", check.threads, "worker threads (default: all cores)")
-        ->check(CLI::Range(1, 1024));
+    checkCommand->add_option("--threads", check.threads, "worker threads, 1..1024 (default: all cores)")->check(kThreadRange);
 
     std::string matricesCamera, matricesConvention;
     CLI::App* matricesCommand = app.add_subcommand(
@@ -600,7 +697,7 @@ int main(int argc, char** argv)
                     "eye_from_clip, clip_from_world, window_from_ndc, ndc_from_window (4 rows of 4, column\n"
                     "vectors p' = M·p), and a 'native' block in the convention's own form (row vectors for\n"
                     "direct3d).");
-    matricesCommand->add_option("--camera", matricesCamera, "camera file (JSON, see README)")->required();
+    matricesCommand->add_option("--camera", matricesCamera, "camera file (JSON, see README)")->required()->check(kNonEmptyPath);
     matricesCommand->add_option("--convention", matricesConvention, "override the convention");
 
     std::string precisionCamera, precisionConvention, precisionAt;
@@ -609,7 +706,7 @@ int main(int argc, char** argv)
         "precision", "How finely each depth layout (unorm16, unorm24, float32 x standard, reversed, infinite far)\n"
                      "resolves eye depth for a camera's near/far: the eye-z step between neighbouring stored\n"
                      "values at each distance, and which layout is best.");
-    precisionCommand->add_option("--camera", precisionCamera, "camera file (JSON, see README)")->required();
+    precisionCommand->add_option("--camera", precisionCamera, "camera file (JSON, see README)")->required()->check(kNonEmptyPath);
     precisionCommand->add_option("--at", precisionAt, "eye-z distances, comma-separated (default: 9 log-spaced from near to far)");
     precisionCommand->add_option("--convention", precisionConvention, "override the convention");
     precisionCommand->add_flag("--json", precisionJson, "print JSON instead of tables");
@@ -618,17 +715,20 @@ int main(int argc, char** argv)
     CLI::App* unprojectCommand = app.add_subcommand(
         "unproject", "The inverse projection: the ray through a pixel centre, the point at a depth value, or a\n"
                      "whole depth map (EXR, PFM, TIFF, 16-bit PNG with --scale) as a PLY point cloud, misses skipped.");
-    unprojectCommand->add_option("--camera", unproject.cameraFile, "camera file (JSON, see README)")->required();
+    unprojectCommand->add_option("--camera", unproject.cameraFile, "camera file (JSON, see README)")->required()->check(kNonEmptyPath);
     unprojectCommand->add_option("--convention", unproject.convention, "override the convention");
     unprojectCommand->add_option("--pixel", unproject.pixel, "COL,ROW (row 0 at the top): print the ray through its centre");
     unprojectCommand->add_option("--depth", unproject.depth, "with --pixel: print the point at this depth value");
     unprojectCommand->add_option("--quantity", unproject.quantity, "what --depth / the map holds: window | ndc | eye-z | distance")
         ->capture_default_str();
-    unprojectCommand->add_option("--depth-map", unproject.depthMap, "a depth map to turn into a point cloud");
-    unprojectCommand->add_option("--scale", unproject.scale, "stored value = depth x scale (required for 16-bit PNG)");
-    unprojectCommand->add_option("-o,--output", unproject.output, "the PLY file to write (atomically)");
+    unprojectCommand->add_option("--depth-map", unproject.depthMap, "a depth map to turn into a point cloud")->check(kNonEmptyPath);
+    unprojectCommand->add_option("--scale", unproject.scale, "stored value = depth x scale (required for 16-bit PNG)")
+        ->check(kPositiveFinite);
+    unprojectCommand->add_option("-o,--output", unproject.output, "the PLY file to write (atomically)")->check(kNonEmptyPath);
     unprojectCommand->add_option("--space", unproject.space, "eye | world coordinates for points")->capture_default_str();
-    unprojectCommand->add_option("--stride", unproject.stride, "use every K-th pixel in x and y")->capture_default_str();
+    unprojectCommand->add_option("--stride", unproject.stride, "use every K-th pixel in x and y, 1..16384")
+        ->capture_default_str()
+        ->check(kImageSideRange);
     unprojectCommand->add_flag("--ascii", unproject.ascii, "write ASCII PLY instead of binary little-endian");
 
     ExportOptions exportOptions;
@@ -642,9 +742,14 @@ int main(int argc, char** argv)
                               "primitive-id (several only into .exr)")
         ->capture_default_str();
     addSceneAndCameraOptions(exportCommand, exportOptions.scene, exportOptions.cameraFile, exportOptions.convention);
-    exportCommand->add_option("-o,--output", exportOptions.output, "FILE.exr | .pfm | .tif | .png (written atomically)");
-    exportCommand->add_option("--scale", exportOptions.scale, "16-bit PNG: stored = value x scale (e.g. 1000 = millimetres)");
-    exportCommand->add_option("--preview", exportOptions.preview, "also write an 8-bit colour-mapped PNG of the first quantity");
+    exportCommand->add_option("-o,--output", exportOptions.output, "FILE.exr | .pfm | .tif | .png (written atomically)")
+        ->check(kNonEmptyPath);
+    exportCommand->add_option("--scale", exportOptions.scale, "16-bit PNG: stored = value x scale (e.g. 1000 = millimetres)")
+        ->check(kPositiveFinite);
+    exportCommand->add_option("--preview", exportOptions.preview, "also write an 8-bit colour-mapped PNG of the first quantity")
+        ->check(kNonEmptyPath);
+    exportCommand->add_option("--threads", exportOptions.threads, "worker threads, 1..1024 (default: all cores)")
+        ->check(kThreadRange);
 
     VerifyOptions verify;
     CLI::App* verifyCommand = app.add_subcommand(
@@ -652,12 +757,17 @@ int main(int argc, char** argv)
                   "ground truth for the same scene and camera, with the same tolerance model, report and exit codes\n"
                   "as check; --diagnose names the classic mistake that explains an inconsistent map.");
     addSceneAndCameraOptions(verifyCommand, verify.scene, verify.cameraFile, verify.convention);
-    verifyCommand->add_option("--depth-map", verify.depthMap, "EXR, PFM, TIFF, or 16-bit PNG with --scale")->required();
+    verifyCommand->add_option("--depth-map", verify.depthMap, "EXR, PFM, TIFF, or 16-bit PNG with --scale")
+        ->required()
+        ->check(kNonEmptyPath);
     verifyCommand->add_option("--quantity", verify.quantity, "what the map holds: window | ndc | eye-z | distance")
         ->capture_default_str();
-    verifyCommand->add_option("--scale", verify.scale, "stored value = depth x scale (required for integer files)");
+    verifyCommand->add_option("--scale", verify.scale, "stored value = depth x scale (required for integer files)")
+        ->check(kPositiveFinite);
     verifyCommand->add_flag("--diagnose", verify.diagnose, "when inconsistent, test the classic hypotheses and name the one that fits");
-    verifyCommand->add_option("--out", verify.outDir, "write truth and map depth EXRs, heatmap, classes and report.json");
+    verifyCommand->add_option("--out", verify.outDir, "write truth and map depth EXRs, heatmap, classes and report.json")
+        ->check(kNonEmptyPath);
+    verifyCommand->add_option("--threads", verify.threads, "worker threads, 1..1024 (default: all cores)")->check(kThreadRange);
     verifyCommand->add_flag("--json", verify.json, "print the report as JSON");
 
     SuiteOptions suite;
@@ -667,10 +777,11 @@ int main(int argc, char** argv)
                  "Exit status 0 only when both hold.");
     suiteCommand->add_flag("--quick", suite.quick, "a representative subset (what CTest runs)");
     suiteCommand->add_option("--filter", suite.filter, "only configurations whose label contains TEXT");
-    suiteCommand->add_option("--json", suite.jsonFile, "write the results as JSON");
-    suiteCommand->add_option("--html", suite.htmlFile, "write a self-contained HTML report with images of every failure");
-    suiteCommand->add_option("--models", suite.modelsDir, "folder of the shared meshes")->capture_default_str();
-    suiteCommand->add_option("--threads", suite.threads, "worker threads (default: all cores)");
+    suiteCommand->add_option("--json", suite.jsonFile, "write the results as JSON")->check(kNonEmptyPath);
+    suiteCommand->add_option("--html", suite.htmlFile, "write a self-contained HTML report with images of every failure")
+        ->check(kNonEmptyPath);
+    suiteCommand->add_option("--models", suite.modelsDir, "folder of the shared meshes")->capture_default_str()->check(kNonEmptyPath);
+    suiteCommand->add_option("--threads", suite.threads, "worker threads, 1..1024 (default: all cores)")->check(kThreadRange);
 
     try {
         app.parse(argc, argv);
@@ -698,11 +809,14 @@ int main(int argc, char** argv)
         std::cerr << "zcheck: error: " << e.what() << "\n";
         return kExitUsage;
     } catch (const std::bad_alloc&) {
-        std::cerr << "zcheck: error: out of memory (is the image or the mesh too large?)\n";
-        return kExitUsage;
+        std::cerr << "zcheck: internal error: out of memory (the mesh or the image is too large for this machine)\n";
+        return kExitInternal;
     } catch (const std::exception& e) {
-        std::cerr << "zcheck: error: " << e.what() << "\n";
-        return kExitUsage;
+        std::string what = e.what();
+        for (char& c : what)
+            if (c == '\n' || c == '\r') c = ' ';
+        std::cerr << "zcheck: internal error: " << what << "\n";
+        return kExitInternal;
     }
-    return kExitUsage;
+    return kExitInternal;
 }

@@ -1,7 +1,11 @@
 #!/usr/bin/env bash
-# Install, build and run the whole test suite.
+# Install, build, and run the whole test suite (what CI runs):
+#   1. every CTest test: C++ unit tests, CLI shell tests, the bad-input catalogue;
+#   2. each libFuzzer harness for ZCHECK_FUZZ_SECONDS (default 60) under ASan + UBSan;
+#   3. the unit tests and the bad-input catalogue again, built with ASan + UBSan.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/build.sh
-cd build
-ctest --output-on-failure --parallel "$(nproc)" --timeout 600
+(cd build && ctest --output-on-failure --parallel "$(nproc)" --timeout 600)
+fuzz/run.sh "${ZCHECK_FUZZ_SECONDS:-60}"
+./scripts/sanitize.sh -L 'unit|catalogue'

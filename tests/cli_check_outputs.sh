@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # `zcheck check` end to end through the executable: exit status, the summary, --json and
 # the files --out writes.
-set -eu
+set -euo pipefail
+source "$(dirname "$0")/lib.sh"
 zcheck=$1
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # zcheck export end to end: one file per format, oiiotool accepts each, the sidecar says
 # enough to reinterpret the file, a failed export keeps the old file, bad input exits 2.
-set -eu
+set -euo pipefail
+source "$(dirname "$0")/lib.sh"
 zcheck=$1
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
@@ -59,12 +60,11 @@ set -e
 cmp -s depth_mm.png before.png
 [[ -z "$(find . -name '.*tmp*')" ]]
 
-expect2() { set +e; out=$("$zcheck" "$@" 2>&1 >/dev/null); status=$?; set -e; [[ $status -eq 2 ]] || { echo "expected exit 2: $*"; exit 1; }; echo "$out"; }
-expect2 export --quantity eye-z -o depth.jpg | grep -q "unknown format"
-expect2 export --quantity depth -o x.exr | grep -q "unknown quantity"
-expect2 export --quantity eye-z,distance -o x.tif | grep -q "only as .exr"
-expect2 export --quantity primitive-id -o x.pfm | grep -q "PFM"
-expect2 export --quantity eye-z -o x.png | grep -q "scale"
-expect2 export --backend gpu -o x.exr | grep -q "backend"
-expect2 export --quantity eye-z | grep -q "needs -o"
+expect_error 2 "unknown format" export --quantity eye-z -o depth.jpg
+expect_error 2 "unknown quantity" export --quantity depth -o x.exr
+expect_error 2 "only as .exr" export --quantity eye-z,distance -o x.tif
+expect_error 2 "PFM" export --quantity primitive-id -o x.pfm
+expect_error 2 "scale" export --quantity eye-z -o x.png
+expect_error 2 "backend" export --backend gpu -o x.exr
+expect_error 2 "needs -o" export --quantity eye-z
 echo "cli_export: 1 passed, 0 failed"

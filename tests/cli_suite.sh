@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # zcheck suite --quick: every clean configuration consistent, every applicable fault
 # detected, JSON and a self-contained HTML report written.
-set -eu
+set -euo pipefail
+source "$(dirname "$0")/lib.sh"
 zcheck=$1
 models=$2
 tmp=$(mktemp -d)

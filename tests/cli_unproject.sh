@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # zcheck unproject end to end: rays through hand-computed points, points from every
 # quantity, whole depth maps to PLY with misses skipped, and bad input.
-set -eu
+set -euo pipefail
+source "$(dirname "$0")/lib.sh"
 zcheck=$1
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
@@ -78,13 +79,12 @@ PY
 
 # Bad input: exit 2 with a message, and an existing output survives.
 echo precious > "$tmp/keep.ply"
-expect2() { set +e; out=$("$zcheck" "$@" 2>&1 >/dev/null); status=$?; set -e; [[ $status -eq 2 ]] || { echo "expected exit 2: $*"; exit 1; }; echo "$out"; }
-expect2 unproject --camera "$tmp/camera.json" --depth-map "$tmp/missing.exr" -o "$tmp/keep.ply" | grep -q "cannot read depth map"
+expect_error 2 "cannot read depth map" unproject --camera "$tmp/camera.json" --depth-map "$tmp/missing.exr" -o "$tmp/keep.ply"
 grep -q precious "$tmp/keep.ply"
-expect2 unproject --camera "$tmp/opengl.json" --depth-map "$tmp/out/ray_depth.exr" -o "$tmp/x.ply" | grep -q "160x120 but the camera"
-expect2 unproject --camera "$tmp/opengl.json" --pixel 2,0 | grep -q "outside"
-expect2 unproject --camera "$tmp/opengl.json" --pixel 0,0 --depth 1 --quantity depth | grep -q "unknown depth quantity"
-expect2 unproject --camera "$tmp/opengl.json" | grep -q "needs --pixel"
+expect_error 2 "160x120 but the camera" unproject --camera "$tmp/opengl.json" --depth-map "$tmp/out/ray_depth.exr" -o "$tmp/x.ply"
+expect_error 2 "outside" unproject --camera "$tmp/opengl.json" --pixel 2,0
+expect_error 2 "unknown depth quantity" unproject --camera "$tmp/opengl.json" --pixel 0,0 --depth 1 --quantity depth
+expect_error 2 "needs --pixel" unproject --camera "$tmp/opengl.json"
 oiiotool "$tmp/out/ray_depth.exr" -d uint16 -o "$tmp/depth16.png"
-expect2 unproject --camera "$tmp/camera.json" --depth-map "$tmp/depth16.png" -o "$tmp/x.ply" | grep -q "give --scale"
+expect_error 2 "give --scale" unproject --camera "$tmp/camera.json" --depth-map "$tmp/depth16.png" -o "$tmp/x.ply"
 echo "cli_unproject: 1 passed, 0 failed"

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # zcheck verify end to end, the README's worked example: a map exported from the raster
 # route verifies (float EXR and millimetre PNG); a wrong one is rejected and diagnosed.
-set -eu
+set -euo pipefail
+source "$(dirname "$0")/lib.sh"
 zcheck=$1
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
@@ -29,10 +30,9 @@ assert r['consistent'] is False and r['depth_map']['quantity'] == 'eye-z'
 assert any(h['consistent'] and h['hypothesis'] == 'distance-as-eye-z' for h in r['diagnosis'])"
 
 # Bad input exits 2.
-expect2() { set +e; out=$("$zcheck" "$@" 2>&1 >/dev/null); status=$?; set -e; [[ $status -eq 2 ]] || { echo "expected exit 2: $*"; exit 1; }; echo "$out"; }
-expect2 verify --depth-map missing.exr | grep -q "cannot read depth map"
-expect2 verify --depth-map render_mm.png --quantity eye-z | grep -q "scale"
-expect2 verify --depth-map render.exr --quantity depth | grep -q "unknown"
-expect2 verify --depth-map render.exr --width 3 2>/dev/null | grep -q "" || true
-expect2 verify | grep -q "depth-map"
+expect_error 2 "cannot read depth map" verify --depth-map missing.exr
+expect_error 2 "scale" verify --depth-map render_mm.png --quantity eye-z
+expect_error 2 "unknown" verify --depth-map render.exr --quantity depth
+expect_error 2 "--width" verify --depth-map render.exr --width 3
+expect_error 2 "depth-map" verify
 echo "cli_verify: 1 passed, 0 failed"

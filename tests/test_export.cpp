@@ -212,6 +212,83 @@ TEST_CASE("an interrupted write leaves the old file intact and no temporary behi
     fs::remove_all(dir);
 }
 
+namespace {
+std::string contentOf(const fs::path& path)
+{
+    std::ifstream in(path, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+std::size_t regularFilesIn(const fs::path& dir)
+{
+    std::size_t files = 0;
+    for (const auto& entry : fs::recursive_directory_iterator(dir)) files += entry.is_regular_file() ? 1 : 0;
+    return files;
+}
+}  // namespace
+
+TEST_CASE("a run's outputs appear all together or not at all", "[export][atomic]")
+{
+    const fs::path dir = scratch();
+    const std::string image = (dir / "depth.exr").string(), sidecar = image + ".json";
+    writeTextFileAtomically(image, "old image");
+    writeTextFileAtomically(sidecar, "old sidecar");
+    {
+        // The image is written, then the sidecar fails: neither old file changes.
+        OutputFiles outputs;
+        outputs.add(image, "-o");
+        outputs.add(sidecar, "the sidecar");
+        outputs.writeText(image, "new image");
+        REQUIRE_THROWS_WITH(outputs.write(sidecar, [](const std::string&) { throw Error("no space left, say"); }),
+                            Catch::Contains("no space left"));
+    }
+    REQUIRE(contentOf(image) == "old image");
+    REQUIRE(contentOf(sidecar) == "old sidecar");
+    REQUIRE(regularFilesIn(dir) == 2);  // no temporary left
+    {
+        // A folder that did not exist is made for the run, and removed again when it fails.
+        OutputFiles outputs;
+        const std::string folder = (dir / "new").string(), report = folder + "/report.json";
+        outputs.addFolder(folder, "--out");
+        outputs.add(report, "--out");
+        outputs.writeText(report, "{}");
+    }
+    REQUIRE_FALSE(fs::exists(dir / "new"));
+    {
+        OutputFiles outputs;
+        outputs.add(image, "-o");
+        outputs.add(sidecar, "the sidecar");
+        outputs.writeText(image, "new image");
+        outputs.writeText(sidecar, "new sidecar");
+        REQUIRE(contentOf(image) == "old image");  // nothing moves before commit
+        outputs.commit();
+    }
+    REQUIRE(contentOf(image) == "new image");
+    REQUIRE(contentOf(sidecar) == "new sidecar");
+    REQUIRE(regularFilesIn(dir) == 2);
+    fs::remove_all(dir);
+}
+
+TEST_CASE("outputs are refused before the run: an input, a duplicate, a folder, a missing folder", "[export][atomic]")
+{
+    const fs::path dir = scratch();
+    const std::string input = (dir / "map.pfm").string();
+    writeTextFileAtomically(input, "input");
+    fs::create_directories(dir / "sub");
+    OutputFiles outputs;
+    outputs.addInput(input);
+    REQUIRE_THROWS_WITH(outputs.add(input, "-o"), Catch::Contains("it is an input of this run"));
+    // The same file through another spelling, and through a symbolic link.
+    REQUIRE_THROWS_WITH(outputs.add((dir / "sub" / ".." / "map.pfm").string(), "-o"), Catch::Contains("input of this run"));
+    fs::create_symlink(input, dir / "link.pfm");
+    REQUIRE_THROWS_WITH(outputs.add((dir / "link.pfm").string(), "-o"), Catch::Contains("input of this run"));
+    outputs.add((dir / "a.png").string(), "-o");
+    REQUIRE_THROWS_WITH(outputs.add((dir / "a.png").string(), "--preview"), Catch::Contains("-o writes the same file"));
+    REQUIRE_THROWS_WITH(outputs.add((dir / "sub").string(), "-o"), Catch::Contains("it is a folder"));
+    REQUIRE_THROWS_WITH(outputs.add((dir / "missing" / "x.png").string(), "-o"), Catch::Contains("does not exist"));
+    REQUIRE_THROWS_WITH(outputs.add("", "-o"), Catch::Contains("-o: the output path is empty"));
+    fs::remove_all(dir);
+}
+
 TEST_CASE("exports of the ray and raster routes agree within the tolerance model", "[export]")
 {
     Fixture f;

@@ -342,6 +342,8 @@ Camera::Camera(const CameraSpec& spec) : spec_(spec)
                            {&clipFromEye, "clip_from_eye"}, {&eyeFromClip, "eye_from_clip"}})
         requireMatrixFinite(*m, name);
 
+    requireRepresentable();
+
     // Near and far as eye-z distances: given, or read off a raw matrix by unprojecting the
     // ends of the NDC depth range on the viewing axis.
     if (p.type != ProjectionType::Matrix) {
@@ -392,6 +394,26 @@ CameraSpec framingCameraSpec(const glm::dvec3& centre, double radius)
     spec.projection.near = (distance - radius) * 0.5;
     spec.projection.far = (distance + radius) * 1.5;
     return spec;
+}
+
+// Rays start at the eye (perspective) or on the eye plane inside the view box (parallel
+// projections); the ray tracer holds them in binary32 and fails beyond ~1e19. The eye and
+// the corners of the near-plane window, in world space, must lie within ±kMaxWorldCoordinate.
+void Camera::requireRepresentable() const
+{
+    auto check = [](const glm::dvec3& pWorld, const char* what) {
+        for (int axis = 0; axis < 3; ++axis)
+            if (!(std::abs(pWorld[axis]) <= kMaxWorldCoordinate))
+                throw Error(std::string(what) + " lies at world coordinate " + formatNumber(pWorld[axis]) +
+                            ", beyond the ±1e15 that the ray tracer can represent (move the scene and camera "
+                            "nearer the origin)");
+    };
+    check(glm::dvec3(worldFromEye[3]), "the camera's eye ('view.eye' or the view translation)");
+    for (double x : {-1.0, 1.0})
+        for (double y : {-1.0, 1.0}) {
+            const glm::dvec4 pWorld = worldFromClip * glm::dvec4(x, y, ndcZNear(), 1.0);
+            check(glm::dvec3(pWorld) / pWorld.w, "a corner of the near-plane window (the projection's box or frustum)");
+        }
 }
 
 }  // namespace zcheck

@@ -1,6 +1,7 @@
 #include "zcheck/camera_file.h"
 
 #include "zcheck/error.h"
+#include "zcheck/input_file.h"
 
 #include <algorithm>
 #include <fstream>
@@ -274,18 +275,42 @@ CameraSpec cameraSpecFromJson(const json& document, const std::string& source)
     return spec;
 }
 
-CameraSpec readCameraFile(const std::string& path)
+json parseJsonStrictly(const std::string& text, const std::string& source)
 {
-    std::ifstream in(path);
-    if (!in) throw Error("cannot read camera file '" + path + "': no such file or not readable");
+    // A key twice in one object is an error: nlohmann keeps the last silently, and the
+    // user who wrote the first would never know it was ignored.
+    std::vector<std::vector<std::string>> keysOfOpenObjects;
+    std::string duplicate;
+    const json::parser_callback_t callback = [&](int, json::parse_event_t event, json& parsed) {
+        if (event == json::parse_event_t::object_start) keysOfOpenObjects.emplace_back();
+        if (event == json::parse_event_t::object_end && !keysOfOpenObjects.empty()) keysOfOpenObjects.pop_back();
+        if (event == json::parse_event_t::key && !keysOfOpenObjects.empty() && duplicate.empty()) {
+            auto& keys = keysOfOpenObjects.back();
+            const std::string key = parsed.get<std::string>();
+            if (std::find(keys.begin(), keys.end(), key) != keys.end()) duplicate = key;
+            keys.push_back(key);
+        }
+        return true;
+    };
     json document;
     try {
-        document = json::parse(in);
+        document = json::parse(text, callback);
     } catch (const json::exception& e) {  // syntax errors, and numbers out of range such as 1e400
         std::string what = e.what();
-        throw Error("camera file '" + path + "' is not valid JSON: " + what.substr(what.find(']') + 2));
+        const std::size_t bracket = what.find(']');
+        what = bracket == std::string::npos ? what : what.substr(bracket + 2);
+        for (char& c : what)
+            if (c == '\n' || c == '\r') c = ' ';
+        throw Error(source + " is not valid JSON: " + what);
     }
-    return cameraSpecFromJson(document, "camera file '" + path + "'");
+    if (!duplicate.empty()) throw Error(source + ": key '" + duplicate + "' appears twice in one object");
+    return document;
+}
+
+CameraSpec readCameraFile(const std::string& path)
+{
+    const std::string text = readInputFile(path, kCameraInput);
+    return cameraSpecFromJson(parseJsonStrictly(text, "camera file '" + path + "'"), "camera file '" + path + "'");
 }
 
 namespace {

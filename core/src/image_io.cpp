@@ -1,7 +1,9 @@
 #include "zcheck/image_io.h"
 
+#include "png_codec.h"
 #include "zcheck/atomic_file.h"
 #include "zcheck/error.h"
+#include "zcheck/input_file.h"
 
 #include <OpenImageIO/imageio.h>
 
@@ -14,6 +16,9 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <cerrno>
+#include <charconv>
+#include <fcntl.h>
 #include <unistd.h>
 
 namespace zcheck {
@@ -21,16 +26,23 @@ namespace zcheck {
 namespace {
 
 // `pixelFormat`: the buffer's format; UNKNOWN means each channel in spec.channelformats.
+// Writes `path` itself (callers make it atomic, atomic_file.h); OpenImageIO's own result of
+// open, write and close is checked, then the file is synced.
 void writeImage(const std::string& path, const OIIO::ImageSpec& spec, const void* pixels,
                 OIIO::TypeDesc pixelFormat = OIIO::TypeDesc::UNKNOWN)
 {
     if (spec.channelformats.empty() && pixelFormat == OIIO::TypeDesc::UNKNOWN) pixelFormat = spec.format;
-    writeAtomically(path, [&](const std::string& temporary) {
-        auto out = OIIO::ImageOutput::create(temporary);
-        if (!out) throw Error("cannot write '" + path + "': " + OIIO::geterror());
-        if (!out->open(temporary, spec) || !out->write_image(pixelFormat, pixels) || !out->close())
-            throw Error("cannot write '" + path + "': " + out->geterror());
-    });
+    auto out = OIIO::ImageOutput::create(path);
+    if (!out) throw Error("cannot write '" + path + "': " + OIIO::geterror());
+    if (!out->open(path, spec) || !out->write_image(pixelFormat, pixels) || !out->close())
+        throw Error("cannot write '" + path + "': " + out->geterror());
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0 || ::fsync(fd) != 0) {
+        const std::string why = std::strerror(errno);
+        if (fd >= 0) ::close(fd);
+        throw Error("cannot write '" + path + "': " + why);
+    }
+    ::close(fd);
 }
 
 }  // namespace
@@ -46,19 +58,12 @@ void writeExr(const std::string& path, int width, int height, const std::vector<
 
 void writePng8(const std::string& path, int width, int height, const std::vector<std::uint8_t>& rgb)
 {
-    OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
-    writeImage(path, spec, rgb.data());
+    writeFileBytes(path, encodePng(width, height, 3, 8, rgb.data()));
 }
 
 std::string pngDataUri(int width, int height, const std::vector<std::uint8_t>& rgb)
 {
-    const std::filesystem::path file = std::filesystem::temp_directory_path() /
-                                       ("zcheck-" + std::to_string(::getpid()) + "-inline.png");
-    writePng8(file.string(), width, height, rgb);
-    std::ifstream in(file, std::ios::binary);
-    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    std::error_code ignored;
-    std::filesystem::remove(file, ignored);
+    const std::string bytes = encodePng(width, height, 3, 8, rgb.data());
     static const char digits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     std::string out = "data:image/png;base64,";
     for (std::size_t i = 0; i < bytes.size(); i += 3) {
@@ -73,33 +78,219 @@ std::string pngDataUri(int width, int height, const std::vector<std::uint8_t>& r
     return out;
 }
 
-DepthMapFile readDepthMap(const std::string& path, const std::string& preferredChannel, double scale)
+namespace {
+
+[[noreturn]] void refuseMap(const std::string& path, const std::string& why)
 {
-    auto in = OIIO::ImageInput::open(path);
-    if (!in) {
-        std::string reason = OIIO::geterror();
+    throw Error("cannot read depth map '" + path + "': " + why);
+}
+
+void requireSize(const std::string& path, long long width, long long height, int expectedWidth, int expectedHeight)
+{
+    if (width != expectedWidth || height != expectedHeight)
+        throw Error("depth map '" + path + "' is " + std::to_string(width) + "x" + std::to_string(height) +
+                    " but the camera's image is " + std::to_string(expectedWidth) + "x" + std::to_string(expectedHeight));
+}
+
+// PFM (Paul Debevec's portable float map): "Pf" (1 channel) or "PF" (3), whitespace, width,
+// height, scale (negative: little-endian), one whitespace byte, then float32 rows from the
+// bottom row of the picture to the top. Read here, strictly: the size is compared with the
+// camera's before anything is allocated, and the data must be exactly as long as declared.
+DepthMapFile readPfm(const std::string& path, const std::string& bytes, int expectedWidth, int expectedHeight)
+{
+    std::size_t at = 2;
+    auto field = [&](const char* what) {
+        while (at < bytes.size() && std::isspace(static_cast<unsigned char>(bytes[at]))) ++at;
+        const std::size_t start = at;
+        while (at < bytes.size() && at - start < 40 && !std::isspace(static_cast<unsigned char>(bytes[at]))) ++at;
+        if (at == start || at >= bytes.size()) refuseMap(path, std::string("malformed PFM header: no ") + what);
+        return bytes.substr(start, at - start);
+    };
+    const int channels = bytes[1] == 'f' ? 1 : 3;
+    const std::string widthText = field("width"), heightText = field("height"), scaleText = field("scale");
+    auto whole = [&](const std::string& text, const char* what) {
+        long long v = -1;
+        const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), v);
+        if (error != std::errc() || end != text.data() + text.size() || v < 1)
+            refuseMap(path, std::string("malformed PFM header: ") + what + " '" + text + "' is not a positive whole number");
+        return v;
+    };
+    const long long width = whole(widthText, "width"), height = whole(heightText, "height");
+    double scale = 0;
+    const auto [end, error] = std::from_chars(scaleText.data(), scaleText.data() + scaleText.size(), scale);
+    if (error != std::errc() || end != scaleText.data() + scaleText.size() || !std::isfinite(scale) || scale == 0)
+        refuseMap(path, "malformed PFM header: scale '" + scaleText + "' must be a nonzero number");
+    ++at;  // the single whitespace byte that ends the header
+    requireSize(path, width, height, expectedWidth, expectedHeight);
+    const std::uint64_t expectedBytes = std::uint64_t(width) * std::uint64_t(height) * std::uint64_t(channels) * 4;
+    if (bytes.size() - at != expectedBytes)
+        refuseMap(path, "the PFM data holds " + std::to_string(bytes.size() - at) + " bytes, but " +
+                            std::to_string(width) + "x" + std::to_string(height) + "x" + std::to_string(channels) +
+                            " float32 values need " + std::to_string(expectedBytes) + (bytes.size() - at < expectedBytes ? " (truncated)" : ""));
+    DepthMapFile map;
+    map.width = int(width), map.height = int(height);
+    map.channel = channels == 1 ? "Y" : "R";
+    map.value.resize(std::size_t(width) * std::size_t(height));
+    const bool bigEndian = scale > 0;
+    for (long long row = 0; row < height; ++row)
+        for (long long col = 0; col < width; ++col) {
+            unsigned char raw[4];
+            std::memcpy(raw, bytes.data() + at + 4 * ((std::size_t(row) * std::size_t(width) + std::size_t(col)) * std::size_t(channels)), 4);
+            if (bigEndian) std::reverse(raw, raw + 4);
+            float v;
+            std::memcpy(&v, raw, 4);
+            map.value[std::size_t(height - 1 - row) * std::size_t(width) + std::size_t(col)] = v;  // stored bottom-up
+        }
+    return map;
+}
+
+// OpenEXR allocates what a header attribute's size field claims (up to 2 GiB for a string)
+// before anything else is checked. The header is walked here first: every attribute must fit
+// in the file, and the data window (the image size) must be the camera's. The layout per the
+// OpenEXR file format: magic, version flags, then attributes `name\0 type\0 int32 size, value`
+// ending with an empty name; multi-part files repeat headers up to an empty header.
+void preflightExr(const std::string& path, int expectedWidth, int expectedHeight)
+{
+    const std::uint64_t fileSize = checkInputFile(path, kDepthMapInput);
+    constexpr std::size_t kMaxHeaderBytes = 16 << 20;
+    std::string head(std::size_t(std::min<std::uint64_t>(fileSize, kMaxHeaderBytes)), '\0');
+    {
+        std::ifstream in(path, std::ios::binary);
+        in.read(head.data(), std::streamsize(head.size()));
+        if (std::uint64_t(in.gcount()) != head.size()) refuseMap(path, "the file could not be read whole");
+    }
+    auto malformed = [&](const std::string& why) { refuseMap(path, "malformed EXR header: " + why); };
+    if (head.size() < 8) malformed("shorter than 8 bytes");
+    std::uint32_t version = 0;
+    std::memcpy(&version, head.data() + 4, 4);
+    const bool multipart = version & 0x1000, longNames = version & 0x400;
+    if ((version & 0xff) != 2) malformed("version " + std::to_string(version & 0xff) + " (expected 2)");
+    std::size_t at = 8;
+    bool sawDataWindow = false;
+    auto text = [&](const char* what) {
+        const std::size_t end = head.find('\0', at);
+        const std::size_t limit = longNames ? 255 : 31;
+        if (end == std::string::npos || end - at > limit)
+            malformed(std::string(what) + " longer than " + std::to_string(limit) + " bytes or unterminated");
+        std::string value = head.substr(at, end - at);
+        at = end + 1;
+        return value;
+    };
+    for (;;) {  // one header (one part)
+        for (;;) {  // its attributes, up to an empty name
+            if (at >= head.size()) malformed("the header does not end within the file's first 16 MiB");
+            if (head[at] == '\0') {
+                ++at;
+                break;
+            }
+            const std::string name = text("an attribute name"), type = text("an attribute type");
+            if (at + 4 > head.size()) malformed("attribute '" + name + "' has no size");
+            std::int32_t size = 0;
+            std::memcpy(&size, head.data() + at, 4);
+            at += 4;
+            if (size < 0 || std::uint64_t(size) > fileSize - at)
+                malformed("attribute '" + name + "' declares " + std::to_string(size) + " bytes, more than the file holds");
+            if (name == "dataWindow" && !sawDataWindow) {
+                if (type != "box2i" || size != 16 || at + 16 > head.size()) malformed("dataWindow is not a box2i");
+                std::int32_t box[4];
+                std::memcpy(box, head.data() + at, 16);
+                requireSize(path, std::int64_t(box[2]) - box[0] + 1, std::int64_t(box[3]) - box[1] + 1, expectedWidth,
+                            expectedHeight);
+                sawDataWindow = true;
+            }
+            at += std::size_t(size);
+        }
+        if (!multipart) break;
+        if (at >= head.size()) malformed("the list of part headers does not end");
+        if (head[at] == '\0') break;  // an empty header ends a multi-part file's headers
+    }
+    if (!sawDataWindow) malformed("no dataWindow attribute");
+}
+
+}  // namespace
+
+DepthMapFile readDepthMap(const std::string& path, const std::string& preferredChannel, double scale, int expectedWidth,
+                          int expectedHeight)
+{
+    if (scale != 0 && !(scale > 0 && std::isfinite(scale)))
+        throw Error("--scale must be a positive finite number, got " + formatNumber(scale));
+    checkInputFile(path, kDepthMapInput);
+    // The format is decided by the file's first bytes, and only that format's reader sees it:
+    // OpenImageIO would otherwise offer unknown bytes to every plugin it has (video, camera
+    // raw, DICOM, ...). PFM is read by zcheck itself (see readPfm).
+    unsigned char magic[4] = {0, 0, 0, 0};
+    {
+        std::ifstream probe(path, std::ios::binary);
+        probe.read(reinterpret_cast<char*>(magic), 4);
+    }
+    if (magic[0] == 'P' && (magic[1] == 'f' || magic[1] == 'F') && std::isspace(magic[2])) {
+        DepthMapFile map = readPfm(path, readInputFile(path, kDepthMapInput), expectedWidth, expectedHeight);
+        if (scale > 0)
+            for (double& v : map.value) v /= scale;
+        return map;
+    }
+    const char* plugin = magic[0] == 0x76 && magic[1] == 0x2f && magic[2] == 0x31 && magic[3] == 0x01 ? "openexr"
+                         : (magic[0] == 'I' && magic[1] == 'I' && magic[2] == 42 && magic[3] == 0) ||
+                                   (magic[0] == 'M' && magic[1] == 'M' && magic[2] == 0 && magic[3] == 42)
+                             ? "tiff"
+                         : magic[0] == 0x89 && magic[1] == 'P' && magic[2] == 'N' && magic[3] == 'G' ? "png"
+                                                                                                      : nullptr;
+    if (!plugin) refuseMap(path, "not an EXR, TIFF, PNG or PFM file (judged by its first bytes)");
+    if (plugin == std::string("png")) {
+        // zcheck's own libpng reader (OpenImageIO's leaks on libpng's error path).
+        if (!(scale > 0))
+            throw Error("depth map '" + path + "' stores integers (16-bit PNG): give --scale (stored value = depth × scale, "
+                        "e.g. 1000 for millimetres)");
+        Png16 png;
+        try {
+            png = decodePng16(readInputFile(path, kDepthMapInput), [&](long long width, long long height) {
+                requireSize(path, width, height, expectedWidth, expectedHeight);
+            });
+        } catch (const Error& e) {
+            const std::string what = e.what();
+            if (what.rfind("depth map '", 0) == 0) throw;  // the size message names the file already
+            refuseMap(path, what);
+        }
+        DepthMapFile map;
+        map.width = png.width, map.height = png.height, map.channel = "Y";
+        map.value.resize(png.codes.size());
+        for (std::size_t i = 0; i < png.codes.size(); ++i) map.value[i] = png.codes[i] == 0 ? NAN : png.codes[i] / scale;
+        return map;
+    }
+    if (plugin == std::string("openexr")) preflightExr(path, expectedWidth, expectedHeight);
+    auto in = OIIO::ImageInput::create(plugin);
+    OIIO::ImageSpec opened;
+    if (!in || !in->open(path, opened)) {
+        std::string reason = in ? in->geterror() : OIIO::geterror();
         for (char& c : reason)
             if (c == '\n') c = ' ';
-        throw Error("cannot read depth map '" + path + "': " + (reason.empty() ? "unreadable" : reason));
+        refuseMap(path, "malformed " + std::string(plugin == std::string("openexr") ? "EXR" : plugin == std::string("tiff") ? "TIFF" : "PNG") +
+                            (reason.empty() ? "" : ": " + reason));
     }
     const OIIO::ImageSpec& spec = in->spec();
-    if (spec.width < 1 || spec.height < 1 || spec.depth > 1)
-        throw Error("cannot read depth map '" + path + "': not a 2-D image");
+    if (spec.width < 1 || spec.height < 1 || spec.depth > 1 || spec.nchannels < 1) refuseMap(path, "not a 2-D image");
+    // Compared with the camera before a pixel is allocated: a header may declare anything.
+    requireSize(path, spec.width, spec.height, expectedWidth, expectedHeight);
     int channel = 0;
     if (spec.channelindex(preferredChannel) >= 0) channel = spec.channelindex(preferredChannel);
-    const bool integer = !spec.format.is_floating_point();
+    const OIIO::TypeDesc format = spec.channelformat(channel);
+    const bool integer = !format.is_floating_point();
     if (integer && !(scale > 0))
-        throw Error("depth map '" + path + "' stores integers (" + std::string(spec.format.c_str()) +
+        throw Error("depth map '" + path + "' stores integers (" + std::string(format.c_str()) +
                     "): give --scale (stored value = depth × scale, e.g. 1000 for millimetres)");
     DepthMapFile map;
     map.width = spec.width, map.height = spec.height;
     map.channel = spec.channelnames.empty() ? "0" : spec.channelnames[std::size_t(channel)];
-    std::vector<double> pixels(std::size_t(spec.width) * spec.height);
-    if (!in->read_image(0, 0, channel, channel + 1, OIIO::TypeDesc::DOUBLE, pixels.data()))
-        throw Error("cannot read depth map '" + path + "': " + in->geterror());
+    std::vector<double> pixels(std::size_t(spec.width) * std::size_t(spec.height));
+    if (!in->read_image(0, 0, channel, channel + 1, OIIO::TypeDesc::DOUBLE, pixels.data())) {
+        std::string reason = in->geterror();
+        for (char& c : reason)
+            if (c == '\n') c = ' ';
+        refuseMap(path, reason.empty() ? "the pixel data is truncated or corrupt" : reason);
+    }
     if (integer) {
         // read_image scales integers to [0,1]; undo it to get the stored code.
-        const double maxCode = std::pow(2.0, double(spec.format.size() * 8)) - 1;
+        const double maxCode = std::pow(2.0, double(format.size() * 8)) - 1;
         for (double& v : pixels) {
             const double code = std::round(v * maxCode);
             v = code == 0 ? NAN : code / scale;
@@ -149,8 +340,7 @@ void writePng16(const std::string& path, const QuantityImage& image, double scal
     std::vector<std::uint16_t> codes(image.value.size(), 0);
     for (std::size_t i = 0; i < codes.size(); ++i)
         if (!image.isMiss(i)) codes[i] = static_cast<std::uint16_t>(std::lround(image.value[i] * scale));
-    OIIO::ImageSpec spec(image.width, image.height, 1, OIIO::TypeDesc::UINT16);
-    writeImage(path, spec, codes.data());
+    writeFileBytes(path, encodePng(image.width, image.height, 1, 16, codes.data()));
 }
 
 // PFM, written here because OpenImageIO 2.4 (Debian 12) reads PFM but has no writer for it.
@@ -162,17 +352,14 @@ void writePfm(const std::string& path, const QuantityImage& image)
     if (image.quantity == ExportQuantity::PrimitiveId || (C != 1 && C != 3))
         throw Error("cannot write '" + path + "': PFM holds 1 or 3 float channels, not " + toString(image.quantity) +
                     " (use .exr or .tif)");
-    writeAtomically(path, [&](const std::string& temporary) {
-        std::ofstream out(temporary, std::ios::binary);
-        out << (C == 1 ? "Pf" : "PF") << "\n" << image.width << " " << image.height << "\n-1.0\n";
-        std::vector<float> row(std::size_t(image.width) * C);
-        for (int y = image.height - 1; y >= 0; --y) {
-            for (std::size_t k = 0; k < row.size(); ++k) row[k] = float(image.value[std::size_t(y) * image.width * C + k]);
-            out.write(reinterpret_cast<const char*>(row.data()), std::streamsize(row.size() * sizeof(float)));
-        }
-        out.flush();
-        if (!out) throw Error("cannot write '" + path + "': write failed");
-    });
+    std::string bytes = std::string(C == 1 ? "Pf" : "PF") + "\n" + std::to_string(image.width) + " " +
+                        std::to_string(image.height) + "\n-1.0\n";
+    std::vector<float> row(std::size_t(image.width) * C);
+    for (int y = image.height - 1; y >= 0; --y) {
+        for (std::size_t k = 0; k < row.size(); ++k) row[k] = float(image.value[std::size_t(y) * image.width * C + k]);
+        bytes.append(reinterpret_cast<const char*>(row.data()), row.size() * sizeof(float));
+    }
+    writeFileBytes(path, bytes);
 }
 
 }  // namespace

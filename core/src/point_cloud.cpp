@@ -5,32 +5,37 @@
 
 #include <cstdint>
 #include <cstring>
-#include <fstream>
+#include <cstdio>
 
 namespace zcheck {
 
 void writePointCloudPly(const std::string& path, const std::vector<glm::dvec3>& points, bool binary,
                         const std::vector<std::string>& comments)
 {
-    writeAtomically(path, [&](const std::string& temporary) {
-        std::ofstream out(temporary, std::ios::binary);
-        out << "ply\nformat " << (binary ? "binary_little_endian" : "ascii") << " 1.0\n";
-        for (const auto& comment : comments) out << "comment " << comment << "\n";
-        out << "element vertex " << points.size() << "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
-        if (binary) {
-            std::vector<char> bytes(points.size() * 12);
-            for (std::size_t i = 0; i < points.size(); ++i) {
-                const float xyz[3] = {float(points[i].x), float(points[i].y), float(points[i].z)};
-                std::memcpy(bytes.data() + 12 * i, xyz, 12);  // x86-64 is little-endian
-            }
-            out.write(bytes.data(), std::streamsize(bytes.size()));
-        } else {
-            out.precision(9);
-            for (const auto& p : points) out << float(p.x) << ' ' << float(p.y) << ' ' << float(p.z) << '\n';
+    std::string bytes = std::string("ply\nformat ") + (binary ? "binary_little_endian" : "ascii") + " 1.0\n";
+    for (std::string comment : comments) {
+        for (char& c : comment)
+            if (c == '\n' || c == '\r') c = ' ';  // a file name may hold anything
+        bytes += "comment " + comment + "\n";
+    }
+    bytes += "element vertex " + std::to_string(points.size()) +
+             "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+    if (binary) {
+        const std::size_t header = bytes.size();
+        bytes.resize(header + points.size() * 12);
+        for (std::size_t i = 0; i < points.size(); ++i) {
+            const float xyz[3] = {float(points[i].x), float(points[i].y), float(points[i].z)};
+            std::memcpy(bytes.data() + header + 12 * i, xyz, 12);  // x86-64 is little-endian
         }
-        out.flush();
-        if (!out) throw Error("cannot write '" + path + "': write failed");
-    });
+    } else {
+        char line[64];
+        for (const auto& p : points) {
+            const int n = std::snprintf(line, sizeof line, "%.9g %.9g %.9g\n", double(float(p.x)), double(float(p.y)),
+                                        double(float(p.z)));
+            bytes.append(line, std::size_t(n));
+        }
+    }
+    writeFileBytes(path, bytes);
 }
 
 }  // namespace zcheck

@@ -35,10 +35,11 @@ void validateScene(const Scene& scene)
     for (const auto& p : scene.positions)
         for (int i = 0; i < 3; ++i) {
             if (!std::isfinite(p[i])) throw Error("scene '" + scene.name + "' has a vertex that is not finite");
-            // binary32 ray tracing needs headroom: squares of coordinates must stay finite.
-            if (std::abs(p[i]) > 1e18f)
-                throw Error("scene '" + scene.name + "' has a vertex coordinate beyond ±1e18 (" +
-                            formatNumber(p[i]) + ")");
+            // binary32 ray tracing needs headroom (Embree fails beyond ~1e19); the same bound
+            // as the camera's (Camera::kMaxWorldCoordinate).
+            if (std::abs(p[i]) > Camera::kMaxWorldCoordinate)
+                throw Error("scene '" + scene.name + "' has a vertex coordinate " + formatNumber(p[i]) +
+                            ", beyond the ±1e15 that the ray tracer can represent");
         }
     for (const auto& t : scene.triangles)
         for (int i = 0; i < 3; ++i)

@@ -166,7 +166,13 @@ public:
     }
     double windowYFromImageY(double yImage) const { return imageYFromWindowY(yImage); }  // an involution
 
+    // The largest world coordinate of the eye and of the near-plane window's corners (rays
+    // are traced in binary32); the constructor refuses cameras beyond it.
+    static constexpr double kMaxWorldCoordinate = 1e15;
+
 private:
+    void requireRepresentable() const;
+
     CameraSpec spec_;
     double left_ = 0, right_ = 0, bottom_ = 0, top_ = 0;
     double near_ = 0, far_ = 0;

@@ -22,7 +22,11 @@
 namespace zcheck {
 
 CameraSpec cameraSpecFromJson(const nlohmann::json& document, const std::string& source);
+// The file must be a regular file of at most 1 MiB (input_file.h).
 CameraSpec readCameraFile(const std::string& path);
+// JSON text parsed strictly: a syntax error or a key repeated within one object throws Error
+// beginning with `source` (e.g. "camera file 'c.json'").
+nlohmann::json parseJsonStrictly(const std::string& text, const std::string& source);
 nlohmann::json toJson(const CameraSpec& spec);
 
 // Every transform of a camera as 4 rows of 4 numbers for column vectors (p' = M·p), plus a

@@ -1,6 +1,9 @@
 #pragma once
-// Image files (library zcheck_imageio, the only place OpenImageIO is used). All writes are
-// atomic (atomic_file.h). Row 0 of every image is the top row as seen.
+// Image files (library zcheck_imageio, the only place OpenImageIO and libpng are used).
+// Writers write the path they are given, checking every write and close (PNG and PFM are
+// encoded by zcheck and written with writeFileBytes; EXR and TIFF by OpenImageIO); a
+// command makes its outputs atomic with OutputFiles (atomic_file.h). Row 0 of every image is
+// the top row as seen.
 #include "zcheck/compare.h"
 #include "zcheck/export.h"
 #include "zcheck/render.h"
@@ -19,8 +22,8 @@ void writeExr(const std::string& path, int width, int height, const std::vector<
 // An 8-bit RGB PNG; `rgb` holds width·height·3 bytes.
 void writePng8(const std::string& path, int width, int height, const std::vector<std::uint8_t>& rgb);
 
-// A depth map read from a file (EXR, PFM, TIFF, PNG, anything OpenImageIO reads), row 0 at
-// the top as seen (OpenImageIO returns PFM's bottom-to-top rows flipped).
+// A depth map read from a file — EXR, TIFF, PNG or PFM, told apart by their first bytes —
+// row 0 at the top as seen (PFM's bottom-to-top rows are flipped).
 struct DepthMapFile {
     int width = 0, height = 0;
     std::string channel;          // the channel read
@@ -28,10 +31,16 @@ struct DepthMapFile {
 };
 // The channel named `preferredChannel` if there is one, else the first. Integer
 // files (16-bit PNG) need `scale`: value = stored / scale, 0 = miss. Float files are divided
-// by `scale` when it is given. Throws Error naming the file.
-DepthMapFile readDepthMap(const std::string& path, const std::string& preferredChannel, double scale);
+// by `scale` when it is given (0: not given; otherwise it must be positive and finite).
+// The file must be a regular file of at most 2 GiB, and its declared size must be
+// expectedWidth × expectedHeight, checked before any pixel is allocated (for EXR after
+// walking its header, whose attribute sizes must fit in the file). PFM is read by zcheck
+// itself; EXR, TIFF and PNG by OpenImageIO, each only by its own reader (unknown bytes are
+// never offered to OpenImageIO's other plugins). Throws Error naming the file and the rule.
+DepthMapFile readDepthMap(const std::string& path, const std::string& preferredChannel, double scale, int expectedWidth,
+                          int expectedHeight);
 
-// Writes exported quantities by the file's extension, atomically:
+// Writes exported quantities by the file's extension:
 //   .exr  any quantities, one channel each (names in export.h), float32 (id: uint32), ZIP
 //   .pfm  one quantity of 1 or 3 float channels; rows stored bottom to top as PFM specifies
 //         (written by zcheck: OpenImageIO 2.4 reads PFM but cannot write it)

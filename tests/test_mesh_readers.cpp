@@ -1,0 +1,183 @@
+// zcheck's own mesh readers (mesh_formats.h): hand-written files with hand-computed
+// triangles, the same mesh in every encoding, the shared models' published counts, and one
+// regression per file that used to crash or hang zcheck through assimp.
+#include "zcheck/error.h"
+#include "zcheck/mesh_formats.h"
+#include "zcheck/mesh_loader.h"
+
+#include <catch2/catch.hpp>
+
+#include <cstring>
+#include <filesystem>
+#include <unistd.h>
+#include <fstream>
+#include <string>
+
+using namespace zcheck;
+
+namespace {
+
+std::string ply(const std::string& format, const std::string& elements)
+{
+    return "ply\nformat " + format + " 1.0\ncomment test\n" + elements + "end_header\n";
+}
+
+template <class T>
+void put(std::string& out, T value, bool bigEndian = false)
+{
+    char raw[sizeof(T)];
+    std::memcpy(raw, &value, sizeof(T));
+    if (bigEndian) std::reverse(raw, raw + sizeof(T));
+    out.append(raw, sizeof(T));
+}
+
+// The unit square in z = 0 with its two triangles (0,1,2) and (0,2,3), in every PLY encoding.
+const std::vector<glm::vec3> kSquare = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+const std::vector<glm::uvec3> kSquareFan = {{0, 1, 2}, {0, 2, 3}};
+
+std::string binarySquare(bool bigEndian)
+{
+    // z is declared first and an extra property sits between them: any order must read.
+    std::string out = ply(bigEndian ? "binary_big_endian" : "binary_little_endian",
+                          "element vertex 4\nproperty double z\nproperty float x\nproperty uchar red\nproperty float y\n"
+                          "element face 1\nproperty list uchar uint vertex_indices\nelement edge 1\nproperty int a\n");
+    for (const auto& p : kSquare) {
+        put(out, double(p.z), bigEndian);
+        put(out, p.x, bigEndian);
+        put(out, std::uint8_t(255), bigEndian);
+        put(out, p.y, bigEndian);
+    }
+    put(out, std::uint8_t(4), bigEndian);
+    for (std::uint32_t i : {0u, 1u, 2u, 3u}) put(out, i, bigEndian);
+    put(out, std::int32_t(7), bigEndian);
+    return out;
+}
+
+void requireSquare(const Scene& scene)
+{
+    REQUIRE(scene.positions == kSquare);
+    REQUIRE(scene.triangles == kSquareFan);
+}
+
+}  // namespace
+
+TEST_CASE("PLY: ascii, binary little- and big-endian give the same triangles, in any property order", "[mesh][ply]")
+{
+    requireSquare(readPly("a.ply", ply("ascii", "element vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+                                                "element face 1\nproperty list uchar int vertex_indices\n") +
+                                           "0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n"));
+    requireSquare(readPly("le.ply", binarySquare(false)));
+    requireSquare(readPly("be.ply", binarySquare(true)));
+    // CRLF line ends, blank lines between items and no newline after the last one.
+    requireSquare(readPly("crlf.ply", "ply\r\nformat ascii 1.0\r\nelement vertex 4\r\nproperty float x\r\nproperty float y\r\n"
+                                      "property float z\r\nelement face 1\r\nproperty list uchar int vertex_indices\r\n"
+                                      "end_header\r\n0 0 0\r\n\r\n1 0 0\r\n1 1 0\r\n0 1 0\r\n4 0 1 2 3"));
+}
+
+TEST_CASE("PLY: malformed files are refused with the element, the item and the rule", "[mesh][ply]")
+{
+    const std::string vertex3 = "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n";
+    const std::string faces = "element face 1\nproperty list uchar int vertex_indices\n";
+    auto refused = [](const std::string& bytes, const std::string& why) {
+        REQUIRE_THROWS_WITH(readPly("m.ply", bytes), Catch::Contains("'m.ply'") && Catch::Contains(why));
+    };
+    refused(ply("ascii", vertex3 + faces) + "0 0 0\n1 0 0\n0 1\n3 0 1 2\n", "vertex 2: the line holds fewer values");
+    refused(ply("ascii", vertex3 + faces) + "0 0 0\n1 0 0\n0 1 0 5\n3 0 1 2\n", "vertex 2: the line holds more values");
+    refused(ply("ascii", vertex3 + faces) + "0 0 0\n1 0 0\n0 1 0\n", "element 'face' declares 1 items, more than the remaining 0");
+    refused(ply("ascii", vertex3 + faces) + "0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n", "refers to vertex 3 but the file has 3");
+    refused(ply("ascii", vertex3 + faces) + "0 0 0\n1 0 0\n0 1 0\n2 0 1\n", "at least 3 vertices");
+    refused(ply("ascii", vertex3 + faces) + "0 0 0\n1 0 x\n0 1 0\n3 0 1 2\n", "is not a number");
+    refused(ply("ascii", "element vertex 3\nproperty float x\nproperty float y\n" + faces) + "0 0\n1 0\n0 1\n3 0 1 2\n",
+            "no 'z' property");
+    refused("ply\nformat binary_big_", "no end_header");
+    refused("ply\nformat ascii 1.0\nelement vertex 3\n", "no end_header");
+    refused(ply("binary_little_endian", "element vertex 2000000000\nproperty float x\nproperty float y\nproperty float z\n"),
+            "declares 2000000000 items, more than the remaining 0 bytes");
+    refused(ply("ascii", vertex3 + "property float y\n" + faces), "property 'y' appears twice");
+    refused(ply("ascii", vertex3 + "element face 1\nproperty list float int vertex_indices\n"), "integer type");
+    refused(ply("ascii", vertex3 + "flavour sweet\n"), "unknown header keyword");
+    refused("plyx\nformat ascii 1.0\nend_header\n", "not a PLY file");
+    refused(ply("ascii", vertex3 + faces) + "1e39 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", "not a finite binary32");
+}
+
+TEST_CASE("regression: assimp crashed on a binary PLY with truncated vertex data or a face list longer than the data",
+          "[mesh][ply][regression]")
+{
+    std::string truncated = binarySquare(false);
+    truncated.resize(truncated.size() - 30);  // inside the vertex data
+    REQUIRE_THROWS_WITH(readPly("t.ply", truncated), Catch::Contains("ends early") || Catch::Contains("more than the"));
+    std::string longList = binarySquare(false);
+    longList.resize(longList.size() - 4);
+    REQUIRE_THROWS_WITH(readPly("l.ply", longList), Catch::Contains("ends early") || Catch::Contains("more than the"));
+}
+
+TEST_CASE("OBJ: polygons become fans, a concave quad is split at its reflex corner, every index form reads", "[mesh][obj]")
+{
+    const Scene square = readObj("s.obj", "# a square\nv 0 0 0\nv 1 0 0\nv 1 1 0 1.0\nv 0 1 0 0.5 0.5 0.5\nvt 0 0\nvn 0 0 1\n"
+                                          "o square\ng face\nusemtl red\ns off\nf 1/1/1 2//1 3/1 -1\n");
+    requireSquare(square);
+    // A dart: corner 2 (index 2, at (1, 0.2)) is reflex; splitting there keeps both
+    // triangles inside the quad: (2,3,0) and (2,0,1).
+    const Scene dart = readObj("d.obj", "v 0 0 0\nv 2 0 0\nv 1 0.2 0\nv 1 2 0\nf 1 2 3 4\n");
+    REQUIRE(dart.triangles == std::vector<glm::uvec3>{{2, 3, 0}, {2, 0, 1}});
+    // A statement continued on the next line.
+    REQUIRE(readObj("c.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 \\\n 3\n").triangles.size() == 1);
+}
+
+TEST_CASE("OBJ: malformed files are refused with the line and the rule", "[mesh][obj]")
+{
+    auto refused = [](const std::string& bytes, const std::string& why) {
+        REQUIRE_THROWS_WITH(readObj("m.obj", bytes), Catch::Contains("'m.obj'") && Catch::Contains(why));
+    };
+    refused("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 0\n", "line 4: vertex index 0 is out of range");
+    refused("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", "refers to vertex 9 but the file defines 3");
+    refused("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n", "vertex index -4 is out of range");
+    refused("v 0 0\n", "line 1: a vertex needs x, y and z");
+    refused("v 0 0 zero\n", "'zero' is not a number");
+    refused("v 0 0 1e400\n", "beyond the range");
+    refused("v 0 0 1e39\n", "not a finite binary32");
+    refused("\x89PNG\r\n", "unknown statement");
+    refused("v 0 0 0\nf 1 1\n", "at least 3 vertices");
+}
+
+TEST_CASE("STL: ascii and binary give the same triangles; the binary size must match its count", "[mesh][stl]")
+{
+    const std::string ascii = "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 1 1 0\nendloop\n"
+                              "endfacet\nendsolid t\n";
+    std::string binary(80, ' ');
+    binary.replace(0, 5, "solid");  // binary files may begin with "solid" too
+    put(binary, std::uint32_t(1));
+    for (float v : {0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 1.f, 1.f, 0.f}) put(binary, v);
+    put(binary, std::uint16_t(0));
+    const Scene a = readStl("a.stl", ascii), b = readStl("b.stl", binary);
+    REQUIRE(a.positions == std::vector<glm::vec3>{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}});
+    REQUIRE(a.positions == b.positions);
+    REQUIRE(a.triangles == b.triangles);
+    REQUIRE_THROWS_WITH(readStl("s.stl", binary + "x"), Catch::Contains("declares 1 triangles (134 bytes)"));
+    REQUIRE_THROWS_WITH(readStl("l.stl", "solid t\nouter loop\nvertex 0 0 0\nendloop\n"), Catch::Contains("exactly 3"));
+}
+
+TEST_CASE("the shared models load with the triangle counts their sources publish", "[mesh][models]")
+{
+    const std::string dir = ZCHECK_MODELS_DIR;
+    // Triangles after fans: beast and suzanne have quads (counted by hand from their f lines).
+    for (auto [file, triangles] : {std::pair{"stanford-bunny.obj", 69451}, {"nefertiti.obj", 99938},
+                                   {"fandisk.obj", 12946}, {"spot.obj", 5856}, {"cow.obj", 5804}, {"teapot.obj", 6320}}) {
+        INFO(file);
+        REQUIRE(loadMesh(dir + "/" + file).triangleCount() == std::size_t(triangles));
+    }
+    REQUIRE(loadMesh(dir + "/suzanne.obj").triangleCount() == 468 * 2 + 32);  // 468 quads, 32 triangles
+    REQUIRE(loadMesh(dir + "/igea.ply").positions.size() == 134345);
+}
+
+TEST_CASE("a mesh whose triangles all have zero area is refused", "[mesh]")
+{
+    const std::string path =
+        (std::filesystem::temp_directory_path() / ("zcheck-degenerate-" + std::to_string(::getpid()) + ".obj")).string();
+    {
+        std::ofstream out(path);
+        out << "v 0 0 0\nv 1 1 1\nv 2 2 2\nf 1 2 3\n";
+    }
+    REQUIRE_THROWS_WITH(loadMesh(path), Catch::Contains("degenerate (zero area)"));
+    std::remove(path.c_str());
+}
