@@ -49,6 +49,8 @@ const CLI::Validator kPositiveFinite(
         return std::string();
     },
     "NUMBER > 0");
+const CLI::Validator kNonEmptyList(
+    [](std::string& value) { return value.empty() ? std::string("the list is empty") : std::string(); }, "LIST");
 const auto kThreadRange = CLI::Range(1, 1024);
 const auto kImageSideRange = CLI::Range(1, 16384);
 
@@ -291,6 +293,10 @@ int runUnprojectCommand(const UnprojectOptions& o)
     const Camera camera(cameraSpecFrom(o.cameraFile, o.convention));
     auto toWorld = [&](const glm::dvec3& pEye) { return glm::dvec3(camera.worldFromEye * glm::dvec4(pEye, 1.0)); };
 
+    if (!o.pixel.empty() && (!o.depthMap.empty() || !o.output.empty()))
+        throw Error("--pixel and --depth-map/-o are alternatives: one pixel's ray or point, or a whole map as a point cloud");
+    if (o.pixel.empty() && o.depth)
+        throw Error("--depth " + formatNumber(*o.depth) + " needs --pixel COL,ROW (a --depth-map holds its own depths)");
     if (!o.pixel.empty()) {
         const glm::ivec2 pixel = parsePixel(o.pixel, camera);
         const glm::dvec2 pWindow = windowFromPixelCentre(camera, pixel.x, pixel.y);
@@ -707,7 +713,8 @@ int main(int argc, char** argv)
                      "resolves eye depth for a camera's near/far: the eye-z step between neighbouring stored\n"
                      "values at each distance, and which layout is best.");
     precisionCommand->add_option("--camera", precisionCamera, "camera file (JSON, see README)")->required()->check(kNonEmptyPath);
-    precisionCommand->add_option("--at", precisionAt, "eye-z distances, comma-separated (default: 9 log-spaced from near to far)");
+    precisionCommand->add_option("--at", precisionAt, "eye-z distances, comma-separated (default: 9 log-spaced from near to far)")
+        ->check(kNonEmptyList);
     precisionCommand->add_option("--convention", precisionConvention, "override the convention");
     precisionCommand->add_flag("--json", precisionJson, "print JSON instead of tables");
 
@@ -783,6 +790,20 @@ int main(int argc, char** argv)
     suiteCommand->add_option("--models", suite.modelsDir, "folder of the shared meshes")->capture_default_str()->check(kNonEmptyPath);
     suiteCommand->add_option("--threads", suite.threads, "worker threads, 1..1024 (default: all cores)")->check(kThreadRange);
 
+    // CLI11 says only "a subcommand is required" for a misspelt one: name it.
+    if (argc > 1 && argv[1][0] != '-') {
+        std::string names;
+        bool found = false;
+        for (const CLI::App* command : app.get_subcommands({})) {
+            found = found || command->get_name() == argv[1];
+            names += (names.empty() ? "" : ", ") + command->get_name();
+        }
+        if (!found) {
+            std::cerr << "zcheck: error: unknown command '" << argv[1] << "' (expected one of: " << names
+                      << "; see 'zcheck --help')\n";
+            return kExitUsage;
+        }
+    }
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {

@@ -12,6 +12,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include <cmath>
+#include <cstdlib>
 #include <random>
 
 using namespace zcheck;
@@ -394,4 +395,43 @@ TEST_CASE("the camera file is read strictly", "[core][validation]")
     REQUIRE_THROWS_WITH(parse(R"({"projection": {"type": "perspective", "fovy_deg": 60, "near": 1, "far": 1},)" + view + "}"),
                         Catch::Contains("projection.far"));
     REQUIRE_THROWS_WITH(readCameraFile("/nonexistent/camera.json"), Catch::Contains("cannot read camera file"));
+}
+
+TEST_CASE("regression: messages printed 180 as 1.8e+02", "[core][regression]")
+{
+    REQUIRE(formatNumber(180) == "180");
+    REQUIRE(formatNumber(0.1) == "0.1");
+    REQUIRE(formatNumber(1e-4) == "0.0001");
+    REQUIRE(formatNumber(123456789012345.0) == "123456789012345");
+    REQUIRE(formatNumber(1e15) == "1e+15");
+    REQUIRE(formatNumber(1.5e-5) == "1.5e-05");
+    REQUIRE(formatNumber(-2.5) == "-2.5");
+    for (double v : {180.0, 1.0 / 3.0, 6.02214076e23, -1e-300, 0.0})
+        REQUIRE(std::strtod(formatNumber(v).c_str(), nullptr) == v);  // every form reads back exactly
+}
+
+TEST_CASE("a camera file with a key twice in one object is refused, naming the key by its path", "[core][camera-file]")
+{
+    const std::string view = R"("view": {"eye": [0, 1, 3], "target": [0, 0, 0]})";
+    REQUIRE_THROWS_WITH(
+        parseJsonStrictly(R"({"convention": "opengl", "convention": "vulkan"})", "camera file 'c.json'"),
+        Catch::Equals("camera file 'c.json': key 'convention' appears twice in one object"));
+    REQUIRE_THROWS_WITH(parseJsonStrictly(R"({"projection": {"near": 1, "far": 9, "near": 2}, )" + view + "}", "f"),
+                        Catch::Contains("key 'projection.near' appears twice"));
+    // The same key in two different objects is fine.
+    REQUIRE_NOTHROW(parseJsonStrictly(R"({"a": {"x": 1}, "b": {"x": 2}, "c": [{"x": 1}, {"x": 2}]})", "f"));
+}
+
+TEST_CASE("cameras beyond what binary32 ray tracing can represent are refused, naming the bound", "[core]")
+{
+    CameraSpec spec;
+    spec.projection = Projection::perspective(60, 0.1, 100);
+    spec.view = View::lookAt({1e16, 0, 0}, {0, 0, 0}, {0, 1, 0});
+    REQUIRE_THROWS_WITH(Camera(spec), Catch::Contains("eye") && Catch::Contains("1e+16") && Catch::Contains("1e15"));
+    spec.view = View::lookAt({0, 0, 3}, {0, 0, 0}, {0, 1, 0});
+    spec.projection.type = ProjectionType::Orthographic;
+    spec.projection.left = -1e19, spec.projection.right = 1, spec.projection.bottom = -1, spec.projection.top = 1;
+    REQUIRE_THROWS_WITH(Camera(spec), Catch::Contains("near-plane window") && Catch::Contains("1e15"));
+    spec.projection.left = -1e14;  // within the bound
+    REQUIRE_NOTHROW(Camera(spec));
 }

@@ -181,3 +181,16 @@ TEST_CASE("a mesh whose triangles all have zero area is refused", "[mesh]")
     REQUIRE_THROWS_WITH(loadMesh(path), Catch::Contains("degenerate (zero area)"));
     std::remove(path.c_str());
 }
+
+TEST_CASE("regression: a PLY face repeating one vertex was dropped silently, so the message blamed an empty file",
+          "[mesh][ply][regression]")
+{
+    const std::string header = "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n";
+    const Scene faces = readPly("f.ply", ply("ascii", header + "element face 1\nproperty list uchar int vertex_indices\n") +
+                                             "0 0 0\n1 0 0\n0 1 0\n3 1 1 1\n");
+    REQUIRE(faces.triangles == std::vector<glm::uvec3>{{1, 1, 1}});  // kept as the file gives it: loadMesh judges it
+    REQUIRE_THROWS_WITH(
+        readPly("s.ply", ply("ascii", header + "element tristrips 1\nproperty list int int vertex_indices\n") +
+                             "0 0 0\n1 0 0\n0 1 0\n4 0 0 0 0\n"),
+        Catch::Contains("all 2 triangles of its strips repeat a vertex index (degenerate, zero area)"));
+}

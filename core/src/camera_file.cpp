@@ -278,16 +278,26 @@ CameraSpec cameraSpecFromJson(const json& document, const std::string& source)
 json parseJsonStrictly(const std::string& text, const std::string& source)
 {
     // A key twice in one object is an error: nlohmann keeps the last silently, and the
-    // user who wrote the first would never know it was ignored.
-    std::vector<std::vector<std::string>> keysOfOpenObjects;
+    // user who wrote the first would never know it was ignored. The message names the key by
+    // its path ("projection.near"), as the camera file's other messages do.
+    struct Open {
+        bool isObject;
+        std::vector<std::string> keys;  // objects: the keys so far; the last one is being read
+    };
+    std::vector<Open> open;
     std::string duplicate;
     const json::parser_callback_t callback = [&](int, json::parse_event_t event, json& parsed) {
-        if (event == json::parse_event_t::object_start) keysOfOpenObjects.emplace_back();
-        if (event == json::parse_event_t::object_end && !keysOfOpenObjects.empty()) keysOfOpenObjects.pop_back();
-        if (event == json::parse_event_t::key && !keysOfOpenObjects.empty() && duplicate.empty()) {
-            auto& keys = keysOfOpenObjects.back();
+        using Event = json::parse_event_t;
+        if (event == Event::object_start || event == Event::array_start) open.push_back({event == Event::object_start, {}});
+        if ((event == Event::object_end || event == Event::array_end) && !open.empty()) open.pop_back();
+        if (event == Event::key && !open.empty() && duplicate.empty()) {
+            auto& keys = open.back().keys;
             const std::string key = parsed.get<std::string>();
-            if (std::find(keys.begin(), keys.end(), key) != keys.end()) duplicate = key;
+            if (std::find(keys.begin(), keys.end(), key) != keys.end()) {
+                for (std::size_t level = 0; level + 1 < open.size(); ++level)
+                    duplicate += open[level].isObject && !open[level].keys.empty() ? open[level].keys.back() + "." : "[].";
+                duplicate += key;
+            }
             keys.push_back(key);
         }
         return true;

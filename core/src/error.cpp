@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 
 namespace zcheck {
 
@@ -14,11 +15,15 @@ std::string formatNumber(double value)
     if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
     char buffer[32];
     std::snprintf(buffer, sizeof buffer, "%.17g", value);
-    // Prefer the shortest form that reads back to the same double.
+    // Prefer the shortest form that reads back to the same double, written without an exponent
+    // when the magnitude is one a person writes out (180, not 1.8e+02).
+    const double magnitude = std::abs(value);
+    const bool plain = magnitude == 0 || (magnitude >= 1e-4 && magnitude < 1e15);
     for (int precision = 1; precision <= 17; ++precision) {
         char shorter[32];
         std::snprintf(shorter, sizeof shorter, "%.*g", precision, value);
-        if (std::strtod(shorter, nullptr) == value) return shorter;
+        if (std::strtod(shorter, nullptr) != value) continue;
+        if (!plain || !std::strchr(shorter, 'e')) return shorter;
     }
     return buffer;
 }

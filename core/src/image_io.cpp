@@ -304,15 +304,6 @@ DepthMapFile readDepthMap(const std::string& path, const std::string& preferredC
 
 namespace {
 
-std::string lowerExtension(const std::string& path)
-{
-    const std::size_t slash = path.find_last_of('/'), dot = path.find_last_of('.');
-    if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
-    std::string ext = path.substr(dot);
-    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-    return ext;
-}
-
 void writePng16(const std::string& path, const QuantityImage& image, double scale)
 {
     const ExportQuantity q = image.quantity;

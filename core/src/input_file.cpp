@@ -2,6 +2,7 @@
 
 #include "zcheck/error.h"
 
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -74,6 +75,15 @@ std::string readInputFile(const std::string& path, const InputKind& kind)
     }
     ::close(fd);
     return bytes;
+}
+
+std::string lowerExtension(const std::string& path)
+{
+    const std::size_t slash = path.find_last_of('/'), dot = path.find_last_of('.');
+    if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
+    std::string ext = path.substr(dot);
+    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    return ext;
 }
 
 }  // namespace zcheck

@@ -11,15 +11,6 @@ namespace zcheck {
 
 namespace {
 
-std::string lowerExtension(const std::string& path)
-{
-    const std::size_t slash = path.find_last_of('/'), dot = path.find_last_of('.');
-    if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
-    std::string ext = path.substr(dot);
-    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-    return ext;
-}
-
 // Refuses a mesh with no triangle of nonzero area (nothing for either route to draw), then
 // validates it and gives it a camera that frames its bounding sphere.
 Scene framed(Scene scene)
@@ -47,6 +38,8 @@ Scene loadMesh(const std::string& path)
     const std::string ext = lowerExtension(path);
     // The content decides where it can (a .ply renamed .obj is still a PLY); else the extension.
     if (bytes.rfind("ply\n", 0) == 0 || bytes.rfind("ply\r\n", 0) == 0 || ext == ".ply") return framed(readPly(path, bytes));
+    if (ext == ".glb" && bytes.rfind("glTF", 0) != 0)
+        throw Error("cannot load mesh '" + path + "': malformed GLB: it does not begin with the magic 'glTF'");
     if (bytes.rfind("glTF", 0) == 0 || ext == ".glb" || ext == ".gltf") return framed(readGltf(path, bytes));
     if (ext == ".obj") return framed(readObj(path, bytes));
     if (ext == ".stl") return framed(readStl(path, bytes));

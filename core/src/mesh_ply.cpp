@@ -61,6 +61,9 @@ public:
         readHeader();
         scene_.name = path_;
         for (const Element& element : elements_) readElement(element);
+        if (scene_.triangles.empty() && stripJoins_ > 0)
+            fail("all " + std::to_string(stripJoins_) +
+                 " triangles of its strips repeat a vertex index (degenerate, zero area): nothing to draw");
         for (const auto& t : scene_.triangles)
             for (int k = 0; k < 3; ++k)
                 if (t[k] >= scene_.positions.size())
@@ -328,12 +331,12 @@ private:
         }
     }
 
-    // Faces are fans; strips alternate winding and restart at kRestart. Triangles that repeat
-    // an index (the joins between strips) have no area and are not geometry: they are skipped.
+    // Faces are fans, kept as the file gives them (loadMesh judges degenerate ones). Strips
+    // alternate winding and restart at kRestart; their triangles that repeat an index are the
+    // joins between strips, an artefact of the encoding, and are skipped (and counted).
     void addPrimitives(const Element& element, std::uint64_t item, const std::vector<std::int64_t>& list)
     {
         auto add = [&](std::int64_t a, std::int64_t b, std::int64_t c) {
-            if (a == b || b == c || a == c) return;
             scene_.triangles.push_back({std::uint32_t(a), std::uint32_t(b), std::uint32_t(c)});
         };
         if (element.kind == ElementKind::Face) {
@@ -341,12 +344,19 @@ private:
             for (std::size_t i = 1; i + 1 < list.size(); ++i) add(list[0], list[i], list[i + 1]);
             return;
         }
+        auto addStripTriangle = [&](std::int64_t a, std::int64_t b, std::int64_t c) {
+            if (a == b || b == c || a == c) {
+                ++stripJoins_;
+                return;
+            }
+            add(a, b, c);
+        };
         std::size_t start = 0;
         for (std::size_t k = 0; k <= list.size(); ++k) {
             if (k < list.size() && list[k] != kRestart) continue;
             for (std::size_t i = start; i + 2 < k; ++i) {
                 const bool even = (i - start) % 2 == 0;
-                add(list[even ? i : i + 1], list[even ? i + 1 : i], list[i + 2]);
+                addStripTriangle(list[even ? i : i + 1], list[even ? i + 1 : i], list[i + 2]);
             }
             start = k + 1;
         }
@@ -357,6 +367,7 @@ private:
     std::size_t data_ = 0;  // cursor into bytes_
     std::vector<Element> elements_;
     bool ascii_ = false, bigEndian_ = false;
+    std::uint64_t stripJoins_ = 0;  // strip triangles skipped for repeating an index
     Scene scene_;
 };
 

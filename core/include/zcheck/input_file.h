@@ -25,4 +25,7 @@ std::uint64_t checkInputFile(const std::string& path, const InputKind& kind);
 // checkInputFile, then the whole content. A short read is an Error, not a shorter string.
 std::string readInputFile(const std::string& path, const InputKind& kind);
 
+// The file name's extension in lower case with its dot (".ply"), or "" if it has none.
+std::string lowerExtension(const std::string& path);
+
 }  // namespace zcheck
