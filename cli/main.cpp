@@ -38,8 +38,13 @@ constexpr int kExitUsage = 2;     // bad input: a file, key, option or value (on
 constexpr int kExitInternal = 3;  // zcheck itself failed: out of memory, a library or internal error
 
 // Option validators, the same in every subcommand.
-const CLI::Validator kNonEmptyPath(
-    [](std::string& value) { return value.empty() ? std::string("the path is empty") : std::string(); }, "PATH");
+// An option whose value may not be empty; `what` names it in the message ("the path is empty").
+CLI::Validator nonEmpty(const std::string& what, const std::string& description)
+{
+    return CLI::Validator(
+        [what](std::string& value) { return value.empty() ? "the " + what + " is empty" : std::string(); }, description);
+}
+const CLI::Validator kNonEmptyPath = nonEmpty("path", "PATH");
 const CLI::Validator kPositiveFinite(
     [](std::string& value) {
         char* end = nullptr;
@@ -49,8 +54,7 @@ const CLI::Validator kPositiveFinite(
         return std::string();
     },
     "NUMBER > 0");
-const CLI::Validator kNonEmptyList(
-    [](std::string& value) { return value.empty() ? std::string("the list is empty") : std::string(); }, "LIST");
+const CLI::Validator kNonEmptyList = nonEmpty("list", "LIST");
 const auto kThreadRange = CLI::Range(1, 1024);
 const auto kImageSideRange = CLI::Range(1, 16384);
 

@@ -110,10 +110,11 @@ void OutputFiles::add(const std::string& path, const std::string& option)
     if (path.empty()) throw Error(option + ": the output path is empty");
     if (path.back() == '/') throw Error("cannot write " + option + " '" + path + "': a file path is needed, not a folder");
     struct stat status {};
-    if (::stat(path.c_str(), &status) == 0 && S_ISDIR(status.st_mode))
-        throw Error("cannot write " + option + " '" + path + "': it is a folder");
-    if (::stat(path.c_str(), &status) == 0 && !S_ISREG(status.st_mode))
-        throw Error("cannot write " + option + " '" + path + "': it exists and is not a regular file");
+    if (::stat(path.c_str(), &status) == 0) {
+        if (S_ISDIR(status.st_mode)) throw Error("cannot write " + option + " '" + path + "': it is a folder");
+        if (!S_ISREG(status.st_mode))
+            throw Error("cannot write " + option + " '" + path + "': it exists and is not a regular file");
+    }
     checkNotInput(path, option);
     for (const Output& other : outputs_)
         if (sameFile(other.path, path))

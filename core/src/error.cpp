@@ -9,6 +9,13 @@ namespace zcheck {
 
 Error::Error(const std::string& message) : std::runtime_error(message) {}
 
+std::string printableExcerpt(std::string_view text, std::size_t maxChars)
+{
+    std::string out;
+    for (char c : text.substr(0, maxChars)) out += (c >= 32 && c < 127) ? c : '?';
+    return out;
+}
+
 std::string formatNumber(double value)
 {
     if (std::isnan(value)) return "nan";

@@ -59,12 +59,7 @@ private:
         throw Error("cannot load mesh '" + path_ + "': malformed OBJ: line " + std::to_string(lineNumber_) + ": " + why);
     }
 
-    static std::string printable(std::string_view text)
-    {
-        std::string out;
-        for (char c : text.substr(0, 40)) out += (c >= 32 && c < 127) ? c : '?';
-        return out;
-    }
+    static std::string printable(std::string_view text) { return printableExcerpt(text, 40); }
 
     static std::string_view nextWord(std::string_view& rest)
     {

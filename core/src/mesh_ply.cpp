@@ -82,12 +82,7 @@ private:
         fail(element.name + " " + std::to_string(item) + ": " + why);
     }
 
-    static std::string printable(std::string_view text)
-    {
-        std::string out;
-        for (char c : text.substr(0, 60)) out += (c >= 32 && c < 127) ? c : '?';
-        return out;
-    }
+    static std::string printable(std::string_view text) { return printableExcerpt(text, 60); }
 
     PlyType typeNamed(const std::string& name) const
     {

@@ -5,6 +5,7 @@
 // Hot loops never throw.
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 namespace zcheck {
 
@@ -15,5 +16,9 @@ public:
 
 // "1.5", "inf", "nan": numbers in messages printed the way a user would type them back.
 std::string formatNumber(double value);
+
+// At most `maxChars` characters of `text` for a message, each byte outside printable ASCII
+// as '?': file contents quoted in an error stay one readable line.
+std::string printableExcerpt(std::string_view text, std::size_t maxChars);
 
 }  // namespace zcheck
