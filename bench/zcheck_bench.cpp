@@ -3,7 +3,7 @@
 // For each named workload: scene load, BVH build, trace (ray generation + Embree + depth
 // in double), raster (transform, clip, bin, scan), compare; each render repeated and the
 // median and best reported. Peak memory is the process's maximum resident set size.
-#include "check.h"
+#include "zcheck/checker.h"
 
 #include "zcheck/error.h"
 #include "zcheck/mesh_loader.h"

@@ -1,35 +1,83 @@
-#include "check.h"
+// zcheck check: one scene through one camera, ray route vs raster route, per pixel.
+#include "common.h"
+#include "run_folder.h"
 
-#include <chrono>
+#include "zcheck/mesh_loader.h"
+#include "zcheck/report.h"
 
-namespace zcheck {
+#include <iostream>
+#include <optional>
 
-CheckRun runCheck(const Scene& scene, const Camera& camera, const RayRenderer& rays, const RasterRenderer& raster,
-                  const ToleranceModel& tolerance)
+namespace zcheck::cli {
+
+namespace {
+
+struct CheckCommandOptions {
+    SceneAndCamera input;
+    std::optional<int> width, height;
+    std::string depthFormat;
+    bool reversedZ = false;
+    std::string outDir;
+    bool json = false;
+    int threads = 0;
+};
+
+int runCheckCommand(const CheckCommandOptions& o)
 {
-    CheckRun run;
-    run.ray = rays.render(camera);
-    run.raster = raster.render(camera);
-    const auto start = std::chrono::steady_clock::now();
-    run.comparison = compareRoutes(scene, camera, run.ray, run.raster, tolerance);
-    run.report.timings.compareMs =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    run.report.timings.bvhBuildMs = rays.buildMilliseconds();
-    run.report.timings.traceMs = run.ray.renderMilliseconds;
-    run.report.timings.rasterMs = run.raster.renderMilliseconds;
-    run.report.scene = scene.name;
-    run.report.triangles = scene.triangleCount();
-    run.report.camera = camera.spec();
-    run.report.tolerance = tolerance;
-    run.report.comparison = run.comparison.report;
-    return run;
+    const auto threadLimit = limitThreads(o.threads);
+    OutputFiles outputs;
+    outputs.addInput(o.input.scene);
+    outputs.addInput(o.input.cameraFile);
+    const RunFolder folder{o.outDir, "raster_depth.exr"};
+    if (!o.outDir.empty()) folder.plan(outputs);
+    Scene scene = loadScene(o.input.scene);
+    CameraSpec spec = cameraSpecFor(scene, o.input);
+    if (o.width) spec.width = *o.width;
+    if (o.height) spec.height = *o.height;
+    if (!o.depthFormat.empty()) spec.depth.format = depthFormatFromName(o.depthFormat);
+    if (o.reversedZ) spec.depth.reversed = true;
+    const Camera camera(spec);  // validated before the BVH is built
+
+    const Checker checker(std::move(scene));
+    const CheckResult run = checker.check(camera);
+    requireSomethingCompared(run.report.comparison, checker.scene().name);
+    const std::string reportJson = checkReportJson(run.report);
+    if (!o.outDir.empty()) {
+        folder.write(outputs, run.ray, run.raster, run.comparison, reportJson);
+        outputs.commit();
+    }
+    std::cout << (o.json ? reportJson + "\n" : formatSummary(run.report));
+    return run.report.comparison.consistent() ? kExitConsistent : kExitInconsistent;
 }
 
-CheckRun runCheck(const Scene& scene, const Camera& camera)
+}  // namespace
+
+Command addCheckCommand(CLI::App& app)
 {
-    const RayRenderer rays(scene);
-    const RasterRenderer raster(scene);
-    return runCheck(scene, camera, rays, raster);
+    auto o = std::make_shared<CheckCommandOptions>();
+    CLI::App* command = app.add_subcommand(
+        "check", "Check one scene through one camera: ray route vs raster route, per pixel.\n"
+                 "Exit status 0 consistent, 1 inconsistent, 2 usage or input error.");
+    addSceneAndCameraOptions(command, o->input);
+    command->add_option("--width", o->width, "override the image width in pixels (1..16384)")->check(kImageSideRange);
+    command->add_option("--height", o->height, "override the image height in pixels (1..16384)")->check(kImageSideRange);
+    command->add_option("--depth-format", o->depthFormat, "override the depth format: float32 | unorm24 | unorm16");
+    command->add_flag("--reversed-z", o->reversedZ, "use reversed-Z (near -> far end of the range, test GREATER)");
+    command->add_option("--out", o->outDir,
+                        "write ray_depth.exr, raster_depth.exr, error_heatmap.png, coverage_classes.png "
+                        "and report.json into this directory (all or none of them: see README)")
+        ->check(kNonEmptyPath);
+    command->add_flag("--json", o->json, "print the report as JSON instead of the summary");
+    command->footer(
+        "Examples:\n"
+        "  zcheck check                                      the built-in default scene, its own camera\n"
+        "  zcheck check --scene bunny.obj --convention direct3d --reversed-z --depth-format unorm24\n"
+        "  zcheck check --camera examples/frustum.json --out results/   camera file; images + report.json\n"
+        "  zcheck check --scene 'builtin:terrain?n=708' --width 1920 --height 1080 --json\n"
+        "Depths are compared as window depth (the depth-buffer value) per pixel; the tolerance is\n"
+        "C*q + S*m (q: storage quantum, m: depth slope per pixel, S = 2^-8 px). See README.md.");
+    addThreadsOption(command, o->threads);
+    return {command, [o] { return runCheckCommand(*o); }};
 }
 
-}  // namespace zcheck
+}  // namespace zcheck::cli

@@ -1,247 +1,87 @@
-#include "suite.h"
+// zcheck suite: every configuration clean and with each injectable mistake of the catalogue.
+#include "common.h"
 
+#include "zcheck/atomic_file.h"
 #include "zcheck/error.h"
-#include "zcheck/mesh_loader.h"
+#include "zcheck/report.h"
+#include "zcheck/suite.h"
+
+#include <unistd.h>
 
 #include <chrono>
 #include <cmath>
-#include <filesystem>
-#include <memory>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
 
-namespace zcheck {
+namespace zcheck::cli {
 
-std::vector<NamedCamera> cameraModels(const Scene& scene, int width, int height)
+namespace {
+
+struct SuiteOptions {
+    bool quick = false;
+    std::string filter, jsonFile, htmlFile, modelsDir;
+    int threads = 0;
+};
+
+int runSuiteCommand(const SuiteOptions& o)
 {
-    CameraSpec base = scene.defaultCamera;
-    base.width = width, base.height = height;
-    const Camera reference(base);
-    const double n = base.projection.near;
-    const double distance = glm::length(base.view.target - base.view.eye);
-    const double tanHalf = std::tan(glm::radians(base.projection.fovyDeg) / 2), aspect = double(width) / height;
-    std::vector<NamedCamera> out;
-    auto add = [&](const std::string& name, const CameraSpec& spec) { out.push_back({name, spec}); };
-
-    add("perspective", base);
-    CameraSpec infinite = base;
-    infinite.projection.far = INFINITY;
-    add("perspective far=inf", infinite);
-
-    CameraSpec frustum = base;
-    frustum.projection.type = ProjectionType::Frustum;
-    frustum.projection.left = -0.6 * n * tanHalf * aspect, frustum.projection.right = 1.1 * n * tanHalf * aspect;
-    frustum.projection.bottom = -0.9 * n * tanHalf, frustum.projection.top = 0.7 * n * tanHalf;
-    add("frustum", frustum);
-
-    CameraSpec pinhole = base;
-    pinhole.projection.type = ProjectionType::Pinhole;
-    pinhole.projection.fx = height / 2.0 / tanHalf * 1.02, pinhole.projection.fy = height / 2.0 / tanHalf;
-    pinhole.projection.cx = (width - 1) / 2.0 + width / 24.0, pinhole.projection.cy = (height - 1) / 2.0 - height / 33.0;
-    add("pinhole", pinhole);
-
-    CameraSpec lens = base;
-    lens.projection.type = ProjectionType::Lens;
-    lens.projection.focalMm = 18.0 / (tanHalf * aspect);
-    add("lens", lens);
-
-    CameraSpec ortho = base;
-    ortho.projection.type = ProjectionType::Orthographic;
-    const double halfHeight = distance * tanHalf;
-    ortho.projection.left = -halfHeight * aspect, ortho.projection.right = halfHeight * aspect * 0.9;
-    ortho.projection.bottom = -halfHeight * 1.1, ortho.projection.top = halfHeight;
-    add("orthographic", ortho);
-
-    for (auto [name, lambda, angle] : {std::tuple{"oblique cavalier", 1.0, 45.0}, std::tuple{"oblique cabinet", 0.5, 63.4}}) {
-        CameraSpec oblique = ortho;
-        oblique.projection.type = ProjectionType::Oblique;
-        oblique.projection.foreshortening = lambda, oblique.projection.angleDeg = angle;
-        // Keep the sheared depth range short so that the scene stays in view.
-        oblique.projection.near = std::max(n, distance * 0.5), oblique.projection.far = distance * 1.6;
-        add(name, oblique);
-    }
-    for (auto [kind, azimuth, elevation] : {std::tuple{"isometric", 45.0, 35.2643896827547}, std::tuple{"dimetric", 45.0, 30.0},
-                                            std::tuple{"trimetric", 25.0, 20.0}}) {
-        CameraSpec axonometric = ortho;
-        axonometric.view = View::axonometricView(kind, base.view.target, distance, azimuth, elevation);
-        axonometric.projection.near = distance * 0.05, axonometric.projection.far = distance * 3;
-        add(std::string("axonometric ") + kind, axonometric);
-    }
-
-    CameraSpec matrix = base;  // the perspective camera's own matrices, pasted raw
-    matrix.projection.type = ProjectionType::Matrix;
-    matrix.projection.clipFromEye = reference.clipFromEye;
-    matrix.view.hasMatrix = true;
-    matrix.view.eyeFromWorld = reference.eyeFromWorld;
-    add("matrix", matrix);
-    return out;
-}
-
-// A raw-matrix camera's matrices must belong to its convention and depth mapping.
-CameraSpec withDepthAndConvention(CameraSpec spec, const Scene& scene, const Convention& convention, DepthSettings depth)
-{
-    spec.convention = convention;
-    spec.depth = depth;
-    if (spec.projection.type == ProjectionType::Matrix) {
-        CameraSpec perspective = scene.defaultCamera;
-        perspective.width = spec.width, perspective.height = spec.height;
-        perspective.convention = convention, perspective.depth = depth;
-        const Camera source(perspective);
-        spec.projection.clipFromEye = source.clipFromEye;
-        spec.view.eyeFromWorld = source.eyeFromWorld;
-    }
-    return spec;
-}
-
-std::string SuiteConfig::label() const
-{
-    return scene + " | " + model + " | " + spec.convention.name + " " + toString(spec.depth.format) +
-           (spec.depth.reversed ? " reversed" : "") + " | " + std::to_string(spec.width) + "x" +
-           std::to_string(spec.height) + (spec.projection.type != ProjectionType::Matrix && !std::isinf(spec.projection.far) &&
-                                                  spec.projection.far / spec.projection.near > 1e6
-                                              ? " | near/far " + formatNumber(spec.projection.far / spec.projection.near)
-                                              : "");
-}
-
-std::vector<SuiteConfig> suiteConfigurations(bool quick, const std::string& modelsDir)
-{
-    const std::vector<std::string> scenes =
-        quick ? std::vector<std::string>{"builtin:default", "builtin:near-crossing", modelsDir + "/stanford-bunny.obj"}
-              : std::vector<std::string>{"builtin:default", "builtin:terrain?n=96", "builtin:near-crossing",
-                                         modelsDir + "/stanford-bunny.obj", modelsDir + "/spot.obj",
-                                         modelsDir + "/teapot.obj", modelsDir + "/suzanne.obj"};
-    const std::vector<std::pair<int, int>> sizes = {{320, 240}, {333, 257}, {256, 256}, {160, 300}};
-    const std::vector<std::string>& conventions = Convention::presetNames();
-    const DepthFormat formats[] = {DepthFormat::Float32, DepthFormat::Unorm24, DepthFormat::Unorm16};
-    const int variants = quick ? 1 : 4;
+    const auto threadLimit = limitThreads(o.threads);
+    OutputFiles outputs;  // validated now, not after a long run
+    if (!o.jsonFile.empty()) outputs.add(o.jsonFile, "--json");
+    if (!o.htmlFile.empty()) outputs.add(o.htmlFile, "--html");
     std::vector<SuiteConfig> configs;
-    for (std::size_t si = 0; si < scenes.size(); ++si) {
-        const Scene scene = loadScene(scenes[si]);
-        const std::string sceneLabel = isBuiltinSceneName(scenes[si]) ? scenes[si] : std::filesystem::path(scenes[si]).filename().string();
-        for (int v = 0; v < variants; ++v) {
-            const auto [width, height] = sizes[(si + std::size_t(v)) % sizes.size()];
-            const std::vector<NamedCamera> models = cameraModels(scene, width, height);
-            for (std::size_t mi = 0; mi < models.size(); ++mi) {
-                if (quick && mi % 3 != 0) continue;  // perspective, pinhole, oblique cavalier, dimetric
-                const std::size_t k = si * 7 + mi * 3 + std::size_t(v) * 5;
-                DepthSettings depth;
-                depth.format = formats[(si + mi + std::size_t(v)) % 3];
-                depth.reversed = (mi + std::size_t(v) + si) % 2 == 1;
-                const Convention convention = Convention::preset(conventions[k % conventions.size()]);
-                configs.push_back({scenes[si], sceneLabel, models[mi].name,
-                                   withDepthAndConvention(models[mi].spec, scene, convention, depth)});
-            }
-        }
-        // Extreme near/far ratios: a tiny near plane, a far plane 1e7 times farther.
-        for (bool reversed : {false, true}) {
-            CameraSpec spec = scene.defaultCamera;
-            spec.width = 320, spec.height = 240;
-            spec.projection.near *= 1e-3;
-            spec.projection.far = spec.projection.near * 1e7;
-            spec.depth.format = reversed ? DepthFormat::Float32 : DepthFormat::Unorm24;
-            spec.depth.reversed = reversed;
-            spec.convention = Convention::preset(conventions[(si + (reversed ? 2 : 0)) % conventions.size()]);
-            if (!quick || si == 0) configs.push_back({scenes[si], sceneLabel, "perspective", spec});
-        }
-    }
-    return configs;
+    std::string modelsDir = o.modelsDir;
+    if (const char* fromEnvironment = std::getenv("ZCHECK_MODELS_DIR"); modelsDir.empty() && fromEnvironment)
+        modelsDir = fromEnvironment;
+    if (modelsDir.empty())
+        std::fprintf(stderr, "zcheck suite: no --models folder (or ZCHECK_MODELS_DIR): built-in scenes only\n");
+    for (auto& config : suiteConfigurations(o.quick, modelsDir))
+        if (o.filter.empty() || config.label().find(o.filter) != std::string::npos) configs.push_back(config);
+    if (configs.empty()) throw Error("--filter '" + o.filter + "' matches no configuration");
+    const bool terminal = ::isatty(2);
+    const auto start = std::chrono::steady_clock::now();
+    int failuresSoFar = 0;
+    const SuiteResult result = runSuite(configs, [&](std::size_t done, std::size_t total, const ConfigOutcome& outcome) {
+        for (FaultResult r : outcome.faults) failuresSoFar += r == FaultResult::Missed ? 1 : 0;
+        failuresSoFar += outcome.clean.consistent() ? 0 : 1;
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (terminal || done == total || done % 25 == 0)
+            std::fprintf(stderr, "%s[%zu/%zu] %.0f s, failures %d: %-70.70s%s", terminal ? "\r" : "", done, total,
+                         seconds, failuresSoFar, outcome.config.label().c_str(), terminal && done < total ? "" : "\n");
+    });
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::cout << "zcheck suite" << (o.quick ? " --quick" : "") << ": " << configs.size() << " configurations x "
+              << injectableMistakes().size() << " faults in " << std::lround(seconds) << " s\n\n"
+              << suiteTable(result) << "\nverdict    " << (result.passed() ? "PASSED" : "FAILED") << "\n";
+
+    if (!o.jsonFile.empty()) outputs.writeText(o.jsonFile, suiteReportJson(result, o.quick, seconds));
+    if (!o.htmlFile.empty()) outputs.writeText(o.htmlFile, suiteReportHtml(result, seconds));
+    outputs.commit();
+    return result.passed() ? kExitConsistent : kExitInconsistent;
 }
 
-// Does `faulty` differ visibly from its clean twin? See suite.h: coverage compared raw, depth
-// beyond twice the snapping noise of the clean twin's triangle (4 q + 2·S·m); none of the
-// checker's explanations (edges, clip planes, clear value) are used.
-bool differsVisibly(const Scene& scene, const Camera& camera, const RenderResult& clean, const RenderResult& faulty)
+}  // namespace
+
+Command addSuiteCommand(CLI::App& app)
 {
-    const double S = ToleranceModel{}.snapPixels();
-    std::size_t different = 0;
-    for (std::size_t i = 0; i < clean.primitiveId.size(); ++i) {
-        if (clean.hit(i) != faulty.hit(i)) {
-            ++different;
-        } else if (clean.hit(i)) {
-            const glm::uvec3 t = scene.triangles[clean.primitiveId[i]];
-            const double m = windowDepthSlope(camera, glm::dvec3(scene.positions[t[0]]), glm::dvec3(scene.positions[t[1]]),
-                                              glm::dvec3(scene.positions[t[2]]));
-            const double q = storageQuantum(camera.depth().format, clean.windowDepth.value[i]);
-            if (!(std::abs(faulty.windowDepth.value[i] - clean.windowDepth.value[i]) <= 4 * q + 2 * S * m)) ++different;
-        }
-    }
-    return different >= std::max<std::size_t>(10, clean.primitiveId.size() / 1000);
+    auto o = std::make_shared<SuiteOptions>();
+    CLI::App* command = app.add_subcommand(
+        "suite", "Run the consistency suite: every configuration clean (no false positive allowed) and with each\n"
+                 "fault of the catalogue injected into one route (each applicable fault must be detected).\n"
+                 "Exit status 0 only when both hold.");
+    command->add_flag("--quick", o->quick, "a representative subset (what CTest runs)");
+    command->add_option("--filter", o->filter, "only configurations whose label contains TEXT");
+    command->add_option("--json", o->jsonFile, "write the results as JSON")->check(kNonEmptyPath);
+    command->add_option("--html", o->htmlFile, "write a self-contained HTML report with images of every failure")
+        ->check(kNonEmptyPath);
+    command->add_option("--models", o->modelsDir,
+                        "folder of the shared meshes (stanford-bunny.obj, spot.obj, teapot.obj, suzanne.obj); "
+                        "default: $ZCHECK_MODELS_DIR, else the built-in scenes only")
+        ->check(kNonEmptyPath);
+    addThreadsOption(command, o->threads);
+
+    return {command, [o] { return runSuiteCommand(*o); }};
 }
 
-std::string toString(FaultResult result)
-{
-    switch (result) {
-    case FaultResult::Detected: return "detected";
-    case FaultResult::Missed: return "MISSED";
-    case FaultResult::NotApplicable: return "not applicable";
-    case FaultResult::Meaningless: return "-";
-    }
-    return "?";
-}
-
-SuiteResult runSuite(const std::vector<SuiteConfig>& configs,
-                     const std::function<void(std::size_t, std::size_t, const ConfigOutcome&)>& progress)
-{
-    constexpr std::size_t kKeptFailures = 24;  // with their images, for the HTML report
-    SuiteResult result;
-    const std::vector<Fault>& catalogue = faultCatalogue();
-    std::string loadedPath;
-    std::unique_ptr<Scene> scene;
-    std::unique_ptr<RayRenderer> rays;
-    std::unique_ptr<RasterRenderer> raster;
-    auto keep = [&](const SuiteConfig& config, const std::string& what, CheckRun run) {
-        if (result.failures.size() < kKeptFailures) result.failures.push_back({config.label(), what, std::move(run)});
-    };
-    for (std::size_t index = 0; index < configs.size(); ++index) {
-        const SuiteConfig& config = configs[index];
-        const auto start = std::chrono::steady_clock::now();
-        if (config.scenePath != loadedPath) {  // configurations come grouped by scene: build each once
-            rays.reset(), raster.reset();
-            scene = std::make_unique<Scene>(loadScene(config.scenePath));
-            rays = std::make_unique<RayRenderer>(*scene);
-            raster = std::make_unique<RasterRenderer>(*scene);
-            loadedPath = config.scenePath;
-        }
-        const Camera camera(config.spec);
-        CheckRun clean = runCheck(*scene, camera, *rays, *raster);
-        ConfigOutcome outcome{config, clean.report.comparison, {}, 0};
-        if (!outcome.clean.consistent()) {
-            ++result.falsePositives;
-            keep(config, "clean chain reported inconsistent (a false positive)", clean);
-        }
-        for (const Fault& fault : catalogue) {
-            FaultInjection injection;
-            if (!fault.inject(camera, injection)) {
-                outcome.faults.push_back(FaultResult::Meaningless);
-                continue;
-            }
-            // The faulty route, its clean twin, and the route it is checked against.
-            CheckRun faulty = clean;
-            bool applicable;
-            if (fault.route == "ray") {
-                rays->sampling = injection.ray;
-                faulty.ray = rays->render(camera);
-                rays->sampling = RayFaults{};
-                applicable = differsVisibly(*scene, camera, clean.ray, faulty.ray);
-            } else {
-                raster->faults = injection.raster;
-                faulty.raster = raster->render(camera);
-                raster->faults = RasterFaults{};
-                applicable = differsVisibly(*scene, camera, clean.raster, faulty.raster);
-            }
-            faulty.comparison = compareRoutes(*scene, camera, faulty.ray, faulty.raster);
-            faulty.report.comparison = faulty.comparison.report;
-            const bool detected = !faulty.comparison.report.consistent();
-            const FaultResult r = detected ? FaultResult::Detected : applicable ? FaultResult::Missed : FaultResult::NotApplicable;
-            outcome.faults.push_back(r);
-            if (r == FaultResult::Missed) {
-                ++result.missedFaults;
-                keep(config, "fault '" + fault.name + "' (" + fault.description + ") not detected", std::move(faulty));
-            }
-        }
-        outcome.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-        result.outcomes.push_back(outcome);
-        progress(index + 1, configs.size(), result.outcomes.back());
-    }
-    return result;
-}
-
-}  // namespace zcheck
+}  // namespace zcheck::cli

@@ -1,6 +1,6 @@
 // End to end: both routes on real scenes across the whole configuration matrix, and the
 // check's sensitivity to deliberately broken chains.
-#include "check.h"
+#include "zcheck/checker.h"
 
 #include "zcheck/mesh_loader.h"
 
@@ -33,8 +33,7 @@ std::string describe(const CameraSpec& spec, const ComparisonReport& r)
 void requireConsistentEverywhere(const std::string& sceneName)
 {
     const Scene scene = loadScene(sceneName);
-    const RayRenderer rays(scene);
-    const RasterRenderer raster(scene);
+    const Checker checker(scene);
     for (const auto& convention : Convention::presetNames())
         for (const auto& format : depthFormatNames())
             for (bool reversed : {false, true})
@@ -43,7 +42,7 @@ void requireConsistentEverywhere(const std::string& sceneName)
                     CameraSpec spec = scene.defaultCamera;
                     spec.convention = Convention::preset(convention);
                     spec.depth = {depthFormatFromName(format), reversed, range.first, range.second};
-                    const CheckRun run = runCheck(scene, Camera(spec), rays, raster);
+                    const CheckResult run = checker.check(Camera(spec));
                     const ComparisonReport& r = run.report.comparison;
                     INFO(sceneName << " " << describe(spec, r));
                     REQUIRE(r.bothHit > 1000);  // the camera actually sees the scene
@@ -52,12 +51,11 @@ void requireConsistentEverywhere(const std::string& sceneName)
                 }
 }
 
-ComparisonReport checkWithSampling(const Scene& scene, const CameraSpec& spec, const RaySampling& sampling)
+ComparisonReport checkWithSampling(const Scene& scene, const CameraSpec& spec, const RayFaults& sampling)
 {
-    RayRenderer rays(scene);
-    rays.sampling = sampling;
-    const RasterRenderer raster(scene);
-    return runCheck(scene, Camera(spec), rays, raster).report.comparison;
+    CheckOptions options;
+    options.faults.ray = sampling;
+    return Checker(scene).check(Camera(spec), options).report.comparison;
 }
 
 }  // namespace
@@ -113,7 +111,7 @@ TEST_CASE("regression: assimp read igea.ply's triangle strips as a single triang
 
 namespace {
 // The check must call a ray route that samples the wrong place inconsistent, loudly.
-void requireCaught(const std::string& sceneName, const RaySampling& fault, std::int64_t minimumUnexplained)
+void requireCaught(const std::string& sceneName, const RayFaults& fault, std::int64_t minimumUnexplained)
 {
     const Scene scene = loadScene(sceneName);
     for (const auto& format : depthFormatNames()) {
@@ -130,7 +128,7 @@ void requireCaught(const std::string& sceneName, const RaySampling& fault, std::
 
 TEST_CASE("a y-flipped ray route is reported inconsistent", "[sensitivity]")
 {
-    RaySampling flipped;
+    RayFaults flipped;
     flipped.flipRows = true;
     for (const std::string& name : {std::string("builtin:default"), kModels + "/stanford-bunny.obj"})
         requireCaught(name, flipped, 1000);
@@ -141,7 +139,7 @@ TEST_CASE("a ray route missing the half-pixel offset is reported inconsistent", 
     for (const std::string& name : {std::string("builtin:default"), std::string("builtin:terrain?n=64"),
                                     kModels + "/stanford-bunny.obj"})
         for (const glm::dvec2 shift : {glm::dvec2(-0.5, 0.0), glm::dvec2(0.0, -0.5), glm::dvec2(-0.5, -0.5)}) {
-            RaySampling shifted;
+            RayFaults shifted;
             shifted.shiftPixels = shift;
             requireCaught(name, shifted, 100);
         }
@@ -150,7 +148,7 @@ TEST_CASE("a ray route missing the half-pixel offset is reported inconsistent", 
 TEST_CASE("a ray route shifted by a tenth of a pixel is still caught", "[sensitivity]")
 {
     const Scene scene = builtinScene("builtin:default");
-    RaySampling shifted;
+    RayFaults shifted;
     shifted.shiftPixels = {0.1, 0.0};
     const ComparisonReport r = checkWithSampling(scene, scene.defaultCamera, shifted);
     INFO(describe(scene.defaultCamera, r));
@@ -168,7 +166,7 @@ TEST_CASE("regression: unorm16 with a tiny near plane flagged surfaces at the cl
         spec.projection.near = 1e-4, spec.projection.far = 1e4;
         spec.depth.format = DepthFormat::Unorm16;
         spec.depth.reversed = reversed;
-        const ComparisonReport r = runCheck(scene, Camera(spec)).report.comparison;
+        const ComparisonReport r = Checker(scene).check(Camera(spec)).report.comparison;
         INFO(describe(spec, r));
         REQUIRE(r.lostAtClearValue > 10000);
         REQUIRE(r.consistent());
@@ -178,8 +176,7 @@ TEST_CASE("regression: unorm16 with a tiny near plane flagged surfaces at the cl
 TEST_CASE("odd image sizes and extreme near/far ratios are consistent", "[e2e]")
 {
     const Scene scene = builtinScene("builtin:default");
-    const RayRenderer rays(scene);
-    const RasterRenderer raster(scene);
+    const Checker checker(scene);
     for (auto size : {std::pair{333, 257}, std::pair{1, 1}, std::pair{2, 3}, std::pair{1001, 17}, std::pair{17, 999}})
         for (auto nearFar : {std::pair{0.1, 100.0}, std::pair{1e-4, 1e4}, std::pair{4.5, 12.0}, std::pair{1e-3, 1e7}})
             for (const auto& format : depthFormatNames())
@@ -189,7 +186,7 @@ TEST_CASE("odd image sizes and extreme near/far ratios are consistent", "[e2e]")
                     spec.projection.near = nearFar.first, spec.projection.far = nearFar.second;
                     spec.depth.format = depthFormatFromName(format);
                     spec.depth.reversed = reversed;
-                    const ComparisonReport r = runCheck(scene, Camera(spec), rays, raster).report.comparison;
+                    const ComparisonReport r = checker.check(Camera(spec)).report.comparison;
                     INFO(size.first << "x" << size.second << " near " << nearFar.first << " far " << nearFar.second
                                     << " " << describe(spec, r));
                     REQUIRE(r.consistent());
@@ -204,7 +201,7 @@ TEST_CASE("glTF files load with their node transforms applied", "[mesh]")
     REQUIRE(quad.triangleCount() == 2);
     REQUIRE(quad.boundsMin() == glm::dvec3(9, 0, -5));
     REQUIRE(quad.boundsMax() == glm::dvec3(11, 2, -5));
-    REQUIRE(runCheck(quad, Camera(quad.defaultCamera)).report.comparison.consistent());
+    REQUIRE(Checker(quad).check(Camera(quad.defaultCamera)).report.comparison.consistent());
 }
 
 TEST_CASE("regression: surfaces lying exactly on the near or far plane gave unexplained mismatches", "[e2e][regression]")
@@ -231,7 +228,7 @@ TEST_CASE("regression: surfaces lying exactly on the near or far plane gave unex
                 spec.view = View::lookAt({0, 0, 0}, {0, 0, -1}, {0, 1, 0});
                 spec.depth.format = depthFormatFromName(format);
                 spec.depth.reversed = reversed;
-                const ComparisonReport r = runCheck(planes, Camera(spec)).report.comparison;
+                const ComparisonReport r = Checker(planes).check(Camera(spec)).report.comparison;
                 INFO(describe(spec, r));
                 REQUIRE(r.consistent());
             }
@@ -248,7 +245,7 @@ TEST_CASE("regression: a mesh far from the world origin lost its edges to binary
     bunny.defaultCamera = framingCameraSpec((lo + hi) / 2.0, glm::length(hi - lo) / 2);
     CameraSpec spec = bunny.defaultCamera;
     spec.width = 1280, spec.height = 960;
-    const ComparisonReport r = runCheck(bunny, Camera(spec)).report.comparison;
+    const ComparisonReport r = Checker(bunny).check(Camera(spec)).report.comparison;
     INFO(describe(spec, r));
     REQUIRE(r.consistent());
 }

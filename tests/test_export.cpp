@@ -1,5 +1,5 @@
 // Export: every quantity through every format and back through OpenImageIO.
-#include "check.h"
+#include "zcheck/checker.h"
 
 #include "zcheck/atomic_file.h"
 #include "zcheck/error.h"
@@ -81,7 +81,7 @@ TEST_CASE("every quantity round-trips through every format that holds it", "[exp
         CameraSpec spec = f.spec;
         spec.depth.reversed = reversed;
         const Camera camera(spec);
-        const CheckRun run = runCheck(f.scene, camera);
+        const CheckResult run = Checker(f.scene).check(camera);
         for (const RenderResult* route : {&run.ray, &run.raster}) {
             std::vector<QuantityImage> all;
             for (const auto& name : exportQuantityNames())
@@ -299,7 +299,7 @@ TEST_CASE("exports of the ray and raster routes agree within the tolerance model
             spec.convention = Convention::preset(convention);
             spec.depth.format = format;
             const Camera camera(spec);
-            const CheckRun run = runCheck(f.scene, camera);
+            const CheckResult run = Checker(f.scene).check(camera);
             // Export window depth and ids from both routes, read the files back, compare them.
             RenderResult fromFile[2];
             for (int r = 0; r < 2; ++r) {

@@ -1,8 +1,8 @@
 // Every projection model and view is consistent through both routes, in every convention,
 // float32 and unorm24, standard and reversed (and with an infinite far plane where it
 // applies), on built-in scenes and the shared meshes.
-#include "check.h"
-#include "suite.h"
+#include "zcheck/checker.h"
+#include "zcheck/suite.h"
 
 #include "zcheck/mesh_loader.h"
 
@@ -19,8 +19,7 @@ const std::string kModels = ZCHECK_MODELS_DIR;
 void requireEveryModelConsistent(const std::string& sceneName)
 {
     const Scene scene = loadScene(sceneName);
-    const RayRenderer rays(scene);
-    const RasterRenderer raster(scene);
+    const Checker checker(scene);
     for (const NamedCamera& model : cameraModels(scene, 320, 240))
         for (const auto& convention : Convention::presetNames())
             for (DepthFormat format : {DepthFormat::Float32, DepthFormat::Unorm24})
@@ -28,7 +27,7 @@ void requireEveryModelConsistent(const std::string& sceneName)
                     DepthSettings depth;
                     depth.format = format, depth.reversed = reversed;
                     const CameraSpec spec = withDepthAndConvention(model.spec, scene, Convention::preset(convention), depth);
-                    const ComparisonReport r = runCheck(scene, Camera(spec), rays, raster).report.comparison;
+                    const ComparisonReport r = checker.check(Camera(spec)).report.comparison;
                     INFO(sceneName << ": " << model.name << ", " << convention << ", " << toString(format)
                                    << (reversed ? ", reversed" : "") << ": both hit " << r.bothHit << ", depth errors "
                                    << r.depthErrors << ", unexplained coverage " << r.coverageUnexplained

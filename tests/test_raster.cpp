@@ -1,5 +1,5 @@
 // Rasterizer rules and analytic depths through both routes.
-#include "check.h"
+#include "zcheck/checker.h"
 
 #include "zcheck/inverse_projection.h"
 
@@ -180,7 +180,7 @@ TEST_CASE("a triangle crossing the near plane and lying behind the camera is cli
                     const double bound = 4 * storageQuantum(DepthFormat::Float32, expected) + slopePerRow / 256;
                     REQUIRE(std::abs(image.windowDepth.value[i] - expected) <= bound);
                 }
-            REQUIRE(runCheck(floor, camera).report.comparison.consistent());
+            REQUIRE(Checker(floor).check(camera).report.comparison.consistent());
         }
 }
 
@@ -221,8 +221,7 @@ TEST_CASE("a plane at a known eye depth yields exactly that depth through each r
     const double D = 7.25, n = 0.5, f = 40;
     const Scene wall = sceneOf({{-100, -100, float(-D)}, {100, -100, float(-D)}, {100, 100, float(-D)}, {-100, 100, float(-D)}},
                                {{0, 1, 2}, {0, 2, 3}});
-    const RayRenderer rays(wall);
-    const RasterRenderer raster(wall);
+    const Checker checker(wall);
     for (const auto& name : Convention::presetNames())
         for (auto [type, far] : {std::pair{ProjectionType::Perspective, f}, std::pair{ProjectionType::Perspective, double(INFINITY)},
                                  std::pair{ProjectionType::Orthographic, f}})
@@ -248,7 +247,7 @@ TEST_CASE("a plane at a known eye depth yields exactly that depth through each r
                                                 : (reversed ? n * (f - D) / (D * (f - n)) : f * (D - n) / (D * (f - n)));
                         const double expected = range.first + (range.second - range.first) * unit;
                         const double q = storageQuantum(spec.depth.format, expected);
-                        const RenderResult byRay = rays.render(camera), byRaster = raster.render(camera);
+                        const RenderResult byRay = checker.renderRay(camera), byRaster = checker.renderRaster(camera);
                         INFO(name << " " << toString(type) << " far " << far << " " << format << (reversed ? " reversed" : "")
                                   << " range [" << range.first << "," << range.second << "]");
                         for (std::size_t i = 0; i < byRay.primitiveId.size(); ++i) {

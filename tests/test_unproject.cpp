@@ -1,5 +1,5 @@
 // The inverse projection applied to whole depth maps: points land on the surface they came from.
-#include "check.h"
+#include "zcheck/checker.h"
 
 #include "zcheck/inverse_projection.h"
 #include "zcheck/mesh_loader.h"
@@ -39,7 +39,7 @@ TEST_CASE("depth from either route, unprojected, lands on the surface it came fr
                 spec.convention = Convention::preset(convention);
                 spec.depth.reversed = reversed;
                 const Camera camera(spec);
-                const CheckRun run = runCheck(scene, camera);
+                const CheckResult run = Checker(scene).check(camera);
                 const double C = ToleranceModel::constantQuanta(spec.depth), S = ToleranceModel{}.snapPixels();
                 std::size_t rayHits = 0, rasterHits = 0, rayPoints = 0, rasterPoints = 0;
                 for (int row = 0; row < camera.height(); ++row)

@@ -1,6 +1,6 @@
 // zcheck verify: a correct map verifies; each classic mutation is rejected and diagnosed.
-#include "faults.h"
-#include "verify.h"
+#include "zcheck/mistakes.h"
+#include "zcheck/verify.h"
 
 #include "zcheck/export.h"
 #include "zcheck/inverse_projection.h"
@@ -13,10 +13,10 @@ using namespace zcheck;
 
 namespace {
 
-ExternalDepthMap mapOf(const Scene& scene, const Camera& camera, const RenderResult& route, ExportQuantity quantity)
+DepthMap mapOf(const Scene& scene, const Camera& camera, const RenderResult& route, ExportQuantity quantity)
 {
     const QuantityImage image = quantityImage(scene, camera, route, quantity);
-    ExternalDepthMap map;
+    DepthMap map;
     map.width = image.width, map.height = image.height;
     map.quantity = quantity == ExportQuantity::Window ? DepthQuantity::Window
                    : quantity == ExportQuantity::EyeZ ? DepthQuantity::EyeZ
@@ -27,10 +27,10 @@ ExternalDepthMap mapOf(const Scene& scene, const Camera& camera, const RenderRes
 }
 
 // The first hypothesis that makes the map consistent, or "".
-std::string diagnosis(const Scene& scene, const Camera& camera, const ExternalDepthMap& map, RayRenderer& rays)
+std::string diagnosis(const Checker& checker, const Camera& camera, const DepthMap& map)
 {
-    for (const Hypothesis& h : diagnoseDepthMap(scene, camera, map, rays))
-        if (h.consistent) return h.name;
+    for (const Hypothesis& h : checker.diagnose(camera, map))
+        if (h.consistent) return h.name + (h.variant.empty() ? "" : " " + h.variant);
     return "";
 }
 
@@ -49,17 +49,16 @@ struct Setup {
 TEST_CASE("a depth map from the raster route verifies, in every quantity and convention", "[verify]")
 {
     Setup s;
-    RayRenderer rays(s.scene);
-    RasterRenderer raster(s.scene);
+    const Checker checker(s.scene);
     for (const auto& convention : Convention::presetNames())
         for (bool reversed : {false, true}) {
             CameraSpec spec = s.spec;
             spec.convention = Convention::preset(convention);
             spec.depth.reversed = reversed;
             const Camera camera(spec);
-            const RenderResult drawn = raster.render(camera);
+            const RenderResult drawn = checker.renderRaster(camera);
             for (ExportQuantity q : {ExportQuantity::Window, ExportQuantity::EyeZ, ExportQuantity::Distance}) {
-                const VerifyRun run = verifyDepthMap(s.scene, camera, mapOf(s.scene, camera, drawn, q), rays);
+                const VerifyResult run = checker.verify(camera, mapOf(s.scene, camera, drawn, q));
                 INFO(convention << (reversed ? " reversed " : " ") << toString(q) << ": unexplained "
                                 << run.comparison.report.unexplained());
                 REQUIRE(run.comparison.report.bothHit > 10000);
@@ -71,49 +70,46 @@ TEST_CASE("a depth map from the raster route verifies, in every quantity and con
 TEST_CASE("mutated depth maps are rejected and the diagnosis names the mutation", "[verify][diagnose]")
 {
     Setup s;
-    RayRenderer rays(s.scene);
-    RasterRenderer raster(s.scene);
+    const Checker checker(s.scene);
     for (const auto& convention : {std::string("opengl"), std::string("direct3d"), std::string("vulkan")}) {
         CameraSpec spec = s.spec;
         spec.convention = Convention::preset(convention);
         const Camera camera(spec);
-        const RenderResult drawn = raster.render(camera);
-        auto requireDiagnosed = [&](const std::string& mutation, const ExternalDepthMap& map, const std::string& expected) {
+        const RenderResult drawn = checker.renderRaster(camera);
+        auto requireDiagnosed = [&](const std::string& mutation, const DepthMap& map, const std::string& expected) {
             INFO(convention << ": " << mutation);
-            REQUIRE_FALSE(verifyDepthMap(s.scene, camera, map, rays).comparison.report.consistent());
-            REQUIRE(diagnosis(s.scene, camera, map, rays) == expected);
+            REQUIRE_FALSE(checker.verify(camera, map).comparison.report.consistent());
+            REQUIRE(diagnosis(checker, camera, map) == expected);
         };
         // Flipped vertically.
-        ExternalDepthMap flipped = mapOf(s.scene, camera, drawn, ExportQuantity::Window);
+        DepthMap flipped = mapOf(s.scene, camera, drawn, ExportQuantity::Window);
         for (int row = 0; row < 75; ++row)
             for (int col = 0; col < 200; ++col)
                 std::swap(flipped.value[std::size_t(row) * 200 + col], flipped.value[std::size_t(149 - row) * 200 + col]);
-        requireDiagnosed("flipped", flipped, "vertical-flip");
+        requireDiagnosed("flipped", flipped, "y-flip");
         // Rendered with pixel centres at integer coordinates (the +0.5 forgotten).
-        rays.sampling.shiftPixels = {-0.5, -0.5};
-        const RenderResult shifted = rays.render(camera);
-        rays.sampling = RayFaults{};
+        RayFaults halfPixel;
+        halfPixel.shiftPixels = {-0.5, -0.5};
+        const RenderResult shifted = checker.renderRay(camera, halfPixel);
         requireDiagnosed("shifted half a pixel", mapOf(s.scene, camera, shifted, ExportQuantity::Window),
-                         "half-pixel-shift x and y");
+                         "half-pixel x and y");
         // The other NDC depth range: an OpenGL-style matrix in a [0,1] pipeline, or the reverse.
-        FaultInjection ndc;
-        for (const Fault& fault : faultCatalogue())
-            if (fault.name == "ndc-range") fault.inject(camera, ndc);
-        raster.faults = ndc.raster;
-        const RenderResult otherRange = raster.render(camera);
-        raster.faults = RasterFaults{};
-        requireDiagnosed("other depth range", mapOf(s.scene, camera, otherRange, ExportQuantity::Window), "other-ndc-range");
+        RouteFaults ndc;
+        for (const Mistake& mistake : mistakeCatalogue())
+            if (mistake.name == "ndc-range") REQUIRE(mistake.inject(camera, ndc));
+        const RenderResult otherRange = checker.renderRaster(camera, ndc.raster);
+        requireDiagnosed("other depth range", mapOf(s.scene, camera, otherRange, ExportQuantity::Window), "ndc-range");
         // A correct reversed-Z renderer, verified as if standard.
         CameraSpec reversedSpec = spec;
         reversedSpec.depth.reversed = true;
         const Camera reversedCamera(reversedSpec);
-        requireDiagnosed("reversed", mapOf(s.scene, reversedCamera, raster.render(reversedCamera), ExportQuantity::Window),
-                         "reversed");
+        requireDiagnosed("reversed", mapOf(s.scene, reversedCamera, checker.renderRaster(reversedCamera), ExportQuantity::Window),
+                         "reversed-as-standard");
         // eye-z passed as window depth; distance passed as eye-z.
-        ExternalDepthMap eyeZ = mapOf(s.scene, camera, drawn, ExportQuantity::EyeZ);
+        DepthMap eyeZ = mapOf(s.scene, camera, drawn, ExportQuantity::EyeZ);
         eyeZ.quantity = DepthQuantity::Window;
         requireDiagnosed("eye-z as window depth", eyeZ, "eye-z-as-window");
-        ExternalDepthMap distance = mapOf(s.scene, camera, drawn, ExportQuantity::Distance);
+        DepthMap distance = mapOf(s.scene, camera, drawn, ExportQuantity::Distance);
         distance.quantity = DepthQuantity::EyeZ;
         requireDiagnosed("distance as eye-z", distance, "distance-as-eye-z");
     }
@@ -122,13 +118,13 @@ TEST_CASE("mutated depth maps are rejected and the diagnosis names the mutation"
 TEST_CASE("a map that no hypothesis explains is diagnosed as such", "[verify][diagnose]")
 {
     Setup s;
-    RayRenderer rays(s.scene);
+    const Checker checker(s.scene);
     const Camera camera(s.spec);
-    ExternalDepthMap noise = mapOf(s.scene, camera, RasterRenderer(s.scene).render(camera), ExportQuantity::EyeZ);
+    DepthMap noise = mapOf(s.scene, camera, checker.renderRaster(camera), ExportQuantity::EyeZ);
     for (std::size_t i = 0; i < noise.value.size(); ++i)
         if (std::isfinite(noise.value[i])) noise.value[i] *= 1.0 + 0.05 * std::sin(double(i));
-    REQUIRE_FALSE(verifyDepthMap(s.scene, camera, noise, rays).comparison.report.consistent());
-    REQUIRE(diagnosis(s.scene, camera, noise, rays).empty());
+    REQUIRE_FALSE(checker.verify(camera, noise).comparison.report.consistent());
+    REQUIRE(diagnosis(checker, camera, noise).empty());
 }
 
 
@@ -185,11 +181,11 @@ TEST_CASE("regression: verify rejected a correct map whose sample landed across 
     // choose the tilt that makes it 6 q.
     const double tilt = -2 * 6 * float32QuantumAtHalf / (across * pixel);  // B rises towards the camera
     const SharedEdge s(0.01 + across * pixel, tilt);
-    RayRenderer rays(s.scene);
-    const RenderResult truth = rays.render(s.camera);
+    const Checker checker(s.scene);
+    const RenderResult truth = checker.renderRay(s.camera);
     const std::size_t centre = 50 * 100 + 50;
     REQUIRE(truth.primitiveId[centre] == 0);  // the truth sees A at this pixel
-    ExternalDepthMap map;
+    DepthMap map;
     map.width = map.height = 100;
     map.quantity = DepthQuantity::Window;
     map.value.resize(truth.windowDepth.value.size());
@@ -200,7 +196,7 @@ TEST_CASE("regression: verify rejected a correct map whose sample landed across 
     REQUIRE(gapQuanta > 5);  // beyond A's own tolerance (4 q, A faces the camera: m = 0) ...
     REQUIRE(gapQuanta < 7);  // ... and within the old 8 q gate
     map.value[centre] = onB;
-    const VerifyRun run = verifyDepthMap(s.scene, s.camera, map, rays);
+    const VerifyResult run = checker.verify(s.camera, map);
     INFO("unexplained " << run.comparison.report.unexplained());
     REQUIRE(run.comparison.report.consistent());
     REQUIRE(run.comparison.pixelClass[centre] == PixelClass::Agree);
@@ -210,7 +206,7 @@ TEST_CASE("regression: verify rejected a correct map whose sample landed across 
     bool failedNearer = false;
     for (double k = 0; k <= 40; k += 0.5) {
         map.value[centre] = truth.windowDepth.value[centre] + k * float32QuantumAtHalf;
-        const bool passes = verifyDepthMap(s.scene, s.camera, map, rays).comparison.report.consistent();
+        const bool passes = checker.verify(s.camera, map).comparison.report.consistent();
         INFO("offset " << k << " q");
         REQUIRE_FALSE((passes && failedNearer));
         failedNearer = failedNearer || !passes;

@@ -1,5 +1,7 @@
 #include "zcheck/inverse_projection.h"
 
+#include "zcheck/error.h"
+
 #include <cmath>
 
 namespace zcheck {
@@ -139,6 +141,29 @@ double distanceOfEyePoint(const Camera& camera, const glm::dvec3& pEye)
 {
     const glm::dvec3 pWindow = windowFromEye(camera, pEye);
     return glm::length(pEye - eyePlaneRayFrom(eyeRayThroughWindow(camera, {pWindow.x, pWindow.y})).origin);
+}
+
+UnprojectedMap unprojectMap(const Camera& camera, const std::vector<double>& values, DepthQuantity quantity,
+                            PointSpace space, int stride)
+{
+    const int W = camera.width(), H = camera.height();
+    if (values.size() != std::size_t(W) * std::size_t(H))
+        throw Error("the depth map holds " + std::to_string(values.size()) + " values, but the camera's image is " +
+                    std::to_string(W) + "x" + std::to_string(H));
+    if (stride < 1) throw Error("the stride must be >= 1, got " + std::to_string(stride));
+    UnprojectedMap out;
+    for (int row = 0; row < H; row += stride)
+        for (int col = 0; col < W; col += stride) {
+            const auto pEye = eyePointFromDepth(camera, windowFromPixelCentre(camera, col, row),
+                                                values[std::size_t(row) * W + col], quantity);
+            if (!pEye) {
+                ++out.misses;
+                continue;
+            }
+            out.points.push_back(space == PointSpace::Eye ? *pEye : glm::dvec3(camera.worldFromEye * glm::dvec4(*pEye, 1.0)));
+            out.pixels.emplace_back(col, row);
+        }
+    return out;
 }
 
 }  // namespace zcheck

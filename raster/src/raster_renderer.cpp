@@ -225,7 +225,7 @@ void drawInTile(const Viewport& vp, const TriangleSetup& t, int tileCol0, int ti
 
 RasterRenderer::RasterRenderer(const Scene& scene) : scene_(scene) { validateScene(scene); }
 
-RenderResult RasterRenderer::render(const Camera& camera) const
+RenderResult RasterRenderer::render(const Camera& camera, const RasterFaults& faults) const
 {
     const auto start = std::chrono::steady_clock::now();
     const Viewport vp(camera, faults);

@@ -1,7 +1,7 @@
 #include "zcheck/ray_renderer.h"
 
 #include "zcheck/error.h"
-#include "zcheck/inverse_projection.h"
+#include "zcheck/camera_rays.h"
 
 #include <embree3/rtcore.h>
 #include <tbb/blocked_range.h>
@@ -118,7 +118,7 @@ RayRenderer::RayRenderer(const Scene& scene) : embree_(std::make_unique<Embree>(
 
 RayRenderer::~RayRenderer() = default;
 
-RenderResult RayRenderer::render(const Camera& camera) const
+RenderResult RayRenderer::render(const Camera& camera, const RayFaults& fault) const
 {
     const auto start = Clock::now();
     const int W = camera.width(), H = camera.height();
@@ -129,7 +129,7 @@ RenderResult RayRenderer::render(const Camera& camera) const
 
     const int tilesX = (W + kTile - 1) / kTile, tilesY = (H + kTile - 1) / kTile;
     RTCScene rtcScene = embree_->scene.get();
-    const RayFaults fault = sampling;
+    const CameraRays cameraRays(camera);
     const glm::dvec3 frameOrigin = embree_->frameOrigin;
 
     tbb::parallel_for(tbb::blocked_range<int>(0, tilesX * tilesY, 4), [&](const tbb::blocked_range<int>& tiles) {
@@ -140,6 +140,7 @@ RenderResult RayRenderer::render(const Camera& camera) const
         alignas(32) int valid[8];
         alignas(32) RTCRayHit8 packet;
         EyePlaneRay rays[8];
+        glm::dvec2 pImage[8];
         int pixelOf[8];
 
         for (int tile = tiles.begin(); tile != tiles.end(); ++tile) {
@@ -154,8 +155,8 @@ RenderResult RayRenderer::render(const Camera& camera) const
                         const int sampleRow = fault.flipRows ? H - 1 - row : row;
                         const int sampleCol = fault.flipCols ? W - 1 - col : col;
                         const glm::dvec2 pWindow = windowFromPixelCentre(camera, sampleCol, sampleRow) + fault.shiftPixels;
-                        rays[k] = valid[k] ? worldEyePlaneRayThroughWindow(camera, pWindow)
-                                           : EyePlaneRay{{0, 0, 0}, {0, 0, 1}, 0, 0};
+                        pImage[k] = {pWindow.x, camera.imageYFromWindowY(pWindow.y)};
+                        rays[k] = valid[k] ? cameraRays.worldRay(pImage[k]) : EyePlaneRay{{0, 0, 0}, {0, 0, 1}, 0, 0};
                         const EyePlaneRay& r = rays[k];
                         packet.ray.org_x[k] = float(r.origin.x - frameOrigin.x);
                         packet.ray.org_y[k] = float(r.origin.y - frameOrigin.y);
@@ -186,16 +187,12 @@ RenderResult RayRenderer::render(const Camera& camera) const
                         double t = glm::dot(normal, a - r.origin) / glm::dot(normal, r.direction);
                         if (!std::isfinite(t)) t = packet.ray.tfar[k];
                         const glm::dvec3 pWorld = r.origin + t * r.direction;
-                        const glm::dvec3 pEye(camera.eyeFromWorld * glm::dvec4(pWorld, 1.0));
                         const std::size_t i = std::size_t(pixelOf[k]);
                         result.primitiveId[i] = primitive;
-                        result.pEye[i] = pEye;
-                        result.windowDepth.value[i] = windowFromEye(camera, pEye).z;
-                        if (fault.distanceAsEyeZ) {
-                            const glm::dvec3 pHitWindow = windowFromEye(camera, pEye);
-                            result.windowDepth.value[i] =
-                                windowDepthFromEyeZ(camera, {pHitWindow.x, pHitWindow.y}, distanceOfEyePoint(camera, pEye));
-                        }
+                        result.pEye[i] = cameraRays.eyeFromWorld(pWorld);
+                        // The fault "distance as eye-z" takes the ray parameter (the distance) for eye-z.
+                        result.windowDepth.value[i] =
+                            cameraRays.windowDepth(pImage[k], fault.distanceAsEyeZ ? t : cameraRays.eyeZ(pWorld));
                     }
                 }
             }

@@ -10,7 +10,9 @@
 // Consumes window coordinates (see camera.h; pixel centres at +0.5) and depth values as
 // stored in the depth buffer (window depth); produces eye- or world-space points and rays.
 #include "zcheck/camera.h"
-#include "zcheck/render.h"
+#include "zcheck/quantity.h"
+
+#include <vector>
 
 #include <optional>
 
@@ -67,6 +69,22 @@ double eyeZFromDistance(const Camera& camera, const glm::dvec2& pWindow, double 
 // is not finite, the clear value (window, ndc), or not positive (eye-z, distance).
 std::optional<glm::dvec3> eyePointFromDepth(const Camera& camera, const glm::dvec2& pWindow, double value,
                                             DepthQuantity quantity);
+
+// Batch unprojection of a whole map: `values` holds width·height depth values of `quantity`
+// (row 0 at the top, the camera's image size); every `stride`-th pixel in x and y from (0, 0)
+// becomes a point, misses (as eyePointFromDepth defines them) are skipped and counted.
+//
+//   const zcheck::UnprojectedMap cloud = zcheck::unprojectMap(camera, depth, zcheck::DepthQuantity::EyeZ);
+//   // cloud.points[k] (world space) was seen at pixel cloud.pixels[k] = (col, row)
+struct UnprojectedMap {
+    std::vector<glm::dvec3> points;   // eye or world space, as asked
+    std::vector<glm::ivec2> pixels;   // (col, row) of each point
+    std::size_t misses = 0;
+};
+enum class PointSpace { Eye, World };
+// Throws Error if values.size() is not width·height or stride < 1.
+UnprojectedMap unprojectMap(const Camera& camera, const std::vector<double>& values, DepthQuantity quantity,
+                            PointSpace space = PointSpace::World, int stride = 1);
 
 // Range of an eye-space point from the centre of projection (or from the eye plane, along
 // the viewing ray, for parallel projections).

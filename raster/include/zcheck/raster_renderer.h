@@ -18,12 +18,16 @@
 // (independent of the thread count) and binned per chunk into 64×64 tiles in submission
 // order; tiles are then drawn in parallel, each walking the chunks in order. The result is
 // bit-identical for any number of threads.
+//
+//   const zcheck::RasterRenderer raster(scene);
+//   const zcheck::RenderResult drawn = raster.render(camera);   // drawn.windowDepth: stored values
 #include "zcheck/render.h"
+#include "zcheck/scene.h"
 
 namespace zcheck {
 
-// Classic mistakes injected into the raster route (the fault catalogue uses them; the
-// defaults are the correct chain).
+// Classic mistakes injected into the raster route (the mistake catalogue passes them to
+// render(); the defaults are the correct chain).
 struct RasterFaults {
     bool overrideClipFromWorld = false;  // draw with `clipFromWorld` instead of the camera's
     glm::dmat4 clipFromWorld{1.0};       // (a wrong projection or view matrix)
@@ -34,17 +38,15 @@ struct RasterFaults {
     bool storeLinearEyeZ = false;        // store (eye-z − near)/(far − near) as the window depth
 };
 
-class RasterRenderer final : public Renderer {
+class RasterRenderer {
 public:
     static constexpr int kSubpixelBits = 8;          // 16.8 fixed point
     static constexpr int kTileSize = 64;             // pixels per tile side
     static constexpr int kChunkTriangles = 16384;    // triangles per set-up chunk
 
     explicit RasterRenderer(const Scene& scene);     // the scene must outlive the renderer
-    std::string name() const override { return "raster"; }
-    RenderResult render(const Camera& camera) const override;
-
-    RasterFaults faults;  // injected faults; default: none
+    // Thread-safety: const, and may run from several threads at once.
+    RenderResult render(const Camera& camera, const RasterFaults& faults = {}) const;
 
 private:
     const Scene& scene_;

@@ -1,5 +1,6 @@
 #pragma once
-// Per-pixel quantities a route can export, with their units and miss values.
+// What a pixel can hold: the four depth quantities, and the per-pixel quantities a route
+// exports, as data (names, channels, units, miss values). No I/O.
 //
 //   quantity        channels          unit                      miss value
 //   window          window            depth-buffer value        the clear value (far end; rangeMin with reversed-Z)
@@ -13,24 +14,43 @@
 //
 // eye-z is planar depth: the distance from the eye plane along the viewing axis. distance
 // is the Euclidean range from the centre of projection (for parallel projections, from the
-// eye plane along the ray). The normal is the triangle's geometric normal, turned to face
-// the camera. Ray route: values from the exact hit (double). Raster route: positions are
-// unprojected from the stored window depth, so they carry the depth format's quantization.
-#include "zcheck/camera.h"
-#include "zcheck/render.h"
-#include "zcheck/scene.h"
-
+// eye plane along the ray). Images are stored row by row, row 0 at the top of the picture;
+// pixel (col,row) is entry row·width + col.
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
 
 namespace zcheck {
 
+constexpr std::uint32_t kNoPrimitive = 0xFFFFFFFFu;  // primitive id of a pixel where nothing was hit
+
+enum class DepthQuantity {
+    Window,    // depth-buffer value, in [depth.rangeMin, depth.rangeMax]
+    Ndc,       // z_ndc
+    EyeZ,      // planar depth: distance along the viewing axis, positive, scene units
+    Distance,  // Euclidean range from the centre of projection, scene units
+};
+std::string toString(DepthQuantity quantity);
+DepthQuantity depthQuantityFromName(const std::string& name);  // throws Error naming the value
+
+struct DepthImage {
+    int width = 0;
+    int height = 0;
+    DepthQuantity quantity = DepthQuantity::Window;
+    std::vector<double> value;  // width·height, row 0 at the top
+
+    double at(int col, int row) const { return value[std::size_t(row) * width + col]; }
+};
+
 enum class ExportQuantity { Window, Ndc, EyeZ, Distance, PositionEye, PositionWorld, Normal, PrimitiveId };
 
 std::string toString(ExportQuantity quantity);
-std::vector<ExportQuantity> exportQuantitiesFromList(const std::string& commaSeparated);  // throws Error
+// "eye-z,normal" → {EyeZ, Normal}; throws Error naming an unknown or repeated name.
+std::vector<ExportQuantity> exportQuantitiesFromList(const std::string& commaSeparated);
 const std::vector<std::string>& exportQuantityNames();
+// The channel name a single-channel quantity is stored under (window, ndc, Z, distance).
+std::string channelNameOf(ExportQuantity quantity);
 
 struct QuantityImage {
     ExportQuantity quantity = ExportQuantity::Window;
@@ -42,10 +62,5 @@ struct QuantityImage {
     double missValue = 0;               // per channel (NaN, +inf, clear value, 0xFFFFFFFF)
     bool isMiss(std::size_t pixel) const;
 };
-
-// The channel name a single-channel quantity is stored under (window, ndc, Z, distance).
-std::string channelNameOf(ExportQuantity quantity);
-
-QuantityImage quantityImage(const Scene& scene, const Camera& camera, const RenderResult& route, ExportQuantity quantity);
 
 }  // namespace zcheck

@@ -1,7 +1,7 @@
 #pragma once
 // The consistency suite: a matrix of configurations (scenes × projection models × conventions
 // × depth formats × reversed-Z / infinite far × resolutions, plus extreme near/far ratios),
-// each checked clean and with every fault of the catalogue injected.
+// each checked clean and with every injectable mistake of the catalogue (mistakes.h) injected.
 //
 // Per configuration and fault:
 //   detected   — the check of the faulty chain is inconsistent;
@@ -13,8 +13,8 @@
 //                clipping where nothing crosses the near plane, is not applicable, and said so.
 // The suite passes when every clean configuration is consistent (no false positive) and every
 // applicable fault is detected.
-#include "check.h"
-#include "faults.h"
+#include "zcheck/checker.h"
+#include "zcheck/mistakes.h"
 
 #include <functional>
 #include <string>
@@ -45,7 +45,8 @@ struct SuiteConfig {
     std::string label() const;  // "builtin:default | pinhole | vulkan float32 reversed | 333x257"
 };
 
-// The matrix; `quick` is a representative subset for CTest. `modelsDir` holds the shared meshes.
+// The matrix; `quick` is a representative subset for CTest. `modelsDir` holds the shared meshes
+// (stanford-bunny.obj, spot.obj, teapot.obj, suzanne.obj); empty: the built-in scenes only.
 std::vector<SuiteConfig> suiteConfigurations(bool quick, const std::string& modelsDir);
 
 enum class FaultResult { Detected, Missed, NotApplicable, Meaningless };
@@ -54,13 +55,13 @@ std::string toString(FaultResult result);
 struct SuiteFailure {
     std::string label;  // configuration
     std::string what;   // "clean chain inconsistent" or "fault X not detected"
-    CheckRun run;       // the run to show (images)
+    CheckResult run;    // the run to show (images)
 };
 
 struct ConfigOutcome {
     SuiteConfig config;
     ComparisonReport clean;
-    std::vector<FaultResult> faults;  // parallel to faultCatalogue()
+    std::vector<FaultResult> faults;  // parallel to injectableMistakes()
     double milliseconds = 0;
 };
 
@@ -72,7 +73,13 @@ struct SuiteResult {
     bool passed() const { return falsePositives == 0 && missedFaults == 0; }
 };
 
-// Runs the configurations; `progress(done, total, outcome)` is called after each.
+// Detected / applicable per injectable mistake over the whole run.
+struct FaultTally {
+    int detected = 0, missed = 0, notApplicable = 0, meaningless = 0;
+};
+std::vector<FaultTally> tallyFaults(const SuiteResult& result);  // parallel to injectableMistakes()
+
+// Runs the configurations, one Checker per scene; `progress(done, total, outcome)` is called after each.
 SuiteResult runSuite(const std::vector<SuiteConfig>& configs,
                      const std::function<void(std::size_t, std::size_t, const ConfigOutcome&)>& progress);
 

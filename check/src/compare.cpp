@@ -1,6 +1,6 @@
 #include "zcheck/compare.h"
 
-#include "zcheck/clip.h"
+#include "zcheck/drawn_polygon.h"
 #include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
 
@@ -24,24 +24,6 @@ std::string toString(PixelClass pixelClass)
     case PixelClass::RasterOnly: return "raster-only";
     }
     return "?";
-}
-
-std::string toString(DepthQuantity quantity)
-{
-    switch (quantity) {
-    case DepthQuantity::Window: return "window";
-    case DepthQuantity::Ndc: return "ndc";
-    case DepthQuantity::EyeZ: return "eye-z";
-    case DepthQuantity::Distance: return "distance";
-    }
-    return "?";
-}
-
-DepthQuantity depthQuantityFromName(const std::string& name)
-{
-    for (DepthQuantity q : {DepthQuantity::Window, DepthQuantity::Ndc, DepthQuantity::EyeZ, DepthQuantity::Distance})
-        if (toString(q) == name) return q;
-    throw Error("unknown depth quantity '" + name + "' (expected window, ndc, eye-z or distance)");
 }
 
 double ToleranceModel::constantQuanta(const DepthSettings& depth)
@@ -68,59 +50,6 @@ double windowDepthSlope(const Camera& camera, const glm::dvec3& a, const glm::dv
     return std::max(dzdx, dzdy);
 }
 
-namespace {
-
-double distanceToSegment(const glm::dvec2& p, const glm::dvec2& a, const glm::dvec2& b)
-{
-    const glm::dvec2 ab = b - a;
-    const double lengthSquared = glm::dot(ab, ab);
-    const double t = lengthSquared > 0 ? std::clamp(glm::dot(p - a, ab) / lengthSquared, 0.0, 1.0) : 0.0;
-    return glm::length(p - (a + t * ab));
-}
-
-}  // namespace
-
-namespace {
-
-// The triangle as drawn: clipped to the near and far planes, its vertices in window space.
-std::vector<glm::dvec2> drawnPolygon(const Camera& camera, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c)
-{
-    const ClipPolygon polygon =
-        clipTriangle(camera.clipFromWorld * glm::dvec4(a, 1.0), camera.clipFromWorld * glm::dvec4(b, 1.0),
-                     camera.clipFromWorld * glm::dvec4(c, 1.0), depthClipPlanes(camera.convention().ndcZMin()));
-    std::vector<glm::dvec2> window;
-    for (int i = 0; i < polygon.size; ++i) {
-        const glm::dvec4& pClip = polygon.pClip[i];
-        window.emplace_back(camera.windowFromNdc * glm::dvec4(glm::dvec3(pClip) / pClip.w, 1.0));
-    }
-    return window;
-}
-
-}  // namespace
-
-double distanceToDrawnEdge(const Camera& camera, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c,
-                           const glm::dvec2& pWindow)
-{
-    const std::vector<glm::dvec2> polygon = drawnPolygon(camera, a, b, c);
-    double nearest = INFINITY;
-    for (std::size_t i = 0; i < polygon.size(); ++i)
-        nearest = std::min(nearest, distanceToSegment(pWindow, polygon[i], polygon[(i + 1) % polygon.size()]));
-    return nearest;
-}
-
-bool insideDrawnTriangle(const Camera& camera, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c,
-                         const glm::dvec2& pWindow)
-{
-    // Convex polygon: inside when the point is on the same side of every edge.
-    const std::vector<glm::dvec2> polygon = drawnPolygon(camera, a, b, c);
-    int positive = 0, negative = 0;
-    for (std::size_t i = 0; i < polygon.size(); ++i) {
-        const glm::dvec2 e = polygon[(i + 1) % polygon.size()] - polygon[i], p = pWindow - polygon[i];
-        const double side = e.x * p.y - e.y * p.x;
-        positive += side > 0, negative += side < 0;
-    }
-    return polygon.size() >= 3 && (positive == 0 || negative == 0);
-}
 
 namespace {
 

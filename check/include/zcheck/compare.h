@@ -169,12 +169,4 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
 // seen edge-on).
 double windowDepthSlope(const Camera& camera, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c);
 
-// Distance in pixels from window point pWindow to the boundary of the triangle as drawn
-// (clipped to the near and far planes, projected to the window); +inf if nothing is drawn.
-double distanceToDrawnEdge(const Camera& camera, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c,
-                           const glm::dvec2& pWindow);
-// Whether window point pWindow lies inside the triangle as drawn.
-bool insideDrawnTriangle(const Camera& camera, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c,
-                         const glm::dvec2& pWindow);
-
 }  // namespace zcheck

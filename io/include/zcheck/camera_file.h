@@ -15,22 +15,19 @@
 // and invalid values throw Error naming the file and the key.
 #include "zcheck/camera.h"
 
-#include <nlohmann/json.hpp>
-
 #include <string>
 
 namespace zcheck {
 
-CameraSpec cameraSpecFromJson(const nlohmann::json& document, const std::string& source);
 // The file must be a regular file of at most 1 MiB (input_file.h).
 CameraSpec readCameraFile(const std::string& path);
-// JSON text parsed strictly: a syntax error or a key repeated within one object throws Error
-// beginning with `source` (e.g. "camera file 'c.json'").
-nlohmann::json parseJsonStrictly(const std::string& text, const std::string& source);
-nlohmann::json toJson(const CameraSpec& spec);
-
+// The same from JSON text; `source` begins every message ("camera file 'c.json'", "dict").
+// A syntax error or a key repeated within one object is an Error too.
+CameraSpec cameraSpecFromJsonText(const std::string& text, const std::string& source);
+// The camera file's JSON for a camera (readCameraFile reads it back to the same spec).
+std::string cameraJsonText(const CameraSpec& spec);
 // Every transform of a camera as 4 rows of 4 numbers for column vectors (p' = M·p), plus a
-// "native" block in the convention's own form (row vectors for direct3d).
-nlohmann::json matricesJson(const Camera& camera);
+// "native" block in the convention's own form (row vectors for direct3d), as JSON text.
+std::string matricesJsonText(const Camera& camera);
 
 }  // namespace zcheck

@@ -4,9 +4,7 @@
 // encoded by zcheck and written with writeFileBytes; EXR and TIFF by OpenImageIO); a
 // command makes its outputs atomic with OutputFiles (atomic_file.h). Row 0 of every image is
 // the top row as seen.
-#include "zcheck/compare.h"
-#include "zcheck/export.h"
-#include "zcheck/render.h"
+#include "zcheck/quantity.h"
 
 #include <cstdint>
 #include <string>
@@ -18,9 +16,6 @@ namespace zcheck {
 // width·height·names.size() values, interleaved.
 void writeExr(const std::string& path, int width, int height, const std::vector<std::string>& names,
               const std::vector<float>& channels);
-
-// An 8-bit RGB PNG; `rgb` holds width·height·3 bytes.
-void writePng8(const std::string& path, int width, int height, const std::vector<std::uint8_t>& rgb);
 
 // A depth map read from a file — EXR, TIFF, PNG or PFM, told apart by their first bytes —
 // row 0 at the top as seen (PFM's bottom-to-top rows are flipped).
@@ -51,19 +46,5 @@ DepthMapFile readDepthMap(const std::string& path, const std::string& preferredC
 // Returns the format's name ("exr", "pfm", "tiff", "png"). Throws Error naming the file.
 std::string writeQuantityFile(const std::string& path, const std::vector<QuantityImage>& images, double scale);
 
-// An 8-bit picture of one quantity for a person: depths through the viridis colour map
-// (near dark blue, far yellow), normals as RGB = (n + 1)/2, ids hashed to colours; misses black.
-std::vector<std::uint8_t> previewRgb(const QuantityImage& image);
-
-// An 8-bit RGB PNG as a data: URI (base64), for self-contained HTML reports.
-std::string pngDataUri(int width, int height, const std::vector<std::uint8_t>& rgb);
-
-// The check's pictures:
-//   error heatmap — |Δ| / tolerance on both-hit pixels: black 0, through blue and green to
-//                   yellow at 1 (the tolerance), red above; unexplained coverage magenta;
-//                   misses and explained edges dark grey.
-//   coverage classes — one colour per PixelClass (legend in the README).
-std::vector<std::uint8_t> errorHeatmapRgb(const Comparison& comparison);
-std::vector<std::uint8_t> pixelClassRgb(const Comparison& comparison);
 
 }  // namespace zcheck

@@ -1,84 +1,10 @@
 #include "zcheck/export.h"
 
-#include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
 
 #include <cmath>
 
 namespace zcheck {
-
-namespace {
-const ExportQuantity kAll[] = {ExportQuantity::Window,      ExportQuantity::Ndc,           ExportQuantity::EyeZ,
-                               ExportQuantity::Distance,    ExportQuantity::PositionEye,   ExportQuantity::PositionWorld,
-                               ExportQuantity::Normal,      ExportQuantity::PrimitiveId};
-}
-
-std::string toString(ExportQuantity quantity)
-{
-    switch (quantity) {
-    case ExportQuantity::Window: return "window";
-    case ExportQuantity::Ndc: return "ndc";
-    case ExportQuantity::EyeZ: return "eye-z";
-    case ExportQuantity::Distance: return "distance";
-    case ExportQuantity::PositionEye: return "position-eye";
-    case ExportQuantity::PositionWorld: return "position-world";
-    case ExportQuantity::Normal: return "normal";
-    case ExportQuantity::PrimitiveId: return "primitive-id";
-    }
-    return "?";
-}
-
-const std::vector<std::string>& exportQuantityNames()
-{
-    static const std::vector<std::string> names = [] {
-        std::vector<std::string> all;
-        for (ExportQuantity q : kAll) all.push_back(toString(q));
-        return all;
-    }();
-    return names;
-}
-
-std::vector<ExportQuantity> exportQuantitiesFromList(const std::string& text)
-{
-    std::vector<ExportQuantity> out;
-    std::size_t start = 0;
-    while (start <= text.size()) {
-        const std::size_t end = std::min(text.find(',', start), text.size());
-        const std::string name = text.substr(start, end - start);
-        bool found = false;
-        for (ExportQuantity q : kAll)
-            if (toString(q) == name) {
-                for (ExportQuantity seen : out)
-                    if (seen == q) throw Error("--quantity lists '" + name + "' twice");
-                out.push_back(q), found = true;
-            }
-        if (!found) {
-            std::string known;
-            for (const auto& n : exportQuantityNames()) known += (known.empty() ? "" : ", ") + n;
-            throw Error("unknown quantity '" + name + "' (expected one or more of " + known + ", comma-separated)");
-        }
-        start = end + 1;
-    }
-    return out;
-}
-
-std::string channelNameOf(ExportQuantity quantity)
-{
-    switch (quantity) {
-    case ExportQuantity::Window: return "window";
-    case ExportQuantity::Ndc: return "ndc";
-    case ExportQuantity::EyeZ: return "Z";
-    case ExportQuantity::Distance: return "distance";
-    default: return toString(quantity);
-    }
-}
-
-bool QuantityImage::isMiss(std::size_t pixel) const
-{
-    if (quantity == ExportQuantity::PrimitiveId) return id[pixel] == kNoPrimitive;
-    const double v = value[pixel * channels.size()];
-    return std::isnan(missValue) ? std::isnan(v) : v == missValue;
-}
 
 QuantityImage quantityImage(const Scene& scene, const Camera& camera, const RenderResult& route, ExportQuantity quantity)
 {

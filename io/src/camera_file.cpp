@@ -1,9 +1,13 @@
 #include "zcheck/camera_file.h"
 
+#include "camera_json.h"
+
 #include "zcheck/error.h"
 #include "zcheck/input_file.h"
 
 #include <algorithm>
+#include <cmath>
+#include <regex>
 #include <fstream>
 #include <sstream>
 
@@ -422,5 +426,33 @@ json matricesJson(const Camera& camera)
     };
     return out;
 }
+
+std::string prettyJson(const nlohmann::json& document)
+{
+    const std::string text = document.dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
+    // An array whose elements are all numbers (or null) is folded onto one line.
+    static const std::regex numberArray(R"(\[(\s*(-?[0-9][0-9.eE+-]*|null)\s*,)*\s*(-?[0-9][0-9.eE+-]*|null)\s*\])");
+    static const std::regex space(R"(\s+)");
+    std::string out;
+    auto last = text.cbegin();
+    for (std::sregex_iterator it(text.begin(), text.end(), numberArray), end; it != end; ++it) {
+        out.append(last, text.cbegin() + it->position());
+        std::string folded = std::regex_replace(it->str(), space, "");
+        std::string spaced;
+        for (char c : folded) spaced += c == ',' ? std::string(", ") : std::string(1, c);
+        out += spaced;
+        last = text.cbegin() + it->position() + it->length();
+    }
+    out.append(last, text.cend());
+    return out;
+}
+
+CameraSpec cameraSpecFromJsonText(const std::string& text, const std::string& source)
+{
+    return cameraSpecFromJson(parseJsonStrictly(text, source), source);
+}
+
+std::string cameraJsonText(const CameraSpec& spec) { return prettyJson(toJson(spec)); }
+std::string matricesJsonText(const Camera& camera) { return prettyJson(matricesJson(camera)); }
 
 }  // namespace zcheck

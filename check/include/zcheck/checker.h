@@ -1,0 +1,141 @@
+#pragma once
+// Checker: one scene, both routes built once, and every question zcheck answers about it.
+//
+//   const zcheck::Checker checker(zcheck::loadScene("bunny.obj"));   // BVH and raster set-up, once
+//   const zcheck::Camera camera(zcheck::readCameraFile("camera.json"));
+//   const zcheck::CheckResult result = checker.check(camera);
+//   if (!result.report.comparison.consistent()) { /* result.comparison.pixelClass says where */ }
+//
+//   zcheck::RayFaults flipped;                      // render with a mistake (faults are arguments)
+//   flipped.flipRows = true;
+//   const zcheck::RenderResult wrong = checker.renderRay(camera, flipped);
+//
+// check() draws the scene through the camera by both routes — the ray route follows the
+// camera's definition (camera_rays.h), the raster route its matrices — and compares them per
+// pixel with the tolerance model (compare.h). verify() and diagnose() judge a depth map
+// rendered elsewhere against the ray route (verify.h).
+//
+// Thread-safety: a Checker is immutable after construction; every member function is const
+// and may be called from several threads at once. Each call allocates its own results.
+#include "zcheck/compare.h"
+#include "zcheck/quantity.h"
+#include "zcheck/raster_renderer.h"
+#include "zcheck/ray_renderer.h"
+#include "zcheck/scene.h"
+
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+namespace zcheck {
+
+enum class Route { Ray, Raster };
+std::string toString(Route route);
+Route routeFromName(const std::string& name);  // "ray" | "raster"; throws Error naming the value
+
+// Faults for either route (a render of one route reads its own part).
+struct RouteFaults {
+    RayFaults ray;
+    RasterFaults raster;
+};
+
+struct Timings {
+    double bvhBuildMs = 0;   // Embree scene build (BVH), wall time
+    double traceMs = 0;      // ray generation + tracing + depth in double, wall time
+    double rasterMs = 0;     // transform, clip, bin, rasterize, wall time
+    double compareMs = 0;    // per-pixel comparison and classification, wall time
+};
+
+// What was compared, how long it took, what was found (report.h prints it).
+struct CheckReport {
+    std::string scene;              // scene name as addressed
+    std::size_t triangles = 0;      // triangles in the scene
+    CameraSpec camera;              // the camera both routes used
+    ToleranceModel tolerance;
+    ComparisonReport comparison;
+    Timings timings;
+};
+
+struct CheckResult {
+    RenderResult ray;        // exact window depths, hit points in eye space
+    RenderResult raster;     // stored depth-buffer values
+    Comparison comparison;   // per-pixel classes and the summary
+    CheckReport report;
+};
+
+struct CheckOptions {
+    ToleranceModel tolerance;
+    RouteFaults faults;      // mistakes injected into either route (default: none)
+};
+
+// A depth map rendered elsewhere, as read: values per pixel in one depth quantity.
+struct DepthMap {
+    int width = 0, height = 0;
+    DepthQuantity quantity = DepthQuantity::Window;
+    std::vector<double> value;   // row 0 at the top; misses as eyePointFromDepth defines them
+                                 // (non-finite; the clear value for window and ndc; ≤ 0 for eye-z, distance)
+    double valueQuantum = 0;     // the storage step of `value` (1/scale for integer files); 0: binary32
+};
+
+struct VerifyResult {
+    RenderResult truth;       // the ray route
+    RenderResult map;         // the map as a render result (see verify.h for the surface it saw)
+    Comparison comparison;
+    CheckReport report;
+};
+
+// One hypothesis of the diagnosis: a mistake of the catalogue (mistakes.h), perhaps one of
+// several variants of it, under which the map was re-read or the truth re-rendered.
+struct Hypothesis {
+    std::string name;         // the mistake's name, e.g. "distance-as-eye-z", "half-pixel"
+    std::string variant;      // which variant, e.g. "x and y"; empty when there is one
+    std::string explanation;  // "consistent if read as ray distance instead of eye-z"
+    bool consistent = false;
+    std::int64_t unexplained = 0;
+};
+
+class VertexNeighbours;
+
+class Checker {
+public:
+    // Validates the scene (throws Error: no triangles, an index out of range) and builds both
+    // routes: Embree's BVH (timed, Timings::bvhBuildMs) and the rasterizer.
+    explicit Checker(Scene scene);
+    ~Checker();
+    Checker(const Checker&) = delete;
+    Checker& operator=(const Checker&) = delete;
+
+    const Scene& scene() const { return scene_; }
+    double bvhBuildMilliseconds() const { return rays_.buildMilliseconds(); }
+
+    // Both routes through `camera`, compared.
+    CheckResult check(const Camera& camera, const CheckOptions& options = {}) const;
+
+    // One route's render: window depth and primitive per pixel (row 0 at the top).
+    RenderResult renderRay(const Camera& camera, const RayFaults& faults = {}) const;
+    RenderResult renderRaster(const Camera& camera, const RasterFaults& faults = {}) const;
+    RenderResult render(const Camera& camera, Route route, const RouteFaults& faults = {}) const;
+    // One route's render as an exported quantity (quantity.h): depth in any of the four
+    // quantities, positions, normals or primitive ids.
+    QuantityImage render(const Camera& camera, ExportQuantity quantity, Route route) const;
+
+    // A depth map rendered elsewhere against the ray route's ground truth, with the same
+    // tolerance model; `map` must be camera.width() × camera.height() (throws Error otherwise).
+    VerifyResult verify(const Camera& camera, const DepthMap& map) const;
+    // Every hypothesis of the mistake catalogue that has a meaning for this camera and map,
+    // in catalogue order; the consistent ones name what explains the map.
+    std::vector<Hypothesis> diagnose(const Camera& camera, const DepthMap& map) const;
+
+    // Triangles around each vertex position, built on first use (verify's surface search).
+    const VertexNeighbours& neighbours() const;
+
+private:
+    Scene scene_;
+    RayRenderer rays_;
+    RasterRenderer raster_;
+    mutable std::once_flag neighboursOnce_;
+    mutable std::unique_ptr<VertexNeighbours> neighbours_;
+};
+
+}  // namespace zcheck

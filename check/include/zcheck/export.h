@@ -1,0 +1,16 @@
+#pragma once
+// A route's render as one of the exported quantities (table in quantity.h).
+//
+// The normal is the triangle's geometric normal, turned to face the camera. Ray route:
+// values from the exact hit (double). Raster route: positions are unprojected from the
+// stored window depth, so they carry the depth format's quantization.
+#include "zcheck/camera.h"
+#include "zcheck/quantity.h"
+#include "zcheck/render.h"
+#include "zcheck/scene.h"
+
+namespace zcheck {
+
+QuantityImage quantityImage(const Scene& scene, const Camera& camera, const RenderResult& route, ExportQuantity quantity);
+
+}  // namespace zcheck

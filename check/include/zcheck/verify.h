@@ -1,0 +1,52 @@
+#pragma once
+// Verifying a depth map rendered elsewhere (a GPU, an engine, Blender, a simulator) against
+// the ray route's ground truth — Checker::verify and Checker::diagnose (checker.h) — and the
+// pieces they are made of.
+//
+// The map does not say which surface it saw: each hit takes the ground truth's surface when
+// the comparison's rule (PixelJudge) accepts the map's depth on it; otherwise, among the
+// triangles within 2 pixels and those sharing a vertex with them, one drawn within S of the
+// pixel centre whose tolerance interval joined with the truth's holds the depth and under
+// which the comparison explains the pixel; otherwise the truth's surface (a depth error) or
+// kUnknownPrimitive. The accepted depths at a pixel are therefore one interval around the
+// true depth: a map nearer the truth never fails where a farther one passes.
+#include "zcheck/checker.h"
+
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace zcheck {
+
+// Triangles around each vertex position (positions, not indices: loaders duplicate vertices),
+// for guessing which surface a map saw. Holds a reference to the scene. Immutable once built.
+class VertexNeighbours {
+public:
+    explicit VertexNeighbours(const Scene& scene);
+    // `primitive` and every triangle that shares a vertex position with it.
+    template <class Visit>
+    void forEachNeighbour(std::uint32_t primitive, Visit&& visit) const
+    {
+        for (int k = 0; k < 3; ++k)
+            for (std::uint32_t t : around_.at(key(scene_.positions[scene_.triangles[primitive][k]]))) visit(t);
+    }
+
+private:
+    static std::string key(const glm::vec3& p);
+    const Scene& scene_;
+    std::unordered_map<std::string, std::vector<std::uint32_t>> around_;
+};
+
+// The map as the raster side of a comparison (window depth per pixel, a hit where the value is
+// not a miss, the surface chosen as above). `quantum` receives each pixel's storage step in
+// window units.
+RenderResult renderResultFromMap(const Scene& scene, const Camera& camera, const DepthMap& map,
+                                 const RenderResult& truth, const VertexNeighbours& neighbours,
+                                 std::vector<double>& quantum);
+
+// The comparison of `map` against an already rendered ground truth `truth` (one BVH, one
+// truth render, many readings of the map).
+VerifyResult verifyAgainst(const Scene& scene, const Camera& camera, const DepthMap& map, RenderResult truth,
+                           const VertexNeighbours& neighbours);
+
+}  // namespace zcheck

@@ -1,0 +1,67 @@
+#include "zcheck/checker.h"
+
+#include "zcheck/error.h"
+#include "zcheck/export.h"
+#include "zcheck/verify.h"
+
+#include <chrono>
+
+namespace zcheck {
+
+std::string toString(Route route) { return route == Route::Ray ? "ray" : "raster"; }
+
+Route routeFromName(const std::string& name)
+{
+    if (name == "ray") return Route::Ray;
+    if (name == "raster") return Route::Raster;
+    throw Error("unknown route '" + name + "' (expected ray or raster)");
+}
+
+Checker::Checker(Scene scene) : scene_(std::move(scene)), rays_(scene_), raster_(scene_) {}
+
+Checker::~Checker() = default;
+
+CheckResult Checker::check(const Camera& camera, const CheckOptions& options) const
+{
+    CheckResult run;
+    run.ray = rays_.render(camera, options.faults.ray);
+    run.raster = raster_.render(camera, options.faults.raster);
+    const auto start = std::chrono::steady_clock::now();
+    run.comparison = compareRoutes(scene_, camera, run.ray, run.raster, options.tolerance);
+    run.report.timings.compareMs =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    run.report.timings.bvhBuildMs = rays_.buildMilliseconds();
+    run.report.timings.traceMs = run.ray.renderMilliseconds;
+    run.report.timings.rasterMs = run.raster.renderMilliseconds;
+    run.report.scene = scene_.name;
+    run.report.triangles = scene_.triangleCount();
+    run.report.camera = camera.spec();
+    run.report.tolerance = options.tolerance;
+    run.report.comparison = run.comparison.report;
+    return run;
+}
+
+RenderResult Checker::renderRay(const Camera& camera, const RayFaults& faults) const { return rays_.render(camera, faults); }
+
+RenderResult Checker::renderRaster(const Camera& camera, const RasterFaults& faults) const
+{
+    return raster_.render(camera, faults);
+}
+
+RenderResult Checker::render(const Camera& camera, Route route, const RouteFaults& faults) const
+{
+    return route == Route::Ray ? renderRay(camera, faults.ray) : renderRaster(camera, faults.raster);
+}
+
+QuantityImage Checker::render(const Camera& camera, ExportQuantity quantity, Route route) const
+{
+    return quantityImage(scene_, camera, render(camera, route), quantity);
+}
+
+const VertexNeighbours& Checker::neighbours() const
+{
+    std::call_once(neighboursOnce_, [&] { neighbours_ = std::make_unique<VertexNeighbours>(scene_); });
+    return *neighbours_;
+}
+
+}  // namespace zcheck

@@ -1,0 +1,316 @@
+#include "zcheck/mistakes.h"
+
+#include "zcheck/inverse_projection.h"
+
+#include <cmath>
+#include <cstdio>
+
+namespace zcheck {
+
+namespace {
+
+using Rereadings = std::vector<Rereading>;
+
+// A projection matrix built wrongly: the raster route draws with it (inject), and the truth
+// is rendered through a raw-matrix camera holding it (reread). `build` returns false where
+// the mistake has no meaning.
+Mistake wrongProjection(std::string name, std::string description, std::string explanation,
+                        std::function<bool(const Camera&, glm::dmat4& clipFromEye)> build)
+{
+    Mistake mistake{std::move(name), std::move(description), Route::Raster, {}, {}};
+    mistake.inject = [build](const Camera& camera, RouteFaults& faults) {
+        glm::dmat4 clipFromEye;
+        if (!build(camera, clipFromEye)) return false;
+        faults.raster.overrideClipFromWorld = true;
+        faults.raster.clipFromWorld = clipFromEye * camera.eyeFromWorld;
+        return true;
+    };
+    mistake.reread = [build, explanation](const Camera& camera, const DepthMap&) {
+        glm::dmat4 clipFromEye;
+        if (!build(camera, clipFromEye)) return Rereadings{};
+        CameraSpec spec = camera.spec();
+        spec.projection.type = ProjectionType::Matrix;
+        spec.projection.clipFromEye = clipFromEye;
+        return Rereadings{{"", explanation, spec, {}, {}}};
+    };
+    return mistake;
+}
+
+// A sampling mistake of the renderer: the ray route samples wrongly (inject), and the truth is
+// rendered with the same wrong sampling (reread).
+Mistake wrongSampling(std::string name, std::string description, std::string explanation, RayFaults faults)
+{
+    Mistake mistake{std::move(name), std::move(description), Route::Ray, {}, {}};
+    mistake.inject = [faults](const Camera&, RouteFaults& injected) {
+        injected.ray = faults;
+        return true;
+    };
+    mistake.reread = [faults, explanation](const Camera&, const DepthMap&) {
+        return Rereadings{{"", explanation, std::nullopt, faults, {}}};
+    };
+    return mistake;
+}
+
+// A sampling mistake that mirrors the image: the ray route samples mirrored (inject), and the
+// map is mirrored back (reread; the comparison judges each pixel at its own position).
+Mistake mirrored(std::string name, std::string description, std::string explanation, bool rows)
+{
+    RayFaults faults;
+    (rows ? faults.flipRows : faults.flipCols) = true;
+    Mistake mistake = wrongSampling(std::move(name), std::move(description), explanation, faults);
+    mistake.reread = [rows, explanation](const Camera&, const DepthMap& map) {
+        DepthMap back = map;
+        for (int row = 0; row < map.height; ++row)
+            for (int col = 0; col < map.width; ++col)
+                back.value[std::size_t(row) * map.width + col] =
+                    map.value[rows ? std::size_t(map.height - 1 - row) * map.width + col
+                                   : std::size_t(row) * map.width + (map.width - 1 - col)];
+        return Rereadings{{"", explanation, std::nullopt, {}, back}};
+    };
+    return mistake;
+}
+
+// The map's values re-read as another quantity (or through a function of the value).
+Rereading readAs(const DepthMap& map, DepthQuantity quantity, std::string explanation,
+                 const std::function<double(double)>& value = {})
+{
+    DepthMap other = map;
+    other.quantity = quantity;
+    if (value)
+        for (double& v : other.value) v = value(v);
+    return {"", std::move(explanation), std::nullopt, {}, other};
+}
+
+// The projection's x and y rows scaled by (kx, ky): field-of-view and aspect mistakes.
+glm::dmat4 scaledRows(const Camera& camera, double kx, double ky)
+{
+    glm::dmat4 m = camera.clipFromEye;
+    for (int c = 0; c < 4; ++c) m[c][0] *= kx, m[c][1] *= ky;
+    return m;
+}
+
+bool hasFovy(const Camera& camera) { return camera.spec().projection.type == ProjectionType::Perspective; }
+bool isRawMatrix(const Camera& camera) { return camera.spec().projection.type == ProjectionType::Matrix; }
+
+// The z row rebuilt with near and far exchanged (the mapping's formula, see camera.cpp).
+glm::dmat4 nearFarSwapped(const Camera& camera)
+{
+    const double a = camera.ndcZNear(), b = camera.ndcZFar();
+    const double n = camera.farDistance(), f = camera.nearDistance();  // swapped
+    const double towardsEye = -camera.convention().eyeForwardZ;       // z_gl = towardsEye·z_eye
+    double P, Q;
+    if (camera.spec().projection.isPerspective()) {
+        P = (a - b) * n / (f - n) - b, Q = (a - b) * n * f / (f - n);
+    } else {
+        P = -(b - a) / (f - n), Q = a - (b - a) * n / (f - n);
+    }
+    glm::dmat4 m = camera.clipFromEye;
+    m[2][2] = P * towardsEye, m[3][2] = Q;
+    return m;
+}
+
+// The projection the camera would have with `change` applied to its spec (false if invalid).
+bool projectionOf(const Camera& camera, const std::function<void(CameraSpec&)>& change, glm::dmat4& clipFromEye)
+{
+    if (isRawMatrix(camera)) return false;
+    CameraSpec other = camera.spec();
+    change(other);
+    try {
+        clipFromEye = Camera(other).clipFromEye;
+    } catch (const std::exception&) {
+        return false;
+    }
+    return true;
+}
+
+std::vector<Mistake> buildCatalogue()
+{
+    std::vector<Mistake> all;
+
+    // Orientation and sampling.
+    RayFaults halfPixel;
+    halfPixel.shiftPixels = {-0.5, -0.5};
+    all.push_back(mirrored("y-flip", "the window's y axis flipped (bottom-left vs top-left origin mixed up)",
+                           "consistent if flipped vertically (the window's y origin is the other corner)", true));
+    all.push_back(mirrored("x-flip", "the image mirrored left to right (a mirrored x axis)",
+                           "consistent if flipped horizontally (a mirrored x axis)", false));
+    Mistake half = wrongSampling("half-pixel", "pixel centres at integer coordinates: the +0.5 offset forgotten", "",
+                                 halfPixel);
+    half.reread = [](const Camera&, const DepthMap&) {
+        Rereadings out;
+        for (auto [dx, dy, what] : {std::tuple{-0.5, -0.5, "x and y"}, std::tuple{-0.5, 0.0, "x"},
+                                    std::tuple{0.0, -0.5, "y"}, std::tuple{0.5, 0.5, "x and y, the other way"}}) {
+            Rereading r;
+            r.variant = what;
+            r.explanation = std::string("consistent if rendered with pixel centres half a pixel off in ") + what +
+                            " (the +0.5 pixel-centre offset missing or doubled)";
+            r.truthFaults.shiftPixels = {dx, dy};
+            out.push_back(r);
+        }
+        return out;
+    };
+    all.push_back(half);
+
+    // The projection matrix.
+    all.push_back(wrongProjection(
+        "ndc-range", "a [-1,1] depth matrix used with a [0,1] convention, or the reverse",
+        "consistent if the projection maps depth to the other NDC range ([-1,1] vs [0,1]) than the viewport expects",
+        [](const Camera& camera, glm::dmat4& m) {
+            return projectionOf(camera, [](CameraSpec& spec) {
+                spec.convention.ndcDepth = spec.convention.ndcDepth == NdcDepthRange::ZeroToOne ? NdcDepthRange::MinusOneToOne
+                                                                                                : NdcDepthRange::ZeroToOne;
+            }, m);
+        }));
+    Mistake reversed = wrongProjection(
+        "reversed-as-standard", "a reversed-Z projection's values read as standard (or the reverse)", "",
+        [](const Camera& camera, glm::dmat4& m) {
+            return projectionOf(camera, [](CameraSpec& spec) { spec.depth.reversed = !spec.depth.reversed; }, m);
+        });
+    // Re-read with the whole depth mapping reversed: projection, clear value and depth test.
+    reversed.reread = [](const Camera& camera, const DepthMap&) {
+        if (isRawMatrix(camera)) return Rereadings{};
+        CameraSpec spec = camera.spec();
+        spec.depth.reversed = !spec.depth.reversed;
+        return Rereadings{{"", std::string("consistent if read as ") + (camera.depth().reversed ? "standard" : "reversed-Z") + " depth",
+                           spec, {}, {}}};
+    };
+    all.push_back(reversed);
+    all.push_back(wrongProjection("handedness", "a left-handed view used in a right-handed pipeline: the eye's x axis mirrored",
+                                  "consistent if the eye's x axis is mirrored (a left- vs right-handed view)",
+                                  [](const Camera& camera, glm::dmat4& m) {
+                                      glm::dmat4 mirror(1.0);
+                                      mirror[0][0] = -1;
+                                      m = camera.clipFromEye * mirror;
+                                      return true;
+                                  }));
+    all.push_back(wrongProjection("transposed", "the projection matrix transposed (row- vs column-major confusion)",
+                                  "consistent if the projection matrix is transposed (row- vs column-major)",
+                                  [](const Camera& camera, glm::dmat4& m) {
+                                      m = glm::transpose(camera.clipFromEye);
+                                      return true;
+                                  }));
+    all.push_back(wrongProjection("aspect-inverted", "height/width used where width/height belongs",
+                                  "consistent if the aspect ratio is height/width instead of width/height",
+                                  [](const Camera& camera, glm::dmat4& m) {
+                                      const double aspect = double(camera.width()) / camera.height();
+                                      m = scaledRows(camera, aspect * aspect, 1.0);
+                                      return camera.width() != camera.height();
+                                  }));
+    all.push_back(wrongProjection("fovy-radians", "the vertical field of view in degrees passed where radians are expected",
+                                  "consistent if the field of view in degrees was taken for radians",
+                                  [](const Camera& camera, glm::dmat4& m) {
+                                      if (!hasFovy(camera)) return false;
+                                      const double fovy = camera.spec().projection.fovyDeg;
+                                      const double k = std::tan(glm::radians(fovy) / 2) / std::tan(fovy / 2);
+                                      m = scaledRows(camera, k, k);
+                                      return true;
+                                  }));
+    all.push_back(wrongProjection("half-fov", "tan(fovy) used where tan(fovy/2) belongs (full vs half field of view)",
+                                  "consistent if tan(fovy) was used where tan(fovy/2) belongs",
+                                  [](const Camera& camera, glm::dmat4& m) {
+                                      if (!hasFovy(camera)) return false;
+                                      const double half = glm::radians(camera.spec().projection.fovyDeg) / 2;
+                                      const double k = std::tan(half) / std::tan(2 * half);
+                                      m = scaledRows(camera, k, k);
+                                      return std::isfinite(k);
+                                  }));
+    all.push_back(wrongProjection("near-far-swapped", "near and far exchanged in the projection",
+                                  "consistent if near and far are exchanged in the projection",
+                                  [](const Camera& camera, glm::dmat4& m) {
+                                      if (camera.farIsInfinite() || isRawMatrix(camera)) return false;
+                                      m = nearFarSwapped(camera);
+                                      return true;
+                                  }));
+    Mistake fovy{"fovy-error", "the vertical field of view off by a small factor (0.98 to 1.02)", Route::Raster, {}, {}};
+    fovy.reread = [](const Camera& camera, const DepthMap&) {
+        Rereadings out;
+        if (!hasFovy(camera)) return out;
+        for (double factor : {0.98, 0.99, 0.995, 1.005, 1.01, 1.02}) {
+            CameraSpec spec = camera.spec();
+            spec.projection.fovyDeg *= factor;
+            char variant[64], text[160];
+            std::snprintf(variant, sizeof variant, "fovy %.4g°", spec.projection.fovyDeg);
+            std::snprintf(text, sizeof text, "consistent with a vertical field of view of %.4g° instead of %.4g°",
+                          spec.projection.fovyDeg, camera.spec().projection.fovyDeg);
+            out.push_back({variant, text, spec, {}, {}});
+        }
+        return out;
+    };
+    all.push_back(fovy);
+
+    // What the numbers are.
+    Mistake linear{"linear-depth", "linear eye depth (z − n)/(f − n) stored as the window depth", Route::Raster, {}, {}};
+    linear.inject = [](const Camera& camera, RouteFaults& faults) {
+        return !camera.farIsInfinite() && (faults.raster.storeLinearEyeZ = true);
+    };
+    linear.reread = [](const Camera& camera, const DepthMap& map) {
+        if (map.quantity != DepthQuantity::Window || camera.farIsInfinite()) return Rereadings{};
+        const double n = camera.nearDistance(), f = camera.farDistance(), clear = camera.clearDepth();
+        const double lo = camera.depth().rangeMin, span = camera.depth().rangeMax - camera.depth().rangeMin;
+        return Rereadings{readAs(map, DepthQuantity::EyeZ,
+                                 "consistent if read as linear depth (z − near)/(far − near) instead of window depth",
+                                 [=](double v) { return std::isfinite(v) && v != clear ? n + (v - lo) / span * (f - n) : INFINITY; })};
+    };
+    all.push_back(linear);
+    Mistake distanceAsEyeZ{"distance-as-eye-z", "ray distance taken as planar depth (eye-z)", Route::Ray, {}, {}};
+    distanceAsEyeZ.inject = [](const Camera&, RouteFaults& faults) { return faults.ray.distanceAsEyeZ = true; };
+    distanceAsEyeZ.reread = [](const Camera&, const DepthMap& map) {
+        const std::string text = "consistent if read as ray distance instead of eye-z";
+        if (map.quantity == DepthQuantity::EyeZ) return Rereadings{readAs(map, DepthQuantity::Distance, text)};
+        if (map.quantity == DepthQuantity::Distance) return Rereadings{};
+        RayFaults faults;
+        faults.distanceAsEyeZ = true;
+        return Rereadings{{"", "consistent if the renderer took the ray distance for eye-z", std::nullopt, faults, {}}};
+    };
+    all.push_back(distanceAsEyeZ);
+    auto quantityMistake = [&](std::string name, std::string description, DepthQuantity declared, DepthQuantity actual,
+                               std::string explanation) {
+        Mistake m{std::move(name), std::move(description), Route::Raster, {}, {}};
+        m.reread = [=](const Camera&, const DepthMap& map) {
+            return map.quantity == declared ? Rereadings{readAs(map, actual, explanation)} : Rereadings{};
+        };
+        all.push_back(m);
+    };
+    quantityMistake("eye-z-as-distance", "planar depth (eye-z) delivered where ray distance was declared",
+                    DepthQuantity::Distance, DepthQuantity::EyeZ, "consistent if read as eye-z (planar depth) instead of ray distance");
+    quantityMistake("eye-z-as-window", "linear eye-z in scene units delivered where window depth was declared",
+                    DepthQuantity::Window, DepthQuantity::EyeZ, "consistent if read as eye-z (linear, scene units) instead of window depth");
+    quantityMistake("distance-as-window", "ray distance delivered where window depth was declared", DepthQuantity::Window,
+                    DepthQuantity::Distance, "consistent if read as ray distance instead of window depth");
+
+    // The rasterizer's own mistakes: nothing to re-read in a finished map.
+    auto rasterOnly = [&](std::string name, std::string description, std::function<bool(const Camera&, RasterFaults&)> set) {
+        Mistake m{std::move(name), std::move(description), Route::Raster, {}, {}};
+        m.inject = [set](const Camera& camera, RouteFaults& faults) { return set(camera, faults.raster); };
+        all.push_back(m);
+    };
+    rasterOnly("no-near-clip", "no clipping at the near plane (geometry behind the eye wraps around)",
+               [](const Camera&, RasterFaults& f) { return f.noNearClip = true; });
+    rasterOnly("screen-linear-eye-z", "eye depth interpolated linearly in screen space instead of perspective-correctly",
+               [](const Camera&, RasterFaults& f) { return f.screenLinearEyeZ = true; });
+    rasterOnly("viewport-minus-one", "the viewport scaled by width − 1 and height − 1",
+               [](const Camera&, RasterFaults& f) { return f.viewportMinusOne = true; });
+    rasterOnly("unorm-truncation", "unorm depth quantized by truncation instead of rounding",
+               [](const Camera& camera, RasterFaults& f) {
+                   return camera.depth().format != DepthFormat::Float32 && (f.truncateUnorm = true);
+               });
+    return all;
+}
+
+}  // namespace
+
+const std::vector<Mistake>& mistakeCatalogue()
+{
+    static const std::vector<Mistake> catalogue = buildCatalogue();
+    return catalogue;
+}
+
+std::vector<const Mistake*> injectableMistakes()
+{
+    std::vector<const Mistake*> out;
+    for (const Mistake& mistake : mistakeCatalogue())
+        if (mistake.inject) out.push_back(&mistake);
+    return out;
+}
+
+}  // namespace zcheck

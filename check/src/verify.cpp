@@ -1,0 +1,191 @@
+#include "zcheck/verify.h"
+
+#include "zcheck/error.h"
+#include "zcheck/drawn_polygon.h"
+#include "zcheck/mistakes.h"
+
+#include "zcheck/inverse_projection.h"
+
+#include <algorithm>
+#include <chrono>
+#include <unordered_map>
+#include <cmath>
+#include <functional>
+
+namespace zcheck {
+
+namespace {
+
+// Window depth of a map value at a window point, or NaN for a miss.
+double windowDepthOfValue(const Camera& camera, const glm::dvec2& pWindow, double value, DepthQuantity quantity)
+{
+    if (quantity == DepthQuantity::Window) {
+        if (!std::isfinite(value) || value == camera.clearDepth() || value == camera.windowDepthFar()) return NAN;
+        return value;
+    }
+    const auto pEye = eyePointFromDepth(camera, pWindow, value, quantity);
+    return pEye ? windowFromEye(camera, *pEye).z : NAN;
+}
+
+}  // namespace
+
+// Window depth of a triangle's plane where the pixel's ray meets it (NaN if it does not).
+double planeWindowDepth(const Scene& scene, const Camera& camera, std::uint32_t primitive, const EyePlaneRay& ray)
+{
+    const glm::uvec3 t = scene.triangles[primitive];
+    const glm::dvec3 a(scene.positions[t[0]]), b(scene.positions[t[1]]), c(scene.positions[t[2]]);
+    const glm::dvec3 normal = glm::cross(b - a, c - a);
+    const double s = glm::dot(normal, a - ray.origin) / glm::dot(normal, ray.direction);
+    return std::isfinite(s) ? windowFromWorld(camera, ray.origin + s * ray.direction).z : NAN;
+}
+
+
+VertexNeighbours::VertexNeighbours(const Scene& scene) : scene_(scene)
+{
+    for (std::uint32_t t = 0; t < scene.triangles.size(); ++t)
+        for (int k = 0; k < 3; ++k) around_[key(scene.positions[scene.triangles[t][k]])].push_back(t);
+}
+
+std::string VertexNeighbours::key(const glm::vec3& p) { return std::string(reinterpret_cast<const char*>(&p), sizeof p); }
+
+RenderResult renderResultFromMap(const Scene& scene, const Camera& camera, const DepthMap& map,
+                                 const RenderResult& truth, const VertexNeighbours& neighbours,
+                                 std::vector<double>& quantum)
+{
+    const int W = camera.width(), H = camera.height();
+    RenderResult out;
+    out.windowDepth = {W, H, DepthQuantity::Window, std::vector<double>(std::size_t(W) * H, camera.clearDepth())};
+    out.primitiveId.assign(std::size_t(W) * H, kNoPrimitive);
+    quantum.assign(std::size_t(W) * H, 0.0);
+    const PixelJudge judge(scene, camera);
+    for (int row = 0; row < H; ++row)
+        for (int col = 0; col < W; ++col) {
+            const std::size_t i = std::size_t(row) * W + col;
+            const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
+            const double value = map.value[i];
+            const double depth = windowDepthOfValue(camera, pWindow, value, map.quantity);
+            // The storage step, carried into window units through the quantity's mapping.
+            const double reference = std::isfinite(depth) ? depth : truth.windowDepth.value[i];
+            if (map.quantity == DepthQuantity::Window && map.valueQuantum == 0) {
+                quantum[i] = storageQuantum(camera.depth().format, reference);
+            } else if (std::isfinite(depth)) {
+                const double step = map.valueQuantum > 0 ? map.valueQuantum
+                                                         : double(std::nextafter(float(std::abs(value)), INFINITY)) - std::abs(double(float(value)));
+                const double other = windowDepthOfValue(camera, pWindow, value + step, map.quantity);
+                quantum[i] = std::isfinite(other) ? std::max(std::abs(other - depth), storageQuantum(DepthFormat::Float32, depth))
+                                                  : storageQuantum(camera.depth().format, depth);
+            } else {
+                quantum[i] = storageQuantum(camera.depth().format, reference);
+            }
+            if (!std::isfinite(depth)) continue;
+            out.windowDepth.value[i] = depth;
+            // Which surface did the map see? The comparison's own rule decides (PixelJudge): the
+            // truth's surface if the map's depth agrees with it; otherwise a surface drawn within S
+            // of the pixel centre whose tolerance interval, joined with the truth's, holds the
+            // map's depth, and under which the comparison explains the pixel. Every accepted set
+            // is then an interval around the true depth, so a map nearer to the truth never fails
+            // where a farther one passes (the regression "verify rejected a correct map at a
+            // sliver's edge" in tests/test_verify.cpp).
+            const std::uint32_t here = truth.primitiveId[i];
+            const double q = quantum[i];
+            const double truthDepth = truth.windowDepth.value[i];
+            double bound = 0;
+            if (here != kNoPrimitive &&
+                judge.bothHit(truthDepth, here, depth, here, q, pWindow, bound) == PixelClass::Agree) {
+                out.primitiveId[i] = here;
+                continue;
+            }
+            std::uint32_t primitive = here != kNoPrimitive ? here : kUnknownPrimitive;
+            double closest = INFINITY;
+            const EyePlaneRay ray = worldEyePlaneRayThroughWindow(camera, pWindow);
+            std::vector<std::uint32_t> considered;
+            auto consider = [&](std::uint32_t candidate) {
+                if (candidate == here || std::find(considered.begin(), considered.end(), candidate) != considered.end())
+                    return;
+                considered.push_back(candidate);
+                const double plane = planeWindowDepth(scene, camera, candidate, ray);
+                if (!std::isfinite(plane)) return;
+                const double tolerance = judge.surfaceTolerance(candidate, q);
+                double lo = plane - tolerance, hi = plane + tolerance;
+                if (here != kNoPrimitive) {
+                    const double truthTolerance = judge.surfaceTolerance(here, q);
+                    lo = std::min(lo, truthDepth - truthTolerance), hi = std::max(hi, truthDepth + truthTolerance);
+                }
+                const double gap = std::abs(plane - depth);
+                if (!(depth >= lo && depth <= hi) || gap >= closest) return;
+                const glm::uvec3 t = scene.triangles[candidate];
+                const glm::dvec3 a(scene.positions[t[0]]), b(scene.positions[t[1]]), c(scene.positions[t[2]]);
+                if (!insideDrawnTriangle(camera, a, b, c, pWindow) && !judge.nearEdge(candidate, pWindow)) return;
+                const bool explained = here != kNoPrimitive
+                                           ? judge.bothHit(truthDepth, here, depth, candidate, q, pWindow, bound) !=
+                                                 PixelClass::DepthError
+                                           : judge.nearEdge(candidate, pWindow) || judge.atClipPlane(candidate, pWindow);
+                if (explained) closest = gap, primitive = candidate;
+            };
+            std::vector<std::uint32_t> seen;
+            for (int dy = -2; dy <= 2; ++dy)
+                for (int dx = -2; dx <= 2; ++dx) {
+                    const int c = col + dx, r = row + dy;
+                    if (c < 0 || c >= W || r < 0 || r >= H) continue;
+                    const std::uint32_t nearby = truth.primitiveId[std::size_t(r) * W + c];
+                    if (nearby == kNoPrimitive || std::find(seen.begin(), seen.end(), nearby) != seen.end()) continue;
+                    seen.push_back(nearby);
+                    neighbours.forEachNeighbour(nearby, consider);
+                }
+            out.primitiveId[i] = primitive;
+        }
+    return out;
+}
+
+VerifyResult verifyAgainst(const Scene& scene, const Camera& camera, const DepthMap& map, RenderResult truth,
+                           const VertexNeighbours& neighbours)
+{
+    if (map.width != camera.width() || map.height != camera.height() ||
+        map.value.size() != std::size_t(map.width) * std::size_t(map.height))
+        throw Error("the depth map is " + std::to_string(map.width) + "x" + std::to_string(map.height) + " (" +
+                    std::to_string(map.value.size()) + " values) but the camera's image is " +
+                    std::to_string(camera.width()) + "x" + std::to_string(camera.height()));
+    VerifyResult run;
+    run.truth = std::move(truth);
+    std::vector<double> quantum;
+    run.map = renderResultFromMap(scene, camera, map, run.truth, neighbours, quantum);
+    const auto start = std::chrono::steady_clock::now();
+    run.comparison = compareRoutes(scene, camera, run.truth, run.map, {}, &quantum);
+    run.report.timings.compareMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    run.report.timings.traceMs = run.truth.renderMilliseconds;
+    run.report.scene = scene.name;
+    run.report.triangles = scene.triangleCount();
+    run.report.camera = camera.spec();
+    run.report.comparison = run.comparison.report;
+    return run;
+}
+
+VerifyResult Checker::verify(const Camera& camera, const DepthMap& map) const
+{
+    VerifyResult run = verifyAgainst(scene_, camera, map, renderRay(camera), neighbours());
+    run.report.timings.bvhBuildMs = bvhBuildMilliseconds();
+    return run;
+}
+
+std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& map) const
+{
+    std::vector<Hypothesis> out;
+    for (const Mistake& mistake : mistakeCatalogue()) {
+        if (!mistake.reread) continue;
+        for (const Rereading& reading : mistake.reread(camera, map)) {
+            // A variant that is not a valid camera (a near plane behind the eye) is no hypothesis.
+            try {
+                const Camera hypothesisCamera(reading.camera ? *reading.camera : camera.spec());
+                const DepthMap& hypothesisMap = reading.map ? *reading.map : map;
+                const VerifyResult run = verifyAgainst(scene_, hypothesisCamera, hypothesisMap,
+                                                       renderRay(hypothesisCamera, reading.truthFaults), neighbours());
+                out.push_back({mistake.name, reading.variant, reading.explanation, run.comparison.report.consistent(),
+                               run.comparison.report.unexplained()});
+            } catch (const Error&) {
+            }
+        }
+    }
+    return out;
+}
+
+}  // namespace zcheck

@@ -1,0 +1,97 @@
+#include "common.h"
+
+#include "zcheck/camera_file.h"
+#include "zcheck/error.h"
+
+#include <cmath>
+#include <cstdlib>
+
+namespace zcheck::cli {
+
+namespace {
+
+// An option whose value may not be empty; `what` names it in the message ("the path is empty").
+CLI::Validator nonEmpty(const std::string& what, const std::string& description)
+{
+    return CLI::Validator(
+        [what](std::string& value) { return value.empty() ? "the " + what + " is empty" : std::string(); }, description);
+}
+
+}  // namespace
+
+const CLI::Validator kNonEmptyPath = nonEmpty("path", "PATH");
+const CLI::Validator kNonEmptyList = nonEmpty("list", "LIST");
+const CLI::Validator kPositiveFinite(
+    [](std::string& value) {
+        char* end = nullptr;
+        const double v = std::strtod(value.c_str(), &end);
+        if (value.empty() || *end != '\0') return "'" + value + "' is not a number";
+        if (!std::isfinite(v) || !(v > 0)) return "must be a positive finite number, got '" + value + "'";
+        return std::string();
+    },
+    "NUMBER > 0");
+const CLI::Range kThreadRange(1, 1024);
+const CLI::Range kImageSideRange(1, 16384);
+
+std::unique_ptr<tbb::global_control> limitThreads(int threads)
+{
+    if (threads <= 0) return nullptr;
+    return std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+}
+
+void addThreadsOption(CLI::App* command, int& threads)
+{
+    command->add_option("--threads", threads, "worker threads, 1..1024 (default: all cores)")->check(kThreadRange);
+}
+
+void requireSomethingCompared(const ComparisonReport& report, const std::string& scene)
+{
+    if (report.bothHit + report.rayOnly + report.rasterOnly == 0)
+        throw Error("nothing to compare: neither route sees any surface of '" + scene +
+                    "' through this camera (is it pointing away, or are near/far wrong?)");
+}
+
+void addSceneAndCameraOptions(CLI::App* command, SceneAndCamera& options)
+{
+    command->add_option("--scene", options.scene,
+                        "builtin:default | builtin:terrain[?n=N] | builtin:near-crossing | a mesh file (OBJ, PLY, STL, glTF/glb)")
+        ->capture_default_str()
+        ->check(kNonEmptyPath);
+    command->add_option("--camera", options.cameraFile, "camera file (JSON, see README); default: the scene's own camera")
+        ->check(kNonEmptyPath);
+    command->add_option("--convention", options.convention,
+                        "override the convention: opengl | direct3d | vulkan | metal | opencv");
+}
+
+CameraSpec cameraSpecFor(const Scene& scene, const SceneAndCamera& options)
+{
+    CameraSpec spec = options.cameraFile.empty() ? scene.defaultCamera : readCameraFile(options.cameraFile);
+    if (!options.convention.empty()) spec.convention = Convention::preset(options.convention);
+    return spec;
+}
+
+CameraSpec cameraSpecFrom(const std::string& cameraFile, const std::string& convention)
+{
+    CameraSpec spec = readCameraFile(cameraFile);
+    if (!convention.empty()) spec.convention = Convention::preset(convention);
+    return spec;
+}
+
+std::vector<double> parseNumberList(const std::string& text, const std::string& option)
+{
+    std::vector<double> values;
+    std::size_t start = 0;
+    while (start <= text.size() && !text.empty()) {
+        const std::size_t end = std::min(text.find(',', start), text.size());
+        const std::string item = text.substr(start, end - start);
+        char* stop = nullptr;
+        const double value = std::strtod(item.c_str(), &stop);
+        if (item.empty() || *stop != '\0' || !std::isfinite(value))
+            throw Error(option + ": '" + item + "' is not a number (expected a comma-separated list)");
+        values.push_back(value);
+        start = end + 1;
+    }
+    return values;
+}
+
+}  // namespace zcheck::cli

@@ -1,0 +1,64 @@
+#pragma once
+// What every subcommand shares: exit statuses, option validators, the scene-and-camera
+// options, the thread limit, and the check/verify --out folder.
+#include "zcheck/checker.h"
+
+#include <CLI/CLI.hpp>
+#include <tbb/global_control.h>
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace zcheck::cli {
+
+constexpr int kExitConsistent = 0;
+constexpr int kExitInconsistent = 1;
+constexpr int kExitUsage = 2;     // bad input: a file, key, option or value (one line names it)
+constexpr int kExitInternal = 3;  // zcheck itself failed: out of memory, a library or internal error
+
+// A subcommand: registered on the app, run when parsed.
+struct Command {
+    CLI::App* app;
+    std::function<int()> run;
+};
+Command addCheckCommand(CLI::App& app);
+Command addMatricesCommand(CLI::App& app);
+Command addPrecisionCommand(CLI::App& app);
+Command addUnprojectCommand(CLI::App& app);
+Command addExportCommand(CLI::App& app);
+Command addVerifyCommand(CLI::App& app);
+Command addSuiteCommand(CLI::App& app);
+
+// Option validators, the same in every subcommand.
+extern const CLI::Validator kNonEmptyPath;
+extern const CLI::Validator kNonEmptyList;
+extern const CLI::Validator kPositiveFinite;
+extern const CLI::Range kThreadRange;
+extern const CLI::Range kImageSideRange;
+
+// At most `threads` worker threads (0: all cores) for the lifetime of the object.
+std::unique_ptr<tbb::global_control> limitThreads(int threads);
+void addThreadsOption(CLI::App* command, int& threads);
+
+// Refuses a comparison with nothing in it: a camera that sees no geometry proves nothing,
+// and must not be reported CONSISTENT.
+void requireSomethingCompared(const ComparisonReport& report, const std::string& scene);
+
+// --scene, --camera and --convention, as check, export and verify take them.
+struct SceneAndCamera {
+    std::string scene = "builtin:default";
+    std::string cameraFile;
+    std::string convention;
+};
+void addSceneAndCameraOptions(CLI::App* command, SceneAndCamera& options);
+// The camera a command uses: the camera file, or the scene's own camera; then --convention.
+CameraSpec cameraSpecFor(const Scene& scene, const SceneAndCamera& options);
+// A camera file (required), then --convention.
+CameraSpec cameraSpecFrom(const std::string& cameraFile, const std::string& convention);
+
+// "1,2.5,3" → {1, 2.5, 3}; throws Error naming `option` for anything that is not a number.
+std::vector<double> parseNumberList(const std::string& text, const std::string& option);
+
+}  // namespace zcheck::cli

@@ -1,0 +1,132 @@
+// zcheck export: one route's render as a depth or geometry file with a JSON sidecar.
+#include "common.h"
+
+#include "camera_json.h"
+#include "zcheck/atomic_file.h"
+#include "zcheck/error.h"
+#include "zcheck/export.h"
+#include "zcheck/image_io.h"
+#include "zcheck/mesh_loader.h"
+#include "zcheck/png_file.h"
+#include "zcheck/version.h"
+
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+
+namespace zcheck::cli {
+
+namespace {
+
+struct ExportOptions {
+    SceneAndCamera input;
+    std::string backend = "ray", quantities = "eye-z", output, preview;
+    double scale = 0;
+    int threads = 0;
+};
+
+nlohmann::json numberOrName(double v)
+{
+    if (std::isnan(v)) return "nan";
+    if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+    return v;
+}
+
+int runExportCommand(const ExportOptions& o)
+{
+    if (o.backend != "ray" && o.backend != "raster") throw Error("--backend must be ray or raster, got '" + o.backend + "'");
+    if (o.output.empty()) throw Error("export needs -o FILE (.exr, .pfm, .tif or .png)");
+    const std::vector<ExportQuantity> quantities = exportQuantitiesFromList(o.quantities);
+    const auto threadLimit = limitThreads(o.threads);
+    OutputFiles outputs;
+    outputs.addInput(o.input.scene);
+    outputs.addInput(o.input.cameraFile);
+    outputs.add(o.output, "-o");
+    outputs.add(o.output + ".json", "the sidecar of -o");
+    if (!o.preview.empty()) outputs.add(o.preview, "--preview");
+    Scene loaded = loadScene(o.input.scene);
+    const CameraSpec spec = cameraSpecFor(loaded, o.input);
+    const Camera camera(spec);
+    const Checker checker(std::move(loaded));
+    const Scene& scene = checker.scene();
+    const RenderResult route = checker.render(camera, routeFromName(o.backend));
+    std::vector<QuantityImage> images;
+    for (ExportQuantity q : quantities) images.push_back(quantityImage(scene, camera, route, q));
+    std::string format;
+    outputs.write(o.output, [&](const std::string& temporary) { format = writeQuantityFile(temporary, images, o.scale); });
+
+    nlohmann::json channels = nlohmann::json::array();
+    for (const auto& image : images)
+        for (const auto& name : image.channels) {
+            nlohmann::json channel = {{"name", name},
+                                      {"quantity", toString(image.quantity)},
+                                      {"unit", image.unit},
+                                      {"type", format == "png" ? "uint16" : image.quantity == ExportQuantity::PrimitiveId ? "uint32" : "float32"},
+                                      {"miss_value", format == "png" ? nlohmann::json(0) : numberOrName(image.missValue)}};
+            if (format == "png") channel["stored_as"] = "round(value * scale); 0 = miss";
+            channels.push_back(channel);
+        }
+    const std::string orientation =
+        format == "pfm" ? "row 0 is the top row of the picture as a standard reader returns it; the file stores rows "
+                          "bottom to top, as the PFM specification says"
+                        : "row 0 (the first row stored and read) is the top row of the picture";
+    nlohmann::json sidecar = {
+        {"zcheck_version", kVersion},
+        {"file", std::filesystem::path(o.output).filename().string()},
+        {"format", format},
+        {"width", camera.width()},
+        {"height", camera.height()},
+        {"orientation", orientation},
+        {"pixel_centres", "pixel (col,row) samples window point (col + 0.5, row + 0.5) from the top-left corner"},
+        {"channels", channels},
+        {"scale", format == "png" ? nlohmann::json(o.scale) : nlohmann::json(nullptr)},
+        {"backend", o.backend},
+        {"scene", scene.name},
+        {"convention", spec.convention.name},
+        {"depth", {{"format", toString(spec.depth.format)}, {"reversed", spec.depth.reversed},
+                   {"range", {spec.depth.rangeMin, spec.depth.rangeMax}}, {"clear_value", camera.clearDepth()}}},
+        {"camera", toJson(spec)},
+        {"matrices", matricesJson(camera)},
+    };
+    outputs.writeText(o.output + ".json", prettyJson(sidecar) + "\n");
+    if (!o.preview.empty())
+        outputs.write(o.preview, [&](const std::string& temporary) {
+            writePng8(temporary, camera.width(), camera.height(), previewRgb(images.front()));
+        });
+    outputs.commit();
+    std::size_t hits = 0;
+    for (std::size_t i = 0; i < route.primitiveId.size(); ++i) hits += route.hit(i) ? 1 : 0;
+    std::cout << prettyJson({{"output", o.output}, {"sidecar", o.output + ".json"}, {"format", format},
+                             {"quantities", o.quantities}, {"backend", o.backend}, {"covered_pixels", hits},
+                             {"pixels", route.primitiveId.size()}})
+              << "\n";
+    return kExitConsistent;
+}
+
+}  // namespace
+
+Command addExportCommand(CLI::App& app)
+{
+    auto o = std::make_shared<ExportOptions>();
+    CLI::App* command = app.add_subcommand(
+        "export", "Render depth with one route and write it as EXR, PFM, TIFF or 16-bit PNG, with a JSON sidecar\n"
+                  "(FILE.json) that says everything needed to read it: quantity, unit, miss value, orientation,\n"
+                  "camera and matrices.");
+    command->add_option("--backend", o->backend, "ray | raster")->capture_default_str();
+    command->add_option("--quantity", o->quantities,
+                              "comma-separated: window, ndc, eye-z, distance, position-eye, position-world, normal, "
+                              "primitive-id (several only into .exr)")
+        ->capture_default_str();
+    addSceneAndCameraOptions(command, o->input);
+    command->add_option("-o,--output", o->output, "FILE.exr | .pfm | .tif | .png (written atomically)")
+        ->check(kNonEmptyPath);
+    command->add_option("--scale", o->scale, "16-bit PNG: stored = value x scale (e.g. 1000 = millimetres)")
+        ->check(kPositiveFinite);
+    command->add_option("--preview", o->preview, "also write an 8-bit colour-mapped PNG of the first quantity")
+        ->check(kNonEmptyPath);
+    addThreadsOption(command, o->threads);
+
+    return {command, [o] { return runExportCommand(*o); }};
+}
+
+}  // namespace zcheck::cli

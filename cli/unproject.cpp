@@ -1,0 +1,151 @@
+// zcheck unproject: the inverse projection — a pixel's ray, the point at a depth value, or a
+// whole depth map as a PLY point cloud.
+#include "common.h"
+
+#include "camera_json.h"
+#include "zcheck/atomic_file.h"
+#include "zcheck/error.h"
+#include "zcheck/image_io.h"
+#include "zcheck/inverse_projection.h"
+#include "zcheck/point_cloud.h"
+
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <optional>
+
+namespace zcheck::cli {
+
+namespace {
+
+struct UnprojectOptions {
+    std::string cameraFile, convention, pixel, depthMap, quantity = "window", output, space = "world";
+    std::optional<double> depth;
+    double scale = 0;
+    int stride = 1;
+    bool ascii = false;
+};
+
+glm::ivec2 parsePixel(const std::string& text, const Camera& camera)
+{
+    const std::vector<double> v = parseNumberList(text, "--pixel");
+    if (v.size() != 2 || v[0] != std::floor(v[0]) || v[1] != std::floor(v[1]))
+        throw Error("--pixel: expected COL,ROW as two whole numbers, got '" + text + "'");
+    if (v[0] < 0 || v[0] >= camera.width() || v[1] < 0 || v[1] >= camera.height())
+        throw Error("--pixel " + text + " is outside the " + std::to_string(camera.width()) + "x" +
+                    std::to_string(camera.height()) + " image");
+    return {int(v[0]), int(v[1])};
+}
+
+// A depth value the camera can produce: window depth within the depth range, z_ndc within the
+// convention's NDC range, eye-z and distance in front of the eye.
+void requireDepthValueInRange(const Camera& camera, DepthQuantity quantity, double value)
+{
+    const std::string given = "--depth " + formatNumber(value) + " (" + toString(quantity) + ")";
+    if (!std::isfinite(value)) throw Error(given + " must be a finite number");
+    const double lo = quantity == DepthQuantity::Window ? camera.depth().rangeMin
+                      : quantity == DepthQuantity::Ndc  ? camera.convention().ndcZMin()
+                                                        : 0.0;
+    const double hi = quantity == DepthQuantity::Window ? camera.depth().rangeMax : quantity == DepthQuantity::Ndc ? 1.0 : INFINITY;
+    const bool inside = quantity == DepthQuantity::Window || quantity == DepthQuantity::Ndc ? value >= lo && value <= hi : value > 0;
+    if (!inside)
+        throw Error(given + (quantity == DepthQuantity::EyeZ || quantity == DepthQuantity::Distance
+                                 ? " must be > 0: the point must lie in front of the eye"
+                                 : " must lie in [" + formatNumber(lo) + ", " + formatNumber(hi) + "], the camera's " +
+                                       (quantity == DepthQuantity::Window ? "depth range" : "NDC depth range")));
+}
+
+nlohmann::json vec3Json(const glm::dvec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); }
+
+int runUnprojectCommand(const UnprojectOptions& o)
+{
+    if (o.space != "eye" && o.space != "world") throw Error("--space must be eye or world, got '" + o.space + "'");
+    const DepthQuantity quantity = depthQuantityFromName(o.quantity);
+    const Camera camera(cameraSpecFrom(o.cameraFile, o.convention));
+    auto toWorld = [&](const glm::dvec3& pEye) { return glm::dvec3(camera.worldFromEye * glm::dvec4(pEye, 1.0)); };
+
+    if (!o.pixel.empty() && (!o.depthMap.empty() || !o.output.empty()))
+        throw Error("--pixel and --depth-map/-o are alternatives: one pixel's ray or point, or a whole map as a point cloud");
+    if (o.pixel.empty() && o.depth)
+        throw Error("--depth " + formatNumber(*o.depth) + " needs --pixel COL,ROW (a --depth-map holds its own depths)");
+    if (!o.pixel.empty()) {
+        const glm::ivec2 pixel = parsePixel(o.pixel, camera);
+        const glm::dvec2 pWindow = windowFromPixelCentre(camera, pixel.x, pixel.y);
+        nlohmann::json out = {{"pixel", {pixel.x, pixel.y}}, {"window", {pWindow.x, pWindow.y}}};
+        if (!o.depth) {
+            const EyePlaneRay rayEye = eyePlaneRayFrom(eyeRayThroughWindow(camera, pWindow));
+            const EyePlaneRay rayWorld = worldEyePlaneRayThroughWindow(camera, pWindow);
+            auto rayJson = [](const EyePlaneRay& r) {
+                return nlohmann::json{{"origin", vec3Json(r.origin)},
+                                      {"direction", vec3Json(r.direction)},
+                                      {"t_near", r.tNear},
+                                      {"t_far", std::isinf(r.tFar) ? nlohmann::json("inf") : nlohmann::json(r.tFar)}};
+            };
+            out["ray"] = {{"definition", "points origin + t·direction, t in [t_near, t_far] between the near and far "
+                                         "planes; origin on the eye plane (the centre of projection for perspective)"}};
+            if (o.space == "eye") out["ray"]["eye"] = rayJson(rayEye);
+            out["ray"]["world"] = rayJson(rayWorld);
+            out["ray"]["eye"] = rayJson(rayEye);
+        } else {
+            requireDepthValueInRange(camera, quantity, *o.depth);
+            const auto pEye = eyePointFromDepth(camera, pWindow, *o.depth, quantity);
+            if (!pEye) throw Error("--depth " + formatNumber(*o.depth) + " is a miss for quantity " + o.quantity);
+            out["point"] = {{"eye", vec3Json(*pEye)}, {"world", vec3Json(toWorld(*pEye))},
+                            {"eye_z", camera.eyeZOf(*pEye)}, {"distance", distanceOfEyePoint(camera, *pEye)}};
+        }
+        std::cout << prettyJson(out) << "\n";
+        return kExitConsistent;
+    }
+
+    if (o.depthMap.empty()) throw Error("unproject needs --pixel COL,ROW or --depth-map FILE");
+    if (o.output.empty()) throw Error("--depth-map needs -o FILE.ply");
+    OutputFiles outputs;
+    outputs.addInput(o.cameraFile);
+    outputs.addInput(o.depthMap);
+    outputs.add(o.output, "-o");
+    const DepthMapFile map = readDepthMap(o.depthMap, channelNameOf(exportQuantitiesFromList(o.quantity).front()), o.scale,
+                                          camera.width(), camera.height());
+    const UnprojectedMap cloud =
+        unprojectMap(camera, map.value, quantity, o.space == "eye" ? PointSpace::Eye : PointSpace::World, o.stride);
+    outputs.write(o.output, [&](const std::string& temporary) {
+        writePointCloudPly(temporary, cloud.points, !o.ascii,
+                           {"zcheck unproject of " + std::filesystem::path(o.depthMap).filename().string() + " (" +
+                                o.quantity + ", channel " + map.channel + ")",
+                            std::string("space ") + o.space +
+                                (o.space == "eye" ? " (" + camera.convention().name + " eye axes)" : "")});
+    });
+    outputs.commit();
+    std::cout << prettyJson({{"points", cloud.points.size()}, {"misses", cloud.misses}, {"channel", map.channel},
+                             {"quantity", o.quantity}, {"space", o.space}, {"output", o.output}})
+              << "\n";
+    return kExitConsistent;
+}
+
+}  // namespace
+
+Command addUnprojectCommand(CLI::App& app)
+{
+    auto o = std::make_shared<UnprojectOptions>();
+    CLI::App* command = app.add_subcommand(
+        "unproject", "The inverse projection: the ray through a pixel centre, the point at a depth value, or a\n"
+                     "whole depth map (EXR, PFM, TIFF, 16-bit PNG with --scale) as a PLY point cloud, misses skipped.");
+    command->add_option("--camera", o->cameraFile, "camera file (JSON, see README)")->required()->check(kNonEmptyPath);
+    command->add_option("--convention", o->convention, "override the convention");
+    command->add_option("--pixel", o->pixel, "COL,ROW (row 0 at the top): print the ray through its centre");
+    command->add_option("--depth", o->depth, "with --pixel: print the point at this depth value");
+    command->add_option("--quantity", o->quantity, "what --depth / the map holds: window | ndc | eye-z | distance")
+        ->capture_default_str();
+    command->add_option("--depth-map", o->depthMap, "a depth map to turn into a point cloud")->check(kNonEmptyPath);
+    command->add_option("--scale", o->scale, "stored value = depth x scale (required for 16-bit PNG)")
+        ->check(kPositiveFinite);
+    command->add_option("-o,--output", o->output, "the PLY file to write (atomically)")->check(kNonEmptyPath);
+    command->add_option("--space", o->space, "eye | world coordinates for points")->capture_default_str();
+    command->add_option("--stride", o->stride, "use every K-th pixel in x and y, 1..16384")
+        ->capture_default_str()
+        ->check(kImageSideRange);
+    command->add_flag("--ascii", o->ascii, "write ASCII PLY instead of binary little-endian");
+
+    return {command, [o] { return runUnprojectCommand(*o); }};
+}
+
+}  // namespace zcheck::cli

@@ -1,0 +1,52 @@
+#pragma once
+// The ray route's camera: rays and expected depths from the camera's *definition*, not from
+// the matrices the raster route draws with, so that a wrong coefficient in a matrix builder
+// cannot appear in both routes and cancel out.
+//
+//   projection (in OpenGL's eye axes: x right, y up, looking down −z; image point (x, y) in
+//   pixels from the top-left corner, W×H pixels):
+//     perspective  direction ((2x/W − 1)·aspect·tan(fovy/2), (1 − 2y/H)·tan(fovy/2), −1)
+//     lens         the same with tan = sensor_width / (2·focal), top = right·H/W
+//     pinhole      OpenCV's u = x − ½, v = y − ½: direction ((u − cx)/fx, −(v − cy)/fy, −1)
+//     frustum      the near-plane point l + (r − l)·x/W, t − (t − b)·y/H, −near, from the eye
+//     orthographic the box point (l + (r − l)·x/W, t − (t − b)·y/H) on the eye plane, direction −z
+//     oblique      the same box point, moved by λ·near·(cos a, sin a) on the eye plane, and
+//                  direction (−λ·cos a, −λ·sin a, −1): depth d shifts a point by λ(d − near)
+//   view: a look-at from eye, target and up (or the rows of a raw eyeFromWorld);
+//   depth: d = eye-z of the hit (its distance along the viewing axis), and window depth from
+//   the convention's mapping written as a formula, with zN, zF the NDC z of near and far
+//   (swapped by reversed-Z):
+//     perspective  z_ndc = (zF·f·(d − n) + zN·n·(f − d)) / (d·(f − n)),  or zF + (zN − zF)·n/d for f = ∞
+//     parallel     z_ndc = zN + (zF − zN)·(d − n)/(f − n)
+//     window       rangeMin + (rangeMax − rangeMin)·(z_ndc − ndcZMin)/(1 − ndcZMin)
+// None of this reads Camera's matrices, nor the camera's resolved near-plane window. A
+// raw-matrix projection has no other definition: its rays and depths necessarily come from
+// the matrix (the inverse-projection module), as the raster route's do.
+#include "zcheck/camera.h"
+#include "zcheck/inverse_projection.h"
+
+namespace zcheck {
+
+class CameraRays {
+public:
+    explicit CameraRays(const Camera& camera);
+
+    // The viewing ray through image point pImage (pixels; x right, y down from the top-left
+    // corner), in world space: origin on the eye plane, unit direction, [tNear, tFar]
+    // between the near and far planes; t is the `distance` quantity.
+    EyePlaneRay worldRay(const glm::dvec2& pImage) const;
+    // Eye-space point (the convention's eye axes) of a world point.
+    glm::dvec3 eyeFromWorld(const glm::dvec3& pWorld) const;
+    // Eye-z (along the viewing axis) of a world point.
+    double eyeZ(const glm::dvec3& pWorld) const { return glm::dot(pWorld - eye_, forward_); }
+    // The window depth of the point at eye-z `eyeZ` on the ray through image point pImage, in
+    // closed form (exact, not quantized); a raw-matrix camera's through its matrix.
+    double windowDepth(const glm::dvec2& pImage, double eyeZ) const;
+
+private:
+    const Camera& camera_;
+    bool fromMatrix_;                     // raw-matrix projection: the inverse-projection module
+    glm::dvec3 eye_, right_, up_, forward_;  // the view as world-space axes
+};
+
+}  // namespace zcheck

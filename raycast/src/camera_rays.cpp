@@ -1,0 +1,102 @@
+#include "zcheck/camera_rays.h"
+
+#include <cmath>
+
+namespace zcheck {
+
+CameraRays::CameraRays(const Camera& camera)
+    : camera_(camera), fromMatrix_(camera.spec().projection.type == ProjectionType::Matrix)
+{
+    const CameraSpec& spec = camera.spec();
+    const Convention& c = spec.convention;
+    if (spec.view.hasMatrix) {
+        // The rows of eyeFromWorld are the eye axes in world space (x right, y = eyeUpY·up,
+        // z = eyeForwardZ·forward); the eye is where it maps to the origin.
+        const glm::dmat4& m = spec.view.eyeFromWorld;
+        const glm::dvec3 rows[3] = {{m[0][0], m[1][0], m[2][0]}, {m[0][1], m[1][1], m[2][1]}, {m[0][2], m[1][2], m[2][2]}};
+        right_ = rows[0], up_ = double(c.eyeUpY) * rows[1], forward_ = double(c.eyeForwardZ) * rows[2];
+        const glm::dvec3 t(m[3][0], m[3][1], m[3][2]);
+        eye_ = -(t.x * rows[0] + t.y * rows[1] + t.z * rows[2]);  // rows orthonormal: R^T·(−t)
+    } else {
+        forward_ = glm::normalize(spec.view.target - spec.view.eye);
+        right_ = glm::normalize(glm::cross(forward_, spec.view.up));
+        up_ = glm::cross(right_, forward_);
+        eye_ = spec.view.eye;
+    }
+}
+
+glm::dvec3 CameraRays::eyeFromWorld(const glm::dvec3& pWorld) const
+{
+    const Convention& c = camera_.convention();
+    const glm::dvec3 v = pWorld - eye_;
+    return {glm::dot(v, right_), c.eyeUpY * glm::dot(v, up_), c.eyeForwardZ * glm::dot(v, forward_)};
+}
+
+EyePlaneRay CameraRays::worldRay(const glm::dvec2& pImage) const
+{
+    if (fromMatrix_) return worldEyePlaneRayThroughWindow(camera_, {pImage.x, camera_.windowYFromImageY(pImage.y)});
+    const Projection& p = camera_.spec().projection;
+    const double W = camera_.width(), H = camera_.height(), x = pImage.x, y = pImage.y, n = p.near;
+    // Origin on the eye plane and direction, in OpenGL's eye axes (x right, y up, −z forward).
+    glm::dvec3 origin(0.0), direction(0.0, 0.0, -1.0);
+    switch (p.type) {
+    case ProjectionType::Perspective: {
+        const double tanHalf = std::tan(glm::radians(p.fovyDeg) / 2);
+        const double aspect = p.aspect > 0 ? p.aspect : W / H;
+        direction = {(2 * x / W - 1) * aspect * tanHalf, (1 - 2 * y / H) * tanHalf, -1.0};
+        break;
+    }
+    case ProjectionType::Lens: {
+        const double right = p.sensorWidthMm / (2 * p.focalMm), top = right * H / W;
+        direction = {(2 * x / W - 1) * right, (1 - 2 * y / H) * top, -1.0};
+        break;
+    }
+    case ProjectionType::Pinhole:
+        direction = {(x - 0.5 - p.cx) / p.fx, -(y - 0.5 - p.cy) / p.fy, -1.0};
+        break;
+    case ProjectionType::Frustum:
+        direction = {(p.left + (p.right - p.left) * x / W) / n, (p.top - (p.top - p.bottom) * y / H) / n, -1.0};
+        break;
+    case ProjectionType::Orthographic:
+    case ProjectionType::Oblique: {
+        origin = {p.left + (p.right - p.left) * x / W, p.top - (p.top - p.bottom) * y / H, 0.0};
+        if (p.type == ProjectionType::Oblique) {
+            const double a = glm::radians(p.angleDeg), lambda = p.foreshortening;
+            origin.x += lambda * n * std::cos(a), origin.y += lambda * n * std::sin(a);
+            direction = {-lambda * std::cos(a), -lambda * std::sin(a), -1.0};
+        }
+        break;
+    }
+    case ProjectionType::Matrix: break;  // handled above
+    }
+    // Into world space: eye-plane point and direction along the view's axes.
+    EyePlaneRay ray;
+    ray.origin = eye_ + origin.x * right_ + origin.y * up_;
+    const glm::dvec3 d = direction.x * right_ + direction.y * up_ - direction.z * forward_;
+    ray.direction = glm::normalize(d);
+    const double eyeZPerT = glm::dot(ray.direction, forward_);  // eye-z gained per unit of t
+    ray.tNear = n / eyeZPerT;
+    ray.tFar = std::isinf(p.far) ? INFINITY : p.far / eyeZPerT;
+    return ray;
+}
+
+double CameraRays::windowDepth(const glm::dvec2& pImage, double d) const
+{
+    const Convention& c = camera_.convention();
+    const DepthSettings& depth = camera_.depth();
+    if (fromMatrix_) return windowDepthFromEyeZ(camera_, {pImage.x, camera_.windowYFromImageY(pImage.y)}, d);
+    const Projection& p = camera_.spec().projection;
+    const double ndcZMin = c.ndcDepth == NdcDepthRange::ZeroToOne ? 0.0 : -1.0;
+    const double zN = depth.reversed ? 1.0 : ndcZMin, zF = depth.reversed ? ndcZMin : 1.0;
+    const double n = p.near, f = p.far;
+    double zNdc;
+    if (p.type == ProjectionType::Orthographic || p.type == ProjectionType::Oblique)
+        zNdc = zN + (zF - zN) * (d - n) / (f - n);
+    else if (std::isinf(f))
+        zNdc = zF + (zN - zF) * n / d;
+    else
+        zNdc = (zF * f * (d - n) + zN * n * (f - d)) / (d * (f - n));
+    return depth.rangeMin + (depth.rangeMax - depth.rangeMin) * (zNdc - ndcZMin) / (1.0 - ndcZMin);
+}
+
+}  // namespace zcheck

@@ -1,0 +1,41 @@
+#pragma once
+// Reports, for people and for programs: every document zcheck prints or writes, as text.
+// JSON documents are indented for people, with arrays of numbers (matrix rows, vectors) on
+// one line; invalid UTF-8 in strings (file names) is replaced, never thrown over. The keys
+// are those the README documents for `--json`.
+#include "zcheck/checker.h"
+#include "zcheck/precision.h"
+#include "zcheck/suite.h"
+
+#include <string>
+#include <vector>
+
+namespace zcheck {
+
+// `zcheck check --json`: the report of one check.
+std::string checkReportJson(const CheckReport& report);
+// The human-readable summary `zcheck check` prints; `comparing` names the two sides.
+std::string formatSummary(const CheckReport& report,
+                          const std::string& comparing = "ray route (Embree) vs raster route (z-buffer)");
+
+// Where a verified map came from, for its report.
+struct DepthMapSource {
+    std::string file, quantity, channel;
+    double scale = 0;  // 0: not given
+};
+// `zcheck verify --json`: the check report plus the map's source and, when given, the diagnosis.
+std::string verifyReportJson(const CheckReport& report, const DepthMapSource& source,
+                             const std::vector<Hypothesis>* diagnosis = nullptr);
+// The diagnosis line for people: the first consistent hypothesis, or the closest one.
+std::string formatDiagnosis(const std::vector<Hypothesis>& hypotheses);
+
+// The suite: the detection table, and the whole run as JSON and as self-contained HTML (with
+// images of every kept failure).
+std::string suiteTable(const SuiteResult& result);
+std::string suiteReportJson(const SuiteResult& result, bool quick, double seconds);
+std::string suiteReportHtml(const SuiteResult& result, double seconds);
+
+// `zcheck precision --json`.
+std::string precisionJson(const CameraSpec& spec, const PrecisionTable& table);
+
+}  // namespace zcheck

@@ -1,0 +1,336 @@
+#include "zcheck/report.h"
+
+#include "camera_json.h"
+#include "zcheck/png_file.h"
+#include "zcheck/report_images.h"
+#include "zcheck/version.h"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+namespace zcheck {
+
+namespace {
+
+nlohmann::json toJson(const PixelFinding& f)
+{
+    auto depthOrNull = [](double d) { return std::isfinite(d) ? nlohmann::json(d) : nlohmann::json(nullptr); };
+    return {
+        {"col", f.col},
+        {"row", f.row},
+        {"class", toString(f.pixelClass)},
+        {"ray_window_depth", depthOrNull(f.rayWindowDepth)},
+        {"raster_window_depth", depthOrNull(f.rasterWindowDepth)},
+        {"error_quanta", depthOrNull(f.errorQuanta)},
+        {"tolerance_quanta", depthOrNull(f.toleranceQuanta)},
+        {"ray_primitive", f.rayPrimitive == kNoPrimitive ? nlohmann::json(nullptr) : nlohmann::json(f.rayPrimitive)},
+        {"raster_primitive",
+         f.rasterPrimitive == kNoPrimitive ? nlohmann::json(nullptr) : nlohmann::json(f.rasterPrimitive)},
+    };
+}
+
+std::string percent(std::int64_t part, std::int64_t whole)
+{
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%6.2f%%", whole > 0 ? 100.0 * double(part) / double(whole) : 0.0);
+    return buffer;
+}
+
+}  // namespace
+
+namespace {
+
+nlohmann::json toJson(const CheckReport& report)
+{
+    const ComparisonReport& c = report.comparison;
+    nlohmann::json unexplained = nlohmann::json::array();
+    for (const auto& f : c.unexplainedSamples) unexplained.push_back(toJson(f));
+    nlohmann::json box = nullptr;
+    if (c.unexplainedMaxCol >= 0)
+        box = {{"min_col", c.unexplainedMinCol},
+               {"min_row", c.unexplainedMinRow},
+               {"max_col", c.unexplainedMaxCol},
+               {"max_row", c.unexplainedMaxRow}};
+    return {
+        {"zcheck_version", kVersion},
+        {"scene", report.scene},
+        {"triangles", report.triangles},
+        {"camera", toJson(report.camera)},
+        {"tolerance",
+         {{"subpixel_bits", report.tolerance.subpixelBits},
+          {"constant_quanta", ToleranceModel::constantQuanta(report.camera.depth)},
+          {"rule", "|d_raster - d_ray| <= C*q + S*m (sum over both surfaces when they differ)"}}},
+        {"pixels",
+         {{"total", std::int64_t(c.width) * c.height},
+          {"both_hit", c.bothHit},
+          {"both_miss", c.bothMiss},
+          {"ray_only", c.rayOnly},
+          {"raster_only", c.rasterOnly},
+          {"agree", c.agree},
+          {"edge_surface", c.edgeSurface},
+          {"depth_errors", c.depthErrors},
+          {"coverage_explained", c.coverageExplained},
+          {"lost_at_clear_value", c.lostAtClearValue},
+          {"at_clip_plane", c.atClipPlane},
+          {"coverage_unexplained", c.coverageUnexplained}}},
+        {"depth_error",
+         {{"max_quanta", c.maxErrorQuanta},
+          {"p99_quanta", c.p99ErrorQuanta},
+          {"max_over_tolerance", c.maxErrorOverTolerance},
+          {"max_relative_eye_z", c.maxRelativeEyeZError},
+          {"p99_relative_eye_z", c.p99RelativeEyeZError},
+          {"bias_samples", c.biasSamples},
+          {"mean_signed_error_quanta", c.meanSignedErrorQuanta},
+          {"depth_bias", c.depthBias},
+          {"worst_pixel", toJson(c.worst)}}},
+        {"unexplained", {{"count", c.unexplained()}, {"bounding_box", box}, {"samples", unexplained}}},
+        {"timings_ms",
+         {{"bvh_build", report.timings.bvhBuildMs},
+          {"trace", report.timings.traceMs},
+          {"raster", report.timings.rasterMs},
+          {"compare", report.timings.compareMs}}},
+        {"consistent", c.consistent()},
+    };
+}
+
+}  // namespace
+
+std::string checkReportJson(const CheckReport& report) { return prettyJson(toJson(report)); }
+
+std::string formatSummary(const CheckReport& report, const std::string& comparing)
+{
+    const ComparisonReport& c = report.comparison;
+    const CameraSpec& cam = report.camera;
+    const std::int64_t total = std::int64_t(c.width) * c.height;
+    std::ostringstream out;
+    char line[256];
+    out << "zcheck " << kVersion << " — " << comparing << "\n";
+    out << "scene      " << report.scene << "  (" << report.triangles << " triangles)\n";
+    std::snprintf(line, sizeof line, "camera     %s, %s, %dx%d, near %g, far %g\n", cam.convention.name.c_str(),
+                  toString(cam.projection.type).c_str(), cam.width, cam.height, cam.projection.near,
+                  cam.projection.far);
+    out << line;
+    std::snprintf(line, sizeof line, "depth      %s%s, range [%g, %g]; tolerance C = %g q, S = 2^-%d px\n",
+                  toString(cam.depth.format).c_str(), cam.depth.reversed ? ", reversed-Z" : "", cam.depth.rangeMin,
+                  cam.depth.rangeMax, ToleranceModel::constantQuanta(cam.depth), report.tolerance.subpixelBits);
+    out << line << "\npixels                             count\n";
+    auto row = [&](const char* label, std::int64_t n, std::int64_t of) {
+        std::snprintf(line, sizeof line, "  %-28s %9lld  %s\n", label, static_cast<long long>(n), percent(n, of).c_str());
+        out << line;
+    };
+    row("both hit", c.bothHit, total);
+    row("  agree", c.agree, total);
+    row("  other surface at edge", c.edgeSurface, total);
+    row("  DEPTH ERROR", c.depthErrors, total);
+    row("both miss", c.bothMiss, total);
+    row("ray only", c.rayOnly, total);
+    row("raster only", c.rasterOnly, total);
+    row("  explained (at an edge)", c.coverageExplained - c.lostAtClearValue - c.atClipPlane, total);
+    row("  explained (at clear value)", c.lostAtClearValue, total);
+    row("  explained (on near/far)", c.atClipPlane, total);
+    row("  UNEXPLAINED", c.coverageUnexplained, total);
+
+    out << "\ndepth error over compared pixels (both hit, same surface or within tolerance)\n";
+    std::snprintf(line, sizeof line, "  max %.3g q, p99 %.3g q; max / tolerance %.3g\n", c.maxErrorQuanta,
+                  c.p99ErrorQuanta, c.maxErrorOverTolerance);
+    out << line;
+    std::snprintf(line, sizeof line, "  relative eye-z error: max %.3g, p99 %.3g\n", c.maxRelativeEyeZError,
+                  c.p99RelativeEyeZError);
+    out << line;
+    if (c.biasSamples > 0) {
+        std::snprintf(line, sizeof line, "  mean signed error %+.3f q over %lld quantization-bound pixels%s\n",
+                      c.meanSignedErrorQuanta, static_cast<long long>(c.biasSamples),
+                      c.depthBias ? "  <- SYSTEMATIC BIAS (rounding is not to nearest)" : "");
+        out << line;
+    }
+    if (c.agree + c.depthErrors > 0) {
+        std::snprintf(line, sizeof line, "  worst pixel (%d, %d): ray %.10g, raster %.10g, %.3g q (tolerance %.3g q)\n",
+                      c.worst.col, c.worst.row, c.worst.rayWindowDepth, c.worst.rasterWindowDepth,
+                      c.worst.errorQuanta, c.worst.toleranceQuanta);
+        out << line;
+    }
+    if (c.unexplained() > 0) {
+        std::snprintf(line, sizeof line, "\nunexplained pixels: %lld within cols %d..%d, rows %d..%d; first:\n",
+                      static_cast<long long>(c.unexplained()), c.unexplainedMinCol, c.unexplainedMaxCol,
+                      c.unexplainedMinRow, c.unexplainedMaxRow);
+        out << line;
+        for (std::size_t k = 0; k < c.unexplainedSamples.size() && k < 5; ++k) {
+            const auto& f = c.unexplainedSamples[k];
+            std::snprintf(line, sizeof line, "  (%d, %d) %-12s ray %.10g, raster %.10g\n", f.col, f.row,
+                          toString(f.pixelClass).c_str(), f.rayWindowDepth, f.rasterWindowDepth);
+            out << line;
+        }
+    }
+    if (c.lostAtClearValue > 0) {
+        std::snprintf(line, sizeof line,
+                      "\nnote: %lld pixels see surfaces whose depth rounds to the clear value in %s, so no depth test\n"
+                      "      can pass there: raise near or use a finer depth format to see them in a real depth buffer\n",
+                      static_cast<long long>(c.lostAtClearValue), toString(cam.depth.format).c_str());
+        out << line;
+    }
+    std::snprintf(line, sizeof line, "\ntimings    BVH build %.1f ms, trace %.1f ms, raster %.1f ms, compare %.1f ms\n",
+                  report.timings.bvhBuildMs, report.timings.traceMs, report.timings.rasterMs,
+                  report.timings.compareMs);
+    out << line;
+    out << "verdict    " << (c.consistent() ? "CONSISTENT" : "INCONSISTENT") << "\n";
+    return out.str();
+}
+
+std::string verifyReportJson(const CheckReport& report, const DepthMapSource& source,
+                             const std::vector<Hypothesis>* diagnosis)
+{
+    nlohmann::json document = toJson(report);
+    document["depth_map"] = {{"file", source.file}, {"quantity", source.quantity}, {"channel", source.channel},
+                             {"scale", source.scale}};
+    if (diagnosis) {
+        nlohmann::json list = nlohmann::json::array();
+        for (const auto& h : *diagnosis)
+            list.push_back({{"hypothesis", h.name}, {"variant", h.variant}, {"explanation", h.explanation},
+                            {"consistent", h.consistent}, {"unexplained", h.unexplained}});
+        document["diagnosis"] = list;
+    }
+    return prettyJson(document);
+}
+
+std::string formatDiagnosis(const std::vector<Hypothesis>& hypotheses)
+{
+    for (const auto& h : hypotheses)
+        if (h.consistent) return "diagnosis  " + h.explanation + "\n";
+    if (hypotheses.empty()) return "diagnosis  no hypothesis applies to this camera and map\n";
+    const Hypothesis* closest = &hypotheses.front();
+    for (const auto& h : hypotheses)
+        if (h.unexplained < closest->unexplained) closest = &h;
+    return "diagnosis  none of the " + std::to_string(hypotheses.size()) +
+           " hypotheses makes the map consistent (closest: " + closest->name +
+           (closest->variant.empty() ? "" : " " + closest->variant) + ", " + std::to_string(closest->unexplained) +
+           " unexplained pixels)\n";
+}
+
+namespace {
+
+std::string htmlEscape(const std::string& text)
+{
+    std::string out;
+    for (char c : text) out += c == '<' ? "&lt;" : c == '>' ? "&gt;" : c == '&' ? "&amp;" : std::string(1, c);
+    return out;
+}
+
+}  // namespace
+
+std::string suiteTable(const SuiteResult& result)
+{
+    std::ostringstream out;
+    const auto tally = tallyFaults(result);
+    const std::vector<const Mistake*> mistakes = injectableMistakes();
+    const int clean = int(result.outcomes.size());
+    char line[256];
+    std::snprintf(line, sizeof line, "clean configurations: %d consistent of %d (false positives: %d)\n\n",
+                  clean - result.falsePositives, clean, result.falsePositives);
+    out << line;
+    std::snprintf(line, sizeof line, "%-22s %-7s %10s %14s %9s  %s\n", "fault", "route", "detected", "not applicable",
+                  "n/a", "");
+    out << line;
+    for (std::size_t k = 0; k < tally.size(); ++k) {
+        const int applicable = tally[k].detected + tally[k].missed;
+        std::snprintf(line, sizeof line, "%-22s %-7s %4d / %-4d %14d %9d  %s\n", mistakes[k]->name.c_str(),
+                      toString(mistakes[k]->route).c_str(), tally[k].detected, applicable, tally[k].notApplicable,
+                      tally[k].meaningless, tally[k].missed ? "<- MISSED" : "");
+        out << line;
+    }
+    out << "\n(detected / applicable. Not applicable: the fault leaves that picture visibly unchanged - the same\n"
+           " coverage, depth within twice the snapping noise - e.g. no near clipping where nothing crosses the near\n"
+           " plane. n/a: the mistake has no meaning there, e.g. a field-of-view mistake on an orthographic camera.)\n";
+    return out.str();
+}
+
+std::string suiteReportJson(const SuiteResult& result, bool quick, double seconds)
+{
+    const std::vector<const Mistake*> mistakes = injectableMistakes();
+    nlohmann::json configsJson = nlohmann::json::array();
+    for (const auto& outcome : result.outcomes) {
+        nlohmann::json faults;
+        for (std::size_t k = 0; k < outcome.faults.size(); ++k) faults[mistakes[k]->name] = toString(outcome.faults[k]);
+        configsJson.push_back({{"label", outcome.config.label()},
+                               {"scene", outcome.config.scene},
+                               {"model", outcome.config.model},
+                               {"camera", toJson(outcome.config.spec)},
+                               {"clean", {{"consistent", outcome.clean.consistent()},
+                                          {"unexplained", outcome.clean.unexplained()},
+                                          {"max_over_tolerance", outcome.clean.maxErrorOverTolerance},
+                                          {"mean_signed_error_quanta", outcome.clean.meanSignedErrorQuanta}}},
+                               {"faults", faults},
+                               {"milliseconds", outcome.milliseconds}});
+    }
+    nlohmann::json table = nlohmann::json::object();
+    const auto tally = tallyFaults(result);
+    for (std::size_t k = 0; k < tally.size(); ++k)
+        table[mistakes[k]->name] = {{"description", mistakes[k]->description},
+                                    {"route", toString(mistakes[k]->route)},
+                                    {"detected", tally[k].detected},
+                                    {"applicable", tally[k].detected + tally[k].missed},
+                                    {"not_applicable", tally[k].notApplicable},
+                                    {"meaningless", tally[k].meaningless}};
+    return prettyJson({{"zcheck_version", kVersion},
+                       {"quick", quick},
+                       {"configurations", configsJson},
+                       {"detection", table},
+                       {"false_positives", result.falsePositives},
+                       {"missed_faults", result.missedFaults},
+                       {"passed", result.passed()},
+                       {"seconds", seconds}}) +
+           "\n";
+}
+
+std::string suiteReportHtml(const SuiteResult& result, double seconds)
+{
+    std::ostringstream html;
+    html << "<!doctype html><html><head><meta charset=\"utf-8\"><title>zcheck suite</title><style>"
+            "body{font-family:sans-serif;margin:2em}pre{background:#f4f4f4;padding:1em}"
+            "img{image-rendering:pixelated;width:320px;margin-right:8px;border:1px solid #ccc}"
+            ".failure{margin-bottom:2em}</style></head><body>"
+         << "<h1>zcheck suite: " << (result.passed() ? "PASSED" : "FAILED") << "</h1><p>" << result.outcomes.size()
+         << " configurations &times; " << injectableMistakes().size() << " faults, " << std::lround(seconds)
+         << " s.</p><pre>" << htmlEscape(suiteTable(result)) << "</pre>";
+    const int allFailures = result.falsePositives + result.missedFaults;
+    html << "<h2>Failures" << (allFailures == 0 ? ": none" : "") << "</h2>";
+    if (allFailures > int(result.failures.size()))
+        html << "<p>Showing the first " << result.failures.size() << " of " << allFailures
+             << " failures with images; the JSON report lists every configuration.</p>";
+    for (const auto& failure : result.failures) {
+        const Comparison& c = failure.run.comparison;
+        QuantityImage depth;
+        depth.quantity = ExportQuantity::Window, depth.width = c.report.width, depth.height = c.report.height;
+        depth.channels = {"window"}, depth.value = failure.run.raster.windowDepth.value;
+        depth.missValue = failure.run.raster.windowDepth.value.empty() ? 0 : NAN;
+        html << "<div class=\"failure\"><h3>" << htmlEscape(failure.label) << "</h3><p>" << htmlEscape(failure.what)
+             << "</p><img title=\"raster depth\" src=\"" << pngDataUri(depth.width, depth.height, previewRgb(depth))
+             << "\"><img title=\"error heatmap\" src=\"" << pngDataUri(depth.width, depth.height, errorHeatmapRgb(c))
+             << "\"><img title=\"coverage classes\" src=\"" << pngDataUri(depth.width, depth.height, pixelClassRgb(c))
+             << "\"><pre>" << htmlEscape(formatSummary(failure.run.report)) << "</pre></div>";
+    }
+    html << "</body></html>\n";
+    return html.str();
+}
+
+std::string precisionJson(const CameraSpec& spec, const PrecisionTable& table)
+{
+    nlohmann::json layouts = nlohmann::json::array();
+    for (std::size_t k = 0; k < table.layouts.size(); ++k) {
+        nlohmann::json steps = nlohmann::json::array();
+        for (double step : table.step[k]) steps.push_back(std::isfinite(step) ? nlohmann::json(step) : nlohmann::json(nullptr));
+        layouts.push_back({{"format", toString(table.layouts[k].format)},
+                           {"mapping", toString(table.layouts[k].mapping)},
+                           {"eye_z_step", steps}});
+    }
+    const PrecisionLayout& best = table.layouts[table.best];
+    return prettyJson({{"camera", toJson(spec)},
+                       {"distances", table.distances},
+                       {"definition", "eye_z_step: eye-z between the stored value at that distance and the next "
+                                      "representable value farther away; null: unresolvable"},
+                       {"layouts", layouts},
+                       {"best", {{"format", toString(best.format)}, {"mapping", toString(best.mapping)},
+                                 {"worst_relative_step", table.bestWorstRelativeStep}}}});
+}
+
+}  // namespace zcheck
