@@ -46,6 +46,16 @@ View View::axonometricView(const std::string& kind, const glm::dvec3& target, do
     return view;
 }
 
+namespace {
+testing::MatrixHook matrixHook = nullptr;
+void applyMatrixHook(const char* which, ProjectionType type, glm::dmat4& matrix)
+{
+    if (matrixHook) matrixHook(which, type, matrix);
+}
+}  // namespace
+
+void testing::setMatrixHook(MatrixHook hook) { matrixHook = hook; }
+
 glm::dmat4 matrixFromRows(const double rows[4][4])
 {
     glm::dmat4 m(0.0);
@@ -303,6 +313,7 @@ Camera::Camera(const CameraSpec& spec) : spec_(spec)
             for (int col = 0; col < 3; ++col) eyeFromWorld[col][row] = axes[row][col];
             eyeFromWorld[3][row] = -glm::dot(axes[row], spec_.view.eye);
         }
+        applyMatrixHook("eye_from_world", p.type, eyeFromWorld);
     }
     worldFromEye = glm::inverse(eyeFromWorld);
 
@@ -317,6 +328,7 @@ Camera::Camera(const CameraSpec& spec) : spec_(spec)
         clipFromClipGl[1][1] = c.ndcUpY;
         clipFromEye = clipFromClipGl * clipGlFromEyeGl(p, left_, right_, bottom_, top_, ndcZNear(), ndcZFar()) *
                       obliqueShear(p) * eyeGlFromEye(c);
+        applyMatrixHook("clip_from_eye", p.type, clipFromEye);
     }
     if (std::abs(glm::determinant(clipFromEye)) < 1e-300 || !std::isfinite(glm::determinant(clipFromEye)))
         throw Error("camera matrix 'clip_from_eye' is singular");
@@ -336,6 +348,7 @@ Camera::Camera(const CameraSpec& spec) : spec_(spec)
         {0, 0, 0, 1},
     };
     windowFromNdc = matrixFromRows(rows);
+    applyMatrixHook("window_from_ndc", p.type, windowFromNdc);
     ndcFromWindow = glm::inverse(windowFromNdc);
 
     for (auto [m, name] : {std::pair{&eyeFromWorld, "eye_from_world"}, {&worldFromEye, "world_from_eye"},

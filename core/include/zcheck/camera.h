@@ -182,6 +182,16 @@ private:
 // right and above, 640×480, near/far hugging the sphere. Used for meshes without a camera.
 CameraSpec framingCameraSpec(const glm::dvec3& centre, double radius);
 
+namespace testing {
+// A test hook (tests/test_independence.cpp proves the two routes independent with it): when
+// set, every Camera built afterwards passes each matrix it derives from the projection
+// model's parameters through it before use — "eye_from_world" (look-at views),
+// "clip_from_eye" (every type but a raw matrix) and "window_from_ndc" — so that a test can
+// perturb one coefficient. nullptr (the default) turns it off. Not thread-safe; tests only.
+using MatrixHook = void (*)(const char* which, ProjectionType type, glm::dmat4& matrix);
+void setMatrixHook(MatrixHook hook);
+}  // namespace testing
+
 // Row-major construction for readable matrix literals: rows[r][c] is row r, column c.
 glm::dmat4 matrixFromRows(const double rows[4][4]);
 

@@ -1,0 +1,1 @@
+from ._zcheck import *  # noqa: F401,F403
