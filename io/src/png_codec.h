@@ -1,5 +1,5 @@
 #pragma once
-// PNG in memory with libpng (private to zcheck_imageio). Encoding: the caller writes the
+// PNG in memory with libpng (private to zcheck_io and zcheck_imageio). Encoding: the caller writes the
 // bytes with writeFileBytes, which checks every write, or embeds them (data: URIs). Decoding:
 // 16-bit greyscale depth maps only, the size checked before any row is allocated.
 #include <cstdint>

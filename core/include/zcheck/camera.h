@@ -19,8 +19,13 @@
 //
 // Cameras are built by a validating constructor: a NaN, a degenerate view, near ≤ 0,
 // far ≤ near, an empty frustum or an image outside 1…16384 pixels per side (or over 2^25
-// pixels in all) throws Error
-// naming the parameter. Nothing is silently repaired.
+// pixels in all) throws Error naming the parameter. Nothing is silently repaired. A Camera
+// is an immutable value once built: share it between threads freely.
+//
+//   zcheck::CameraSpec spec;                                   // opengl, 640×480, looking at the origin
+//   spec.projection = zcheck::Projection::perspective(60.0, 0.1, 100.0);
+//   spec.view = zcheck::View::lookAt({0, 1, 3}, {0, 0, 0}, {0, 1, 0});
+//   const zcheck::Camera camera(spec);                          // camera.clipFromWorld, ...
 #include "zcheck/convention.h"
 
 #include <glm/glm.hpp>

@@ -1,14 +1,20 @@
 #pragma once
 // The inverse-projection module: from window coordinates back into eye and world space.
 //
-// One rule serves every projective camera (perspective, orthographic, off-axis frustum and,
-// later, oblique and raw matrices): the ray through a window point (x, y) is obtained by
-// unprojecting (x, y) at the window depths of the near and far planes through
-// eyeFromClip = inverse(clipFromEye) and dividing by w. A far point with w = 0 (infinite far
-// plane) is a direction. Everything is computed in double.
+// One rule serves every projective camera (perspective, orthographic, off-axis frustum,
+// oblique, raw matrices): the ray through a window point (x, y) is obtained by unprojecting
+// (x, y) at the window depths of the near and far planes through eyeFromClip =
+// inverse(clipFromEye) and dividing by w. A far point with w = 0 (infinite far plane) is a
+// direction. Everything is computed in double. It is what `unproject`, `verify` and depth
+// conversions use; the ray route of a check builds its rays from the camera's definition
+// instead (camera_rays.h), except for raw-matrix cameras.
 //
 // Consumes window coordinates (see camera.h; pixel centres at +0.5) and depth values as
 // stored in the depth buffer (window depth); produces eye- or world-space points and rays.
+// Pure functions of the camera: thread-safe.
+//
+//   const glm::dvec2 pWindow = zcheck::windowFromPixelCentre(camera, col, row);
+//   const auto pEye = zcheck::eyePointFromDepth(camera, pWindow, depth, zcheck::DepthQuantity::EyeZ);
 #include "zcheck/camera.h"
 #include "zcheck/quantity.h"
 

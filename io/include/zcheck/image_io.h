@@ -1,5 +1,5 @@
 #pragma once
-// Image files (library zcheck_imageio, the only place OpenImageIO and libpng are used).
+// Depth-map, EXR and TIFF files (library zcheck::imageio, the only place OpenImageIO is used).
 // Writers write the path they are given, checking every write and close (PNG and PFM are
 // encoded by zcheck and written with writeFileBytes; EXR and TIFF by OpenImageIO); a
 // command makes its outputs atomic with OutputFiles (atomic_file.h). Row 0 of every image is

@@ -1,5 +1,5 @@
 #pragma once
-// The mesh readers zcheck vouches for (library zcheck_meshio). Each reads a whole file held
+// The mesh readers zcheck vouches for (library zcheck_scene). Each reads a whole file held
 // in memory, bounds every count, offset and index by the bytes actually present before it
 // allocates or loops, and throws Error with one line naming the file, the place (element and
 // item, line, JSON path) and the rule. None recurses on input structure; all are fuzzed

@@ -1,5 +1,5 @@
 #pragma once
-// Scene loading by name (library zcheck_meshio).
+// Scene loading by name (library zcheck::scene).
 #include "zcheck/scene.h"
 
 #include <string>

@@ -3,7 +3,7 @@
 //
 // Positions are binary32 (what a GPU and Embree consume); every route converts them to
 // double before it transforms them. Scenes are addressed by name: `builtin:NAME[?k=v&…]`
-// or a mesh file path (loaded by zcheck_meshio).
+// or a mesh file path (loaded by mesh_loader.h).
 #include "zcheck/camera.h"
 
 #include <glm/glm.hpp>

@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# The installed package works for a consumer: `cmake --install` into a fresh prefix, then
+# examples/cpp configures with find_package(zcheck), builds against it, and runs.
+set -euo pipefail
+build=$1
+source_dir=$2
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+cmake --install "$build" --prefix "$tmp/prefix" > /dev/null
+# Nothing of the build tree may leak into what was installed.
+if grep -rIl "$build\|$source_dir" "$tmp/prefix/include" "$tmp/prefix/lib/cmake"; then
+    echo "package_consumer: build-tree paths in the installed headers or CMake files" >&2
+    exit 1
+fi
+test -f "$tmp/prefix/include/zcheck/version.h"
+test ! -e "$tmp/prefix/include/zcheck/version.h.in"
+cmake -S "$source_dir/examples/cpp" -B "$tmp/example" -DCMAKE_PREFIX_PATH="$tmp/prefix" > "$tmp/configure.log" 2>&1 ||
+    { cat "$tmp/configure.log" >&2; exit 1; }
+cmake --build "$tmp/example" > "$tmp/build.log" 2>&1 || { cat "$tmp/build.log" >&2; exit 1; }
+"$tmp/example/consistency_gate" > "$tmp/out.txt"
+[[ $(grep -c "CONSISTENT" "$tmp/out.txt") -eq 5 ]]
+! grep -q "INCONSISTENT" "$tmp/out.txt"
+# The installed command-line tool runs from the prefix (no build-tree paths compiled in).
+"$tmp/prefix/bin/zcheck" --version | grep -q "$(cat "$source_dir/CMakeLists.txt" | sed -n 's/^project(zcheck VERSION \([0-9.]*\).*/\1/p')"
+echo "package_consumer: 1 passed, 0 failed"
