@@ -161,12 +161,14 @@ std::vector<Mistake> buildCatalogue()
                                                                                                 : NdcDepthRange::ZeroToOne;
             }, m);
         }));
-    Mistake reversed = wrongProjection(
-        "reversed-as-standard", "a reversed-Z projection's values read as standard (or the reverse)", "",
-        [](const Camera& camera, glm::dmat4& m) {
-            return projectionOf(camera, [](CameraSpec& spec) { spec.depth.reversed = !spec.depth.reversed; }, m);
-        });
-    // Re-read with the whole depth mapping reversed: projection, clear value and depth test.
+    // A correct reversed-Z renderer where standard depth was declared (or the reverse): the
+    // raster route draws with the other depth mapping whole (projection, depth test, clear
+    // value), and the map is re-read with it.
+    Mistake reversed{"reversed-as-standard", "a reversed-Z projection's values read as standard (or the reverse)",
+                     Route::Raster, {}, {}};
+    reversed.inject = [](const Camera& camera, RouteFaults& faults) {
+        return !isRawMatrix(camera) && (faults.raster.otherDepthMapping = true);
+    };
     reversed.reread = [](const Camera& camera, const DepthMap&) {
         if (isRawMatrix(camera)) return Rereadings{};
         CameraSpec spec = camera.spec();
@@ -214,13 +216,16 @@ std::vector<Mistake> buildCatalogue()
                                       m = scaledRows(camera, k, k);
                                       return std::isfinite(k);
                                   }));
-    all.push_back(wrongProjection("near-far-swapped", "near and far exchanged in the projection",
-                                  "consistent if near and far are exchanged in the projection",
-                                  [](const Camera& camera, glm::dmat4& m) {
-                                      if (camera.farIsInfinite() || isRawMatrix(camera)) return false;
-                                      m = nearFarSwapped(camera);
-                                      return true;
-                                  }));
+    // With near and far exchanged the depth test keeps the farthest surface, which no
+    // re-reading of the ray route's nearest hits can produce: inject only.
+    Mistake swapped = wrongProjection("near-far-swapped", "near and far exchanged in the projection", "",
+                                      [](const Camera& camera, glm::dmat4& m) {
+                                          if (camera.farIsInfinite() || isRawMatrix(camera)) return false;
+                                          m = nearFarSwapped(camera);
+                                          return true;
+                                      });
+    swapped.reread = nullptr;
+    all.push_back(swapped);
     Mistake fovy{"fovy-error", "the vertical field of view off by a small factor (0.98 to 1.02)", Route::Raster, {}, {}};
     fovy.reread = [](const Camera& camera, const DepthMap&) {
         Rereadings out;

@@ -1,1 +1,127 @@
-from ._zcheck import *  # noqa: F401,F403
+"""zcheck — check a graphics transform chain by computing every pixel's depth twice.
+
+The ray route (Embree) follows the camera's definition; the raster route (a software z-buffer)
+follows its matrices. If view, projection, depth mapping, viewport orientation and pixel-centre
+convention agree, both depths agree within a stated tolerance at every pixel.
+
+    import zcheck
+    scene = zcheck.Scene.from_file("builtin:default")        # or Scene.from_arrays(V, F)
+    camera = scene.default_camera                            # or Camera.from_file / from_dict /
+                                                             #    from_opencv / from_matrices
+    checker = zcheck.Checker(scene)                          # BVH and rasterizer, built once
+    report = checker.check(camera)                           # report.consistent, report.to_dict()
+    z = checker.render(camera, "eye-z")                      # (H, W) float32, row 0 at the top
+    checker.verify(camera, my_depth, "eye-z").consistent     # a depth map from your renderer
+
+Conventions every function follows:
+  * images are numpy arrays of shape (height, width[, channels]); row 0 is the TOP row; pixel
+    (col, row) is array[row, col] and its centre is the image point (col + 0.5, row + 0.5);
+  * matrices are numpy 4x4 arrays written for column vectors, M[r, c] with p' = M @ p, named
+    dest_from_src (eye_from_world maps world points into eye space; cam_from_world is OpenCV's
+    [R | t]; world_from_cam is the camera's pose, "c2w");
+  * depth quantities: "window" (the depth-buffer value), "ndc" (z_ndc), "eye-z" (planar depth
+    along the viewing axis, positive) and "distance" (Euclidean range from the centre of
+    projection); functions that read depth take the quantity as a required argument;
+  * bad input raises zcheck.Error (a ValueError) with the one-line message the zcheck command
+    prints after "zcheck: error: ".
+"""
+
+import json as _json
+import math as _math
+import numbers as _numbers
+
+from ._zcheck import (  # noqa: F401
+    Camera,
+    Checker,
+    Error,
+    Report,
+    Scene,
+    __version__,
+    builtin_scenes,
+    conventions,
+    depth_formats,
+    depth_quantities,
+    mistakes,
+    pixel_classes,
+    quantities,
+    read_depth_map,
+    routes,
+    unproject,
+)
+
+__all__ = [
+    "Camera",
+    "Checker",
+    "Error",
+    "Report",
+    "Scene",
+    "__version__",
+    "builtin_scenes",
+    "conventions",
+    "depth_formats",
+    "depth_quantities",
+    "mistakes",
+    "pixel_classes",
+    "quantities",
+    "read_depth_map",
+    "routes",
+    "unproject",
+]
+
+
+def _jsonable(value, path):
+    """The camera dict as plain JSON values: numpy arrays and scalars become lists and numbers,
+    +-inf becomes "inf"/"-inf" (the camera file's spelling of an infinite far plane) and NaN
+    "nan" (which the camera reader then refuses by key, as it would in a file)."""
+    if isinstance(value, dict):
+        out = {}
+        for key, item in value.items():
+            if not isinstance(key, str):
+                raise Error(f"camera dict: key {key!r}{' in ' + repr(path) if path else ''} is not a string")
+            out[key] = _jsonable(item, f"{path}.{key}" if path else key)
+        return out
+    if hasattr(value, "tolist") and not isinstance(value, (str, bytes)):  # numpy arrays and scalars
+        return _jsonable(value.tolist(), path)
+    if isinstance(value, (list, tuple)):
+        return [_jsonable(item, path) for item in value]
+    if isinstance(value, bool) or value is None or isinstance(value, str):
+        return value
+    if isinstance(value, _numbers.Integral):
+        return int(value)
+    if isinstance(value, _numbers.Real):
+        v = float(value)
+        if _math.isnan(v):
+            return "nan"
+        if _math.isinf(v):
+            return "inf" if v > 0 else "-inf"
+        return v
+    raise Error(f"camera dict: '{path}' has a value of type {type(value).__name__}, which JSON cannot hold")
+
+
+def _camera_from_dict(cls, d, source="camera dict"):
+    """A camera from a dict with the camera file's keys (see the README's "The camera file"):
+
+        zcheck.Camera.from_dict({
+            "convention": "opengl",
+            "image": {"width": 640, "height": 480},
+            "projection": {"type": "perspective", "fovy_deg": 60, "near": 0.1, "far": 100},
+            "view": {"eye": [0, 1, 3], "target": [0, 0, 0], "up": [0, 1, 0]},
+            "depth": {"format": "float32", "reversed": False, "range": [0, 1]}})
+
+    Values may be numpy arrays or scalars; math.inf is written "inf" (an infinite far plane).
+    Unknown keys, wrong types and invalid values raise zcheck.Error with the camera file's
+    messages, beginning with `source` ("camera dict") instead of "camera file 'PATH'".
+    """
+    if not isinstance(d, dict):
+        raise Error(f"{source}: must be a dict with the camera file's keys, got {type(d).__name__}")
+    return cls.from_json(_json.dumps(_jsonable(d, "")), source)
+
+
+Camera.from_dict = classmethod(_camera_from_dict)
+
+for _name in ("Camera", "Checker", "Error", "Report", "Scene", "read_depth_map", "unproject"):
+    try:
+        globals()[_name].__module__ = "zcheck"
+    except (AttributeError, TypeError):  # pragma: no cover - builtin functions keep theirs
+        pass
+del _name

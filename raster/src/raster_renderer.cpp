@@ -227,6 +227,13 @@ RasterRenderer::RasterRenderer(const Scene& scene) : scene_(scene) { validateSce
 
 RenderResult RasterRenderer::render(const Camera& camera, const RasterFaults& faults) const
 {
+    if (faults.otherDepthMapping && camera.spec().projection.type != ProjectionType::Matrix) {
+        CameraSpec other = camera.spec();
+        other.depth.reversed = !other.depth.reversed;
+        RasterFaults rest = faults;
+        rest.otherDepthMapping = false;
+        return render(Camera(other), rest);
+    }
     const auto start = std::chrono::steady_clock::now();
     const Viewport vp(camera, faults);
     const int W = camera.width(), H = camera.height();

@@ -36,6 +36,9 @@ struct RasterFaults {
     bool viewportMinusOne = false;       // viewport scaled by (width − 1, height − 1)
     bool truncateUnorm = false;          // unorm-N stores floor(d·(2^N − 1)) instead of rounding
     bool storeLinearEyeZ = false;        // store (eye-z − near)/(far − near) as the window depth
+    bool otherDepthMapping = false;      // draw with the other depth mapping: reversed-Z's projection,
+                                         // depth test and clear value where standard was declared, or
+                                         // the reverse (not for raw-matrix cameras: ignored there)
 };
 
 class RasterRenderer {
