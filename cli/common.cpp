@@ -44,13 +44,6 @@ void addThreadsOption(CLI::App* command, int& threads)
     command->add_option("--threads", threads, "worker threads, 1..1024 (default: all cores)")->check(kThreadRange);
 }
 
-void requireSomethingCompared(const ComparisonReport& report, const std::string& scene)
-{
-    if (report.bothHit + report.rayOnly + report.rasterOnly == 0)
-        throw Error("nothing to compare: neither route sees any surface of '" + scene +
-                    "' through this camera (is it pointing away, or are near/far wrong?)");
-}
-
 void addSceneAndCameraOptions(CLI::App* command, SceneAndCamera& options)
 {
     command->add_option("--scene", options.scene,

@@ -42,10 +42,6 @@ extern const CLI::Range kImageSideRange;
 std::unique_ptr<tbb::global_control> limitThreads(int threads);
 void addThreadsOption(CLI::App* command, int& threads);
 
-// Refuses a comparison with nothing in it: a camera that sees no geometry proves nothing,
-// and must not be reported CONSISTENT.
-void requireSomethingCompared(const ComparisonReport& report, const std::string& scene);
-
 // --scene, --camera and --convention, as check, export and verify take them.
 struct SceneAndCamera {
     std::string scene = "builtin:default";

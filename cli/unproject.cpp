@@ -37,24 +37,6 @@ glm::ivec2 parsePixel(const std::string& text, const Camera& camera)
     return {int(v[0]), int(v[1])};
 }
 
-// A depth value the camera can produce: window depth within the depth range, z_ndc within the
-// convention's NDC range, eye-z and distance in front of the eye.
-void requireDepthValueInRange(const Camera& camera, DepthQuantity quantity, double value)
-{
-    const std::string given = "--depth " + formatNumber(value) + " (" + toString(quantity) + ")";
-    if (!std::isfinite(value)) throw Error(given + " must be a finite number");
-    const double lo = quantity == DepthQuantity::Window ? camera.depth().rangeMin
-                      : quantity == DepthQuantity::Ndc  ? camera.convention().ndcZMin()
-                                                        : 0.0;
-    const double hi = quantity == DepthQuantity::Window ? camera.depth().rangeMax : quantity == DepthQuantity::Ndc ? 1.0 : INFINITY;
-    const bool inside = quantity == DepthQuantity::Window || quantity == DepthQuantity::Ndc ? value >= lo && value <= hi : value > 0;
-    if (!inside)
-        throw Error(given + (quantity == DepthQuantity::EyeZ || quantity == DepthQuantity::Distance
-                                 ? " must be > 0: the point must lie in front of the eye"
-                                 : " must lie in [" + formatNumber(lo) + ", " + formatNumber(hi) + "], the camera's " +
-                                       (quantity == DepthQuantity::Window ? "depth range" : "NDC depth range")));
-}
-
 nlohmann::json vec3Json(const glm::dvec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); }
 
 int runUnprojectCommand(const UnprojectOptions& o)
@@ -87,7 +69,7 @@ int runUnprojectCommand(const UnprojectOptions& o)
             out["ray"]["world"] = rayJson(rayWorld);
             out["ray"]["eye"] = rayJson(rayEye);
         } else {
-            requireDepthValueInRange(camera, quantity, *o.depth);
+            requireDepthValue(camera, quantity, *o.depth, "--depth");
             const auto pEye = eyePointFromDepth(camera, pWindow, *o.depth, quantity);
             if (!pEye) throw Error("--depth " + formatNumber(*o.depth) + " is a miss for quantity " + o.quantity);
             out["point"] = {{"eye", vec3Json(*pEye)}, {"world", vec3Json(toWorld(*pEye))},

@@ -34,7 +34,7 @@ int runVerifyCommand(const VerifyOptions& o)
     const Camera camera(cameraSpecFor(scene, o.input));
     const DepthMapFile file = readDepthMap(o.depthMap, channelNameOf(exportQuantitiesFromList(o.quantity).front()), o.scale,
                                            camera.width(), camera.height());
-    const DepthMap map{file.width, file.height, quantity, file.value, o.scale > 0 ? 1.0 / o.scale : 0.0};
+    const DepthMap map{file.width, file.height, quantity, file.value, file.valueQuantum};
     const Checker checker(std::move(scene));
     const VerifyResult run = checker.verify(camera, map);
     requireSomethingCompared(run.comparison.report, checker.scene().name);

@@ -436,3 +436,17 @@ TEST_CASE("cameras beyond what binary32 ray tracing can represent are refused, n
     spec.projection.left = -1e14;  // within the bound
     REQUIRE_NOTHROW(Camera(spec));
 }
+
+TEST_CASE("regression: prettyJson rewrote number lists inside strings", "[json]")
+{
+    const nlohmann::json document = {{"explanation", "maps depth to [-1,1] instead of [0,1]"},
+                                     {"file", "a[1,2].exr"},
+                                     {"quoted", "say \"[3,4]\" twice"},
+                                     {"row", {1, 2.5, -3}}};
+    const std::string text = prettyJson(document);
+    REQUIRE(text.find("\"maps depth to [-1,1] instead of [0,1]\"") != std::string::npos);
+    REQUIRE(text.find("\"a[1,2].exr\"") != std::string::npos);
+    REQUIRE(text.find("[3,4]") != std::string::npos);
+    REQUIRE(text.find("[1, 2.5, -3]") != std::string::npos);  // numbers still fold onto one line
+    REQUIRE(nlohmann::json::parse(text) == document);
+}

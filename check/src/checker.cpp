@@ -17,6 +17,13 @@ Route routeFromName(const std::string& name)
     throw Error("unknown route '" + name + "' (expected ray or raster)");
 }
 
+void requireSomethingCompared(const ComparisonReport& report, const std::string& scene)
+{
+    if (report.bothHit + report.rayOnly + report.rasterOnly == 0)
+        throw Error("nothing to compare: neither route sees any surface of '" + scene +
+                    "' through this camera (is it pointing away, or are near/far wrong?)");
+}
+
 Checker::Checker(Scene scene) : scene_(std::move(scene)), rays_(scene_), raster_(scene_) {}
 
 Checker::~Checker() = default;

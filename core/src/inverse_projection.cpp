@@ -143,6 +143,23 @@ double distanceOfEyePoint(const Camera& camera, const glm::dvec3& pEye)
     return glm::length(pEye - eyePlaneRayFrom(eyeRayThroughWindow(camera, {pWindow.x, pWindow.y})).origin);
 }
 
+void requireDepthValue(const Camera& camera, DepthQuantity quantity, double value, const std::string& name)
+{
+    const std::string given = name + " " + formatNumber(value) + " (" + toString(quantity) + ")";
+    if (!std::isfinite(value)) throw Error(given + " must be a finite number");
+    const bool linear = quantity == DepthQuantity::EyeZ || quantity == DepthQuantity::Distance;
+    if (linear) {
+        if (!(value > 0)) throw Error(given + " must be > 0: the point must lie in front of the eye");
+        return;
+    }
+    const bool window = quantity == DepthQuantity::Window;
+    const double lo = window ? camera.depth().rangeMin : camera.convention().ndcZMin();
+    const double hi = window ? camera.depth().rangeMax : 1.0;
+    if (!(value >= lo && value <= hi))
+        throw Error(given + " must lie in [" + formatNumber(lo) + ", " + formatNumber(hi) + "], the camera's " +
+                    (window ? "depth range" : "NDC depth range"));
+}
+
 UnprojectedMap unprojectMap(const Camera& camera, const std::vector<double>& values, DepthQuantity quantity,
                             PointSpace space, int stride)
 {

@@ -6,6 +6,7 @@
 #include "zcheck/input_file.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <regex>
 #include <fstream>
@@ -430,20 +431,32 @@ json matricesJson(const Camera& camera)
 std::string prettyJson(const nlohmann::json& document)
 {
     const std::string text = document.dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
-    // An array whose elements are all numbers (or null) is folded onto one line.
+    // An array whose elements are all numbers (or null) is folded onto one line; text inside
+    // strings (file names, explanations such as "[-1,1]") is copied as it is.
     static const std::regex numberArray(R"(\[(\s*(-?[0-9][0-9.eE+-]*|null)\s*,)*\s*(-?[0-9][0-9.eE+-]*|null)\s*\])");
-    static const std::regex space(R"(\s+)");
     std::string out;
-    auto last = text.cbegin();
-    for (std::sregex_iterator it(text.begin(), text.end(), numberArray), end; it != end; ++it) {
-        out.append(last, text.cbegin() + it->position());
-        std::string folded = std::regex_replace(it->str(), space, "");
-        std::string spaced;
-        for (char c : folded) spaced += c == ',' ? std::string(", ") : std::string(1, c);
-        out += spaced;
-        last = text.cbegin() + it->position() + it->length();
+    out.reserve(text.size());
+    bool inString = false;
+    for (std::size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        if (inString) {
+            out += c;
+            if (c == '\\' && i + 1 < text.size()) out += text[++i];  // an escaped character, quotes included
+            else if (c == '"') inString = false;
+            continue;
+        }
+        std::smatch match;
+        if (c == '[' && std::regex_search(text.cbegin() + std::ptrdiff_t(i), text.cend(), match, numberArray,
+                                          std::regex_constants::match_continuous)) {
+            for (char k : match.str())
+                if (k == ',') out += ", ";
+                else if (!std::isspace(static_cast<unsigned char>(k))) out += k;
+            i += std::size_t(match.length()) - 1;
+            continue;
+        }
+        inString = c == '"';
+        out += c;
     }
-    out.append(last, text.cend());
     return out;
 }
 

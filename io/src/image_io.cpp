@@ -230,7 +230,7 @@ DepthMapFile readDepthMap(const std::string& path, const std::string& preferredC
             refuseMap(path, what);
         }
         DepthMapFile map;
-        map.width = png.width, map.height = png.height, map.channel = "Y";
+        map.width = png.width, map.height = png.height, map.channel = "Y", map.valueQuantum = 1.0 / scale;
         map.value.resize(png.codes.size());
         for (std::size_t i = 0; i < png.codes.size(); ++i) map.value[i] = png.codes[i] == 0 ? NAN : png.codes[i] / scale;
         return map;
@@ -267,6 +267,7 @@ DepthMapFile readDepthMap(const std::string& path, const std::string& preferredC
         refuseMap(path, reason.empty() ? "the pixel data is truncated or corrupt" : reason);
     }
     if (integer) {
+        map.valueQuantum = 1.0 / scale;
         // read_image scales integers to [0,1]; undo it to get the stored code.
         const double maxCode = std::pow(2.0, double(format.size() * 8)) - 1;
         for (double& v : pixels) {

@@ -179,18 +179,10 @@ std::unique_ptr<tbb::global_control> threadLimit(std::optional<int> threads)
     return std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, std::size_t(*threads));
 }
 
-// The command line's refusal (cli/common.cpp): a camera that sees nothing proves nothing.
-void requireSomethingCompared(const ComparisonReport& report, const std::string& scene)
-{
-    if (report.bothHit + report.rayOnly + report.rasterOnly == 0)
-        throw Error("nothing to compare: neither route sees any surface of '" + scene +
-                    "' through this camera (is it pointing away, or are near/far wrong?)");
-}
-
 // ---------------------------------------------------------------------------------------------
 // scenes
 
-Scene sceneFromArrays(py::handle vertices, py::handle triangles, const std::string& name)
+Scene sceneFromArrays(py::object vertices, py::object triangles, const std::string& name)
 {
     const std::string where = "Scene.from_arrays: ";
     const py::array v = numericArray(vertices, where + "vertices");
@@ -240,23 +232,8 @@ Scene sceneFromArrays(py::handle vertices, py::handle triangles, const std::stri
         for (py::ssize_t j = 0; j < tu.shape(0); ++j)
             for (int k = 0; k < 3; ++k) setIndex(j, k, static_cast<long double>(pt(j, k)));
     }
-    validateScene(scene);
-    // The rule of the mesh loader (scene/src/mesh_loader.cpp): at least one triangle with area,
-    // and a default camera that frames the bounding sphere.
-    bool anyArea = false;
-    for (const auto& tri : scene.triangles) {
-        const glm::dvec3 a(scene.positions[tri[0]]), b(scene.positions[tri[1]]), c(scene.positions[tri[2]]);
-        if (glm::length(glm::cross(b - a, c - a)) > 0) {
-            anyArea = true;
-            break;
-        }
-    }
-    if (!anyArea)
-        fail(where + "all " + std::to_string(scene.triangles.size()) +
-             " triangles are degenerate (zero area): nothing to draw");
-    const glm::dvec3 lo = scene.boundsMin(), hi = scene.boundsMax();
-    const double radius = std::max(glm::length(hi - lo) / 2, 1e-6);
-    scene.defaultCamera = framingCameraSpec((lo + hi) / 2.0, radius);
+    // The mesh loader's rule (scene.h): something with area to draw, and a camera framing it.
+    scene = frameScene(std::move(scene), "Scene.from_arrays: the mesh");
     return scene;
 }
 
@@ -302,8 +279,8 @@ void requireImageSize(const std::optional<int>& width, const std::optional<int>&
     if (!width || !height) fail(where + ": width and height (the image size in pixels) are required");
 }
 
-Camera cameraFromOpencv(py::handle K, py::handle R, py::handle t, std::optional<int> width, std::optional<int> height,
-                        py::handle camFromWorld, py::handle worldFromCam, double near, double far, double pixelCenter,
+Camera cameraFromOpencv(py::object K, py::object R, py::object t, std::optional<int> width, std::optional<int> height,
+                        py::object camFromWorld, py::object worldFromCam, double near, double far, double pixelCenter,
                         const std::string& convention, const std::string& depthFormat, bool reversed,
                         std::pair<double, double> depthRange)
 {
@@ -389,8 +366,8 @@ Camera cameraFromOpencv(py::handle K, py::handle R, py::handle t, std::optional<
     return makeCamera(spec, where);
 }
 
-Camera cameraFromMatrices(py::handle clipFromEye, py::handle eyeFromWorld, std::optional<int> width,
-                          std::optional<int> height, py::handle worldFromEye, const std::string& convention,
+Camera cameraFromMatrices(py::object clipFromEye, py::object eyeFromWorld, std::optional<int> width,
+                          std::optional<int> height, py::object worldFromEye, const std::string& convention,
                           const std::string& vectors, const std::string& depthFormat, bool reversed,
                           std::pair<double, double> depthRange)
 {
@@ -489,15 +466,7 @@ py::dict pointAt(const Camera& camera, int col, int row, double value, const std
 {
     const DepthQuantity quantity = depthQuantityFromName(quantityName);
     const glm::ivec2 pixel = requirePixel(camera, col, row);
-    const std::string given = "depth " + formatNumber(value) + " (" + toString(quantity) + ")";
-    if (!std::isfinite(value)) fail(given + " must be a finite number");
-    const bool linear = quantity == DepthQuantity::EyeZ || quantity == DepthQuantity::Distance;
-    const double lo = quantity == DepthQuantity::Window ? camera.depth().rangeMin : camera.convention().ndcZMin();
-    const double hi = quantity == DepthQuantity::Window ? camera.depth().rangeMax : 1.0;
-    if (linear ? !(value > 0) : !(value >= lo && value <= hi))
-        fail(given + (linear ? " must be > 0: the point must lie in front of the eye"
-                             : " must lie in [" + formatNumber(lo) + ", " + formatNumber(hi) + "], the camera's " +
-                                   (quantity == DepthQuantity::Window ? "depth range" : "NDC depth range")));
+    requireDepthValue(camera, quantity, value, "depth");
     const glm::dvec2 pWindow = windowFromPixelCentre(camera, pixel.x, pixel.y);
     const auto pEye = eyePointFromDepth(camera, pWindow, value, quantity);
     if (!pEye) fail("depth " + formatNumber(value) + " is a miss for quantity " + quantityName);
@@ -634,6 +603,8 @@ Conventions every function follows:
 PYBIND11_MODULE(_zcheck, m)
 {
     m.doc() = kModuleDoc;
+    // Classes and signatures say zcheck.Camera, not zcheck._zcheck.Camera (the name is restored at the end).
+    m.attr("__name__") = "zcheck";
     py::register_exception<Error>(m, "Error", PyExc_ValueError);
     m.attr("Error").attr("__doc__") =
         "Bad input (a file, key, value, array shape or option): the message is the one line the zcheck command "
@@ -1004,7 +975,7 @@ Misses hold the quantity's miss value: the clear value (window), NDC z of the fa
 +inf (eye-z, distance), NaN (positions, normals), 0xFFFFFFFF (primitive-id).)doc")
         .def(
             "verify",
-            [](const Checker& checker, const Camera& camera, py::handle depth, const std::string& quantityName,
+            [](const Checker& checker, const Camera& camera, py::object depth, const std::string& quantityName,
                std::optional<double> miss, std::optional<double> scale, bool diagnose, std::optional<int> threads) {
                 const DepthQuantity quantity = depthQuantityFromName(quantityName);
                 MapInput input = mapFromArray(depth, camera, miss, scale);
@@ -1087,7 +1058,7 @@ map's storage quantum 1/scale when a scale is given. to_dict() equals `zcheck ve
 document but for timings.)doc")
         .def(
             "diagnose",
-            [](const Checker& checker, const Camera& camera, py::handle depth, const std::string& quantityName,
+            [](const Checker& checker, const Camera& camera, py::object depth, const std::string& quantityName,
                std::optional<double> miss, std::optional<double> scale, std::optional<int> threads) {
                 const DepthQuantity quantity = depthQuantityFromName(quantityName);
                 MapInput input = mapFromArray(depth, camera, miss, scale);
@@ -1113,7 +1084,7 @@ name what explains the map (e.g. "y-flip", "distance-as-eye-z"). Arguments as fo
     // ----------------------------------------------------------------------------- functions
     m.def(
         "unproject",
-        [](const Camera& camera, py::handle depth, const std::string& quantityName, const std::string& space,
+        [](const Camera& camera, py::object depth, const std::string& quantityName, const std::string& space,
            int stride, std::optional<double> miss, std::optional<double> scale) {
             if (space != "eye" && space != "world") fail("space must be eye or world, got '" + space + "'");
             if (stride < 1 || stride > 16384) fail("stride must be in 1..16384, got " + std::to_string(stride));
@@ -1178,4 +1149,6 @@ quantity: read that quantity's channel if the file has it (window, ndc, Z for ey
           else the first channel, as the command line does; or
 channel:  read exactly this channel (an error if the file has none of that name).
 scale:    stored value = depth x scale; float files are divided by it.)doc");
+
+    m.attr("__name__") = "zcheck._zcheck";
 }

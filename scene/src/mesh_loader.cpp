@@ -11,23 +11,11 @@ namespace zcheck {
 
 namespace {
 
-// Refuses a mesh with no triangle of nonzero area (nothing for either route to draw), then
-// validates it and gives it a camera that frames its bounding sphere.
 Scene framed(Scene scene)
 {
     if (scene.triangles.empty()) throw Error("cannot load mesh '" + scene.name + "': it holds no triangles");
-    validateScene(scene);
-    const bool anyArea = std::any_of(scene.triangles.begin(), scene.triangles.end(), [&](const glm::uvec3& t) {
-        const glm::dvec3 a(scene.positions[t[0]]), b(scene.positions[t[1]]), c(scene.positions[t[2]]);
-        return glm::length(glm::cross(b - a, c - a)) > 0;
-    });
-    if (!anyArea)
-        throw Error("cannot load mesh '" + scene.name + "': all its " + std::to_string(scene.triangles.size()) +
-                    " triangles are degenerate (zero area): nothing to draw");
-    const glm::dvec3 lo = scene.boundsMin(), hi = scene.boundsMax();
-    const double radius = std::max(glm::length(hi - lo) / 2, 1e-6);
-    scene.defaultCamera = framingCameraSpec((lo + hi) / 2.0, radius);
-    return scene;
+    const std::string what = "cannot load mesh '" + scene.name + "'";
+    return frameScene(std::move(scene), what);
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include "zcheck/error.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace zcheck {
@@ -45,6 +46,22 @@ void validateScene(const Scene& scene)
         for (int i = 0; i < 3; ++i)
             if (t[i] >= scene.positions.size())
                 throw Error("scene '" + scene.name + "' has a vertex index out of range (" + std::to_string(t[i]) + ")");
+}
+
+Scene frameScene(Scene scene, const std::string& what)
+{
+    validateScene(scene);
+    const bool anyArea = std::any_of(scene.triangles.begin(), scene.triangles.end(), [&](const glm::uvec3& t) {
+        const glm::dvec3 a(scene.positions[t[0]]), b(scene.positions[t[1]]), c(scene.positions[t[2]]);
+        return glm::length(glm::cross(b - a, c - a)) > 0;
+    });
+    if (!anyArea)
+        throw Error(what + ": all its " + std::to_string(scene.triangles.size()) +
+                    " triangles are degenerate (zero area): nothing to draw");
+    const glm::dvec3 lo = scene.boundsMin(), hi = scene.boundsMax();
+    const double radius = std::max(glm::length(hi - lo) / 2, 1e-6);
+    scene.defaultCamera = framingCameraSpec((lo + hi) / 2.0, radius);
+    return scene;
 }
 
 }  // namespace zcheck

@@ -97,6 +97,11 @@ struct Hypothesis {
 
 class VertexNeighbours;
 
+// Refuses a comparison with nothing in it (throws Error naming `scene`): a camera that sees
+// no geometry proves nothing, and must not be reported CONSISTENT. check/verify front-ends
+// call it on the report before they print a verdict.
+void requireSomethingCompared(const ComparisonReport& report, const std::string& scene);
+
 class Checker {
 public:
     // Validates the scene (throws Error: no triangles, an index out of range) and builds both

@@ -76,6 +76,12 @@ double eyeZFromDistance(const Camera& camera, const glm::dvec2& pWindow, double 
 std::optional<glm::dvec3> eyePointFromDepth(const Camera& camera, const glm::dvec2& pWindow, double value,
                                             DepthQuantity quantity);
 
+// Refuses (throws Error) a depth value the camera cannot produce: window depth outside the
+// depth range, z_ndc outside the convention's NDC range, eye-z or distance not in front of
+// the eye, or anything not finite. `name` begins the message ("--depth 2 (window) must lie in
+// [0, 1], the camera's depth range").
+void requireDepthValue(const Camera& camera, DepthQuantity quantity, double value, const std::string& name);
+
 // Batch unprojection of a whole map: `values` holds width·height depth values of `quantity`
 // (row 0 at the top, the camera's image size); every `stride`-th pixel in x and y from (0, 0)
 // becomes a point, misses (as eyePointFromDepth defines them) are skipped and counted.

@@ -23,6 +23,8 @@ struct DepthMapFile {
     int width = 0, height = 0;
     std::string channel;          // the channel read
     std::vector<double> value;    // width·height; NaN where an integer file stores 0 (a miss)
+    double valueQuantum = 0;      // the storage step of `value`: 1/scale for integer files, 0 for
+                                  // float files (binary32: the step depends on the value)
 };
 // The channel named `preferredChannel` if there is one, else the first. Integer
 // files (16-bit PNG) need `scale`: value = stored / scale, 0 = miss. Float files are divided

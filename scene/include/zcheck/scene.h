@@ -30,6 +30,12 @@ struct Scene {
 // Throws Error for a scene with no triangles or an index out of range.
 void validateScene(const Scene& scene);
 
+// Makes a triangle soup a scene to check: validates it (validateScene), refuses it when no
+// triangle has a nonzero area (nothing to draw), and gives it a default camera that frames its
+// bounding sphere (framingCameraSpec). Messages begin with `what` ("cannot load mesh 'a.obj'").
+// The mesh loader and the Python module's Scene.from_arrays use it.
+Scene frameScene(Scene scene, const std::string& what);
+
 bool isBuiltinSceneName(const std::string& name);
 const std::vector<std::string>& builtinSceneNames();  // "default", "terrain", "near-crossing"
 

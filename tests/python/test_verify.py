@@ -1,0 +1,148 @@
+"""Checker.verify / verify_file / diagnose and read_depth_map against `zcheck export` + `zcheck verify`."""
+import json
+
+import numpy as np
+import pytest
+
+import zcheck
+from helpers import H, W, assert_documents_equal, run_cli, without_timings
+
+
+def consistent_names(hypotheses):
+    return [h["hypothesis"] for h in hypotheses if h["consistent"]]
+
+
+def test_ray_render_verifies_and_its_flip_does_not(default_checker, small_camera):
+    z = default_checker.render(small_camera, "eye-z")
+    report = default_checker.verify(small_camera, z, "eye-z")
+    assert report.consistent and report.unexplained == 0 and report.both_hit > 0.5 * W * H
+    doc = report.to_dict()
+    assert doc["depth_map"] == {"file": "<array>", "quantity": "eye-z", "channel": "", "scale": 0.0}
+    assert "diagnosis" not in doc
+
+    flipped = z[::-1]
+    bad = default_checker.verify(small_camera, flipped, "eye-z")
+    assert not bad.consistent and bad.unexplained > 1000 and bad.diagnosis is None
+    hypotheses = default_checker.diagnose(small_camera, flipped, "eye-z")
+    assert consistent_names(hypotheses)[0] == "y-flip"
+    assert set(hypotheses[0]) == {"hypothesis", "variant", "explanation", "consistent", "unexplained"}
+    diagnosed = default_checker.verify(small_camera, flipped, "eye-z", diagnose=True)
+    assert diagnosed.diagnosis == hypotheses
+    # (the JSON's explanations can differ in spacing: prettyJson folds "[-1,1]" inside strings too)
+    squeeze = lambda hs: [{**h, "explanation": h["explanation"].replace(" ", "")} for h in hs]
+    assert squeeze(diagnosed.to_dict()["diagnosis"]) == squeeze(hypotheses)
+    assert diagnosed.summary().rstrip().endswith("diagnosis  " + next(h["explanation"] for h in hypotheses
+                                                                           if h["consistent"]))
+    # the unflipped map needs no diagnosis, even when asked for one
+    assert default_checker.verify(small_camera, z, "eye-z", diagnose=True).diagnosis is None
+
+
+def test_every_quantity_round_trips_and_the_wrong_one_is_named(default_checker, small_camera):
+    for quantity in zcheck.depth_quantities:
+        values = default_checker.render(small_camera, quantity)
+        assert default_checker.verify(small_camera, values, quantity).consistent, quantity
+    distance = default_checker.render(small_camera, "distance")
+    assert not default_checker.verify(small_camera, distance, "eye-z").consistent
+    assert "distance-as-eye-z" in consistent_names(default_checker.diagnose(small_camera, distance, "eye-z"))
+
+
+def test_map_dtypes_miss_and_scale(default_checker, small_camera):
+    z = default_checker.render(small_camera, "eye-z", dtype=np.float64)
+    hit = np.isfinite(z)
+    # millimetres as uint16, 0 = miss, as a 16-bit PNG holds them
+    mm = np.where(hit, np.round(z * 1000), 0).astype(np.uint16)
+    report = default_checker.verify(small_camera, mm, "eye-z", scale=1000)
+    assert report.consistent and report.both_hit == hit.sum()
+    assert report.to_dict()["depth_map"]["scale"] == 1000
+    # a renderer's own "no surface" value
+    assert default_checker.verify(small_camera, np.where(hit, z, -7.0), "eye-z", miss=-7.0).consistent
+    assert default_checker.verify(small_camera, np.where(hit, z, 0.0), "eye-z").consistent  # <= 0 is a miss
+    far = np.where(hit, z, 1e9)
+    assert not default_checker.verify(small_camera, far, "eye-z").consistent  # a surface at 1e9 that is not there
+    assert default_checker.verify(small_camera, far, "eye-z", miss=1e9).consistent
+    # the same map in metres with a scale: stored = depth x scale
+    assert default_checker.verify(small_camera, z * 4, "eye-z", scale=4).consistent
+    # a float map off by 1 mm is not within float32 tolerance
+    assert not default_checker.verify(small_camera, z + 1e-3, "eye-z").consistent
+
+
+@pytest.mark.parametrize("suffix,exported,read_as", [("pfm", "eye-z", "eye-z"), ("exr", "eye-z", "eye-z"),
+                                                     ("exr", "distance", "eye-z"), ("tif", "window", "window")])
+def test_cli_export_then_python_verify_matches_cli_verify(tmp_path, default_checker, small_camera, small_camera_file,
+                                                          suffix, exported, read_as):
+    path = tmp_path / f"depth.{suffix}"
+    run_cli("export", "--camera", small_camera_file, "--quantity", exported, "-o", path, check_rc=0)
+    rc, out, _ = run_cli("verify", "--camera", small_camera_file, "--depth-map", path, "--quantity", read_as,
+                         "--diagnose", "--json")
+    cli = json.loads(out)
+    assert rc == (0 if cli["consistent"] else 1)
+    assert cli["consistent"] is (exported == read_as)
+
+    # the file holds exactly what render() returns (float32, row 0 at the top)
+    values = zcheck.read_depth_map(str(path), small_camera, quantity=exported)
+    assert values.shape == (H, W) and values.dtype == np.float64
+    assert np.array_equal(values, default_checker.render(small_camera, exported).astype(np.float64))
+
+    # read_depth_map + verify: the same verdict and counts
+    report = default_checker.verify(small_camera, values, read_as, diagnose=True)
+    assert report.consistent is cli["consistent"]
+    assert report.to_dict()["pixels"] == cli["pixels"]
+    if not report.consistent:
+        assert consistent_names(report.diagnosis) == consistent_names(cli["diagnosis"])
+
+    # verify_file: the command's whole document but for the timings
+    from_file = default_checker.verify_file(small_camera, str(path), read_as, diagnose=True)
+    assert_documents_equal(without_timings(from_file.to_dict()), without_timings(cli))
+
+
+def test_png_millimetres_match_the_cli(tmp_path, default_checker, small_camera, small_camera_file):
+    path = tmp_path / "depth_mm.png"
+    run_cli("export", "--camera", small_camera_file, "--quantity", "eye-z", "--scale", 1000, "-o", path, check_rc=0)
+    _, out, _ = run_cli("verify", "--camera", small_camera_file, "--depth-map", path, "--quantity", "eye-z",
+                        "--scale", 1000, "--json", check_rc=0)
+    from_file = default_checker.verify_file(small_camera, str(path), "eye-z", scale=1000)
+    assert_documents_equal(without_timings(from_file.to_dict()), without_timings(json.loads(out)))
+    values = zcheck.read_depth_map(str(path), small_camera, scale=1000)
+    z = default_checker.render(small_camera, "eye-z", dtype=np.float64)
+    assert np.array_equal(np.isnan(values), np.isinf(z))
+    assert np.allclose(values[np.isfinite(z)], z[np.isfinite(z)], rtol=0, atol=0.5e-3 + 1e-12)
+    with pytest.raises(zcheck.Error) as caught:
+        zcheck.read_depth_map(str(path), small_camera)
+    rc, _, err = run_cli("verify", "--camera", small_camera_file, "--depth-map", path, "--quantity", "eye-z")
+    assert rc == 2 and err.strip() == "zcheck: error: " + str(caught.value)
+
+
+def test_read_depth_map_channels(tmp_path, default_checker, small_camera, small_camera_file):
+    path = tmp_path / "both.exr"
+    run_cli("export", "--camera", small_camera_file, "--quantity", "eye-z,distance", "-o", path, check_rc=0)
+    z = zcheck.read_depth_map(str(path), small_camera, quantity="eye-z")
+    d = zcheck.read_depth_map(str(path), small_camera, channel="distance")
+    assert np.array_equal(z, default_checker.render(small_camera, "eye-z").astype(np.float64))
+    assert np.array_equal(d, default_checker.render(small_camera, "distance").astype(np.float64))
+    with pytest.raises(zcheck.Error, match="has no channel 'depth'"):
+        zcheck.read_depth_map(str(path), small_camera, channel="depth")
+    with pytest.raises(zcheck.Error, match="160x120|160|120"):
+        zcheck.read_depth_map(str(path), small_camera.replace(width=80))
+
+
+def write_pfm(path, image):
+    """A 1-channel little-endian PFM (rows stored bottom to top, as the format says)."""
+    height, width = image.shape
+    with open(path, "wb") as f:
+        f.write(f"Pf\n{width} {height}\n-1.0\n".encode())
+        f.write(np.ascontiguousarray(image[::-1], dtype="<f4").tobytes())
+
+
+def test_regression_verify_scale_on_a_float_map_kept_the_integer_quantum(tmp_path, default_checker, small_camera,
+                                                                          small_camera_file):
+    """`verify --scale 1000` on a float map in millimetres took 1/scale (1 mm) as the storage
+    step, as for a 16-bit PNG, and so accepted errors a thousand times the float's own step."""
+    eye_z = default_checker.render(small_camera, "eye-z", route="raster").astype(np.float64)
+    millimetres = np.where(np.isfinite(eye_z), eye_z * 1000.0, np.inf)
+    good, bad = tmp_path / "good.pfm", tmp_path / "bad.pfm"
+    write_pfm(good, millimetres)
+    # 0.25 mm too far everywhere: far beyond binary32's step (~1e-3 mm at these depths), within 1 mm.
+    write_pfm(bad, np.where(np.isfinite(millimetres), millimetres + 0.25, np.inf))
+    args = ("verify", "--camera", small_camera_file, "--quantity", "eye-z", "--scale", "1000", "--depth-map")
+    assert run_cli(*args, good)[0] == 0
+    assert run_cli(*args, bad)[0] == 1
