@@ -36,23 +36,13 @@ int runVerifyCommand(const VerifyOptions& o)
                                            camera.width(), camera.height());
     const DepthMap map{file.width, file.height, quantity, file.value, file.valueQuantum};
     const Checker checker(std::move(scene));
-    const VerifyResult run = checker.verify(camera, map);
-    requireSomethingCompared(run.comparison.report, checker.scene().name);
-    std::vector<Hypothesis> hypotheses;
-    const bool diagnosed = o.diagnose && !run.comparison.report.consistent();
-    if (diagnosed) hypotheses = checker.diagnose(camera, map);
-    const std::string reportJson =
-        verifyReportJson(run.report, {o.depthMap, o.quantity, file.channel, o.scale}, diagnosed ? &hypotheses : nullptr);
+    const VerifyOutcome verified = verifyAndReport(checker, camera, map, {o.depthMap, o.quantity, file.channel, o.scale}, o.diagnose);
+    const VerifyResult& run = verified.run;
     if (!o.outDir.empty()) {
-        folder.write(outputs, run.truth, run.map, run.comparison, reportJson);
+        folder.write(outputs, run.truth, run.map, run.comparison, verified.json);
         outputs.commit();
     }
-    if (o.json) {
-        std::cout << reportJson << "\n";
-    } else {
-        std::cout << formatSummary(run.report, "ground truth (Embree) vs depth map '" + o.depthMap + "' (" + o.quantity + ")");
-        if (diagnosed) std::cout << "\n" << formatDiagnosis(hypotheses);
-    }
+    std::cout << (o.json ? verified.json : verified.summary) << (o.json ? "\n" : "");
     return run.comparison.report.consistent() ? kExitConsistent : kExitInconsistent;
 }
 

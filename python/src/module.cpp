@@ -5,6 +5,7 @@
 // Arrays are row-major numpy arrays; images have row 0 at the top; matrices are written as on
 // paper for column vectors (M[r, c], p' = M·p), while GLM stores m[c][r].
 // The GIL is released around every render, check, verify, diagnosis, scene load and BVH build.
+#include "bindings.h"
 #include "camera_json.h"
 #include "zcheck/camera.h"
 #include "zcheck/camera_file.h"
@@ -12,7 +13,6 @@
 #include "zcheck/compare.h"
 #include "zcheck/convention.h"
 #include "zcheck/error.h"
-#include "zcheck/image_io.h"
 #include "zcheck/inverse_projection.h"
 #include "zcheck/mesh_loader.h"
 #include "zcheck/mistakes.h"
@@ -36,10 +36,10 @@
 
 namespace py = pybind11;
 using namespace zcheck;
+using namespace zcheck::python;
 
 namespace {
 
-[[noreturn]] void fail(const std::string& message) { throw Error(message); }
 
 // ---------------------------------------------------------------------------------------------
 // numpy helpers
@@ -150,17 +150,6 @@ ExportQuantity exportQuantityFromName(const std::string& name)
     fail("unknown quantity '" + name + "' (expected one of " + joined(names) + ")");
 }
 
-ExportQuantity exportOf(DepthQuantity q)
-{
-    switch (q) {
-    case DepthQuantity::Window: return ExportQuantity::Window;
-    case DepthQuantity::Ndc: return ExportQuantity::Ndc;
-    case DepthQuantity::EyeZ: return ExportQuantity::EyeZ;
-    case DepthQuantity::Distance: return ExportQuantity::Distance;
-    }
-    return ExportQuantity::Window;
-}
-
 const std::vector<std::string>& depthQuantityNames()
 {
     static const std::vector<std::string> names = {"window", "ndc", "eye-z", "distance"};
@@ -171,13 +160,6 @@ constexpr int kPixelClassCount = int(PixelClass::RasterOnly) + 1;
 
 // ---------------------------------------------------------------------------------------------
 // threads: at most N worker threads for one call (TBB's limit is process-wide while it lives)
-
-std::unique_ptr<tbb::global_control> threadLimit(std::optional<int> threads)
-{
-    if (!threads) return nullptr;
-    if (*threads < 1 || *threads > 1024) fail("threads must be in 1..1024, got " + std::to_string(*threads));
-    return std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, std::size_t(*threads));
-}
 
 // ---------------------------------------------------------------------------------------------
 // scenes
@@ -528,25 +510,6 @@ MapInput mapFromArray(py::handle depth, const Camera& camera, std::optional<doub
 // ---------------------------------------------------------------------------------------------
 // reports
 
-struct PyReport {
-    CheckReport report;
-    bool verify = false;
-    std::string json;     // exactly what `zcheck check --json` / `zcheck verify --json` prints
-    std::string summary;  // exactly what they print without --json
-    std::vector<std::uint8_t> pixelClass;
-    std::vector<float> errorOverTolerance;
-    std::vector<double> rayWindowDepth, comparedWindowDepth;
-    std::optional<std::vector<Hypothesis>> diagnosis;
-};
-
-template <class T>
-py::array_t<T> image(const std::vector<T>& values, int width, int height)
-{
-    py::array_t<T> out({py::ssize_t(height), py::ssize_t(width)});
-    std::copy(values.begin(), values.end(), out.mutable_data());
-    return out;
-}
-
 py::list diagnosisList(const std::vector<Hypothesis>& hypotheses)
 {
     py::list out;
@@ -560,15 +523,6 @@ py::list diagnosisList(const std::vector<Hypothesis>& hypotheses)
         out.append(d);
     }
     return out;
-}
-
-void fillComparison(PyReport& r, const Comparison& c, const RenderResult& ray, const RenderResult& compared)
-{
-    r.pixelClass.resize(c.pixelClass.size());
-    for (std::size_t i = 0; i < c.pixelClass.size(); ++i) r.pixelClass[i] = std::uint8_t(c.pixelClass[i]);
-    r.errorOverTolerance = c.errorOverTolerance;
-    r.rayWindowDepth = ray.windowDepth.value;
-    r.comparedWindowDepth = compared.windowDepth.value;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -985,19 +939,13 @@ Misses hold the quantity's miss value: the clear value (window), NDC z of the fa
                     py::gil_scoped_release release;
                     const auto limit = threadLimit(threads);
                     const DepthMap map{camera.width(), camera.height(), quantity, std::move(input.values), input.quantum};
-                    const VerifyResult run = checker.verify(camera, map);
-                    requireSomethingCompared(run.comparison.report, checker.scene().name);
-                    std::vector<Hypothesis> hypotheses;
-                    const bool diagnosed = diagnose && !run.comparison.report.consistent();
-                    if (diagnosed) hypotheses = checker.diagnose(camera, map);
-                    const std::string file = "<array>";
+                    VerifyOutcome verified =
+                        verifyAndReport(checker, camera, map, {"<array>", quantityName, "", scale ? *scale : 0.0}, diagnose);
+                    const VerifyResult& run = verified.run;
                     r->report = run.report;
-                    r->json = verifyReportJson(run.report, {file, quantityName, "", scale ? *scale : 0.0},
-                                               diagnosed ? &hypotheses : nullptr);
-                    r->summary =
-                        formatSummary(run.report, "ground truth (Embree) vs depth map '" + file + "' (" + quantityName + ")");
-                    if (diagnosed) r->summary += "\n" + formatDiagnosis(hypotheses);
-                    if (diagnosed) r->diagnosis = std::move(hypotheses);
+                    r->json = std::move(verified.json);
+                    r->summary = std::move(verified.summary);
+                    if (verified.diagnosed) r->diagnosis = std::move(verified.diagnosis);
                     fillComparison(*r, run.comparison, run.truth, run.map);
                 }
                 return r;
@@ -1015,47 +963,6 @@ scale:    stored value = depth x scale. Integer arrays need it (value = stored /
           quantum 1/scale, like a 16-bit PNG); float arrays are divided by it.
 diagnose: when inconsistent, also run diagnose() and put it in the report (`--diagnose`).
 Returns a Report whose to_dict() is `zcheck verify --json`'s document (depth_map.file "<array>").)doc")
-        .def(
-            "verify_file",
-            [](const Checker& checker, const Camera& camera, const std::string& path, const std::string& quantityName,
-               std::optional<double> scale, bool diagnose, std::optional<int> threads) {
-                // Exactly `zcheck verify --depth-map PATH --quantity Q [--scale S] [--diagnose]`
-                // (cli/verify.cpp): the quantity's channel, and the quantum 1/scale when a scale is given.
-                const DepthQuantity quantity = depthQuantityFromName(quantityName);
-                if (scale && !(std::isfinite(*scale) && *scale > 0))
-                    fail("scale must be a positive finite number, got " + formatNumber(*scale));
-                const double s = scale ? *scale : 0.0;
-                auto r = std::make_unique<PyReport>();
-                r->verify = true;
-                {
-                    py::gil_scoped_release release;
-                    const auto limit = threadLimit(threads);
-                    const DepthMapFile file =
-                        readDepthMap(path, channelNameOf(exportOf(quantity)), s, camera.width(), camera.height());
-                    const DepthMap map{file.width, file.height, quantity, file.value, s > 0 ? 1.0 / s : 0.0};
-                    const VerifyResult run = checker.verify(camera, map);
-                    requireSomethingCompared(run.comparison.report, checker.scene().name);
-                    std::vector<Hypothesis> hypotheses;
-                    const bool diagnosed = diagnose && !run.comparison.report.consistent();
-                    if (diagnosed) hypotheses = checker.diagnose(camera, map);
-                    r->report = run.report;
-                    r->json = verifyReportJson(run.report, {path, quantityName, file.channel, s},
-                                               diagnosed ? &hypotheses : nullptr);
-                    r->summary =
-                        formatSummary(run.report, "ground truth (Embree) vs depth map '" + path + "' (" + quantityName + ")");
-                    if (diagnosed) r->summary += "\n" + formatDiagnosis(hypotheses);
-                    if (diagnosed) r->diagnosis = std::move(hypotheses);
-                    fillComparison(*r, run.comparison, run.truth, run.map);
-                }
-                return r;
-            },
-            py::arg("camera"), py::arg("path"), py::arg("quantity"), py::kw_only(), py::arg("scale") = py::none(),
-            py::arg("diagnose") = false, py::arg("threads") = py::none(),
-            R"doc(A depth map file against the ground truth, exactly as `zcheck verify --depth-map PATH --quantity Q
-[--scale S] [--diagnose]` does it: EXR, PFM, TIFF or 16-bit PNG (scale required: value = stored /
-scale, 0 = miss), the quantity's channel (window, ndc, Z, distance) or else the first, and the
-map's storage quantum 1/scale when a scale is given. to_dict() equals `zcheck verify --json`'s
-document but for timings.)doc")
         .def(
             "diagnose",
             [](const Checker& checker, const Camera& camera, py::object depth, const std::string& quantityName,
@@ -1119,36 +1026,7 @@ stride:   every stride-th pixel in x and y from (0, 0).
 Returns (points, pixels): points (N, 3) float64, pixels (N, 2) int64 as (col, row) with row 0 at
 the top, one per non-miss pixel, in scan order.)doc");
 
-    m.def(
-        "read_depth_map",
-        [](const std::string& path, const Camera& camera, std::optional<std::string> quantity,
-           std::optional<std::string> channel, std::optional<double> scale) {
-            if (quantity && channel) fail("read_depth_map: give quantity or channel, not both");
-            const std::string preferred =
-                channel ? *channel : quantity ? channelNameOf(exportOf(depthQuantityFromName(*quantity))) : std::string();
-            if (scale && !(std::isfinite(*scale) && *scale > 0))
-                fail("scale must be a positive finite number, got " + formatNumber(*scale));
-            DepthMapFile file;
-            {
-                py::gil_scoped_release release;
-                file = readDepthMap(path, preferred, scale ? *scale : 0.0, camera.width(), camera.height());
-            }
-            if (channel && file.channel != *channel)
-                fail("depth map '" + path + "' has no channel '" + *channel + "' (the first channel is '" + file.channel +
-                     "')");
-            return image(file.value, file.width, file.height);
-        },
-        py::arg("path"), py::arg("camera"), py::kw_only(), py::arg("quantity") = py::none(),
-        py::arg("channel") = py::none(), py::arg("scale") = py::none(),
-        R"doc(Read a depth map file as `zcheck verify` and `zcheck unproject` do: EXR, PFM, TIFF, or a 16-bit
-PNG with scale (value = stored / scale, 0 = miss -> NaN), told apart by their first bytes. Returns
-an (H, W) float64 array, row 0 at the top (PFM's bottom-to-top rows are flipped).
 
-camera:   the map must have the camera's size.
-quantity: read that quantity's channel if the file has it (window, ndc, Z for eye-z, distance),
-          else the first channel, as the command line does; or
-channel:  read exactly this channel (an error if the file has none of that name).
-scale:    stored value = depth x scale; float files are divided by it.)doc");
 
     m.attr("__name__") = "zcheck._zcheck";
 }

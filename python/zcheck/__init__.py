@@ -44,7 +44,6 @@ from ._zcheck import (  # noqa: F401
     mistakes,
     pixel_classes,
     quantities,
-    read_depth_map,
     routes,
     unproject,
 )
@@ -118,6 +117,41 @@ def _camera_from_dict(cls, d, source="camera dict"):
 
 
 Camera.from_dict = classmethod(_camera_from_dict)
+
+
+def _files():
+    """zcheck._zcheck_files, imported on first use: it links OpenImageIO, whose start-up
+    (~0.5 s) `import zcheck` should not pay when no image file is read."""
+    from . import _zcheck_files
+    return _zcheck_files
+
+
+def read_depth_map(path, camera, *, quantity=None, channel=None, scale=None):
+    """Read a depth map file as `zcheck verify` and `zcheck unproject` do: EXR, PFM, TIFF, or a 16-bit
+PNG with scale (value = stored / scale, 0 = miss -> NaN), told apart by their first bytes. Returns
+an (H, W) float64 array, row 0 at the top (PFM's bottom-to-top rows are flipped).
+
+camera:   the map must have the camera's size.
+quantity: read that quantity's channel if the file has it (window, ndc, Z for eye-z, distance),
+          else the first channel, as the command line does; or
+channel:  read exactly this channel (an error if the file has none of that name).
+scale:    stored value = depth x scale; float files are divided by it.
+    """
+    return _files().read_depth_map(str(path), camera, quantity=quantity, channel=channel, scale=scale)
+
+
+def _verify_file(self, camera, path, quantity, *, scale=None, diagnose=False, threads=None):
+    """A depth map file against the ground truth, exactly as `zcheck verify --depth-map PATH --quantity Q
+[--scale S] [--diagnose]` does it: EXR, PFM, TIFF or 16-bit PNG (scale required: value = stored /
+scale, 0 = miss), the quantity's channel (window, ndc, Z, distance) or else the first, and the
+file's storage quantum (1/scale for integer files, binary32's own step for float files). to_dict() equals `zcheck verify --json`'s
+document but for timings.
+    """
+    return _files().verify_file(self, camera, str(path), quantity, scale=scale, diagnose=diagnose, threads=threads)
+
+
+_verify_file.__name__ = _verify_file.__qualname__ = "verify_file"
+Checker.verify_file = _verify_file
 
 for _name in ("Camera", "Checker", "Error", "Report", "Scene", "read_depth_map", "unproject"):
     try:

@@ -193,6 +193,21 @@ std::string verifyReportJson(const CheckReport& report, const DepthMapSource& so
     return prettyJson(document);
 }
 
+VerifyOutcome verifyAndReport(const Checker& checker, const Camera& camera, const DepthMap& map,
+                              const DepthMapSource& source, bool diagnose)
+{
+    VerifyOutcome out;
+    out.run = checker.verify(camera, map);
+    requireSomethingCompared(out.run.comparison.report, checker.scene().name);
+    out.diagnosed = diagnose && !out.run.comparison.report.consistent();
+    if (out.diagnosed) out.diagnosis = checker.diagnose(camera, map);
+    out.json = verifyReportJson(out.run.report, source, out.diagnosed ? &out.diagnosis : nullptr);
+    out.summary = formatSummary(out.run.report, "ground truth (Embree) vs depth map '" + source.file + "' (" +
+                                                    source.quantity + ")");
+    if (out.diagnosed) out.summary += "\n" + formatDiagnosis(out.diagnosis);
+    return out;
+}
+
 std::string formatDiagnosis(const std::vector<Hypothesis>& hypotheses)
 {
     for (const auto& h : hypotheses)

@@ -146,3 +146,6 @@ def test_regression_verify_scale_on_a_float_map_kept_the_integer_quantum(tmp_pat
     args = ("verify", "--camera", small_camera_file, "--quantity", "eye-z", "--scale", "1000", "--depth-map")
     assert run_cli(*args, good)[0] == 0
     assert run_cli(*args, bad)[0] == 1
+    # The module's file reader takes the same quantum.
+    assert default_checker.verify_file(small_camera, str(good), "eye-z", scale=1000).consistent
+    assert not default_checker.verify_file(small_camera, str(bad), "eye-z", scale=1000).consistent

@@ -26,6 +26,20 @@ struct DepthMapSource {
 // `zcheck verify --json`: the check report plus the map's source and, when given, the diagnosis.
 std::string verifyReportJson(const CheckReport& report, const DepthMapSource& source,
                              const std::vector<Hypothesis>* diagnosis = nullptr);
+// One verification as `zcheck verify` reports it: the comparison (refused with Error "nothing to
+// compare" when neither side sees a surface), the diagnosis when asked for and the map is
+// inconsistent, the JSON document and the summary. The command line and the Python module
+// both go through it.
+struct VerifyOutcome {
+    VerifyResult run;
+    bool diagnosed = false;
+    std::vector<Hypothesis> diagnosis;
+    std::string json;      // `zcheck verify --json`
+    std::string summary;   // `zcheck verify`, the diagnosis line included
+};
+VerifyOutcome verifyAndReport(const Checker& checker, const Camera& camera, const DepthMap& map,
+                              const DepthMapSource& source, bool diagnose);
+
 // The diagnosis line for people: the first consistent hypothesis, or the closest one.
 std::string formatDiagnosis(const std::vector<Hypothesis>& hypotheses);
 

@@ -1,0 +1,34 @@
+#include "bindings.h"
+
+namespace zcheck::python {
+
+void fail(const std::string& message) { throw Error(message); }
+
+ExportQuantity exportOf(DepthQuantity q)
+{
+    switch (q) {
+    case DepthQuantity::Window: return ExportQuantity::Window;
+    case DepthQuantity::Ndc: return ExportQuantity::Ndc;
+    case DepthQuantity::EyeZ: return ExportQuantity::EyeZ;
+    case DepthQuantity::Distance: return ExportQuantity::Distance;
+    }
+    return ExportQuantity::Window;
+}
+
+std::unique_ptr<tbb::global_control> threadLimit(std::optional<int> threads)
+{
+    if (!threads) return nullptr;
+    if (*threads < 1 || *threads > 1024) fail("threads must be in 1..1024, got " + std::to_string(*threads));
+    return std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, std::size_t(*threads));
+}
+
+void fillComparison(PyReport& r, const Comparison& c, const RenderResult& ray, const RenderResult& compared)
+{
+    r.pixelClass.resize(c.pixelClass.size());
+    for (std::size_t i = 0; i < c.pixelClass.size(); ++i) r.pixelClass[i] = std::uint8_t(c.pixelClass[i]);
+    r.errorOverTolerance = c.errorOverTolerance;
+    r.rayWindowDepth = ray.windowDepth.value;
+    r.comparedWindowDepth = compared.windowDepth.value;
+}
+
+}  // namespace zcheck::python

@@ -1,0 +1,53 @@
+#pragma once
+// What the two extension modules share: zcheck._zcheck (everything but image files) and
+// zcheck._zcheck_files (depth-map files through OpenImageIO, imported on first use so that
+// `import zcheck` does not pay OpenImageIO's start-up).
+#include "zcheck/checker.h"
+#include "zcheck/error.h"
+#include "zcheck/quantity.h"
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <tbb/global_control.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace zcheck::python {
+
+namespace py = pybind11;
+
+// Raises zcheck.Error with `message`.
+[[noreturn]] void fail(const std::string& message);
+// The export quantity that stores a depth quantity (its channel name: window, ndc, Z, distance).
+ExportQuantity exportOf(DepthQuantity q);
+// At most N worker threads for one call (TBB's limit is process-wide while it lives); none: all.
+std::unique_ptr<tbb::global_control> threadLimit(std::optional<int> threads);
+
+// zcheck.Report: the result of Checker.check, Checker.verify or Checker.verify_file.
+struct PyReport {
+    CheckReport report;
+    bool verify = false;
+    std::string json;     // exactly what `zcheck check --json` / `zcheck verify --json` prints
+    std::string summary;  // exactly what they print without --json
+    std::vector<std::uint8_t> pixelClass;
+    std::vector<float> errorOverTolerance;
+    std::vector<double> rayWindowDepth, comparedWindowDepth;
+    std::optional<std::vector<Hypothesis>> diagnosis;
+};
+void fillComparison(PyReport& r, const Comparison& c, const RenderResult& ray, const RenderResult& compared);
+
+// An (height, width) array of `values` (row 0 at the top).
+template <class T>
+py::array_t<T> image(const std::vector<T>& values, int width, int height)
+{
+    py::array_t<T> out({py::ssize_t(height), py::ssize_t(width)});
+    std::copy(values.begin(), values.end(), out.mutable_data());
+    return out;
+}
+
+}  // namespace zcheck::python
