@@ -1,11 +1,11 @@
 // zcheck export: one route's render as a depth or geometry file with a JSON sidecar.
 #include "common.h"
+#include "image_plugin.h"
 
 #include "camera_json.h"
 #include "zcheck/atomic_file.h"
 #include "zcheck/error.h"
 #include "zcheck/export.h"
-#include "zcheck/image_io.h"
 #include "zcheck/mesh_loader.h"
 #include "zcheck/png_file.h"
 #include "zcheck/version.h"
@@ -53,7 +53,7 @@ int runExportCommand(const ExportOptions& o)
     std::vector<QuantityImage> images;
     for (ExportQuantity q : quantities) images.push_back(quantityImage(scene, camera, route, q));
     std::string format;
-    outputs.write(o.output, [&](const std::string& temporary) { format = writeQuantityFile(temporary, images, o.scale); });
+    outputs.write(o.output, [&](const std::string& temporary) { format = cli::images().writeQuantityFile(temporary, images, o.scale); });
 
     nlohmann::json channels = nlohmann::json::array();
     for (const auto& image : images)

@@ -1,6 +1,7 @@
 #include "run_folder.h"
 
-#include "zcheck/image_io.h"
+#include "image_plugin.h"
+
 #include "zcheck/png_file.h"
 #include "zcheck/report_images.h"
 
@@ -26,8 +27,8 @@ void RunFolder::write(OutputFiles& outputs, const RenderResult& ray, const Rende
                       const Comparison& comparison, const std::string& reportJson) const
 {
     const int W = comparison.report.width, H = comparison.report.height;
-    outputs.write(path("ray_depth.exr"), [&](const std::string& t) { writeExr(t, W, H, {"window"}, asFloats(ray.windowDepth)); });
-    outputs.write(path(secondName), [&](const std::string& t) { writeExr(t, W, H, {"window"}, asFloats(second.windowDepth)); });
+    outputs.write(path("ray_depth.exr"), [&](const std::string& t) { images().writeExr(t, W, H, {"window"}, asFloats(ray.windowDepth)); });
+    outputs.write(path(secondName), [&](const std::string& t) { images().writeExr(t, W, H, {"window"}, asFloats(second.windowDepth)); });
     outputs.write(path("error_heatmap.png"), [&](const std::string& t) { writePng8(t, W, H, errorHeatmapRgb(comparison)); });
     outputs.write(path("coverage_classes.png"), [&](const std::string& t) { writePng8(t, W, H, pixelClassRgb(comparison)); });
     outputs.writeText(path("report.json"), reportJson + "\n");

@@ -1,11 +1,11 @@
 // zcheck unproject: the inverse projection — a pixel's ray, the point at a depth value, or a
 // whole depth map as a PLY point cloud.
 #include "common.h"
+#include "image_plugin.h"
 
 #include "camera_json.h"
 #include "zcheck/atomic_file.h"
 #include "zcheck/error.h"
-#include "zcheck/image_io.h"
 #include "zcheck/inverse_projection.h"
 #include "zcheck/point_cloud.h"
 
@@ -85,7 +85,7 @@ int runUnprojectCommand(const UnprojectOptions& o)
     outputs.addInput(o.cameraFile);
     outputs.addInput(o.depthMap);
     outputs.add(o.output, "-o");
-    const DepthMapFile map = readDepthMap(o.depthMap, channelNameOf(exportQuantitiesFromList(o.quantity).front()), o.scale,
+    const DepthMapFile map = images().readDepthMap(o.depthMap, channelNameOf(exportQuantitiesFromList(o.quantity).front()), o.scale,
                                           camera.width(), camera.height());
     const UnprojectedMap cloud =
         unprojectMap(camera, map.value, quantity, o.space == "eye" ? PointSpace::Eye : PointSpace::World, o.stride);

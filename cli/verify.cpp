@@ -1,8 +1,8 @@
 // zcheck verify: a depth map rendered elsewhere against the ground truth, and its diagnosis.
 #include "common.h"
+#include "image_plugin.h"
 #include "run_folder.h"
 
-#include "zcheck/image_io.h"
 #include "zcheck/mesh_loader.h"
 #include "zcheck/report.h"
 
@@ -32,7 +32,7 @@ int runVerifyCommand(const VerifyOptions& o)
     if (!o.outDir.empty()) folder.plan(outputs);
     Scene scene = loadScene(o.input.scene);
     const Camera camera(cameraSpecFor(scene, o.input));
-    const DepthMapFile file = readDepthMap(o.depthMap, channelNameOf(exportQuantitiesFromList(o.quantity).front()), o.scale,
+    const DepthMapFile file = images().readDepthMap(o.depthMap, channelNameOf(exportQuantitiesFromList(o.quantity).front()), o.scale,
                                            camera.width(), camera.height());
     const DepthMap map{file.width, file.height, quantity, file.value, file.valueQuantum};
     const Checker checker(std::move(scene));

@@ -22,4 +22,8 @@ cmake --build "$tmp/example" > "$tmp/build.log" 2>&1 || { cat "$tmp/build.log" >
 ! grep -q "INCONSISTENT" "$tmp/out.txt"
 # The installed command-line tool runs from the prefix (no build-tree paths compiled in).
 "$tmp/prefix/bin/zcheck" --version | grep -q "$(cat "$source_dir/CMakeLists.txt" | sed -n 's/^project(zcheck VERSION \([0-9.]*\).*/\1/p')"
+# It starts without OpenImageIO, and loads it (the installed plugin) when it writes an image.
+! ldd "$tmp/prefix/bin/zcheck" | grep -q OpenImageIO
+"$tmp/prefix/bin/zcheck" export --quantity eye-z -o "$tmp/depth.exr" > /dev/null
+"$tmp/prefix/bin/zcheck" verify --depth-map "$tmp/depth.exr" --quantity eye-z > /dev/null
 echo "package_consumer: 1 passed, 0 failed"
