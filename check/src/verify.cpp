@@ -11,6 +11,7 @@
 #include <unordered_map>
 #include <cmath>
 #include <functional>
+#include <optional>
 
 namespace zcheck {
 
@@ -170,6 +171,8 @@ VerifyResult Checker::verify(const Camera& camera, const DepthMap& map) const
 std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& map) const
 {
     std::vector<Hypothesis> out;
+    // A hypothesis that only re-reads the map compares it with the truth as it is: rendered once.
+    std::optional<RenderResult> truth;
     for (const Mistake& mistake : mistakeCatalogue()) {
         if (!mistake.reread) continue;
         for (const Rereading& reading : mistake.reread(camera, map)) {
@@ -177,8 +180,11 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
             try {
                 const Camera hypothesisCamera(reading.camera ? *reading.camera : camera.spec());
                 const DepthMap& hypothesisMap = reading.map ? *reading.map : map;
-                const VerifyResult run = verifyAgainst(scene_, hypothesisCamera, hypothesisMap,
-                                                       renderRay(hypothesisCamera, reading.truthFaults), neighbours());
+                const bool sameTruth = !reading.camera && reading.truthFaults.none();
+                if (sameTruth && !truth) truth = renderRay(camera);
+                const VerifyResult run =
+                    verifyAgainst(scene_, hypothesisCamera, hypothesisMap,
+                                  sameTruth ? *truth : renderRay(hypothesisCamera, reading.truthFaults), neighbours());
                 out.push_back({mistake.name, reading.variant, reading.explanation, run.comparison.report.consistent(),
                                run.comparison.report.unexplained()});
             } catch (const Error&) {

@@ -31,4 +31,14 @@ void fillComparison(PyReport& r, const Comparison& c, const RenderResult& ray, c
     r.comparedWindowDepth = compared.windowDepth.value;
 }
 
+void fillVerification(PyReport& r, VerifyOutcome verified)
+{
+    r.verify = true;
+    r.report = verified.run.report;
+    r.json = std::move(verified.json);
+    r.summary = std::move(verified.summary);
+    if (verified.diagnosed) r.diagnosis = std::move(verified.diagnosis);
+    fillComparison(r, verified.run.comparison, verified.run.truth, verified.run.map);
+}
+
 }  // namespace zcheck::python

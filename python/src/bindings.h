@@ -5,6 +5,7 @@
 #include "zcheck/checker.h"
 #include "zcheck/error.h"
 #include "zcheck/quantity.h"
+#include "zcheck/report.h"
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -40,6 +41,8 @@ struct PyReport {
     std::optional<std::vector<Hypothesis>> diagnosis;
 };
 void fillComparison(PyReport& r, const Comparison& c, const RenderResult& ray, const RenderResult& compared);
+// A verification (verifyAndReport, report.h) as a Report: verify and verify_file share it.
+void fillVerification(PyReport& r, VerifyOutcome verified);
 
 // An (height, width) array of `values` (row 0 at the top).
 template <class T>

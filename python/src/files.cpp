@@ -35,24 +35,13 @@ PYBIND11_MODULE(_zcheck_files, m)
                 const DepthMapFile file =
                     readDepthMap(path, channelNameOf(exportOf(quantity)), s, camera.width(), camera.height());
                 const DepthMap map{file.width, file.height, quantity, file.value, file.valueQuantum};
-                VerifyOutcome verified =
-                    verifyAndReport(checker, camera, map, {path, quantityName, file.channel, s}, diagnose);
-                const VerifyResult& run = verified.run;
-                r->report = run.report;
-                r->json = std::move(verified.json);
-                r->summary = std::move(verified.summary);
-                if (verified.diagnosed) r->diagnosis = std::move(verified.diagnosis);
-                fillComparison(*r, run.comparison, run.truth, run.map);
+                fillVerification(*r, verifyAndReport(checker, camera, map, {path, quantityName, file.channel, s}, diagnose));
             }
             return r;
         },
         py::arg("checker"), py::arg("camera"), py::arg("path"), py::arg("quantity"), py::kw_only(), py::arg("scale") = py::none(),
         py::arg("diagnose") = false, py::arg("threads") = py::none(),
-        R"doc(A depth map file against the ground truth, exactly as `zcheck verify --depth-map PATH --quantity Q
-[--scale S] [--diagnose]` does it: EXR, PFM, TIFF or 16-bit PNG (scale required: value = stored /
-scale, 0 = miss), the quantity's channel (window, ndc, Z, distance) or else the first, and the
-file's storage quantum (1/scale for integer files, binary32's own step for float files). to_dict() equals `zcheck verify --json`'s
-document but for timings.)doc");
+        R"doc(See zcheck.Checker.verify_file.)doc");
 
     m.def(
         "read_depth_map",
@@ -75,13 +64,5 @@ document but for timings.)doc");
         },
         py::arg("path"), py::arg("camera"), py::kw_only(), py::arg("quantity") = py::none(),
         py::arg("channel") = py::none(), py::arg("scale") = py::none(),
-        R"doc(Read a depth map file as `zcheck verify` and `zcheck unproject` do: EXR, PFM, TIFF, or a 16-bit
-PNG with scale (value = stored / scale, 0 = miss -> NaN), told apart by their first bytes. Returns
-an (H, W) float64 array, row 0 at the top (PFM's bottom-to-top rows are flipped).
-
-camera:   the map must have the camera's size.
-quantity: read that quantity's channel if the file has it (window, ndc, Z for eye-z, distance),
-          else the first channel, as the command line does; or
-channel:  read exactly this channel (an error if the file has none of that name).
-scale:    stored value = depth x scale; float files are divided by it.)doc");
+        R"doc(See zcheck.read_depth_map.)doc");
 }

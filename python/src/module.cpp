@@ -939,14 +939,8 @@ Misses hold the quantity's miss value: the clear value (window), NDC z of the fa
                     py::gil_scoped_release release;
                     const auto limit = threadLimit(threads);
                     const DepthMap map{camera.width(), camera.height(), quantity, std::move(input.values), input.quantum};
-                    VerifyOutcome verified =
-                        verifyAndReport(checker, camera, map, {"<array>", quantityName, "", scale ? *scale : 0.0}, diagnose);
-                    const VerifyResult& run = verified.run;
-                    r->report = run.report;
-                    r->json = std::move(verified.json);
-                    r->summary = std::move(verified.summary);
-                    if (verified.diagnosed) r->diagnosis = std::move(verified.diagnosis);
-                    fillComparison(*r, run.comparison, run.truth, run.map);
+                    fillVerification(*r, verifyAndReport(checker, camera, map,
+                                                         {"<array>", quantityName, "", scale ? *scale : 0.0}, diagnose));
                 }
                 return r;
             },

@@ -30,6 +30,8 @@ struct RayFaults {
     bool flipRows = false;             // sample row H−1−row instead of row
     bool flipCols = false;             // sample column W−1−col instead of col
     bool distanceAsEyeZ = false;       // the hit's ray distance turned into depth as if it were eye-z
+
+    bool none() const { return shiftPixels == glm::dvec2(0.0) && !flipRows && !flipCols && !distanceAsEyeZ; }
 };
 
 class RayRenderer {
