@@ -30,6 +30,7 @@ Command addUnprojectCommand(CLI::App& app);
 Command addExportCommand(CLI::App& app);
 Command addVerifyCommand(CLI::App& app);
 Command addSuiteCommand(CLI::App& app);
+Command addBenchCommand(CLI::App& app);
 
 // Option validators, the same in every subcommand.
 extern const CLI::Validator kNonEmptyPath;

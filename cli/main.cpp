@@ -1,6 +1,6 @@
 // zcheck — the command line: a dispatcher. Each subcommand lives in its own file (check.cpp,
-// matrices.cpp, precision.cpp, unproject.cpp, export.cpp, verify.cpp, suite.cpp) and calls the
-// libraries. Exit status: 0 consistent, 1 inconsistent, 2 usage or input error, 3 internal
+// matrices.cpp, precision.cpp, unproject.cpp, export.cpp, verify.cpp, suite.cpp, bench.cpp)
+// and calls the libraries. Exit status: 0 consistent, 1 inconsistent, 2 usage or input error, 3 internal
 // failure (out of memory, a library error); errors are one line on stderr.
 #include "common.h"
 
@@ -21,7 +21,7 @@ int main(int argc, char** argv)
     app.set_version_flag("--version", std::string(zcheck::kVersion));
     const Command commands[] = {addCheckCommand(app),  addMatricesCommand(app), addPrecisionCommand(app),
                                 addUnprojectCommand(app), addExportCommand(app), addVerifyCommand(app),
-                                addSuiteCommand(app)};
+                                addSuiteCommand(app),  addBenchCommand(app)};
 
     // CLI11 says only "a subcommand is required" for a misspelt one: name it.
     if (argc > 1 && argv[1][0] != '-') {

@@ -247,7 +247,7 @@ TEST_CASE("a plane at a known eye depth yields exactly that depth through each r
                                                 : (reversed ? n * (f - D) / (D * (f - n)) : f * (D - n) / (D * (f - n)));
                         const double expected = range.first + (range.second - range.first) * unit;
                         const double q = storageQuantum(spec.depth.format, expected);
-                        const RenderResult byRay = checker.renderRay(camera), byRaster = checker.renderRaster(camera);
+                        const RenderResult byRay = checker.renderRay(camera, {}, EyePoints::Keep), byRaster = checker.renderRaster(camera);
                         INFO(name << " " << toString(type) << " far " << far << " " << format << (reversed ? " reversed" : "")
                                   << " range [" << range.first << "," << range.second << "]");
                         for (std::size_t i = 0; i < byRay.primitiveId.size(); ++i) {

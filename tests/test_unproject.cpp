@@ -39,7 +39,9 @@ TEST_CASE("depth from either route, unprojected, lands on the surface it came fr
                 spec.convention = Convention::preset(convention);
                 spec.depth.reversed = reversed;
                 const Camera camera(spec);
-                const CheckResult run = Checker(scene).check(camera);
+                const Checker checker(scene);
+                const CheckResult run = checker.check(camera);
+                const RenderResult ray = checker.renderRay(camera, {}, EyePoints::Keep);  // with its eye points
                 const double C = ToleranceModel::constantQuanta(spec.depth), S = ToleranceModel{}.snapPixels();
                 std::size_t rayHits = 0, rasterHits = 0, rayPoints = 0, rasterPoints = 0;
                 for (int row = 0; row < camera.height(); ++row)
@@ -48,11 +50,11 @@ TEST_CASE("depth from either route, unprojected, lands on the surface it came fr
                         const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
                         INFO(name << " " << convention << (reversed ? " reversed" : "") << " pixel " << col << "," << row);
                         // Ray route: exact window depth, and its eye-z and distance.
-                        const auto fromWindow = eyePointFromDepth(camera, pWindow, run.ray.windowDepth.value[i], DepthQuantity::Window);
-                        REQUIRE(fromWindow.has_value() == run.ray.hit(i));
-                        if (run.ray.hit(i)) {
+                        const auto fromWindow = eyePointFromDepth(camera, pWindow, ray.windowDepth.value[i], DepthQuantity::Window);
+                        REQUIRE(fromWindow.has_value() == ray.hit(i));
+                        if (ray.hit(i)) {
                             ++rayHits, ++rayPoints;
-                            const glm::dvec3 pEye = run.ray.pEye[i];
+                            const glm::dvec3 pEye = ray.pEye[i];
                             const double scale = 1e-9 * (1 + glm::length(pEye));
                             REQUIRE(glm::length(*fromWindow - pEye) <= 1e-6 * glm::length(pEye));
                             const auto fromEyeZ = eyePointFromDepth(camera, pWindow, camera.eyeZOf(pEye), DepthQuantity::EyeZ);
@@ -61,7 +63,7 @@ TEST_CASE("depth from either route, unprojected, lands on the surface it came fr
                             REQUIRE(glm::length(*fromEyeZ - pEye) <= scale);
                             REQUIRE(glm::length(*fromDistance - pEye) <= scale);
                             const glm::dvec3 pWorld(camera.worldFromEye * glm::dvec4(*fromEyeZ, 1.0));
-                            REQUIRE(planeOf(scene, run.ray.primitiveId[i]).distance(pWorld) <= scale);
+                            REQUIRE(planeOf(scene, ray.primitiveId[i]).distance(pWorld) <= scale);
                         }
                         // Raster route: the stored (quantized) value, within the tolerance model
                         // turned into a distance along the ray.

@@ -48,7 +48,10 @@ CheckResult Checker::check(const Camera& camera, const CheckOptions& options) co
     return run;
 }
 
-RenderResult Checker::renderRay(const Camera& camera, const RayFaults& faults) const { return rays_.render(camera, faults); }
+RenderResult Checker::renderRay(const Camera& camera, const RayFaults& faults, EyePoints eyePoints) const
+{
+    return rays_.render(camera, faults, eyePoints);
+}
 
 RenderResult Checker::renderRaster(const Camera& camera, const RasterFaults& faults) const
 {
@@ -62,7 +65,9 @@ RenderResult Checker::render(const Camera& camera, Route route, const RouteFault
 
 QuantityImage Checker::render(const Camera& camera, ExportQuantity quantity, Route route) const
 {
-    return quantityImage(scene_, camera, render(camera, route), quantity);
+    // The ray route's eye-space points are exact: exports of eye-z, distance and positions read them.
+    const RenderResult drawn = route == Route::Ray ? renderRay(camera, {}, EyePoints::Keep) : renderRaster(camera);
+    return quantityImage(scene_, camera, drawn, quantity);
 }
 
 const VertexNeighbours& Checker::neighbours() const

@@ -4,8 +4,11 @@
 #include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace zcheck {
 
@@ -53,12 +56,32 @@ double windowDepthSlope(const Camera& camera, const glm::dvec3& a, const glm::dv
 
 namespace {
 
-double percentile99(std::vector<double>& values)
+// The 99th percentile of non-negative values held in several vectors, without joining them:
+// a radix select on the bit patterns (for non-negative floats they order as the values do),
+// the top 16 bits first, then the values that share the chosen prefix.
+template <class Vectors>
+double percentile99(const Vectors& parts)
 {
-    if (values.empty()) return 0.0;
-    const std::size_t k = std::min(values.size() - 1, static_cast<std::size_t>(std::ceil(0.99 * values.size())) - 1);
-    std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(k), values.end());
-    return values[k];
+    std::size_t count = 0;
+    for (const std::vector<float>& part : parts) count += part.size();
+    if (count == 0) return 0.0;
+    std::size_t k = std::min(count - 1, static_cast<std::size_t>(std::ceil(0.99 * double(count))) - 1);
+    auto bits = [](float v) {
+        std::uint32_t b;
+        std::memcpy(&b, &v, sizeof b);
+        return b;
+    };
+    std::vector<std::size_t> histogram(std::size_t(1) << 16, 0);
+    for (const std::vector<float>& part : parts)
+        for (float v : part) ++histogram[bits(v) >> 16];
+    std::uint32_t prefix = 0;
+    while (k >= histogram[prefix]) k -= histogram[prefix++];
+    std::vector<float> sharing;
+    for (const std::vector<float>& part : parts)
+        for (float v : part)
+            if (bits(v) >> 16 == prefix) sharing.push_back(v);
+    std::nth_element(sharing.begin(), sharing.begin() + std::ptrdiff_t(k), sharing.end());
+    return sharing[k];
 }
 
 }  // namespace
@@ -69,8 +92,9 @@ PixelJudge::PixelJudge(const Scene& scene, const Camera& camera, const Tolerance
       C_(ToleranceModel::constantQuanta(camera.depth())),
       S_(tolerance.snapPixels()),
       E_(16 * std::ldexp(1.0, -52) * std::max(std::abs(camera.depth().rangeMin), std::abs(camera.depth().rangeMax))),
-      slopeCache_(scene.triangleCount(), NAN)
+      slopeCache_(std::make_unique<std::atomic<double>[]>(scene.triangleCount()))
 {
+    for (std::size_t t = 0; t < scene.triangleCount(); ++t) slopeCache_[t].store(NAN, std::memory_order_relaxed);
 }
 
 glm::dvec3 PixelJudge::vertex(std::uint32_t primitive, int corner) const
@@ -82,8 +106,12 @@ glm::dvec3 PixelJudge::vertex(std::uint32_t primitive, int corner) const
 double PixelJudge::slope(std::uint32_t primitive) const
 {
     if (!known(primitive)) return 0.0;
-    double& m = slopeCache_[primitive];
-    if (std::isnan(m)) m = windowDepthSlope(camera_, vertex(primitive, 0), vertex(primitive, 1), vertex(primitive, 2));
+    std::atomic<double>& cached = slopeCache_[primitive];
+    double m = cached.load(std::memory_order_relaxed);
+    if (std::isnan(m)) {
+        m = windowDepthSlope(camera_, vertex(primitive, 0), vertex(primitive, 1), vertex(primitive, 2));
+        cached.store(m, std::memory_order_relaxed);
+    }
     return m;
 }
 
@@ -134,113 +162,175 @@ bool isUnexplained(PixelClass c)
 
 }  // namespace
 
+namespace {
+
+// What one block of rows contributes to the report; blocks are merged in scan order.
+struct BlockTally {
+    ComparisonReport report;  // counts, maxima, worst pixel, samples, bounding box, bias samples
+    std::vector<float> errorQuanta, relativeEyeZ;  // per pixel compared on depth (binary32 suffices for statistics)
+    double signedErrorSum = 0;
+    std::int64_t quarterCounts[4] = {0, 0, 0, 0};
+};
+
+constexpr int kBlockRows = 8;
+constexpr std::size_t kUnexplainedSamples = 20;  // the first ones in scan order (compare.h)  // rows per block: fixed, so the merge order never depends on threads
+
+void noteUnexplained(ComparisonReport& r, const PixelFinding& f)
+{
+    if (r.unexplainedSamples.size() < kUnexplainedSamples) r.unexplainedSamples.push_back(f);
+    if (r.unexplainedMaxCol < 0) {
+        r.unexplainedMinCol = r.unexplainedMaxCol = f.col;
+        r.unexplainedMinRow = r.unexplainedMaxRow = f.row;
+    }
+    r.unexplainedMinCol = std::min(r.unexplainedMinCol, f.col);
+    r.unexplainedMaxCol = std::max(r.unexplainedMaxCol, f.col);
+    r.unexplainedMinRow = std::min(r.unexplainedMinRow, f.row);
+    r.unexplainedMaxRow = std::max(r.unexplainedMaxRow, f.row);
+}
+
+// Appends `block` (the rows after those of `total`) to `total`.
+void merge(BlockTally& total, BlockTally& block)
+{
+    ComparisonReport& r = total.report;
+    const ComparisonReport& b = block.report;
+    const bool firstCompared = r.agree + r.depthErrors == 0 && b.agree + b.depthErrors > 0;
+    if (firstCompared || b.maxErrorOverTolerance > r.maxErrorOverTolerance) {
+        r.maxErrorOverTolerance = std::max(r.maxErrorOverTolerance, b.maxErrorOverTolerance);
+        r.worst = b.worst;
+    }
+    r.bothHit += b.bothHit, r.bothMiss += b.bothMiss, r.rayOnly += b.rayOnly, r.rasterOnly += b.rasterOnly;
+    r.agree += b.agree, r.edgeSurface += b.edgeSurface, r.depthErrors += b.depthErrors;
+    r.coverageExplained += b.coverageExplained, r.lostAtClearValue += b.lostAtClearValue;
+    r.atClipPlane += b.atClipPlane, r.coverageUnexplained += b.coverageUnexplained;
+    r.maxErrorQuanta = std::max(r.maxErrorQuanta, b.maxErrorQuanta);
+    r.maxRelativeEyeZError = std::max(r.maxRelativeEyeZError, b.maxRelativeEyeZError);
+    r.biasSamples += b.biasSamples;
+    for (const PixelFinding& f : b.unexplainedSamples)
+        if (r.unexplainedSamples.size() < kUnexplainedSamples) r.unexplainedSamples.push_back(f);
+    if (b.unexplainedMaxCol >= 0) {  // the box of all of them, not only of the samples
+        const bool first = r.unexplainedMaxCol < 0;
+        r.unexplainedMinCol = first ? b.unexplainedMinCol : std::min(r.unexplainedMinCol, b.unexplainedMinCol);
+        r.unexplainedMinRow = first ? b.unexplainedMinRow : std::min(r.unexplainedMinRow, b.unexplainedMinRow);
+        r.unexplainedMaxCol = first ? b.unexplainedMaxCol : std::max(r.unexplainedMaxCol, b.unexplainedMaxCol);
+        r.unexplainedMaxRow = first ? b.unexplainedMaxRow : std::max(r.unexplainedMaxRow, b.unexplainedMaxRow);
+    }
+    total.signedErrorSum += block.signedErrorSum;
+    for (int k = 0; k < 4; ++k) total.quarterCounts[k] += block.quarterCounts[k];
+}
+
+}  // namespace
+
 Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderResult& ray,
                          const RenderResult& raster, const ToleranceModel& tolerance,
                          const std::vector<double>* rasterQuantum)
 {
     const int W = camera.width(), H = camera.height();
     Comparison out;
-    ComparisonReport& r = out.report;
-    r.width = W, r.height = H;
     out.pixelClass.assign(std::size_t(W) * H, PixelClass::BothMiss);
     out.errorOverTolerance.assign(std::size_t(W) * H, 0.0f);
 
     const PixelJudge judge(scene, camera, tolerance);
     const DepthFormat format = camera.depth().format;
     const double S = tolerance.snapPixels();
-    std::vector<double> errorQuanta, relativeEyeZ;
-    double signedErrorSum = 0;
-    std::int64_t quarterCounts[4] = {0, 0, 0, 0};
 
-    for (int row = 0; row < H; ++row) {
-        for (int col = 0; col < W; ++col) {
-            const std::size_t i = std::size_t(row) * W + col;
-            const bool rayHit = ray.hit(i), rasterHit = raster.hit(i);
-            const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
-            PixelFinding f;
-            f.col = col, f.row = row;
-            f.rayWindowDepth = ray.windowDepth.value[i];
-            f.rasterWindowDepth = raster.windowDepth.value[i];
-            f.rayPrimitive = ray.primitiveId[i];
-            f.rasterPrimitive = raster.primitiveId[i];
-
-            if (!rayHit && !rasterHit) {
-                ++r.bothMiss;
-                f.pixelClass = PixelClass::BothMiss;
-            } else if (rayHit && rasterHit) {
-                ++r.bothHit;
-                const double q = rasterQuantum ? (*rasterQuantum)[i] : storageQuantum(format, f.rayWindowDepth);
-                const double error = std::abs(f.rasterWindowDepth - f.rayWindowDepth);
-                const bool samePrimitive = f.rayPrimitive == f.rasterPrimitive;
-                double bound = 0;
-                f.pixelClass = judge.bothHit(f.rayWindowDepth, f.rayPrimitive, f.rasterWindowDepth, f.rasterPrimitive, q,
-                                             pWindow, bound);
-                f.errorQuanta = error / q;
-                f.toleranceQuanta = bound / q;
-                const double ratio = bound > 0 ? error / bound : (error > 0 ? INFINITY : 0.0);
-                if (samePrimitive && S * judge.slope(f.rayPrimitive) <= 0.1 * q) {
-                    // Quantization dominates here: feed the bias test.
-                    signedErrorSum += (f.rasterWindowDepth - f.rayWindowDepth) / q;
-                    const double position = f.rayWindowDepth / q;
-                    ++quarterCounts[std::clamp(int(4 * (position - std::floor(position))), 0, 3)];
-                    ++r.biasSamples;
+    auto compareBlock = [&](int firstRow, int lastRow, BlockTally& tally) {
+        ComparisonReport& r = tally.report;
+        for (int row = firstRow; row < lastRow; ++row) {
+            for (int col = 0; col < W; ++col) {
+                const std::size_t i = std::size_t(row) * W + col;
+                const bool rayHit = ray.hit(i), rasterHit = raster.hit(i);
+                if (!rayHit && !rasterHit) {
+                    ++r.bothMiss;  // pixelClass is BothMiss already
+                    continue;
                 }
-                if (f.pixelClass == PixelClass::EdgeSurface) {
-                    ++r.edgeSurface;
-                } else {
-                    f.pixelClass == PixelClass::Agree ? ++r.agree : ++r.depthErrors;
-                    out.errorOverTolerance[i] = static_cast<float>(ratio);
-                    errorQuanta.push_back(f.errorQuanta);
-                    const double eyeZRay = ray.pEye.empty() ? eyeZFromWindowDepth(camera, pWindow, f.rayWindowDepth)
-                                                            : camera.eyeZOf(ray.pEye[i]);
-                    const double eyeZRaster = eyeZFromWindowDepth(camera, pWindow, f.rasterWindowDepth);
-                    relativeEyeZ.push_back(std::abs(eyeZRaster - eyeZRay) / std::abs(eyeZRay));
-                    r.maxErrorQuanta = std::max(r.maxErrorQuanta, f.errorQuanta);
-                    if (ratio > r.maxErrorOverTolerance || r.agree + r.depthErrors == 1) {
-                        r.maxErrorOverTolerance = std::max(r.maxErrorOverTolerance, ratio);
-                        r.worst = f;
+                const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
+                PixelFinding f;
+                f.col = col, f.row = row;
+                f.rayWindowDepth = ray.windowDepth.value[i];
+                f.rasterWindowDepth = raster.windowDepth.value[i];
+                f.rayPrimitive = ray.primitiveId[i];
+                f.rasterPrimitive = raster.primitiveId[i];
+
+                if (rayHit && rasterHit) {
+                    ++r.bothHit;
+                    const double q = rasterQuantum ? (*rasterQuantum)[i] : storageQuantum(format, f.rayWindowDepth);
+                    const double error = std::abs(f.rasterWindowDepth - f.rayWindowDepth);
+                    const bool samePrimitive = f.rayPrimitive == f.rasterPrimitive;
+                    double bound = 0;
+                    f.pixelClass = judge.bothHit(f.rayWindowDepth, f.rayPrimitive, f.rasterWindowDepth,
+                                                 f.rasterPrimitive, q, pWindow, bound);
+                    f.errorQuanta = error / q;
+                    f.toleranceQuanta = bound / q;
+                    const double ratio = bound > 0 ? error / bound : (error > 0 ? INFINITY : 0.0);
+                    if (samePrimitive && S * judge.slope(f.rayPrimitive) <= 0.1 * q) {
+                        // Quantization dominates here: feed the bias test.
+                        tally.signedErrorSum += (f.rasterWindowDepth - f.rayWindowDepth) / q;
+                        const double position = f.rayWindowDepth / q;
+                        ++tally.quarterCounts[std::clamp(int(4 * (position - std::floor(position))), 0, 3)];
+                        ++r.biasSamples;
                     }
-                }
-            } else {
-                // Coverage mismatch: only one route sees a surface. Explained at an edge of its
-                // triangle, (ray route only) at the clear value, or on the near/far plane.
-                rayHit ? ++r.rayOnly : ++r.rasterOnly;
-                const std::uint32_t primitive = rayHit ? f.rayPrimitive : f.rasterPrimitive;
-                const double q = rasterQuantum ? (*rasterQuantum)[i] : storageQuantum(format, f.rayWindowDepth);
-                const bool atClear =
-                    rayHit && std::abs(f.rayWindowDepth - camera.clearDepth()) <= judge.surfaceTolerance(primitive, q);
-                if (judge.nearEdge(primitive, pWindow)) {
-                    f.pixelClass = rayHit ? PixelClass::RayOnlyEdge : PixelClass::RasterOnlyEdge;
-                } else if (atClear) {
-                    f.pixelClass = PixelClass::RayOnlyAtClear;
-                    ++r.lostAtClearValue;
-                } else if (judge.atClipPlane(primitive, pWindow)) {
-                    f.pixelClass = PixelClass::AtClipPlane;
-                    ++r.atClipPlane;
+                    if (f.pixelClass == PixelClass::EdgeSurface) {
+                        ++r.edgeSurface;
+                    } else {
+                        f.pixelClass == PixelClass::Agree ? ++r.agree : ++r.depthErrors;
+                        out.errorOverTolerance[i] = static_cast<float>(ratio);
+                        tally.errorQuanta.push_back(float(f.errorQuanta));
+                        const double eyeZRay = ray.pEye.empty() ? eyeZFromWindowDepth(camera, pWindow, f.rayWindowDepth)
+                                                                : camera.eyeZOf(ray.pEye[i]);
+                        const double eyeZRaster = eyeZFromWindowDepth(camera, pWindow, f.rasterWindowDepth);
+                        const double relative = std::abs(eyeZRaster - eyeZRay) / std::abs(eyeZRay);
+                        tally.relativeEyeZ.push_back(float(relative));
+                        r.maxRelativeEyeZError = std::max(r.maxRelativeEyeZError, relative);
+                        r.maxErrorQuanta = std::max(r.maxErrorQuanta, f.errorQuanta);
+                        if (ratio > r.maxErrorOverTolerance || r.agree + r.depthErrors == 1) {
+                            r.maxErrorOverTolerance = std::max(r.maxErrorOverTolerance, ratio);
+                            r.worst = f;
+                        }
+                    }
                 } else {
-                    f.pixelClass = rayHit ? PixelClass::RayOnly : PixelClass::RasterOnly;
+                    // Coverage mismatch: only one route sees a surface. Explained at an edge of its
+                    // triangle, (ray route only) at the clear value, or on the near/far plane.
+                    rayHit ? ++r.rayOnly : ++r.rasterOnly;
+                    const std::uint32_t primitive = rayHit ? f.rayPrimitive : f.rasterPrimitive;
+                    const double q = rasterQuantum ? (*rasterQuantum)[i] : storageQuantum(format, f.rayWindowDepth);
+                    const bool atClear =
+                        rayHit && std::abs(f.rayWindowDepth - camera.clearDepth()) <= judge.surfaceTolerance(primitive, q);
+                    if (judge.nearEdge(primitive, pWindow)) {
+                        f.pixelClass = rayHit ? PixelClass::RayOnlyEdge : PixelClass::RasterOnlyEdge;
+                    } else if (atClear) {
+                        f.pixelClass = PixelClass::RayOnlyAtClear;
+                        ++r.lostAtClearValue;
+                    } else if (judge.atClipPlane(primitive, pWindow)) {
+                        f.pixelClass = PixelClass::AtClipPlane;
+                        ++r.atClipPlane;
+                    } else {
+                        f.pixelClass = rayHit ? PixelClass::RayOnly : PixelClass::RasterOnly;
+                    }
+                    isUnexplained(f.pixelClass) ? ++r.coverageUnexplained : ++r.coverageExplained;
                 }
-                isUnexplained(f.pixelClass) ? ++r.coverageUnexplained : ++r.coverageExplained;
-            }
-
-            out.pixelClass[i] = f.pixelClass;
-            if (isUnexplained(f.pixelClass)) {
-                if (r.unexplainedSamples.size() < 20) r.unexplainedSamples.push_back(f);
-                if (r.unexplainedMaxCol < 0) {
-                    r.unexplainedMinCol = r.unexplainedMaxCol = col;
-                    r.unexplainedMinRow = r.unexplainedMaxRow = row;
-                }
-                r.unexplainedMinCol = std::min(r.unexplainedMinCol, col);
-                r.unexplainedMaxCol = std::max(r.unexplainedMaxCol, col);
-                r.unexplainedMinRow = std::min(r.unexplainedMinRow, row);
-                r.unexplainedMaxRow = std::max(r.unexplainedMaxRow, row);
+                out.pixelClass[i] = f.pixelClass;
+                if (isUnexplained(f.pixelClass)) noteUnexplained(r, f);
             }
         }
-    }
-    for (double v : relativeEyeZ) r.maxRelativeEyeZError = std::max(r.maxRelativeEyeZError, v);
+    };
+
+    std::vector<BlockTally> blocks(std::size_t((H + kBlockRows - 1) / kBlockRows));
+    tbb::parallel_for(std::size_t(0), blocks.size(), [&](std::size_t b) {
+        compareBlock(int(b) * kBlockRows, std::min(H, int(b + 1) * kBlockRows), blocks[b]);
+    });
+    BlockTally total;
+    for (BlockTally& block : blocks) merge(total, block);
+    std::vector<std::vector<float>> errorQuanta, relativeEyeZ;
+    for (BlockTally& block : blocks)
+        errorQuanta.push_back(std::move(block.errorQuanta)), relativeEyeZ.push_back(std::move(block.relativeEyeZ));
+    blocks.clear();
+
+    out.report = std::move(total.report);
+    ComparisonReport& r = out.report;
+    r.width = W, r.height = H;
     r.p99ErrorQuanta = percentile99(errorQuanta);
-    if (r.biasSamples > 0) r.meanSignedErrorQuanta = signedErrorSum / double(r.biasSamples);
-    const bool spread = std::all_of(std::begin(quarterCounts), std::end(quarterCounts),
+    if (r.biasSamples > 0) r.meanSignedErrorQuanta = total.signedErrorSum / double(r.biasSamples);
+    const bool spread = std::all_of(std::begin(total.quarterCounts), std::end(total.quarterCounts),
                                     [&](std::int64_t n) { return n >= r.biasSamples / 10; });
     r.depthBias = r.biasSamples >= 1000 && spread && std::abs(r.meanSignedErrorQuanta) > 0.25;
     r.p99RelativeEyeZError = percentile99(relativeEyeZ);

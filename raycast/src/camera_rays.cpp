@@ -32,13 +32,11 @@ glm::dvec3 CameraRays::eyeFromWorld(const glm::dvec3& pWorld) const
     return {glm::dot(v, right_), c.eyeUpY * glm::dot(v, up_), c.eyeForwardZ * glm::dot(v, forward_)};
 }
 
-EyePlaneRay CameraRays::worldRay(const glm::dvec2& pImage) const
+void CameraRays::eyeRay(const glm::dvec2& pImage, glm::dvec3& origin, glm::dvec3& direction) const
 {
-    if (fromMatrix_) return worldEyePlaneRayThroughWindow(camera_, {pImage.x, camera_.windowYFromImageY(pImage.y)});
     const Projection& p = camera_.spec().projection;
     const double W = camera_.width(), H = camera_.height(), x = pImage.x, y = pImage.y, n = p.near;
-    // Origin on the eye plane and direction, in OpenGL's eye axes (x right, y up, −z forward).
-    glm::dvec3 origin(0.0), direction(0.0, 0.0, -1.0);
+    origin = glm::dvec3(0.0), direction = {0.0, 0.0, -1.0};
     switch (p.type) {
     case ProjectionType::Perspective: {
         const double tanHalf = std::tan(glm::radians(p.fovyDeg) / 2);
@@ -67,17 +65,40 @@ EyePlaneRay CameraRays::worldRay(const glm::dvec2& pImage) const
         }
         break;
     }
-    case ProjectionType::Matrix: break;  // handled above
+    case ProjectionType::Matrix: break;  // no definition but the matrix: see worldRay
     }
+}
+
+EyePlaneRay CameraRays::worldRay(const glm::dvec2& pImage) const
+{
+    if (fromMatrix_) return worldEyePlaneRayThroughWindow(camera_, {pImage.x, camera_.windowYFromImageY(pImage.y)});
+    glm::dvec3 origin, direction;
+    eyeRay(pImage, origin, direction);
     // Into world space: eye-plane point and direction along the view's axes.
     EyePlaneRay ray;
-    ray.origin = eye_ + origin.x * right_ + origin.y * up_;
-    const glm::dvec3 d = direction.x * right_ + direction.y * up_ - direction.z * forward_;
-    ray.direction = glm::normalize(d);
+    ray.origin = eye_ + worldFromEyeVector(origin);
+    ray.direction = glm::normalize(worldFromEyeVector(direction));
     const double eyeZPerT = glm::dot(ray.direction, forward_);  // eye-z gained per unit of t
-    ray.tNear = n / eyeZPerT;
+    const Projection& p = camera_.spec().projection;
+    ray.tNear = p.near / eyeZPerT;
     ray.tFar = std::isinf(p.far) ? INFINITY : p.far / eyeZPerT;
     return ray;
+}
+
+std::optional<AffineRays> CameraRays::affine() const
+{
+    if (fromMatrix_) return std::nullopt;
+    // Each model's ray is affine in the image point: three points fix it.
+    glm::dvec3 o00, d00, o10, d10, o01, d01;
+    eyeRay({0.0, 0.0}, o00, d00);
+    eyeRay({1.0, 0.0}, o10, d10);
+    eyeRay({0.0, 1.0}, o01, d01);
+    AffineRays rays;
+    rays.origin = eye_ + worldFromEyeVector(o00);
+    rays.originPerX = worldFromEyeVector(o10 - o00), rays.originPerY = worldFromEyeVector(o01 - o00);
+    rays.direction = worldFromEyeVector(d00);  // eye-z component 1: t is eye-z
+    rays.directionPerX = worldFromEyeVector(d10 - d00), rays.directionPerY = worldFromEyeVector(d01 - d00);
+    return rays;
 }
 
 double CameraRays::windowDepth(const glm::dvec2& pImage, double d) const

@@ -55,9 +55,9 @@ private:
     unsigned saved_;
 };
 
-constexpr int kTile = 8;        // 8×8 pixels per tile
-constexpr int kPacketW = 4;     // a packet covers 4×2 pixels
-constexpr int kPacketH = 2;
+constexpr int kTile = 8;         // 8×8 pixels per tile
+constexpr int kPacketSide = 4;   // a packet covers 4×4 pixels (rtcIntersect16)
+constexpr int kPacketRays = kPacketSide * kPacketSide;
 
 }  // namespace
 
@@ -118,18 +118,20 @@ RayRenderer::RayRenderer(const Scene& scene) : embree_(std::make_unique<Embree>(
 
 RayRenderer::~RayRenderer() = default;
 
-RenderResult RayRenderer::render(const Camera& camera, const RayFaults& fault) const
+RenderResult RayRenderer::render(const Camera& camera, const RayFaults& fault, EyePoints eyePoints) const
 {
     const auto start = Clock::now();
     const int W = camera.width(), H = camera.height();
     RenderResult result;
     result.windowDepth = {W, H, DepthQuantity::Window, std::vector<double>(std::size_t(W) * H, camera.clearDepth())};
     result.primitiveId.assign(std::size_t(W) * H, kNoPrimitive);
-    result.pEye.assign(std::size_t(W) * H, glm::dvec3(NAN));
+    if (eyePoints == EyePoints::Keep) result.pEye.assign(std::size_t(W) * H, glm::dvec3(NAN));
 
     const int tilesX = (W + kTile - 1) / kTile, tilesY = (H + kTile - 1) / kTile;
     RTCScene rtcScene = embree_->scene.get();
     const CameraRays cameraRays(camera);
+    const std::optional<AffineRays> affine = cameraRays.affine();
+    const double near = camera.nearDistance(), far = camera.farDistance();
     const glm::dvec3 frameOrigin = embree_->frameOrigin;
 
     tbb::parallel_for(tbb::blocked_range<int>(0, tilesX * tilesY, 4), [&](const tbb::blocked_range<int>& tiles) {
@@ -137,35 +139,41 @@ RenderResult RayRenderer::render(const Camera& camera, const RayFaults& fault) c
         RTCIntersectContext context;
         rtcInitIntersectContext(&context);
         context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-        alignas(32) int valid[8];
-        alignas(32) RTCRayHit8 packet;
-        EyePlaneRay rays[8];
-        glm::dvec2 pImage[8];
-        int pixelOf[8];
+        alignas(64) int valid[kPacketRays];
+        alignas(64) RTCRayHit16 packet;
+        glm::dvec3 origin[kPacketRays], direction[kPacketRays];
+        glm::dvec2 pImage[kPacketRays];
 
         for (int tile = tiles.begin(); tile != tiles.end(); ++tile) {
             const int tileX = (tile % tilesX) * kTile, tileY = (tile / tilesX) * kTile;
-            for (int py = 0; py < kTile; py += kPacketH) {
-                for (int px = 0; px < kTile; px += kPacketW) {
-                    for (int k = 0; k < 8; ++k) {
-                        const int col = tileX + px + k % kPacketW, row = tileY + py + k / kPacketW;
+            for (int py = 0; py < kTile; py += kPacketSide) {
+                for (int px = 0; px < kTile; px += kPacketSide) {
+                    for (int k = 0; k < kPacketRays; ++k) {
+                        const int col = tileX + px + k % kPacketSide, row = tileY + py + k / kPacketSide;
                         valid[k] = (col < W && row < H) ? -1 : 0;
-                        pixelOf[k] = row * W + col;
                         // Every field of every lane is initialised, valid or not.
                         const int sampleRow = fault.flipRows ? H - 1 - row : row;
                         const int sampleCol = fault.flipCols ? W - 1 - col : col;
                         const glm::dvec2 pWindow = windowFromPixelCentre(camera, sampleCol, sampleRow) + fault.shiftPixels;
                         pImage[k] = {pWindow.x, camera.imageYFromWindowY(pWindow.y)};
-                        rays[k] = valid[k] ? cameraRays.worldRay(pImage[k]) : EyePlaneRay{{0, 0, 0}, {0, 0, 1}, 0, 0};
-                        const EyePlaneRay& r = rays[k];
-                        packet.ray.org_x[k] = float(r.origin.x - frameOrigin.x);
-                        packet.ray.org_y[k] = float(r.origin.y - frameOrigin.y);
-                        packet.ray.org_z[k] = float(r.origin.z - frameOrigin.z);
-                        packet.ray.dir_x[k] = float(r.direction.x);
-                        packet.ray.dir_y[k] = float(r.direction.y);
-                        packet.ray.dir_z[k] = float(r.direction.z);
-                        packet.ray.tnear[k] = float(r.tNear);
-                        packet.ray.tfar[k] = std::isinf(r.tFar) ? INFINITY : float(r.tFar);
+                        float tNear = float(near), tFar = std::isinf(far) ? INFINITY : float(far);
+                        if (affine) {  // t is eye-z: the near and far planes lie at t = near and far
+                            origin[k] = affine->originAt(pImage[k]);
+                            direction[k] = affine->directionAt(pImage[k]);
+                        } else {
+                            const EyePlaneRay r = cameraRays.worldRay(pImage[k]);
+                            origin[k] = r.origin, direction[k] = r.direction;
+                            tNear = float(r.tNear), tFar = std::isinf(r.tFar) ? INFINITY : float(r.tFar);
+                        }
+                        if (!valid[k]) origin[k] = frameOrigin, direction[k] = {0.0, 0.0, 1.0}, tNear = 0, tFar = 0;
+                        packet.ray.org_x[k] = float(origin[k].x - frameOrigin.x);
+                        packet.ray.org_y[k] = float(origin[k].y - frameOrigin.y);
+                        packet.ray.org_z[k] = float(origin[k].z - frameOrigin.z);
+                        packet.ray.dir_x[k] = float(direction[k].x);
+                        packet.ray.dir_y[k] = float(direction[k].y);
+                        packet.ray.dir_z[k] = float(direction[k].z);
+                        packet.ray.tnear[k] = tNear;
+                        packet.ray.tfar[k] = tFar;
                         packet.ray.time[k] = 0.0f;
                         packet.ray.mask[k] = 0xFFFFFFFFu;  // Debian's Embree has ray masks on
                         packet.ray.id[k] = unsigned(k);
@@ -174,25 +182,24 @@ RenderResult RayRenderer::render(const Camera& camera, const RayFaults& fault) c
                         packet.hit.primID[k] = RTC_INVALID_GEOMETRY_ID;
                         packet.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
                     }
-                    rtcIntersect8(valid, rtcScene, &context, &packet);
-                    for (int k = 0; k < 8; ++k) {
+                    rtcIntersect16(valid, rtcScene, &context, &packet);
+                    for (int k = 0; k < kPacketRays; ++k) {
                         if (!valid[k] || packet.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) continue;
                         const std::uint32_t primitive = packet.hit.primID[k];
                         const glm::uvec3& tri = scene_.triangles[primitive];
                         const glm::dvec3 a(scene_.positions[tri[0]]), b(scene_.positions[tri[1]]),
                             c(scene_.positions[tri[2]]);
                         // The hit again, in double: the ray against the hit triangle's plane.
-                        const EyePlaneRay& r = rays[k];
                         const glm::dvec3 normal = glm::cross(b - a, c - a);
-                        double t = glm::dot(normal, a - r.origin) / glm::dot(normal, r.direction);
+                        double t = glm::dot(normal, a - origin[k]) / glm::dot(normal, direction[k]);
                         if (!std::isfinite(t)) t = packet.ray.tfar[k];
-                        const glm::dvec3 pWorld = r.origin + t * r.direction;
-                        const std::size_t i = std::size_t(pixelOf[k]);
+                        const glm::dvec3 pWorld = origin[k] + t * direction[k];
+                        const std::size_t i = std::size_t(tileY + py + k / kPacketSide) * W + tileX + px + k % kPacketSide;
                         result.primitiveId[i] = primitive;
-                        result.pEye[i] = cameraRays.eyeFromWorld(pWorld);
-                        // The fault "distance as eye-z" takes the ray parameter (the distance) for eye-z.
-                        result.windowDepth.value[i] =
-                            cameraRays.windowDepth(pImage[k], fault.distanceAsEyeZ ? t : cameraRays.eyeZ(pWorld));
+                        if (eyePoints == EyePoints::Keep) result.pEye[i] = cameraRays.eyeFromWorld(pWorld);
+                        // The fault "distance as eye-z" takes the distance along the ray for eye-z.
+                        const double eyeZ = fault.distanceAsEyeZ ? t * glm::length(direction[k]) : cameraRays.eyeZ(pWorld);
+                        result.windowDepth.value[i] = cameraRays.windowDepth(pImage[k], eyeZ);
                     }
                 }
             }

@@ -114,19 +114,22 @@ Scene defaultScene()
     return sceneFrom("builtin:default", std::move(s), camera);
 }
 
-Scene terrainScene(const std::string& name, int n)
+// `size`: the side of the square; the whole shape (heights and the camera too) scales with it.
+Scene terrainScene(const std::string& name, int n, double size)
 {
     Soup s;
+    const double k = size / 100.0;  // the shape is defined on a side of 100
     // Smooth, asymmetric hills with fine detail: sum of incommensurate sines.
-    s.heightfield(n, -50.0, 50.0, -50.0, 50.0, [](double x, double z) {
-        return 3.0 * std::sin(0.11 * x + 0.3) * std::cos(0.07 * z - 0.2) + 1.2 * std::sin(0.31 * x + 0.23 * z) +
-               0.35 * std::sin(1.3 * x - 0.9 * z + 1.0) + 0.04 * x;
+    s.heightfield(n, -50.0 * k, 50.0 * k, -50.0 * k, 50.0 * k, [k](double xs, double zs) {
+        const double x = xs / k, z = zs / k;
+        return k * (3.0 * std::sin(0.11 * x + 0.3) * std::cos(0.07 * z - 0.2) + 1.2 * std::sin(0.31 * x + 0.23 * z) +
+                    0.35 * std::sin(1.3 * x - 0.9 * z + 1.0) + 0.04 * x);
     });
     CameraSpec camera;
     camera.width = 640;
     camera.height = 480;
-    camera.projection = Projection::perspective(50.0, 0.5, 200.0);
-    camera.view = View::lookAt({-35.0, 14.0, 42.0}, {8.0, -2.0, -10.0}, {0.0, 1.0, 0.0});
+    camera.projection = Projection::perspective(50.0, 0.5 * k, 200.0 * k);
+    camera.view = View::lookAt(glm::dvec3(-35.0, 14.0, 42.0) * k, glm::dvec3(8.0, -2.0, -10.0) * k, {0.0, 1.0, 0.0});
     return sceneFrom(name, std::move(s), camera);
 }
 
@@ -199,8 +202,9 @@ Scene builtinScene(const std::string& fullName)
         return nearCrossingScene();
     }
     if (base == "terrain") {
-        rejectUnknown({"n"});
+        rejectUnknown({"n", "size"});
         int n = 256;
+        double size = 100.0;
         if (params.count("n")) {
             const std::string& text = params["n"];
             char* end = nullptr;
@@ -209,7 +213,15 @@ Scene builtinScene(const std::string& fullName)
                 throw Error("scene '" + fullName + "': 'n' must be an integer in 2..4096, got '" + text + "'");
             n = static_cast<int>(value);
         }
-        return terrainScene("builtin:" + rest, n);
+        if (params.count("size")) {
+            const std::string& text = params["size"];
+            char* end = nullptr;
+            const double value = std::strtod(text.c_str(), &end);
+            if (text.empty() || *end != '\0' || !(value >= 1e-3 && value <= 1e6))
+                throw Error("scene '" + fullName + "': 'size' must be a number in 0.001..1e6, got '" + text + "'");
+            size = value;
+        }
+        return terrainScene("builtin:" + rest, n, size);
     }
     std::string known;
     for (const auto& name : builtinSceneNames()) known += (known.empty() ? "builtin:" : ", builtin:") + name;

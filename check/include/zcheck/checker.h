@@ -118,7 +118,7 @@ public:
     CheckResult check(const Camera& camera, const CheckOptions& options = {}) const;
 
     // One route's render: window depth and primitive per pixel (row 0 at the top).
-    RenderResult renderRay(const Camera& camera, const RayFaults& faults = {}) const;
+    RenderResult renderRay(const Camera& camera, const RayFaults& faults = {}, EyePoints eyePoints = EyePoints::Omit) const;
     RenderResult renderRaster(const Camera& camera, const RasterFaults& faults = {}) const;
     RenderResult render(const Camera& camera, Route route, const RouteFaults& faults = {}) const;
     // One route's render as an exported quantity (quantity.h): depth in any of the four

@@ -36,7 +36,9 @@
 #include "zcheck/render.h"
 #include "zcheck/scene.h"
 
+#include <atomic>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace zcheck {
@@ -125,7 +127,8 @@ struct Comparison {
 // The per-pixel rule above, in one place: the comparison applies it to the raster's surface,
 // and `verify` (which must guess the surface a map saw) applies it to every candidate surface,
 // so that which surfaces a pixel may show and whether its depth agrees are one decision.
-// Not thread-safe (it caches each triangle's slope); one per thread.
+// Thread-safe: const calls may run from several threads at once (each triangle's slope is
+// computed on first use and cached; racing threads store the same value).
 class PixelJudge {
 public:
     PixelJudge(const Scene& scene, const Camera& camera, const ToleranceModel& tolerance = {});
@@ -151,10 +154,11 @@ private:
     const Scene& scene_;
     const Camera& camera_;
     double C_, S_, E_;
-    mutable std::vector<double> slopeCache_;  // per primitive, NaN until computed
+    std::unique_ptr<std::atomic<double>[]> slopeCache_;  // per primitive, NaN until computed
 };
 
-// Compares two renders of `scene` through `camera`. `ray` must carry exact depths (the ray
+// Compares two renders of `scene` through `camera`, rows in parallel (fixed blocks merged in
+// scan order, so the report is the same for any number of threads). `ray` must carry exact depths (the ray
 // route); `raster` holds stored depth-buffer values. `rasterQuantum`, when given, is the
 // storage quantum of each raster pixel in window-depth units (a map stored as eye-z or
 // distance, or as scaled integers); otherwise q comes from the camera's depth format.

@@ -25,11 +25,28 @@
 #include "zcheck/camera.h"
 #include "zcheck/inverse_projection.h"
 
+#include <optional>
+
 namespace zcheck {
+
+// For every model but a raw matrix, the ray through image point p = (x, y) is affine in p:
+// origin(p) = origin + x·originPerX + y·originPerY on the eye plane, and direction(p) likewise,
+// scaled to gain one unit of eye-z per unit of t (so t along it *is* eye-z, and the near and
+// far planes lie at t = near and t = far). World space.
+struct AffineRays {
+    glm::dvec3 origin, originPerX, originPerY;
+    glm::dvec3 direction, directionPerX, directionPerY;
+
+    glm::dvec3 originAt(const glm::dvec2& p) const { return origin + p.x * originPerX + p.y * originPerY; }
+    glm::dvec3 directionAt(const glm::dvec2& p) const { return direction + p.x * directionPerX + p.y * directionPerY; }
+};
 
 class CameraRays {
 public:
     explicit CameraRays(const Camera& camera);
+
+    // The rays as an affine function of the image point; empty for a raw-matrix projection.
+    std::optional<AffineRays> affine() const;
 
     // The viewing ray through image point pImage (pixels; x right, y down from the top-left
     // corner), in world space: origin on the eye plane, unit direction, [tNear, tFar]
@@ -44,6 +61,10 @@ public:
     double windowDepth(const glm::dvec2& pImage, double eyeZ) const;
 
 private:
+    // The ray through pImage in OpenGL's eye axes: eye-plane origin and direction (z = −1).
+    void eyeRay(const glm::dvec2& pImage, glm::dvec3& origin, glm::dvec3& direction) const;
+    glm::dvec3 worldFromEyeVector(const glm::dvec3& v) const { return v.x * right_ + v.y * up_ - v.z * forward_; }
+
     const Camera& camera_;
     bool fromMatrix_;                     // raw-matrix projection: the inverse-projection module
     glm::dvec3 eye_, right_, up_, forward_;  // the view as world-space axes

@@ -2,9 +2,10 @@
 // The ray route: Embree traces one ray per pixel through the pixel centre.
 //
 // Rays come from the camera's definition (camera_rays.h, double), are handed to Embree in
-// binary32 from the eye plane (see EyePlaneRay) with [tNear, tFar] spanning near to far
-// plane, traced as coherent 4×2 packets (rtcIntersect8), 8 packets per 8×8 tile, tiles in
-// parallel with TBB. Each hit is then recomputed in double against the hit triangle's plane,
+// binary32 from the eye plane with [tNear, tFar] spanning near to far plane (for every model
+// but a raw matrix the direction gains one unit of eye-z per unit of t: AffineRays), traced
+// as coherent 4×4 packets (rtcIntersect16), four packets per 8×8 tile, tiles in parallel
+// with TBB. Each hit is then recomputed in double against the hit triangle's plane,
 // and its eye-z turned into the exact window depth the depth buffer should hold by the
 // convention's depth mapping in closed form — never through the raster route's matrices.
 //
@@ -34,6 +35,10 @@ struct RayFaults {
     bool none() const { return shiftPixels == glm::dvec2(0.0) && !flipRows && !flipCols && !distanceAsEyeZ; }
 };
 
+// Whether a render also keeps each hit's eye-space point (exports of eye-z, distance and
+// positions read it; a check does not).
+enum class EyePoints { Omit, Keep };
+
 class RayRenderer {
 public:
     explicit RayRenderer(const Scene& scene);  // builds the BVH (timed); throws Error; `scene` must outlive it
@@ -41,7 +46,8 @@ public:
     RayRenderer(const RayRenderer&) = delete;
     RayRenderer& operator=(const RayRenderer&) = delete;
 
-    RenderResult render(const Camera& camera, const RayFaults& faults = {}) const;
+    // EyePoints::Keep also fills RenderResult::pEye (24 bytes per pixel more).
+    RenderResult render(const Camera& camera, const RayFaults& faults = {}, EyePoints eyePoints = EyePoints::Omit) const;
 
     double buildMilliseconds() const { return buildMilliseconds_; }
 

@@ -1,0 +1,297 @@
+// zcheck bench: how fast a whole check runs, phase by phase, and (--reference) how that
+// compares with what the checked pipelines themselves cost: Mesa's llvmpipe drawing the same
+// depth buffer, and Embree tracing the same rays at its best. Not a test: it measures.
+#include "common.h"
+
+#include "zcheck/embree_reference.h"
+#include "zcheck/error.h"
+#include "zcheck/gl_reference.h"
+#include "zcheck/mesh_loader.h"
+
+#include <nlohmann/json.hpp>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <optional>
+#include <thread>
+
+namespace zcheck::cli {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double millisecondsSince(Clock::time_point start)
+{
+    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+double peakResidentMiB()
+{
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    return double(usage.ru_maxrss) / 1024.0;  // KiB on Linux
+}
+
+// The workload of the speed issue: a million-triangle terrain seen from above at 1080p,
+// every pixel covered.
+const char* const kWorkloadScene = "builtin:terrain?n=709&size=2";
+CameraSpec workloadCamera()
+{
+    CameraSpec spec;
+    spec.width = 1920, spec.height = 1080;
+    spec.projection = Projection::perspective(60.0, 0.01, 10.0);
+    spec.view = View::lookAt({0.0, 0.6, -0.15}, {0.0, 0.0, 0.0}, {0.0, 1.0, 0.0});
+    spec.depth.format = DepthFormat::Unorm24;
+    return spec;
+}
+
+struct Phase {
+    std::vector<double> ms;
+    double median() const
+    {
+        std::vector<double> sorted = ms;
+        std::sort(sorted.begin(), sorted.end());
+        return sorted.empty() ? 0.0 : sorted[sorted.size() / 2];
+    }
+    double best() const { return ms.empty() ? 0.0 : *std::min_element(ms.begin(), ms.end()); }
+};
+
+struct BenchOptions {
+    SceneAndCamera input{kWorkloadScene, "", ""};
+    std::optional<int> width, height;
+    int repeat = 5;
+    int threads = 0;
+    bool reference = false;
+    bool json = false;
+};
+
+// One line a script can split on whitespace: name, median, best, an optional rate.
+void printPhase(const std::string& name, const Phase& phase, const std::string& rate = "")
+{
+    std::printf("%-24s median %9.1f ms   best %9.1f ms   %s\n", name.c_str(), phase.median(), phase.best(), rate.c_str());
+}
+
+std::string rate(double value, const char* unit)
+{
+    char text[64];
+    std::snprintf(text, sizeof text, "%.2f %s", value, unit);
+    return text;
+}
+
+struct Ratio {
+    std::string name;
+    double value;
+    double target;
+    bool atMost;  // the target is an upper bound (else a lower bound)
+    bool met() const { return atMost ? value <= target : value >= target; }
+};
+
+int runBenchCommand(const BenchOptions& o)
+{
+    const int threads = o.threads > 0 ? o.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+    const auto threadLimit = limitThreads(threads);
+    const bool progress = isatty(STDERR_FILENO) && !o.json;
+    const bool workload = o.input.scene == kWorkloadScene && o.input.cameraFile.empty();
+
+    // The camera comes from the first load (a file is read once before timing: cold-cache
+    // effects are not what this measures).
+    CameraSpec spec;
+    {
+        const Scene scene = loadScene(o.input.scene);
+        spec = workload ? workloadCamera() : cameraSpecFor(scene, o.input);
+        if (workload && !o.input.convention.empty()) spec.convention = Convention::preset(o.input.convention);
+    }
+    if (o.width) spec.width = *o.width;
+    if (o.height) spec.height = *o.height;
+    const Camera camera(spec);
+    const bool isFile = !isBuiltinSceneName(o.input.scene);
+    const double fileMB = isFile ? double(std::filesystem::file_size(o.input.scene)) / 1e6 : 0.0;
+
+    // The whole check, N times: load, BVH, trace, raster, compare, as `zcheck check` runs them.
+    Phase load, bvh, trace, raster, compare, whole;
+    std::size_t triangles = 0;
+    bool consistent = true;
+    double peakMiB = 0;
+    std::optional<Scene> lastScene;
+    RenderResult lastRaster;
+    for (int r = 0; r < o.repeat; ++r) {
+        if (progress) std::fprintf(stderr, "\rbench: whole check %d/%d", r + 1, o.repeat), std::fflush(stderr);
+        const auto start = Clock::now();
+        Scene scene = loadScene(o.input.scene);
+        load.ms.push_back(millisecondsSince(start));
+        const Checker checker(std::move(scene));
+        CheckResult run = checker.check(camera);
+        whole.ms.push_back(millisecondsSince(start));
+        bvh.ms.push_back(run.report.timings.bvhBuildMs);
+        trace.ms.push_back(run.report.timings.traceMs);
+        raster.ms.push_back(run.report.timings.rasterMs);
+        compare.ms.push_back(run.report.timings.compareMs);
+        triangles = checker.scene().triangleCount();
+        consistent = consistent && run.report.comparison.consistent();
+        if (r == 0) peakMiB = peakResidentMiB();  // one whole check's peak, before anything else is kept
+        if (r + 1 == o.repeat && o.reference) lastScene = checker.scene(), lastRaster = std::move(run.raster);
+    }
+    if (progress) std::fprintf(stderr, "\r%40s\r", "");
+    const double pixels = double(camera.width()) * camera.height();
+    const double budgetMiB = (150.0 * double(triangles) + 32.0 * pixels) / (1024.0 * 1024.0);
+
+    // The references, after zcheck's peak memory was read.
+    Phase embreeBuild, embreeTrace, glDraw;
+    std::string glRenderer, glSkipped;
+    double glAgreement = NAN;
+    if (o.reference) {
+        const Scene& scene = *lastScene;
+        std::vector<std::uint32_t> primitiveId;
+        for (int r = 0; r < o.repeat; ++r) {
+            if (progress) std::fprintf(stderr, "\rbench: Embree reference %d/%d", r + 1, o.repeat), std::fflush(stderr);
+            const reference::EmbreeReference embree(scene);
+            embreeBuild.ms.push_back(embree.buildMilliseconds());
+            if (r + 1 < o.repeat) continue;
+            embree.trace(camera, primitiveId);  // warm-up
+            for (int k = 0; k < o.repeat; ++k) embreeTrace.ms.push_back(embree.trace(camera, primitiveId));
+        }
+        if (progress) std::fprintf(stderr, "\rbench: llvmpipe reference%20s", ""), std::fflush(stderr);
+        if (!reference::glReferenceAvailable()) {
+            glSkipped = "not built (libegl-dev was missing at build time)";
+        } else {
+            reference::GlDepthInput input;
+            input.positions = &scene.positions[0].x;
+            input.vertexCount = scene.positions.size();
+            input.indices = &scene.triangles[0].x;
+            input.triangleCount = scene.triangles.size();
+            for (int c = 0; c < 4; ++c)
+                for (int k = 0; k < 4; ++k) input.clipFromWorld[std::size_t(4 * c + k)] = camera.clipFromWorld[c][k];
+            input.width = camera.width(), input.height = camera.height();
+            input.reversedZ = camera.depth().reversed;
+            input.zeroToOne = camera.convention().ndcZMin() == 0.0;
+            input.threads = threads;
+            try {
+                const reference::GlDepthTiming gl = reference::timeGlDepthDraw(input, o.repeat);
+                glDraw.ms = gl.drawMs;
+                glRenderer = gl.renderer;
+                // The same picture? Coverage and depth per pixel, the raster's rows being top-down too.
+                std::size_t same = 0;
+                for (std::size_t i = 0; i < gl.depth.size(); ++i) {
+                    const bool glHit = gl.depth[i] != float(camera.clearDepth());
+                    same += glHit == lastRaster.hit(i) &&
+                            (!glHit || std::abs(gl.depth[i] - lastRaster.windowDepth.value[i]) <= 1e-5);
+                }
+                glAgreement = gl.depth.empty() ? NAN : double(same) / double(gl.depth.size());
+            } catch (const std::exception& e) {
+                glSkipped = e.what();
+            }
+        }
+        if (progress) std::fprintf(stderr, "\r%40s\r", "");
+    }
+
+    std::vector<Ratio> ratios;
+    ratios.push_back({"compare/(trace+raster)", compare.median() / (trace.median() + raster.median()), 0.10, true});
+    ratios.push_back({"peak-rss/budget", peakMiB / budgetMiB, 1.0, true});
+    if (isFile) ratios.push_back({"load-MB/s", fileMB / (load.median() / 1e3), 150.0, false});
+    if (!glDraw.ms.empty()) ratios.push_back({"raster/llvmpipe", raster.median() / glDraw.median(), 0.33, true});
+    if (!embreeTrace.ms.empty()) {
+        ratios.push_back({"trace-throughput/embree", embreeTrace.median() / trace.median(), 0.9, false});
+        ratios.push_back({"whole/(load+embree-bvh+embree-trace)",
+                          whole.median() / (load.median() + embreeBuild.median() + embreeTrace.median()), 1.3, true});
+    }
+
+    if (o.json) {
+        auto phaseJson = [](const Phase& p) { return nlohmann::ordered_json{{"median_ms", p.median()}, {"best_ms", p.best()}, {"ms", p.ms}}; };
+        nlohmann::ordered_json out;
+        out["scene"] = o.input.scene;
+        out["triangles"] = triangles;
+        out["width"] = camera.width(), out["height"] = camera.height();
+        out["threads"] = threads, out["repeat"] = o.repeat;
+        out["consistent"] = consistent;
+        out["phases"] = {{"load", phaseJson(load)},     {"bvh", phaseJson(bvh)},         {"trace", phaseJson(trace)},
+                         {"raster", phaseJson(raster)}, {"compare", phaseJson(compare)}, {"whole", phaseJson(whole)}};
+        out["mrays_per_s"] = pixels / trace.median() / 1e3;
+        out["mtris_per_s"] = double(triangles) / raster.median() / 1e3;
+        out["peak_rss_mib"] = peakMiB;
+        out["memory_budget_mib"] = budgetMiB;
+        if (isFile) out["load_mb_per_s"] = fileMB / (load.median() / 1e3);
+        if (o.reference) {
+            auto& ref = out["reference"];
+            ref["embree_bvh"] = phaseJson(embreeBuild);
+            ref["embree_trace"] = phaseJson(embreeTrace);
+            ref["embree_mrays_per_s"] = pixels / embreeTrace.median() / 1e3;
+            if (!glDraw.ms.empty()) {
+                ref["llvmpipe_draw"] = phaseJson(glDraw);
+                ref["llvmpipe_renderer"] = glRenderer;
+                ref["llvmpipe_agreement"] = glAgreement;
+            } else {
+                ref["llvmpipe_skipped"] = glSkipped;
+            }
+        }
+        for (const Ratio& r : ratios)
+            out["ratios"][r.name] = {{"value", r.value}, {"target", r.target}, {"bound", r.atMost ? "at most" : "at least"}, {"met", r.met()}};
+        std::cout << out.dump(2) << "\n";
+        return kExitConsistent;
+    }
+
+    std::printf("zcheck bench: %s, %zu triangles, %dx%d, %s, %d threads, %d repeats, %s\n", o.input.scene.c_str(), triangles,
+                camera.width(), camera.height(), (toString(camera.depth().format) + (camera.depth().reversed ? " reversed-Z" : "")).c_str(), threads, o.repeat,
+                consistent ? "consistent" : "INCONSISTENT");
+    printPhase("load", load, isFile ? rate(fileMB / (load.median() / 1e3), "MB/s") : "(built in)");
+    printPhase("bvh build", bvh);
+    printPhase("trace", trace, rate(pixels / trace.median() / 1e3, "Mrays/s"));
+    printPhase("raster", raster, rate(double(triangles) / raster.median() / 1e3, "Mtris/s"));
+    printPhase("compare", compare);
+    printPhase("whole check", whole, "load + bvh + trace + raster + compare");
+    std::printf("%-24s %.1f MiB   budget %.1f MiB (150 B/triangle + 32 B/pixel)\n", "peak RSS", peakMiB, budgetMiB);
+    if (o.reference) {
+        printPhase("reference embree-bvh", embreeBuild);
+        printPhase("reference embree-trace", embreeTrace, rate(pixels / embreeTrace.median() / 1e3, "Mrays/s (rtcIntersect16)"));
+        if (!glDraw.ms.empty())
+            printPhase("reference llvmpipe", glDraw, glRenderer + ", LP_NUM_THREADS=" + std::to_string(threads) + ", " +
+                                                         rate(100.0 * glAgreement, "% pixels as zcheck's raster"));
+        else
+            std::printf("%-24s skipped: %s\n", "reference llvmpipe", glSkipped.c_str());
+    }
+    for (const Ratio& r : ratios)
+        std::printf("ratio %-34s %8.3f   target %s %.2f   %s\n", r.name.c_str(), r.value, r.atMost ? "<=" : ">=", r.target,
+                    r.met() ? "met" : "NOT met");
+    return kExitConsistent;
+}
+
+}  // namespace
+
+Command addBenchCommand(CLI::App& app)
+{
+    auto o = std::make_shared<BenchOptions>();
+    CLI::App* command = app.add_subcommand(
+        "bench", "Measure a whole check phase by phase (load, BVH build, trace, raster, compare) and its\n"
+                 "peak memory; with --reference, side by side with Embree's best trace and Mesa's llvmpipe.");
+    addSceneAndCameraOptions(command, o->input);
+    command->add_option("--width", o->width, "override the image width in pixels (1..16384)")->check(kImageSideRange);
+    command->add_option("--height", o->height, "override the image height in pixels (1..16384)")->check(kImageSideRange);
+    command->add_option("--repeat", o->repeat, "whole checks to time (median and best are reported), 1..1000")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 1000));
+    command->add_option("--threads", o->threads,
+                        "worker threads, 1..1024, also llvmpipe's LP_NUM_THREADS (default: all cores)")
+        ->check(kThreadRange);
+    command->add_flag("--reference", o->reference,
+                      "also time, in this process, Embree's own best packet trace (rtcIntersect16, 8x8 tiles) and\n"
+                      "a depth-only OpenGL draw on Mesa llvmpipe through EGL, and print the ratios to the targets");
+    command->add_flag("--json", o->json, "print the measurements as JSON");
+    command->footer(
+        "Without --scene and --camera the workload is the speed issue's: builtin:terrain?n=709&size=2\n"
+        "(1,002,528 triangles) at 1920x1080, unorm24, OpenGL perspective fovy 60, near 0.01, far 10,\n"
+        "eye (0, 0.6, -0.15) looking at the origin: every pixel covered.\n"
+        "Each repeat is a whole check in this process: the scene is loaded, the BVH built, both\n"
+        "routes rendered and compared. Peak RSS is read after the first one. Lines are\n"
+        "'<phase> median <ms> ms best <ms> ms <rate>' and 'ratio <name> <value> target <bound>'.\n"
+        "Examples:\n"
+        "  zcheck bench --reference                         the workload, with both references\n"
+        "  zcheck bench --scene terrain.obj --camera cam.json --threads 1 --json\n"
+        "  zcheck bench --scene 'builtin:terrain?n=1416&size=2' --width 3840 --height 2160");
+    return {command, [o] { return runBenchCommand(*o); }};
+}
+
+}  // namespace zcheck::cli

@@ -1,0 +1,40 @@
+#pragma once
+// A yardstick, not part of the check: Embree's own best primary-ray throughput on a scene and
+// camera, for `zcheck bench --reference` to set zcheck's ray route against.
+//
+// What it does is what an Embree user would write for speed, and nothing zcheck needs:
+//   - its own BVH with the ray route's settings (robust, medium quality), timed;
+//   - one ray per pixel centre, generated in binary32 as an affine function of the pixel
+//     (origin and direction interpolated from the image corners, unnormalised, t ∈ [0, ∞));
+//   - 8×8 tiles in parallel with TBB, each traced as four 4×4 packets with rtcIntersect16 and a
+//     coherent context; the primitive id stored per pixel into a buffer allocated beforehand.
+// Not done: no clip planes, no double-precision hit, no depth. The projection must be affine
+// in the pixel (every model but a raw matrix with a perspective term other than w = −z).
+#include "zcheck/camera.h"
+#include "zcheck/scene.h"
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace zcheck::reference {
+
+class EmbreeReference {
+public:
+    explicit EmbreeReference(const Scene& scene);  // builds the BVH; throws Error
+    ~EmbreeReference();
+    EmbreeReference(const EmbreeReference&) = delete;
+    EmbreeReference& operator=(const EmbreeReference&) = delete;
+
+    double buildMilliseconds() const { return buildMilliseconds_; }
+    // Traces one frame; returns its wall time in milliseconds. primitiveId: width·height
+    // entries (resized once), the hit primitive or 0xFFFFFFFF, rows top-down.
+    double trace(const Camera& camera, std::vector<std::uint32_t>& primitiveId) const;
+
+private:
+    struct Embree;
+    std::unique_ptr<Embree> embree_;
+    double buildMilliseconds_ = 0;
+};
+
+}  // namespace zcheck::reference

@@ -1,0 +1,132 @@
+#include "zcheck/embree_reference.h"
+
+#include "zcheck/camera_rays.h"
+#include "zcheck/error.h"
+
+#include <embree3/rtcore.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <xmmintrin.h>
+
+#include <chrono>
+
+namespace zcheck::reference {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double millisecondsSince(Clock::time_point start)
+{
+    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+constexpr int kTile = 8;    // pixels per tile side
+constexpr int kPacket = 4;  // a packet covers 4×4 pixels
+
+}  // namespace
+
+struct EmbreeReference::Embree {
+    RTCDevice device = nullptr;
+    RTCScene scene = nullptr;
+    glm::dvec3 frameOrigin{0.0};  // as the ray route: binary32 coordinates centred on the scene
+
+    ~Embree()
+    {
+        if (scene) rtcReleaseScene(scene);
+        if (device) rtcReleaseDevice(device);
+    }
+};
+
+EmbreeReference::EmbreeReference(const Scene& scene) : embree_(std::make_unique<Embree>())
+{
+    const auto start = Clock::now();
+    embree_->device = rtcNewDevice(nullptr);
+    if (!embree_->device) throw Error("reference: cannot create an Embree device");
+    embree_->scene = rtcNewScene(embree_->device);
+    rtcSetSceneFlags(embree_->scene, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(embree_->scene, RTC_BUILD_QUALITY_MEDIUM);
+    RTCGeometry geometry = rtcNewGeometry(embree_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                                 3 * sizeof(float), scene.positions.size()));
+    auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                   3 * sizeof(unsigned), scene.triangles.size()));
+    if (!vertices || !indices) {
+        rtcReleaseGeometry(geometry);
+        throw Error("reference: Embree could not allocate geometry buffers");
+    }
+    embree_->frameOrigin = glm::dvec3(glm::vec3((scene.boundsMin() + scene.boundsMax()) / 2.0));
+    for (std::size_t v = 0; v < scene.positions.size(); ++v)
+        for (int k = 0; k < 3; ++k) vertices[3 * v + k] = float(double(scene.positions[v][k]) - embree_->frameOrigin[k]);
+    for (std::size_t t = 0; t < scene.triangles.size(); ++t)
+        for (int k = 0; k < 3; ++k) indices[3 * t + k] = scene.triangles[t][k];
+    rtcCommitGeometry(geometry);
+    rtcAttachGeometryByID(embree_->scene, geometry, 0);
+    rtcReleaseGeometry(geometry);
+    rtcCommitScene(embree_->scene);
+    if (rtcGetDeviceError(embree_->device) != RTC_ERROR_NONE) throw Error("reference: Embree failed to build the BVH");
+    buildMilliseconds_ = millisecondsSince(start);
+}
+
+EmbreeReference::~EmbreeReference() = default;
+
+double EmbreeReference::trace(const Camera& camera, std::vector<std::uint32_t>& primitiveId) const
+{
+    const int W = camera.width(), H = camera.height();
+    primitiveId.resize(std::size_t(W) * H);
+    // Origin and near-plane point are affine in the image point for every model but a raw
+    // matrix: three rays fix both (the set-up is outside the timing).
+    const CameraRays cameraRays(camera);
+    auto affine = [&](double x, double y, glm::vec3& origin, glm::vec3& direction) {
+        const EyePlaneRay r = cameraRays.worldRay({x, y});
+        origin = glm::vec3(r.origin - embree_->frameOrigin);
+        direction = glm::vec3(r.tNear * r.direction);
+    };
+    glm::vec3 o00, d00, o10, d10, o01, d01;
+    affine(0.5, 0.5, o00, d00);
+    affine(1.5, 0.5, o10, d10);
+    affine(0.5, 1.5, o01, d01);
+    const glm::vec3 dOdx = o10 - o00, dOdy = o01 - o00, dDdx = d10 - d00, dDdy = d01 - d00;
+
+    const int tilesX = (W + kTile - 1) / kTile, tilesY = (H + kTile - 1) / kTile;
+    RTCScene scene = embree_->scene;
+    const auto start = Clock::now();
+    tbb::parallel_for(tbb::blocked_range<int>(0, tilesX * tilesY, 4), [&](const tbb::blocked_range<int>& tiles) {
+        const unsigned savedCsr = _mm_getcsr();
+        _mm_setcsr(savedCsr | 0x8040);  // flush denormals, as Embree recommends
+        RTCIntersectContext context;
+        rtcInitIntersectContext(&context);
+        context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+        alignas(64) int valid[16];
+        alignas(64) RTCRayHit16 packet;
+        for (int tile = tiles.begin(); tile != tiles.end(); ++tile) {
+            const int tileX = (tile % tilesX) * kTile, tileY = (tile / tilesX) * kTile;
+            for (int py = 0; py < kTile; py += kPacket)
+                for (int px = 0; px < kTile; px += kPacket) {
+                    for (int k = 0; k < 16; ++k) {
+                        const int col = tileX + px + k % kPacket, row = tileY + py + k / kPacket;
+                        valid[k] = (col < W && row < H) ? -1 : 0;
+                        const float x = float(col), y = float(row);
+                        const glm::vec3 o = o00 + x * dOdx + y * dOdy, d = d00 + x * dDdx + y * dDdy;
+                        packet.ray.org_x[k] = o.x, packet.ray.org_y[k] = o.y, packet.ray.org_z[k] = o.z;
+                        packet.ray.dir_x[k] = d.x, packet.ray.dir_y[k] = d.y, packet.ray.dir_z[k] = d.z;
+                        packet.ray.tnear[k] = 0.0f;
+                        packet.ray.tfar[k] = INFINITY;
+                        packet.ray.time[k] = 0.0f;
+                        packet.ray.mask[k] = 0xFFFFFFFFu;
+                        packet.ray.id[k] = unsigned(k);
+                        packet.ray.flags[k] = 0;
+                        packet.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+                    }
+                    rtcIntersect16(valid, scene, &context, &packet);
+                    for (int k = 0; k < 16; ++k)
+                        if (valid[k])
+                            primitiveId[std::size_t(tileY + py + k / kPacket) * W + tileX + px + k % kPacket] =
+                                packet.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID ? 0xFFFFFFFFu : packet.hit.primID[k];
+                }
+        }
+        _mm_setcsr(savedCsr);
+    });
+    return millisecondsSince(start);
+}
+
+}  // namespace zcheck::reference
