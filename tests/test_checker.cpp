@@ -5,6 +5,10 @@
 #include "zcheck/mistakes.h"
 
 #include <catch2/catch.hpp>
+#include <tbb/global_control.h>
+
+#include <algorithm>
+#include <cmath>
 
 #include <set>
 #include <thread>
@@ -110,4 +114,55 @@ TEST_CASE("verify refuses a map whose size is not the camera's", "[checker]")
     const Camera camera(smallCamera(checker.scene()));
     const DepthMap map{10, 10, DepthQuantity::EyeZ, std::vector<double>(100, 1.0), 0};
     REQUIRE_THROWS_WITH(checker.verify(camera, map), Catch::Contains("10x10") && Catch::Contains("160x120"));
+}
+
+// The comparison runs in fixed blocks of rows merged in scan order; its report must not
+// depend on the thread count, and its statistics must equal the ones computed the plain way.
+TEST_CASE("the comparison's report is the same for 1 and 2 threads, and its p99 is the sorted one", "[checker][threads]")
+{
+    const Checker checker(builtinScene("builtin:default"));
+    CameraSpec spec = smallCamera(checker.scene());
+    spec.depth.format = DepthFormat::Unorm16;  // errors of a few quanta: a spread to rank
+    const Camera camera(spec);
+    CheckResult one, two;
+    {
+        const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+        one = checker.check(camera);
+    }
+    {
+        const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+        two = checker.check(camera);
+    }
+    const ComparisonReport& a = one.report.comparison;
+    const ComparisonReport& b = two.report.comparison;
+    REQUIRE(one.comparison.pixelClass == two.comparison.pixelClass);
+    REQUIRE(a.agree == b.agree);
+    REQUIRE(a.edgeSurface == b.edgeSurface);
+    REQUIRE(a.coverageExplained == b.coverageExplained);
+    REQUIRE(a.worst.col == b.worst.col);
+    REQUIRE(a.worst.row == b.worst.row);
+    REQUIRE(a.maxErrorOverTolerance == b.maxErrorOverTolerance);
+    REQUIRE(a.meanSignedErrorQuanta == b.meanSignedErrorQuanta);
+    REQUIRE(a.p99ErrorQuanta == b.p99ErrorQuanta);
+    REQUIRE(a.p99RelativeEyeZError == b.p99RelativeEyeZError);
+
+    // p99 of |d_raster − d_ray| / q over the pixels compared on depth, by sorting.
+    std::vector<float> errorQuanta;
+    const std::size_t n = one.ray.primitiveId.size();
+    float maxRatio = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const PixelClass c = one.comparison.pixelClass[i];
+        if (c != PixelClass::Agree && c != PixelClass::DepthError) continue;
+        const double ray = one.ray.windowDepth.value[i], raster = one.raster.windowDepth.value[i];
+        errorQuanta.push_back(float(std::abs(raster - ray) / storageQuantum(spec.depth.format, ray)));
+        maxRatio = std::max(maxRatio, one.comparison.errorOverTolerance[i]);
+    }
+    REQUIRE(errorQuanta.size() > 1000);
+    std::sort(errorQuanta.begin(), errorQuanta.end());
+    REQUIRE(errorQuanta.back() > errorQuanta.front());
+    const std::size_t k = std::size_t(std::ceil(0.99 * double(errorQuanta.size()))) - 1;
+    REQUIRE(a.p99ErrorQuanta == double(errorQuanta[k]));
+    // The worst pixel holds the largest error / tolerance.
+    REQUIRE(one.comparison.errorOverTolerance[std::size_t(a.worst.row) * std::size_t(camera.width()) +
+                                              std::size_t(a.worst.col)] == maxRatio);
 }

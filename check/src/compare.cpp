@@ -1,8 +1,10 @@
 #include "zcheck/compare.h"
 
+#include "zcheck/camera_rays.h"
 #include "zcheck/drawn_polygon.h"
 #include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
+#include "zcheck/large_buffer.h"
 
 #include <tbb/parallel_for.h>
 
@@ -226,10 +228,11 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
 {
     const int W = camera.width(), H = camera.height();
     Comparison out;
-    out.pixelClass.assign(std::size_t(W) * H, PixelClass::BothMiss);
-    out.errorOverTolerance.assign(std::size_t(W) * H, 0.0f);
+    assignLarge(out.pixelClass, std::size_t(W) * H, PixelClass::BothMiss);
+    assignLarge(out.errorOverTolerance, std::size_t(W) * H, 0.0f);
 
     const PixelJudge judge(scene, camera, tolerance);
+    const CameraRays cameraRays(camera);  // eye-z of a window depth in closed form
     const DepthFormat format = camera.depth().format;
     const double S = tolerance.snapPixels();
 
@@ -275,9 +278,10 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
                         f.pixelClass == PixelClass::Agree ? ++r.agree : ++r.depthErrors;
                         out.errorOverTolerance[i] = static_cast<float>(ratio);
                         tally.errorQuanta.push_back(float(f.errorQuanta));
-                        const double eyeZRay = ray.pEye.empty() ? eyeZFromWindowDepth(camera, pWindow, f.rayWindowDepth)
+                        const glm::dvec2 pImage(col + 0.5, row + 0.5);
+                        const double eyeZRay = ray.pEye.empty() ? cameraRays.eyeZFromWindowDepth(pImage, f.rayWindowDepth)
                                                                 : camera.eyeZOf(ray.pEye[i]);
-                        const double eyeZRaster = eyeZFromWindowDepth(camera, pWindow, f.rasterWindowDepth);
+                        const double eyeZRaster = cameraRays.eyeZFromWindowDepth(pImage, f.rasterWindowDepth);
                         const double relative = std::abs(eyeZRaster - eyeZRay) / std::abs(eyeZRay);
                         tally.relativeEyeZ.push_back(float(relative));
                         r.maxRelativeEyeZError = std::max(r.maxRelativeEyeZError, relative);

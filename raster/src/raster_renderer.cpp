@@ -4,6 +4,7 @@
 #include "zcheck/raster_renderer.h"
 
 #include "zcheck/clip.h"
+#include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
 
 #include <tbb/blocked_range.h>
@@ -32,10 +33,23 @@ struct TriangleSetup {
     std::uint32_t primitive;
 };
 
+// A vertex after divide, viewport and snapping; `valid` is false where it cannot be snapped
+// (only a fault, no near clipping, brings such vertices here).
+struct SnappedVertex {
+    std::int64_t X, Y;  // 16.8 fixed point, image rows top-down
+    double z;           // the value interpolated: window depth (or eye-z under a fault)
+    bool valid;
+};
+
+// A bin entry names a triangle of the scene whose three vertices needed no clipping (its
+// set-up is recomputed from the snapped vertices when drawn), or, with kClippedBit, a set-up
+// of the chunk's clipped triangles. Nothing per triangle is stored beyond these 4 bytes.
+constexpr std::uint32_t kClippedBit = 0x80000000u;
+
 struct Chunk {
-    std::vector<TriangleSetup> triangles;
-    std::vector<std::uint32_t> tileStart;   // CSR: triangles of tile t are binned[tileStart[t] .. tileStart[t+1])
-    std::vector<std::uint32_t> binned;      // indices into triangles, submission order per tile
+    std::vector<TriangleSetup> clipped;     // set-ups of the triangles clipping produced
+    std::vector<std::uint32_t> tileStart;   // CSR: entries of tile t are binned[tileStart[t] .. tileStart[t+1])
+    std::vector<std::uint32_t> binned;      // bin entries, submission order per tile
 };
 
 struct Viewport {
@@ -73,37 +87,44 @@ struct Viewport {
     }
 };
 
-// Perspective divide, viewport, image rows top-down, snap. Appends the triangle unless it
-// covers no pixel centre.
-void setupTriangle(const Viewport& vp, const glm::dvec4 (&pClip)[3], std::uint32_t primitive,
-                   std::vector<TriangleSetup>& out)
+// Perspective divide, viewport, image rows top-down, snap: one vertex, the same arithmetic
+// whether the vertex is the scene's or one that clipping made.
+SnappedVertex snapVertex(const Viewport& vp, const glm::dvec4& pClip)
 {
-    std::int64_t X[3], Y[3];
-    double z[3];
-    for (int k = 0; k < 3; ++k) {
-        const glm::dvec3 pNdc = glm::dvec3(pClip[k]) / pClip[k].w;
-        const glm::dvec3 pWindow(vp.windowFromNdc * glm::dvec4(pNdc, 1.0));
-        const double yImage = vp.camera.imageYFromWindowY(pWindow.y);
-        // Only a fault (no near clipping) can bring w ≤ 0 here: skip what cannot be snapped.
-        if (!(std::abs(pWindow.x) < 2 * kMaxImageCoordinate) || !(std::abs(yImage) < 2 * kMaxImageCoordinate)) return;
-        X[k] = std::llround(pWindow.x * kSubpixel);
-        Y[k] = std::llround(yImage * kSubpixel);
-        // The fault "eye-z interpolated in screen space" interpolates eye-z instead of depth.
-        if (vp.faults.screenLinearEyeZ) {
-            const glm::dvec4 pEye = vp.camera.eyeFromClip * pClip[k];
-            z[k] = vp.camera.eyeZOf(glm::dvec3(pEye) / pEye.w);
-        } else {
-            z[k] = pWindow.z;
-        }
+    SnappedVertex v{};
+    const glm::dvec3 pNdc = glm::dvec3(pClip) / pClip.w;
+    const glm::dvec3 pWindow(vp.windowFromNdc * glm::dvec4(pNdc, 1.0));
+    const double yImage = vp.camera.imageYFromWindowY(pWindow.y);
+    // Only a fault (no near clipping) can bring w ≤ 0 here: mark what cannot be snapped.
+    v.valid = std::abs(pWindow.x) < 2 * kMaxImageCoordinate && std::abs(yImage) < 2 * kMaxImageCoordinate;
+    if (!v.valid) return v;
+    v.X = std::llround(pWindow.x * kSubpixel);
+    v.Y = std::llround(yImage * kSubpixel);
+    // The fault "eye-z interpolated in screen space" interpolates eye-z instead of depth.
+    if (vp.faults.screenLinearEyeZ) {
+        const glm::dvec4 pEye = vp.camera.eyeFromClip * pClip;
+        v.z = vp.camera.eyeZOf(glm::dvec3(pEye) / pEye.w);
+    } else {
+        v.z = pWindow.z;
     }
+    return v;
+}
+
+// Edge functions, pixel bounding box and depth plane of a snapped triangle. False when it
+// covers no pixel centre (zero area, outside the image, or a vertex that cannot be snapped).
+bool setupFromSnapped(const Viewport& vp, const SnappedVertex& v0, const SnappedVertex& v1, const SnappedVertex& v2,
+                      std::uint32_t primitive, TriangleSetup& t)
+{
+    if (!v0.valid || !v1.valid || !v2.valid) return false;
+    std::int64_t X[3] = {v0.X, v1.X, v2.X}, Y[3] = {v0.Y, v1.Y, v2.Y};
+    double z[3] = {v0.z, v1.z, v2.z};
     std::int64_t area2 = (X[1] - X[0]) * (Y[2] - Y[0]) - (Y[1] - Y[0]) * (X[2] - X[0]);
-    if (area2 == 0) return;  // covers no sample point
-    if (area2 < 0) {         // no culling: both windings are drawn, normalised to area2 > 0
+    if (area2 == 0) return false;  // covers no sample point
+    if (area2 < 0) {               // no culling: both windings are drawn, normalised to area2 > 0
         std::swap(X[1], X[2]), std::swap(Y[1], Y[2]), std::swap(z[1], z[2]);
         area2 = -area2;
     }
 
-    TriangleSetup t;
     // Pixel (c, r) samples at fixed point (c·256 + 128, r·256 + 128).
     auto firstCentre = [](std::int64_t lo) { return int((lo - kHalfPixel + kSubpixel - 1) >> RasterRenderer::kSubpixelBits); };
     auto lastCentre = [](std::int64_t hi) { return int((hi - kHalfPixel) >> RasterRenderer::kSubpixelBits); };
@@ -111,7 +132,7 @@ void setupTriangle(const Viewport& vp, const glm::dvec4 (&pClip)[3], std::uint32
     t.maxCol = std::min(vp.width - 1, lastCentre(std::max({X[0], X[1], X[2]})));
     t.minRow = std::max(0, firstCentre(std::min({Y[0], Y[1], Y[2]})));
     t.maxRow = std::min(vp.height - 1, lastCentre(std::max({Y[0], Y[1], Y[2]})));
-    if (t.minCol > t.maxCol || t.minRow > t.maxRow) return;
+    if (t.minCol > t.maxCol || t.minRow > t.maxRow) return false;
 
     for (int e = 0; e < 3; ++e) {
         const int a = e, b = (e + 1) % 3;
@@ -132,43 +153,43 @@ void setupTriangle(const Viewport& vp, const glm::dvec4 (&pClip)[3], std::uint32
     t.dzdx = (dz1 * dy2 - dz2 * dy1) / det;
     t.dzdy = (dx1 * dz2 - dx2 * dz1) / det;
     t.primitive = primitive;
-    out.push_back(t);
+    return true;
 }
 
-// Clip one world triangle and set up what survives (a fan when clipping made a polygon).
-// codeX: the vertex's outcode, one bit per clip plane it lies outside.
-void setupPrimitive(const Viewport& vp, const glm::dvec4& a, const glm::dvec4& b, const glm::dvec4& c,
-                    unsigned codeA, unsigned codeB, unsigned codeC, std::uint32_t primitive,
-                    std::vector<TriangleSetup>& out)
+// Clip one world triangle that crosses a clip plane and set up what survives (a fan when
+// clipping made a polygon).
+void setupClippedPrimitive(const Viewport& vp, const glm::dvec4& a, const glm::dvec4& b, const glm::dvec4& c,
+                           std::uint32_t primitive, std::vector<TriangleSetup>& out)
 {
-    if (codeA & codeB & codeC) return;  // wholly outside one plane
-    if ((codeA | codeB | codeC) == 0) {
-        const glm::dvec4 triangle[3] = {a, b, c};
-        setupTriangle(vp, triangle, primitive, out);
-        return;
-    }
     const ClipPolygon polygon = clipTriangle(a, b, c, vp.planes);
     for (int k = 1; k + 1 < polygon.size; ++k) {
-        const glm::dvec4 triangle[3] = {polygon.pClip[0], polygon.pClip[k], polygon.pClip[k + 1]};
-        setupTriangle(vp, triangle, primitive, out);
+        TriangleSetup t;
+        if (setupFromSnapped(vp, snapVertex(vp, polygon.pClip[0]), snapVertex(vp, polygon.pClip[k]),
+                             snapVertex(vp, polygon.pClip[k + 1]), primitive, t))
+            out.push_back(t);
     }
 }
 
-void binChunk(const Viewport& vp, Chunk& chunk)
+// What binning needs of one entry: its pixel bounding box.
+struct BinItem {
+    std::uint32_t entry;
+    int minCol, maxCol, minRow, maxRow;
+};
+
+void binChunk(const Viewport& vp, const std::vector<BinItem>& items, Chunk& chunk)
 {
     const int tiles = vp.tilesX * vp.tilesY;
     const int T = RasterRenderer::kTileSize;
     chunk.tileStart.assign(std::size_t(tiles) + 1, 0);
-    auto forEachTile = [&](const TriangleSetup& t, auto&& visit) {
+    auto forEachTile = [&](const BinItem& t, auto&& visit) {
         for (int ty = t.minRow / T; ty <= t.maxRow / T; ++ty)
             for (int tx = t.minCol / T; tx <= t.maxCol / T; ++tx) visit(ty * vp.tilesX + tx);
     };
-    for (const auto& t : chunk.triangles) forEachTile(t, [&](int tile) { ++chunk.tileStart[std::size_t(tile) + 1]; });
+    for (const BinItem& item : items) forEachTile(item, [&](int tile) { ++chunk.tileStart[std::size_t(tile) + 1]; });
     for (int tile = 0; tile < tiles; ++tile) chunk.tileStart[tile + 1] += chunk.tileStart[tile];
     chunk.binned.resize(chunk.tileStart[tiles]);
     std::vector<std::uint32_t> fill(chunk.tileStart.begin(), chunk.tileStart.end() - 1);
-    for (std::uint32_t index = 0; index < chunk.triangles.size(); ++index)
-        forEachTile(chunk.triangles[index], [&](int tile) { chunk.binned[fill[tile]++] = index; });
+    for (const BinItem& item : items) forEachTile(item, [&](int tile) { chunk.binned[fill[tile]++] = item.entry; });
 }
 
 // The stored value under the pixel faults (never called for a clean chain).
@@ -237,42 +258,69 @@ RenderResult RasterRenderer::render(const Camera& camera, const RasterFaults& fa
     const auto start = std::chrono::steady_clock::now();
     const Viewport vp(camera, faults);
     const int W = camera.width(), H = camera.height();
-    RenderResult result;
-    result.windowDepth = {W, H, DepthQuantity::Window, std::vector<double>(std::size_t(W) * H, camera.clearDepth())};
-    result.primitiveId.assign(std::size_t(W) * H, kNoPrimitive);
+    RenderResult result = RenderResult::cleared(W, H, camera.clearDepth());
 
-    // Vertices to clip space, in double, with their outcodes.
-    std::vector<glm::dvec4> pClip(scene_.positions.size());
-    std::vector<unsigned char> outcode(scene_.positions.size());
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pClip.size(), 4096), [&](const auto& range) {
+    // Vertices to clip space in double, their outcodes, and those inside every clip plane
+    // snapped once (a vertex outside one is snapped only where clipping made it).
+    const auto clipOf = [&](std::uint32_t v) { return vp.clipFromWorld * glm::dvec4(glm::dvec3(scene_.positions[v]), 1.0); };
+    std::vector<SnappedVertex> snapped;
+    std::vector<unsigned char> outcode;
+    assignLarge(snapped, scene_.positions.size(), SnappedVertex{});
+    assignLarge(outcode, scene_.positions.size(), static_cast<unsigned char>(0));
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, snapped.size(), 4096), [&](const auto& range) {
         for (std::size_t v = range.begin(); v != range.end(); ++v) {
-            pClip[v] = vp.clipFromWorld * glm::dvec4(glm::dvec3(scene_.positions[v]), 1.0);
-            outcode[v] = static_cast<unsigned char>(vp.outcode(pClip[v]));
+            const glm::dvec4 pClip = clipOf(std::uint32_t(v));
+            outcode[v] = static_cast<unsigned char>(vp.outcode(pClip));
+            if (outcode[v] == 0) snapped[v] = snapVertex(vp, pClip);
         }
     });
 
     // Set-up and binning, one fixed-size chunk of triangles per task.
     const std::size_t triangleCount = scene_.triangles.size();
+    if (triangleCount >= kClippedBit) throw Error("the raster route draws at most 2^31 - 1 triangles");
     std::vector<Chunk> chunks((triangleCount + kChunkTriangles - 1) / kChunkTriangles);
     tbb::parallel_for(std::size_t(0), chunks.size(), [&](std::size_t c) {
         Chunk& chunk = chunks[c];
         const std::size_t first = c * kChunkTriangles, last = std::min(triangleCount, first + kChunkTriangles);
-        chunk.triangles.reserve(last - first);
+        std::vector<BinItem> items;
+        items.reserve(last - first);
+        TriangleSetup t;
         for (std::size_t p = first; p < last; ++p) {
             const glm::uvec3& tri = scene_.triangles[p];
-            setupPrimitive(vp, pClip[tri[0]], pClip[tri[1]], pClip[tri[2]], outcode[tri[0]], outcode[tri[1]],
-                           outcode[tri[2]], std::uint32_t(p), chunk.triangles);
+            const unsigned codeA = outcode[tri[0]], codeB = outcode[tri[1]], codeC = outcode[tri[2]];
+            if (codeA & codeB & codeC) continue;  // wholly outside one plane
+            if ((codeA | codeB | codeC) == 0) {
+                if (setupFromSnapped(vp, snapped[tri[0]], snapped[tri[1]], snapped[tri[2]], std::uint32_t(p), t))
+                    items.push_back({std::uint32_t(p), t.minCol, t.maxCol, t.minRow, t.maxRow});
+                continue;
+            }
+            const std::size_t before = chunk.clipped.size();
+            setupClippedPrimitive(vp, clipOf(tri[0]), clipOf(tri[1]), clipOf(tri[2]), std::uint32_t(p), chunk.clipped);
+            for (std::size_t k = before; k < chunk.clipped.size(); ++k) {
+                const TriangleSetup& piece = chunk.clipped[k];
+                items.push_back({kClippedBit | std::uint32_t(k), piece.minCol, piece.maxCol, piece.minRow, piece.maxRow});
+            }
         }
-        binChunk(vp, chunk);
+        binChunk(vp, items, chunk);
     });
 
-    // Tiles in parallel; inside a tile, chunks and their triangles in submission order.
+    // Tiles in parallel; inside a tile, chunks and their triangles in submission order. A
+    // triangle that needed no clipping is set up again from its snapped vertices.
     tbb::parallel_for(0, vp.tilesX * vp.tilesY, [&](int tile) {
         const int col0 = (tile % vp.tilesX) * kTileSize, row0 = (tile / vp.tilesX) * kTileSize;
         const int col1 = std::min(W, col0 + kTileSize) - 1, row1 = std::min(H, row0 + kTileSize) - 1;
+        TriangleSetup t;
         for (const Chunk& chunk : chunks)
-            for (std::uint32_t k = chunk.tileStart[tile]; k < chunk.tileStart[tile + 1]; ++k)
-                drawInTile(vp, chunk.triangles[chunk.binned[k]], col0, row0, col1, row1, result);
+            for (std::uint32_t k = chunk.tileStart[tile]; k < chunk.tileStart[tile + 1]; ++k) {
+                const std::uint32_t entry = chunk.binned[k];
+                if (entry & kClippedBit) {
+                    drawInTile(vp, chunk.clipped[entry & ~kClippedBit], col0, row0, col1, row1, result);
+                } else {
+                    const glm::uvec3& tri = scene_.triangles[entry];
+                    setupFromSnapped(vp, snapped[tri[0]], snapped[tri[1]], snapped[tri[2]], entry, t);
+                    drawInTile(vp, t, col0, row0, col1, row1, result);
+                }
+            }
     });
     result.renderMilliseconds =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

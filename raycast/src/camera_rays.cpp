@@ -23,6 +23,25 @@ CameraRays::CameraRays(const Camera& camera)
         up_ = glm::cross(right_, forward_);
         eye_ = spec.view.eye;
     }
+    if (fromMatrix_) return;
+    // The depth mapping of the header, folded into window = A + B/d (perspective) or A + B·d
+    // (parallel): z_ndc = a + b/d or a + b·d, then window = rangeMin + (z_ndc − ndcZMin)·s.
+    const Projection& p = spec.projection;
+    const DepthSettings& depth = spec.depth;
+    const double ndcZMin = c.ndcDepth == NdcDepthRange::ZeroToOne ? 0.0 : -1.0;
+    const double zN = depth.reversed ? 1.0 : ndcZMin, zF = depth.reversed ? ndcZMin : 1.0;
+    const double n = p.near, f = p.far;
+    parallel_ = p.type == ProjectionType::Orthographic || p.type == ProjectionType::Oblique;
+    double a, b;
+    if (parallel_)
+        a = zN - (zF - zN) * n / (f - n), b = (zF - zN) / (f - n);
+    else if (std::isinf(f))
+        a = zF, b = (zN - zF) * n;
+    else
+        a = (zF * f - zN * n) / (f - n), b = n * f * (zN - zF) / (f - n);
+    const double scale = (depth.rangeMax - depth.rangeMin) / (1.0 - ndcZMin);
+    depthA_ = depth.rangeMin + (a - ndcZMin) * scale;
+    depthB_ = b * scale;
 }
 
 glm::dvec3 CameraRays::eyeFromWorld(const glm::dvec3& pWorld) const
@@ -103,21 +122,14 @@ std::optional<AffineRays> CameraRays::affine() const
 
 double CameraRays::windowDepth(const glm::dvec2& pImage, double d) const
 {
-    const Convention& c = camera_.convention();
-    const DepthSettings& depth = camera_.depth();
     if (fromMatrix_) return windowDepthFromEyeZ(camera_, {pImage.x, camera_.windowYFromImageY(pImage.y)}, d);
-    const Projection& p = camera_.spec().projection;
-    const double ndcZMin = c.ndcDepth == NdcDepthRange::ZeroToOne ? 0.0 : -1.0;
-    const double zN = depth.reversed ? 1.0 : ndcZMin, zF = depth.reversed ? ndcZMin : 1.0;
-    const double n = p.near, f = p.far;
-    double zNdc;
-    if (p.type == ProjectionType::Orthographic || p.type == ProjectionType::Oblique)
-        zNdc = zN + (zF - zN) * (d - n) / (f - n);
-    else if (std::isinf(f))
-        zNdc = zF + (zN - zF) * n / d;
-    else
-        zNdc = (zF * f * (d - n) + zN * n * (f - d)) / (d * (f - n));
-    return depth.rangeMin + (depth.rangeMax - depth.rangeMin) * (zNdc - ndcZMin) / (1.0 - ndcZMin);
+    return depthA_ + (parallel_ ? depthB_ * d : depthB_ / d);
+}
+
+double CameraRays::eyeZFromWindowDepth(const glm::dvec2& pImage, double w) const
+{
+    if (fromMatrix_) return zcheck::eyeZFromWindowDepth(camera_, {pImage.x, camera_.windowYFromImageY(pImage.y)}, w);
+    return parallel_ ? (w - depthA_) / depthB_ : depthB_ / (w - depthA_);
 }
 
 }  // namespace zcheck

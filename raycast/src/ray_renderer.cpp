@@ -122,10 +122,8 @@ RenderResult RayRenderer::render(const Camera& camera, const RayFaults& fault, E
 {
     const auto start = Clock::now();
     const int W = camera.width(), H = camera.height();
-    RenderResult result;
-    result.windowDepth = {W, H, DepthQuantity::Window, std::vector<double>(std::size_t(W) * H, camera.clearDepth())};
-    result.primitiveId.assign(std::size_t(W) * H, kNoPrimitive);
-    if (eyePoints == EyePoints::Keep) result.pEye.assign(std::size_t(W) * H, glm::dvec3(NAN));
+    RenderResult result = RenderResult::cleared(W, H, camera.clearDepth());
+    if (eyePoints == EyePoints::Keep) assignLarge(result.pEye, std::size_t(W) * H, glm::dvec3(NAN));
 
     const int tilesX = (W + kTile - 1) / kTile, tilesY = (H + kTile - 1) / kTile;
     RTCScene rtcScene = embree_->scene.get();

@@ -4,6 +4,7 @@
 // Images are stored row by row, row 0 at the top of the picture, width·height entries;
 // pixel (col,row) is entry row·width + col.
 #include "zcheck/camera.h"
+#include "zcheck/large_buffer.h"
 #include "zcheck/quantity.h"
 
 #include <cstdint>
@@ -22,6 +23,18 @@ struct RenderResult {
     double renderMilliseconds = 0;           // wall time of render()
 
     bool hit(std::size_t pixel) const { return primitiveId[pixel] != kNoPrimitive; }
+
+    // A render where nothing was hit yet: every pixel at the clear value and kNoPrimitive
+    // (buffers on huge pages: large_buffer.h).
+    static RenderResult cleared(int width, int height, double clearDepth)
+    {
+        RenderResult result;
+        result.windowDepth.width = width, result.windowDepth.height = height;
+        result.windowDepth.quantity = DepthQuantity::Window;
+        assignLarge(result.windowDepth.value, std::size_t(width) * height, clearDepth);
+        assignLarge(result.primitiveId, std::size_t(width) * height, kNoPrimitive);
+        return result;
+    }
 };
 
 }  // namespace zcheck

@@ -19,6 +19,7 @@
 //     perspective  z_ndc = (zF·f·(d − n) + zN·n·(f − d)) / (d·(f − n)),  or zF + (zN − zF)·n/d for f = ∞
 //     parallel     z_ndc = zN + (zF − zN)·(d − n)/(f − n)
 //     window       rangeMin + (rangeMax − rangeMin)·(z_ndc − ndcZMin)/(1 − ndcZMin)
+//   (folded once per camera into window = A + B/d, or A + B·d for parallel projections)
 // None of this reads Camera's matrices, nor the camera's resolved near-plane window. A
 // raw-matrix projection has no other definition: its rays and depths necessarily come from
 // the matrix (the inverse-projection module), as the raster route's do.
@@ -59,6 +60,8 @@ public:
     // The window depth of the point at eye-z `eyeZ` on the ray through image point pImage, in
     // closed form (exact, not quantized); a raw-matrix camera's through its matrix.
     double windowDepth(const glm::dvec2& pImage, double eyeZ) const;
+    // Its inverse: the eye-z at which the ray through pImage has window depth `windowDepth`.
+    double eyeZFromWindowDepth(const glm::dvec2& pImage, double windowDepth) const;
 
 private:
     // The ray through pImage in OpenGL's eye axes: eye-plane origin and direction (z = −1).
@@ -67,6 +70,8 @@ private:
 
     const Camera& camera_;
     bool fromMatrix_;                     // raw-matrix projection: the inverse-projection module
+    bool parallel_ = false;               // orthographic or oblique: window depth affine in eye-z
+    double depthA_ = 0, depthB_ = 0;      // window depth = A + B/eyeZ, or A + B·eyeZ when parallel
     glm::dvec3 eye_, right_, up_, forward_;  // the view as world-space axes
 };
 
