@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 #include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -28,13 +29,6 @@ using Clock = std::chrono::steady_clock;
 double millisecondsSince(Clock::time_point start)
 {
     return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-double peakResidentMiB()
-{
-    rusage usage{};
-    getrusage(RUSAGE_SELF, &usage);
-    return double(usage.ru_maxrss) / 1024.0;  // KiB on Linux
 }
 
 // The workload of the speed issue: a million-triangle terrain seen from above at 1080p,
@@ -60,6 +54,55 @@ struct Phase {
     }
     double best() const { return ms.empty() ? 0.0 : *std::min_element(ms.begin(), ms.end()); }
 };
+
+// One whole check as `zcheck check` runs it, in a child process of its own: fresh memory and
+// fresh page tables each time, so that no repeat inherits the warm heap of the one before.
+struct WholeCheck {
+    double loadMs, bvhMs, traceMs, rasterMs, compareMs, wholeMs;
+    std::size_t triangles;
+    bool consistent;
+    double peakMiB;  // the child's maximum resident set
+};
+
+WholeCheck wholeCheckInChild(const std::string& sceneName, const Camera& camera, int threads)
+{
+    int channel[2];
+    if (pipe(channel) != 0) throw std::runtime_error("bench: cannot create a pipe");
+    const pid_t child = fork();
+    if (child < 0) throw std::runtime_error("bench: cannot fork");
+    if (child == 0) {
+        close(channel[0]);
+        try {
+            const auto threadLimit = limitThreads(threads);
+            WholeCheck w{};
+            const auto start = Clock::now();
+            Scene scene = loadScene(sceneName);
+            w.loadMs = millisecondsSince(start);
+            const Checker checker(std::move(scene));
+            const CheckResult run = checker.check(camera);
+            w.wholeMs = millisecondsSince(start);
+            w.bvhMs = run.report.timings.bvhBuildMs, w.traceMs = run.report.timings.traceMs;
+            w.rasterMs = run.report.timings.rasterMs, w.compareMs = run.report.timings.compareMs;
+            w.triangles = checker.scene().triangleCount();
+            w.consistent = run.report.comparison.consistent();
+            const bool written = write(channel[1], &w, sizeof w) == ssize_t(sizeof w);
+            _exit(written ? 0 : kExitInternal);
+        } catch (...) {
+            _exit(kExitInternal);
+        }
+    }
+    close(channel[1]);
+    WholeCheck w{};
+    const bool complete = read(channel[0], &w, sizeof w) == ssize_t(sizeof w);
+    close(channel[0]);
+    int status = 0;
+    rusage usage{};
+    wait4(child, &status, 0, &usage);
+    if (!complete || !WIFEXITED(status) || WEXITSTATUS(status) != 0)
+        throw std::runtime_error("bench: the check in the child process failed (run `zcheck check` with the same scene and camera)");
+    w.peakMiB = double(usage.ru_maxrss) / 1024.0;  // KiB on Linux
+    return w;
+}
 
 struct BenchOptions {
     SceneAndCamera input{kWorkloadScene, "", ""};
@@ -94,12 +137,11 @@ struct Ratio {
 int runBenchCommand(const BenchOptions& o)
 {
     const int threads = o.threads > 0 ? o.threads : int(std::max(1u, std::thread::hardware_concurrency()));
-    const auto threadLimit = limitThreads(threads);
     const bool progress = isatty(STDERR_FILENO) && !o.json;
     const bool workload = o.input.scene == kWorkloadScene && o.input.cameraFile.empty();
 
-    // The camera comes from the first load (a file is read once before timing: cold-cache
-    // effects are not what this measures).
+    // The camera comes from a first load (a file is read once before timing: cold-cache
+    // effects are not what this measures). TBB is not started before the children fork.
     CameraSpec spec;
     {
         const Scene scene = loadScene(o.input.scene);
@@ -112,40 +154,31 @@ int runBenchCommand(const BenchOptions& o)
     const bool isFile = !isBuiltinSceneName(o.input.scene);
     const double fileMB = isFile ? double(std::filesystem::file_size(o.input.scene)) / 1e6 : 0.0;
 
-    // The whole check, N times: load, BVH, trace, raster, compare, as `zcheck check` runs them.
+    // The whole check, N times, each in a process of its own.
     Phase load, bvh, trace, raster, compare, whole;
     std::size_t triangles = 0;
     bool consistent = true;
     double peakMiB = 0;
-    std::optional<Scene> lastScene;
-    RenderResult lastRaster;
     for (int r = 0; r < o.repeat; ++r) {
         if (progress) std::fprintf(stderr, "\rbench: whole check %d/%d", r + 1, o.repeat), std::fflush(stderr);
-        const auto start = Clock::now();
-        Scene scene = loadScene(o.input.scene);
-        load.ms.push_back(millisecondsSince(start));
-        const Checker checker(std::move(scene));
-        CheckResult run = checker.check(camera);
-        whole.ms.push_back(millisecondsSince(start));
-        bvh.ms.push_back(run.report.timings.bvhBuildMs);
-        trace.ms.push_back(run.report.timings.traceMs);
-        raster.ms.push_back(run.report.timings.rasterMs);
-        compare.ms.push_back(run.report.timings.compareMs);
-        triangles = checker.scene().triangleCount();
-        consistent = consistent && run.report.comparison.consistent();
-        if (r == 0) peakMiB = peakResidentMiB();  // one whole check's peak, before anything else is kept
-        if (r + 1 == o.repeat && o.reference) lastScene = checker.scene(), lastRaster = std::move(run.raster);
+        const WholeCheck w = wholeCheckInChild(o.input.scene, camera, threads);
+        load.ms.push_back(w.loadMs), bvh.ms.push_back(w.bvhMs), trace.ms.push_back(w.traceMs);
+        raster.ms.push_back(w.rasterMs), compare.ms.push_back(w.compareMs), whole.ms.push_back(w.wholeMs);
+        triangles = w.triangles;
+        consistent = consistent && w.consistent;
+        peakMiB = std::max(peakMiB, w.peakMiB);
     }
     if (progress) std::fprintf(stderr, "\r%40s\r", "");
+    const auto threadLimit = limitThreads(threads);
     const double pixels = double(camera.width()) * camera.height();
     const double budgetMiB = (150.0 * double(triangles) + 32.0 * pixels) / (1024.0 * 1024.0);
 
-    // The references, after zcheck's peak memory was read.
+    // The references, in this process.
     Phase embreeBuild, embreeTrace, glDraw;
     std::string glRenderer, glSkipped;
     double glAgreement = NAN;
     if (o.reference) {
-        const Scene& scene = *lastScene;
+        const Scene scene = loadScene(o.input.scene);
         std::vector<std::uint32_t> primitiveId;
         for (int r = 0; r < o.repeat; ++r) {
             if (progress) std::fprintf(stderr, "\rbench: Embree reference %d/%d", r + 1, o.repeat), std::fflush(stderr);
@@ -172,6 +205,7 @@ int runBenchCommand(const BenchOptions& o)
             input.threads = threads;
             try {
                 const reference::GlDepthTiming gl = reference::timeGlDepthDraw(input, o.repeat);
+                const RenderResult lastRaster = RasterRenderer(scene).render(camera);
                 glDraw.ms = gl.drawMs;
                 glRenderer = gl.renderer;
                 // The same picture? Coverage and depth per pixel, the raster's rows being top-down too.
@@ -284,8 +318,9 @@ Command addBenchCommand(CLI::App& app)
         "Without --scene and --camera the workload is the speed issue's: builtin:terrain?n=709&size=2\n"
         "(1,002,528 triangles) at 1920x1080, unorm24, OpenGL perspective fovy 60, near 0.01, far 10,\n"
         "eye (0, 0.6, -0.15) looking at the origin: every pixel covered.\n"
-        "Each repeat is a whole check in this process: the scene is loaded, the BVH built, both\n"
-        "routes rendered and compared. Peak RSS is read after the first one. Lines are\n"
+        "Each repeat is a whole check in a child process of its own, as `zcheck check` runs it: the\n"
+        "scene is loaded, the BVH built, both routes rendered and compared. Peak RSS is the largest\n"
+        "child's; the references run afterwards in this process. Lines are\n"
         "'<phase> median <ms> ms best <ms> ms <rate>' and 'ratio <name> <value> target <bound>'.\n"
         "Examples:\n"
         "  zcheck bench --reference                         the workload, with both references\n"

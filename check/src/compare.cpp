@@ -41,31 +41,41 @@ double ToleranceModel::constantQuanta(const DepthSettings& depth)
     return 4.0;
 }
 
-double windowDepthSlope(const Camera& camera, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c)
-{
+DepthSlopeFrame::DepthSlopeFrame(const Camera& camera)
     // The plane n·p + d = 0 in world space maps to clip space through the transpose of
     // worldFromClip; there a·x + b·y + c·z + d·w = 0, so in NDC z = −(a·x + b·y + d)/c.
+    : clipPlaneFromWorldPlane(glm::transpose(camera.worldFromClip)),
+      zWindowPerZNdc(std::abs(camera.windowFromNdc[2][2])),
+      ndcPerPixelX(std::abs(camera.ndcFromWindow[0][0])),
+      ndcPerPixelY(std::abs(camera.ndcFromWindow[1][1]))
+{
+}
+
+double DepthSlopeFrame::slope(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) const
+{
     const glm::dvec3 normal = glm::cross(b - a, c - a);
-    const glm::dvec4 planeWorld(normal, -glm::dot(normal, a));
-    const glm::dvec4 planeClip = glm::transpose(camera.worldFromClip) * planeWorld;
+    const glm::dvec4 planeClip = clipPlaneFromWorldPlane * glm::dvec4(normal, -glm::dot(normal, a));
     if (planeClip.z == 0) return INFINITY;
-    const double zWindowPerZNdc = std::abs(camera.windowFromNdc[2][2]);
-    const double dzdx = zWindowPerZNdc * std::abs(planeClip.x / planeClip.z) * std::abs(camera.ndcFromWindow[0][0]);
-    const double dzdy = zWindowPerZNdc * std::abs(planeClip.y / planeClip.z) * std::abs(camera.ndcFromWindow[1][1]);
+    const double dzdx = zWindowPerZNdc * std::abs(planeClip.x / planeClip.z) * ndcPerPixelX;
+    const double dzdy = zWindowPerZNdc * std::abs(planeClip.y / planeClip.z) * ndcPerPixelY;
     return std::max(dzdx, dzdy);
 }
 
+double windowDepthSlope(const Camera& camera, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c)
+{
+    return DepthSlopeFrame(camera).slope(a, b, c);
+}
 
 namespace {
 
-// The 99th percentile of non-negative values held in several vectors, without joining them:
+// The 99th percentile of non-negative values held in several runs, without joining them:
 // a radix select on the bit patterns (for non-negative floats they order as the values do),
 // the top 16 bits first, then the values that share the chosen prefix.
-template <class Vectors>
-double percentile99(const Vectors& parts)
+// `parts`: (first value, count) pairs.
+double percentile99(const std::vector<std::pair<const float*, std::size_t>>& parts)
 {
     std::size_t count = 0;
-    for (const std::vector<float>& part : parts) count += part.size();
+    for (const auto& part : parts) count += part.second;
     if (count == 0) return 0.0;
     std::size_t k = std::min(count - 1, static_cast<std::size_t>(std::ceil(0.99 * double(count))) - 1);
     auto bits = [](float v) {
@@ -74,14 +84,14 @@ double percentile99(const Vectors& parts)
         return b;
     };
     std::vector<std::size_t> histogram(std::size_t(1) << 16, 0);
-    for (const std::vector<float>& part : parts)
-        for (float v : part) ++histogram[bits(v) >> 16];
+    for (const auto& [values, n] : parts)
+        for (std::size_t j = 0; j < n; ++j) ++histogram[bits(values[j]) >> 16];
     std::uint32_t prefix = 0;
     while (k >= histogram[prefix]) k -= histogram[prefix++];
     std::vector<float> sharing;
-    for (const std::vector<float>& part : parts)
-        for (float v : part)
-            if (bits(v) >> 16 == prefix) sharing.push_back(v);
+    for (const auto& [values, n] : parts)
+        for (std::size_t j = 0; j < n; ++j)
+            if (bits(values[j]) >> 16 == prefix) sharing.push_back(values[j]);
     std::nth_element(sharing.begin(), sharing.begin() + std::ptrdiff_t(k), sharing.end());
     return sharing[k];
 }
@@ -94,8 +104,10 @@ PixelJudge::PixelJudge(const Scene& scene, const Camera& camera, const Tolerance
       C_(ToleranceModel::constantQuanta(camera.depth())),
       S_(tolerance.snapPixels()),
       E_(16 * std::ldexp(1.0, -52) * std::max(std::abs(camera.depth().rangeMin), std::abs(camera.depth().rangeMax))),
-      slopeCache_(std::make_unique<std::atomic<double>[]>(scene.triangleCount()))
+      slopeFrame_(camera),
+      slopeCache_(new std::atomic<double>[scene.triangleCount()])  // not touched yet
 {
+    adviseHugePages(slopeCache_.get(), scene.triangleCount() * sizeof(std::atomic<double>));
     for (std::size_t t = 0; t < scene.triangleCount(); ++t) slopeCache_[t].store(NAN, std::memory_order_relaxed);
 }
 
@@ -111,7 +123,7 @@ double PixelJudge::slope(std::uint32_t primitive) const
     std::atomic<double>& cached = slopeCache_[primitive];
     double m = cached.load(std::memory_order_relaxed);
     if (std::isnan(m)) {
-        m = windowDepthSlope(camera_, vertex(primitive, 0), vertex(primitive, 1), vertex(primitive, 2));
+        m = slopeFrame_.slope(vertex(primitive, 0), vertex(primitive, 1), vertex(primitive, 2));
         cached.store(m, std::memory_order_relaxed);
     }
     return m;
@@ -169,7 +181,7 @@ namespace {
 // What one block of rows contributes to the report; blocks are merged in scan order.
 struct BlockTally {
     ComparisonReport report;  // counts, maxima, worst pixel, samples, bounding box, bias samples
-    std::vector<float> errorQuanta, relativeEyeZ;  // per pixel compared on depth (binary32 suffices for statistics)
+    std::size_t compared = 0;  // pixels compared on depth; their statistics start at the block's first pixel
     double signedErrorSum = 0;
     std::int64_t quarterCounts[4] = {0, 0, 0, 0};
 };
@@ -217,6 +229,7 @@ void merge(BlockTally& total, BlockTally& block)
         r.unexplainedMaxRow = first ? b.unexplainedMaxRow : std::max(r.unexplainedMaxRow, b.unexplainedMaxRow);
     }
     total.signedErrorSum += block.signedErrorSum;
+    total.compared += block.compared;
     for (int k = 0; k < 4; ++k) total.quarterCounts[k] += block.quarterCounts[k];
 }
 
@@ -233,11 +246,18 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
 
     const PixelJudge judge(scene, camera, tolerance);
     const CameraRays cameraRays(camera);  // eye-z of a window depth in closed form
+    // Per pixel compared on depth, for the 99th percentiles (binary32 suffices for statistics);
+    // each block of rows fills its own rows' range from the start.
+    std::vector<float> errorQuanta, relativeEyeZ;
+    assignLarge(errorQuanta, std::size_t(W) * H, 0.0f);
+    assignLarge(relativeEyeZ, std::size_t(W) * H, 0.0f);
     const DepthFormat format = camera.depth().format;
     const double S = tolerance.snapPixels();
 
     auto compareBlock = [&](int firstRow, int lastRow, BlockTally& tally) {
         ComparisonReport& r = tally.report;
+        float* const blockErrorQuanta = &errorQuanta[std::size_t(firstRow) * W];
+        float* const blockRelativeEyeZ = &relativeEyeZ[std::size_t(firstRow) * W];
         for (int row = firstRow; row < lastRow; ++row) {
             for (int col = 0; col < W; ++col) {
                 const std::size_t i = std::size_t(row) * W + col;
@@ -277,13 +297,13 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
                     } else {
                         f.pixelClass == PixelClass::Agree ? ++r.agree : ++r.depthErrors;
                         out.errorOverTolerance[i] = static_cast<float>(ratio);
-                        tally.errorQuanta.push_back(float(f.errorQuanta));
+                        blockErrorQuanta[tally.compared] = float(f.errorQuanta);
                         const glm::dvec2 pImage(col + 0.5, row + 0.5);
                         const double eyeZRay = ray.pEye.empty() ? cameraRays.eyeZFromWindowDepth(pImage, f.rayWindowDepth)
                                                                 : camera.eyeZOf(ray.pEye[i]);
                         const double eyeZRaster = cameraRays.eyeZFromWindowDepth(pImage, f.rasterWindowDepth);
                         const double relative = std::abs(eyeZRaster - eyeZRay) / std::abs(eyeZRay);
-                        tally.relativeEyeZ.push_back(float(relative));
+                        blockRelativeEyeZ[tally.compared++] = float(relative);
                         r.maxRelativeEyeZError = std::max(r.maxRelativeEyeZError, relative);
                         r.maxErrorQuanta = std::max(r.maxErrorQuanta, f.errorQuanta);
                         if (ratio > r.maxErrorOverTolerance || r.agree + r.depthErrors == 1) {
@@ -324,20 +344,23 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
     });
     BlockTally total;
     for (BlockTally& block : blocks) merge(total, block);
-    std::vector<std::vector<float>> errorQuanta, relativeEyeZ;
-    for (BlockTally& block : blocks)
-        errorQuanta.push_back(std::move(block.errorQuanta)), relativeEyeZ.push_back(std::move(block.relativeEyeZ));
+    std::vector<std::pair<const float*, std::size_t>> errorQuantaParts, relativeEyeZParts;
+    for (std::size_t b = 0; b < blocks.size(); ++b) {
+        const std::size_t first = b * kBlockRows * std::size_t(W);
+        errorQuantaParts.emplace_back(&errorQuanta[first], blocks[b].compared);
+        relativeEyeZParts.emplace_back(&relativeEyeZ[first], blocks[b].compared);
+    }
     blocks.clear();
 
     out.report = std::move(total.report);
     ComparisonReport& r = out.report;
     r.width = W, r.height = H;
-    r.p99ErrorQuanta = percentile99(errorQuanta);
+    r.p99ErrorQuanta = percentile99(errorQuantaParts);
     if (r.biasSamples > 0) r.meanSignedErrorQuanta = total.signedErrorSum / double(r.biasSamples);
     const bool spread = std::all_of(std::begin(total.quarterCounts), std::end(total.quarterCounts),
                                     [&](std::int64_t n) { return n >= r.biasSamples / 10; });
     r.depthBias = r.biasSamples >= 1000 && spread && std::abs(r.meanSignedErrorQuanta) > 0.25;
-    r.p99RelativeEyeZError = percentile99(relativeEyeZ);
+    r.p99RelativeEyeZError = percentile99(relativeEyeZParts);
     return out;
 }
 

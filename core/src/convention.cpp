@@ -71,26 +71,4 @@ DepthFormat depthFormatFromName(const std::string& name)
     throw Error("unknown depth format '" + name + "' (expected one of " + joined(depthFormatNames()) + ")");
 }
 
-namespace {
-double unormMax(DepthFormat format)
-{
-    return format == DepthFormat::Unorm24 ? 16777215.0 : 65535.0;
-}
-}  // namespace
-
-double quantizeDepth(DepthFormat format, double windowDepth)
-{
-    if (format == DepthFormat::Float32) return static_cast<double>(static_cast<float>(windowDepth));
-    const double maxCode = unormMax(format);
-    const double code = std::nearbyint(std::clamp(windowDepth, 0.0, 1.0) * maxCode);
-    return code / maxCode;
-}
-
-double storageQuantum(DepthFormat format, double windowDepth)
-{
-    if (format != DepthFormat::Float32) return 1.0 / unormMax(format);
-    const float magnitude = std::fabs(static_cast<float>(windowDepth));
-    return static_cast<double>(std::nextafter(magnitude, INFINITY)) - static_cast<double>(magnitude);
-}
-
 }  // namespace zcheck

@@ -37,11 +37,6 @@ EyePlaneRay worldEyePlaneRayThroughWindow(const Camera& camera, const glm::dvec2
     return ray;
 }
 
-glm::dvec2 windowFromPixelCentre(const Camera& camera, int col, int row)
-{
-    return {col + 0.5, camera.windowYFromImageY(row + 0.5)};
-}
-
 Ray eyeRayThroughWindow(const Camera& camera, const glm::dvec2& pWindow)
 {
     const glm::dvec4 nearEye = camera.eyeFromClip * clipFromWindow(camera, {pWindow, camera.windowDepthNear()});

@@ -1,6 +1,7 @@
 #include "zcheck/input_file.h"
 
 #include "zcheck/error.h"
+#include "zcheck/large_buffer.h"
 
 #include <cctype>
 #include <cerrno>
@@ -61,7 +62,10 @@ std::string readInputFile(const std::string& path, const InputKind& kind)
         ::close(fd);
         refuse(path, kind, "it grew over the " + sizeText(kind.maxBytes) + " limit while being read");
     }
-    std::string bytes(size, '\0');
+    std::string bytes;
+    bytes.reserve(size);
+    adviseHugePages(bytes.data(), size);  // a mesh of tens of megabytes: see large_buffer.h
+    bytes.resize(size);
     std::uint64_t done = 0;
     while (done < size) {
         const ssize_t n = ::read(fd, bytes.data() + done, size - done);

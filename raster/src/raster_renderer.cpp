@@ -110,29 +110,42 @@ SnappedVertex snapVertex(const Viewport& vp, const glm::dvec4& pClip)
     return v;
 }
 
-// Edge functions, pixel bounding box and depth plane of a snapped triangle. False when it
-// covers no pixel centre (zero area, outside the image, or a vertex that cannot be snapped).
-bool setupFromSnapped(const Viewport& vp, const SnappedVertex& v0, const SnappedVertex& v1, const SnappedVertex& v2,
-                      std::uint32_t primitive, TriangleSetup& t)
+// The pixels whose centres a snapped triangle may cover, inclusive and inside the image.
+struct PixelBox {
+    int minCol, maxCol, minRow, maxRow;
+};
+
+// The box of a snapped triangle; false when it covers no pixel centre (zero area, outside
+// the image, or a vertex that cannot be snapped). `area2` receives twice its signed area.
+bool coveredBox(const Viewport& vp, const SnappedVertex& v0, const SnappedVertex& v1, const SnappedVertex& v2,
+                PixelBox& box, std::int64_t& area2)
 {
     if (!v0.valid || !v1.valid || !v2.valid) return false;
-    std::int64_t X[3] = {v0.X, v1.X, v2.X}, Y[3] = {v0.Y, v1.Y, v2.Y};
-    double z[3] = {v0.z, v1.z, v2.z};
-    std::int64_t area2 = (X[1] - X[0]) * (Y[2] - Y[0]) - (Y[1] - Y[0]) * (X[2] - X[0]);
+    area2 = (v1.X - v0.X) * (v2.Y - v0.Y) - (v1.Y - v0.Y) * (v2.X - v0.X);
     if (area2 == 0) return false;  // covers no sample point
-    if (area2 < 0) {               // no culling: both windings are drawn, normalised to area2 > 0
-        std::swap(X[1], X[2]), std::swap(Y[1], Y[2]), std::swap(z[1], z[2]);
-        area2 = -area2;
-    }
-
     // Pixel (c, r) samples at fixed point (c·256 + 128, r·256 + 128).
     auto firstCentre = [](std::int64_t lo) { return int((lo - kHalfPixel + kSubpixel - 1) >> RasterRenderer::kSubpixelBits); };
     auto lastCentre = [](std::int64_t hi) { return int((hi - kHalfPixel) >> RasterRenderer::kSubpixelBits); };
-    t.minCol = std::max(0, firstCentre(std::min({X[0], X[1], X[2]})));
-    t.maxCol = std::min(vp.width - 1, lastCentre(std::max({X[0], X[1], X[2]})));
-    t.minRow = std::max(0, firstCentre(std::min({Y[0], Y[1], Y[2]})));
-    t.maxRow = std::min(vp.height - 1, lastCentre(std::max({Y[0], Y[1], Y[2]})));
-    if (t.minCol > t.maxCol || t.minRow > t.maxRow) return false;
+    box.minCol = std::max(0, firstCentre(std::min({v0.X, v1.X, v2.X})));
+    box.maxCol = std::min(vp.width - 1, lastCentre(std::max({v0.X, v1.X, v2.X})));
+    box.minRow = std::max(0, firstCentre(std::min({v0.Y, v1.Y, v2.Y})));
+    box.maxRow = std::min(vp.height - 1, lastCentre(std::max({v0.Y, v1.Y, v2.Y})));
+    return box.minCol <= box.maxCol && box.minRow <= box.maxRow;
+}
+
+// Edge functions, pixel bounding box and depth plane of a snapped triangle; false when it
+// covers no pixel centre (coveredBox).
+bool setupFromSnapped(const Viewport& vp, const SnappedVertex& v0, const SnappedVertex& v1, const SnappedVertex& v2,
+                      std::uint32_t primitive, TriangleSetup& t)
+{
+    PixelBox box;
+    std::int64_t area2;
+    if (!coveredBox(vp, v0, v1, v2, box, area2)) return false;
+    t.minCol = box.minCol, t.maxCol = box.maxCol, t.minRow = box.minRow, t.maxRow = box.maxRow;
+    std::int64_t X[3] = {v0.X, v1.X, v2.X}, Y[3] = {v0.Y, v1.Y, v2.Y};
+    double z[3] = {v0.z, v1.z, v2.z};
+    if (area2 < 0)  // no culling: both windings are drawn, normalised to area2 > 0
+        std::swap(X[1], X[2]), std::swap(Y[1], Y[2]), std::swap(z[1], z[2]);
 
     for (int e = 0; e < 3; ++e) {
         const int a = e, b = (e + 1) % 3;
@@ -284,14 +297,15 @@ RenderResult RasterRenderer::render(const Camera& camera, const RasterFaults& fa
         const std::size_t first = c * kChunkTriangles, last = std::min(triangleCount, first + kChunkTriangles);
         std::vector<BinItem> items;
         items.reserve(last - first);
-        TriangleSetup t;
+        PixelBox box;
+        std::int64_t area2;
         for (std::size_t p = first; p < last; ++p) {
             const glm::uvec3& tri = scene_.triangles[p];
             const unsigned codeA = outcode[tri[0]], codeB = outcode[tri[1]], codeC = outcode[tri[2]];
             if (codeA & codeB & codeC) continue;  // wholly outside one plane
             if ((codeA | codeB | codeC) == 0) {
-                if (setupFromSnapped(vp, snapped[tri[0]], snapped[tri[1]], snapped[tri[2]], std::uint32_t(p), t))
-                    items.push_back({std::uint32_t(p), t.minCol, t.maxCol, t.minRow, t.maxRow});
+                if (coveredBox(vp, snapped[tri[0]], snapped[tri[1]], snapped[tri[2]], box, area2))
+                    items.push_back({std::uint32_t(p), box.minCol, box.maxCol, box.minRow, box.maxRow});
                 continue;
             }
             const std::size_t before = chunk.clipped.size();

@@ -181,14 +181,19 @@ RenderResult RayRenderer::render(const Camera& camera, const RayFaults& fault, E
                         packet.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
                     }
                     rtcIntersect16(valid, rtcScene, &context, &packet);
+                    // Neighbouring rays mostly hit the same triangle: its plane is kept.
+                    std::uint32_t planeOf = RTC_INVALID_GEOMETRY_ID;
+                    glm::dvec3 a, normal;
                     for (int k = 0; k < kPacketRays; ++k) {
                         if (!valid[k] || packet.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) continue;
                         const std::uint32_t primitive = packet.hit.primID[k];
-                        const glm::uvec3& tri = scene_.triangles[primitive];
-                        const glm::dvec3 a(scene_.positions[tri[0]]), b(scene_.positions[tri[1]]),
-                            c(scene_.positions[tri[2]]);
+                        if (primitive != planeOf) {
+                            const glm::uvec3& tri = scene_.triangles[primitive];
+                            a = glm::dvec3(scene_.positions[tri[0]]);
+                            normal = glm::cross(glm::dvec3(scene_.positions[tri[1]]) - a, glm::dvec3(scene_.positions[tri[2]]) - a);
+                            planeOf = primitive;
+                        }
                         // The hit again, in double: the ray against the hit triangle's plane.
-                        const glm::dvec3 normal = glm::cross(b - a, c - a);
                         double t = glm::dot(normal, a - origin[k]) / glm::dot(normal, direction[k]);
                         if (!std::isfinite(t)) t = packet.ray.tfar[k];
                         const glm::dvec3 pWorld = origin[k] + t * direction[k];

@@ -22,6 +22,11 @@ public:
     Scene read()
     {
         scene_.name = path_;
+        // Capacity for typical lines (a vertex takes about 30 bytes, a face about 20): reserved
+        // address space costs no memory until touched, and the arrays need not move while they
+        // grow (beyond it they grow as usual).
+        scene_.positions.reserve(bytes_.size() / 24);
+        scene_.triangles.reserve(bytes_.size() / 16);
         std::size_t position = 0;
         std::string joined;  // a statement continued over several lines with a trailing backslash
         while (position < bytes_.size()) {

@@ -124,6 +124,16 @@ struct Comparison {
     std::vector<float> errorOverTolerance;   // per pixel: |Δ| / tolerance for both-hit, 0 elsewhere
 };
 
+// Window-depth slope m of a world-space triangle's plane, per pixel (may be +inf for a plane
+// seen edge-on), with what it needs of the camera computed once.
+struct DepthSlopeFrame {
+    explicit DepthSlopeFrame(const Camera& camera);
+    double slope(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) const;
+
+    glm::dmat4 clipPlaneFromWorldPlane;  // transpose(worldFromClip)
+    double zWindowPerZNdc, ndcPerPixelX, ndcPerPixelY;
+};
+
 // The per-pixel rule above, in one place: the comparison applies it to the raster's surface,
 // and `verify` (which must guess the surface a map saw) applies it to every candidate surface,
 // so that which surfaces a pixel may show and whether its depth agrees are one decision.
@@ -154,6 +164,7 @@ private:
     const Scene& scene_;
     const Camera& camera_;
     double C_, S_, E_;
+    DepthSlopeFrame slopeFrame_;
     std::unique_ptr<std::atomic<double>[]> slopeCache_;  // per primitive, NaN until computed
 };
 
@@ -169,8 +180,7 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
                          const RenderResult& raster, const ToleranceModel& tolerance = {},
                          const std::vector<double>* rasterQuantum = nullptr);
 
-// Window-depth slope m of a world-space triangle's plane, per pixel (may be +inf for a plane
-// seen edge-on).
+// The same for one triangle (DepthSlopeFrame::slope).
 double windowDepthSlope(const Camera& camera, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c);
 
 }  // namespace zcheck

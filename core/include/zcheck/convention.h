@@ -14,6 +14,8 @@
 // projection matrix: clipFromEye maps the near plane to the far end of NDC z), the depth
 // range [min,max] the viewport maps NDC z to (glDepthRange / MinDepth-MaxDepth), and the
 // storage format of the depth buffer.
+#include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -50,13 +52,28 @@ std::string toString(DepthFormat format);
 DepthFormat depthFormatFromName(const std::string& name);  // throws Error naming the value
 const std::vector<std::string>& depthFormatNames();
 
+// The largest code of a unorm format, 2^N − 1.
+inline double unormMax(DepthFormat format) { return format == DepthFormat::Unorm24 ? 16777215.0 : 65535.0; }
+
 // The value the depth buffer stores for window depth `windowDepth` (clamped to [0,1] for
-// unorm formats), returned as a double so that all formats compare alike.
-double quantizeDepth(DepthFormat format, double windowDepth);
+// unorm formats, rounded to the nearest code), returned as a double so that all formats
+// compare alike. Inline: the rasterizer calls it per pixel.
+inline double quantizeDepth(DepthFormat format, double windowDepth)
+{
+    if (format == DepthFormat::Float32) return static_cast<double>(static_cast<float>(windowDepth));
+    const double maxCode = unormMax(format);
+    const double code = std::nearbyint(std::clamp(windowDepth, 0.0, 1.0) * maxCode);
+    return code / maxCode;
+}
 
 // The storage quantum q at a stored value: 1 LSB = 1/(2^N − 1) for unorm-N, the spacing of
 // binary32 numbers above |value| (1 ulp) for float32.
-double storageQuantum(DepthFormat format, double windowDepth);
+inline double storageQuantum(DepthFormat format, double windowDepth)
+{
+    if (format != DepthFormat::Float32) return 1.0 / unormMax(format);
+    const float magnitude = std::fabs(static_cast<float>(windowDepth));
+    return static_cast<double>(std::nextafter(magnitude, INFINITY)) - static_cast<double>(magnitude);
+}
 
 struct DepthSettings {
     DepthFormat format = DepthFormat::Float32;

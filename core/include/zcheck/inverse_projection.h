@@ -36,7 +36,10 @@ struct Ray {
 };
 
 // Window coordinates of the centre of pixel (col, row); row 0 is the top row of the image.
-glm::dvec2 windowFromPixelCentre(const Camera& camera, int col, int row);
+inline glm::dvec2 windowFromPixelCentre(const Camera& camera, int col, int row)
+{
+    return {col + 0.5, camera.windowYFromImageY(row + 0.5)};
+}
 
 // The viewing ray through a window point, between the near and far planes.
 Ray eyeRayThroughWindow(const Camera& camera, const glm::dvec2& pWindow);
