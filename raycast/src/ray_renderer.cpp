@@ -181,11 +181,20 @@ RenderResult RayRenderer::render(const Camera& camera, const RayFaults& fault, E
                         packet.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
                     }
                     rtcIntersect16(valid, rtcScene, &context, &packet);
+                    // The hit triangles' indices and vertices lie scattered over the scene's
+                    // arrays: ask for all of them before using any, so their cache misses overlap.
+                    auto hitAt = [&](int k) { return valid[k] && packet.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID; };
+                    for (int k = 0; k < kPacketRays; ++k)
+                        if (hitAt(k)) __builtin_prefetch(&scene_.triangles[packet.hit.primID[k]]);
+                    for (int k = 0; k < kPacketRays; ++k)
+                        if (hitAt(k))
+                            for (const std::uint32_t v : {0, 1, 2})
+                                __builtin_prefetch(&scene_.positions[scene_.triangles[packet.hit.primID[k]][int(v)]]);
                     // Neighbouring rays mostly hit the same triangle: its plane is kept.
                     std::uint32_t planeOf = RTC_INVALID_GEOMETRY_ID;
                     glm::dvec3 a, normal;
                     for (int k = 0; k < kPacketRays; ++k) {
-                        if (!valid[k] || packet.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) continue;
+                        if (!hitAt(k)) continue;
                         const std::uint32_t primitive = packet.hit.primID[k];
                         if (primitive != planeOf) {
                             const glm::uvec3& tri = scene_.triangles[primitive];
