@@ -17,7 +17,11 @@ grep -qE "^trace .* [0-9.]+ Mrays/s$" "$tmp/bench.txt"
 grep -qE "^raster .* [0-9.]+ Mtris/s$" "$tmp/bench.txt"
 grep -qE "^peak RSS +[0-9.]+ MiB +budget [0-9.]+ MiB" "$tmp/bench.txt"
 
-"$zcheck" bench --scene "builtin:terrain?n=60" --width 320 --height 180 --repeat 2 --threads 2 --reference --json > "$tmp/bench.json"
+# Mesa's driver, loaded and unloaded by the llvmpipe yardstick, leaks a few hundred bytes the
+# leak checker cannot even name (the code is unloaded by then): under the sanitizers this one
+# run goes without leak detection; zcheck's own code is leak-checked by the run above.
+ASAN_OPTIONS="${ASAN_OPTIONS:-}:detect_leaks=0" \
+    "$zcheck" bench --scene "builtin:terrain?n=60" --width 320 --height 180 --repeat 2 --threads 2 --reference --json > "$tmp/bench.json"
 python3 - "$tmp/bench.json" <<'PY'
 import json, sys
 r = json.load(open(sys.argv[1]))
