@@ -18,18 +18,26 @@
 namespace zcheck::reference {
 namespace {
 
-[[noreturn]] void fail(const std::string& step) { throw std::runtime_error("GL reference: " + step); }
+[[noreturn]] void fail(const std::string& step)
+{
+    throw std::runtime_error("GL reference: " + step);
+}
 
-std::string hex(unsigned value) {
+std::string hex(unsigned value)
+{
     char text[16];
     std::snprintf(text, sizeof text, "0x%04X", value);
     return text;
 }
 
-[[noreturn]] void failEgl(const std::string& step) { fail(step + " (EGL error " + hex(eglGetError()) + ")"); }
+[[noreturn]] void failEgl(const std::string& step)
+{
+    fail(step + " (EGL error " + hex(eglGetError()) + ")");
+}
 
 // Whether a space-separated extension string lists `name` exactly (not as a prefix).
-bool hasExtension(const char* extensions, const char* name) {
+bool hasExtension(const char* extensions, const char* name)
+{
     if (extensions == nullptr) return false;
     const std::size_t length = std::strlen(name);
     for (const char* at = extensions; (at = std::strstr(at, name)) != nullptr; at += length) {
@@ -41,7 +49,8 @@ bool hasExtension(const char* extensions, const char* name) {
 }
 
 // Mesa reads these when eglInitialize creates the driver screen, so they must be set first.
-void configureMesaEnvironment(int threads) {
+void configureMesaEnvironment(int threads)
+{
     setenv("LP_NUM_THREADS", std::to_string(threads).c_str(), /*overwrite=*/1);
     setenv("LIBGL_ALWAYS_SOFTWARE", "1", /*overwrite=*/0);
     setenv("GALLIUM_DRIVER", "llvmpipe", /*overwrite=*/0);
@@ -53,7 +62,8 @@ public:
     EglSession() = default;
     EglSession(const EglSession&) = delete;
     EglSession& operator=(const EglSession&) = delete;
-    ~EglSession() {
+    ~EglSession()
+    {
         if (current_) eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
         if (context_ != EGL_NO_CONTEXT) eglDestroyContext(display_, context_);
         if (initialized_) eglTerminate(display_);
@@ -61,10 +71,12 @@ public:
 
     // Surfaceless display, desktop OpenGL core context (4.5, else 3.3) made current with no
     // surface: rendering goes to a framebuffer object only.
-    void open() {
+    void open()
+    {
         const char* clientExtensions = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
         if (!hasExtension(clientExtensions, "EGL_EXT_platform_base")) fail("EGL_EXT_platform_base missing");
-        if (!hasExtension(clientExtensions, "EGL_MESA_platform_surfaceless")) fail("EGL_MESA_platform_surfaceless missing");
+        if (!hasExtension(clientExtensions, "EGL_MESA_platform_surfaceless"))
+            fail("EGL_MESA_platform_surfaceless missing");
         const auto getPlatformDisplay =
             reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(eglGetProcAddress("eglGetPlatformDisplayEXT"));
         if (getPlatformDisplay == nullptr) fail("eglGetPlatformDisplayEXT not found");
@@ -75,7 +87,8 @@ public:
         initialized_ = true;
 
         const char* displayExtensions = eglQueryString(display_, EGL_EXTENSIONS);
-        if (!hasExtension(displayExtensions, "EGL_KHR_surfaceless_context")) fail("EGL_KHR_surfaceless_context missing");
+        if (!hasExtension(displayExtensions, "EGL_KHR_surfaceless_context"))
+            fail("EGL_KHR_surfaceless_context missing");
         if (eglBindAPI(EGL_OPENGL_API) != EGL_TRUE) failEgl("eglBindAPI(EGL_OPENGL_API)");
 
         // Surface type 0 matches every config: no surface is ever created.
@@ -86,8 +99,12 @@ public:
             failEgl("no EGL config with EGL_OPENGL_BIT");
 
         for (const auto& [major, minor] : {std::pair{4, 5}, std::pair{3, 3}}) {
-            const EGLint contextAttributes[] = {EGL_CONTEXT_MAJOR_VERSION, major, EGL_CONTEXT_MINOR_VERSION, minor,
-                                                EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+            const EGLint contextAttributes[] = {EGL_CONTEXT_MAJOR_VERSION,
+                                                major,
+                                                EGL_CONTEXT_MINOR_VERSION,
+                                                minor,
+                                                EGL_CONTEXT_OPENGL_PROFILE_MASK,
+                                                EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
                                                 EGL_NONE};
             context_ = eglCreateContext(display_, config, EGL_NO_CONTEXT, contextAttributes);
             if (context_ != EGL_NO_CONTEXT) break;
@@ -105,8 +122,8 @@ private:
     bool current_ = false;
 };
 
-template <typename Function>
-void load(Function& function, const char* name) {
+template <typename Function> void load(Function& function, const char* name)
+{
     function = reinterpret_cast<Function>(eglGetProcAddress(name));
     if (function == nullptr) fail(std::string(name) + " not found");
 }
@@ -167,7 +184,8 @@ struct Gl {
     PFNGLPIXELSTOREIPROC PixelStorei;
     PFNGLREADPIXELSPROC ReadPixels;
 
-    void loadAll() {
+    void loadAll()
+    {
         load(GetError, "glGetError");
         load(GetString, "glGetString");
         load(GetStringi, "glGetStringi");
@@ -223,14 +241,16 @@ struct Gl {
     }
 
     // Throws naming `step` if any GL error is pending (all pending errors are drained).
-    void check(const char* step) const {
+    void check(const char* step) const
+    {
         GLenum first = GL_NO_ERROR;
         for (GLenum error; (error = GetError()) != GL_NO_ERROR;)
             if (first == GL_NO_ERROR) first = error;
         if (first != GL_NO_ERROR) fail(std::string(step) + " (GL error " + hex(first) + ")");
     }
 
-    bool supportsClipControl() const {
+    bool supportsClipControl() const
+    {
         GLint major = 0, minor = 0;
         GetIntegerv(GL_MAJOR_VERSION, &major);
         GetIntegerv(GL_MINOR_VERSION, &minor);
@@ -257,7 +277,8 @@ struct GlObjects {
     explicit GlObjects(const Gl& functions) : gl(functions) {}
     GlObjects(const GlObjects&) = delete;
     GlObjects& operator=(const GlObjects&) = delete;
-    ~GlObjects() {
+    ~GlObjects()
+    {
         gl.UseProgram(0);
         gl.DeleteProgram(program);
         gl.DeleteShader(vertexShader);
@@ -283,7 +304,8 @@ constexpr const char* kFragmentShader = R"(#version 330 core
 void main() {}
 )";
 
-GLuint compileShader(const Gl& gl, GLenum stage, const char* source, const char* stageName) {
+GLuint compileShader(const Gl& gl, GLenum stage, const char* source, const char* stageName)
+{
     const GLuint shader = gl.CreateShader(stage);
     if (shader == 0) fail(std::string("glCreateShader (") + stageName + ")");
     gl.ShaderSource(shader, 1, &source, nullptr);
@@ -299,7 +321,8 @@ GLuint compileShader(const Gl& gl, GLenum stage, const char* source, const char*
     return shader;
 }
 
-void validate(const GlDepthInput& input, int repeats) {
+void validate(const GlDepthInput& input, int repeats)
+{
     if (input.positions == nullptr || input.indices == nullptr) throw std::invalid_argument("GL reference: null mesh");
     if (input.width <= 0 || input.height <= 0) throw std::invalid_argument("GL reference: empty viewport");
     if (input.threads < 0) throw std::invalid_argument("GL reference: negative thread count");
@@ -308,14 +331,19 @@ void validate(const GlDepthInput& input, int repeats) {
         throw std::invalid_argument("GL reference: too many triangles for one glDrawElements");
     // An out-of-range index would make llvmpipe read past the vertex buffer.
     for (std::size_t i = 0; i < 3 * input.triangleCount; ++i)
-        if (input.indices[i] >= input.vertexCount) throw std::invalid_argument("GL reference: vertex index out of range");
+        if (input.indices[i] >= input.vertexCount)
+            throw std::invalid_argument("GL reference: vertex index out of range");
 }
 
-}  // namespace
+} // namespace
 
-bool glReferenceAvailable() { return true; }
+bool glReferenceAvailable()
+{
+    return true;
+}
 
-GlDepthTiming timeGlDepthDraw(const GlDepthInput& input, int repeats) {
+GlDepthTiming timeGlDepthDraw(const GlDepthInput& input, int repeats)
+{
     validate(input, repeats);
     configureMesaEnvironment(input.threads);
 
@@ -351,8 +379,9 @@ GlDepthTiming timeGlDepthDraw(const GlDepthInput& input, int repeats) {
     const GLint clipFromWorldLocation = gl.GetUniformLocation(objects.program, "clipFromWorld");
     if (clipFromWorldLocation < 0) fail("uniform clipFromWorld not found");
     std::array<GLfloat, 16> clipFromWorld{};
-    for (std::size_t i = 0; i < clipFromWorld.size(); ++i) clipFromWorld[i] = static_cast<GLfloat>(input.clipFromWorld[i]);
-    gl.UniformMatrix4fv(clipFromWorldLocation, 1, GL_FALSE, clipFromWorld.data());  // column-major, as given
+    for (std::size_t i = 0; i < clipFromWorld.size(); ++i)
+        clipFromWorld[i] = static_cast<GLfloat>(input.clipFromWorld[i]);
+    gl.UniformMatrix4fv(clipFromWorldLocation, 1, GL_FALSE, clipFromWorld.data()); // column-major, as given
     gl.check("building the shader program");
 
     // Mesh, uploaded once.
@@ -365,7 +394,7 @@ GlDepthTiming timeGlDepthDraw(const GlDepthInput& input, int repeats) {
     gl.VertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), nullptr);
     gl.EnableVertexAttribArray(0);
     gl.GenBuffers(1, &objects.indexBuffer);
-    gl.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, objects.indexBuffer);  // recorded in the vertex array
+    gl.BindBuffer(GL_ELEMENT_ARRAY_BUFFER, objects.indexBuffer); // recorded in the vertex array
     gl.BufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(3 * input.triangleCount * sizeof(std::uint32_t)),
                   input.indices, GL_STATIC_DRAW);
     gl.check("uploading the mesh");
@@ -401,7 +430,7 @@ GlDepthTiming timeGlDepthDraw(const GlDepthInput& input, int repeats) {
         gl.DrawElements(GL_TRIANGLES, indexCount, GL_UNSIGNED_INT, nullptr);
         gl.Finish();
     };
-    draw();  // warm-up: llvmpipe generates its shader and rasterizer code with LLVM here
+    draw(); // warm-up: llvmpipe generates its shader and rasterizer code with LLVM here
     gl.check("warm-up draw");
     timing.drawMs.reserve(static_cast<std::size_t>(repeats));
     for (int repeat = 0; repeat < repeats; ++repeat) {
@@ -425,4 +454,4 @@ GlDepthTiming timeGlDepthDraw(const GlDepthInput& input, int repeats) {
     return timing;
 }
 
-}  // namespace zcheck::reference
+} // namespace zcheck::reference

@@ -1,9 +1,7 @@
 // Tries the llvmpipe yardstick by hand: draws an N×N heightfield (~2·(N−1)² triangles)
 // at 1920×1080, prints the draw times, and checks the depth it read back.
 //
-//   g++ -std=c++17 -O2 -I reference/include reference/src/gl_reference.cpp
-//       reference/tests/gl_reference_try.cpp -lEGL -o /tmp/gl_try    (one line)
-//   /tmp/gl_try [N=709] [threads=2] [--reversed] [--again THREADS]
+//   ./build/reference/gl_reference_try [N=709] [threads=2] [--reversed] [--again THREADS]
 //
 // --reversed  draws with a reversed-Z [0, 1] projection (near → 1, far → 0).
 // --again T   draws a second time in the same process with T threads, and prints the most
@@ -28,12 +26,16 @@
 
 namespace {
 
-using Mat4 = std::array<double, 16>;  // column-major: element (row r, column c) at [4c + r]
+using Mat4 = std::array<double, 16>; // column-major: element (row r, column c) at [4c + r]
 using Vec3 = std::array<double, 3>;
 
-double& at(Mat4& m, int row, int column) { return m[4 * column + row]; }
+double& at(Mat4& m, int row, int column)
+{
+    return m[4 * column + row];
+}
 
-Mat4 multiply(const Mat4& a, const Mat4& b) {
+Mat4 multiply(const Mat4& a, const Mat4& b)
+{
     Mat4 product{};
     for (int row = 0; row < 4; ++row)
         for (int column = 0; column < 4; ++column)
@@ -41,18 +43,27 @@ Mat4 multiply(const Mat4& a, const Mat4& b) {
     return product;
 }
 
-Vec3 subtract(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-Vec3 cross(const Vec3& a, const Vec3& b) {
+Vec3 subtract(const Vec3& a, const Vec3& b)
+{
+    return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+}
+Vec3 cross(const Vec3& a, const Vec3& b)
+{
     return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
 }
-double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-Vec3 normalize(const Vec3& v) {
+double dot(const Vec3& a, const Vec3& b)
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+Vec3 normalize(const Vec3& v)
+{
     const double length = std::sqrt(dot(v, v));
     return {v[0] / length, v[1] / length, v[2] / length};
 }
 
 // gluLookAt: rows s, u, −f, then a translation by −eye.
-Mat4 lookAt(const Vec3& eye, const Vec3& center, const Vec3& up) {
+Mat4 lookAt(const Vec3& eye, const Vec3& center, const Vec3& up)
+{
     const Vec3 f = normalize(subtract(center, eye));
     const Vec3 s = normalize(cross(f, up));
     const Vec3 u = cross(s, f);
@@ -70,7 +81,8 @@ Mat4 lookAt(const Vec3& eye, const Vec3& center, const Vec3& up) {
 }
 
 // gluPerspective: OpenGL clip space, −w ≤ z ≤ w with near → −1.
-Mat4 perspective(double fovyRadians, double aspect, double near, double far) {
+Mat4 perspective(double fovyRadians, double aspect, double near, double far)
+{
     const double focal = 1.0 / std::tan(fovyRadians / 2.0);
     Mat4 clipFromView{};
     at(clipFromView, 0, 0) = focal / aspect;
@@ -83,7 +95,8 @@ Mat4 perspective(double fovyRadians, double aspect, double near, double far) {
 
 // Reversed-Z [0, 1]: z_clip / w_clip = n(f/d − 1)/(f − n) for eye distance d = −z_view,
 // so near → 1 and far → 0.
-Mat4 reversedPerspective(double fovyRadians, double aspect, double near, double far) {
+Mat4 reversedPerspective(double fovyRadians, double aspect, double near, double far)
+{
     Mat4 clipFromView = perspective(fovyRadians, aspect, near, far);
     at(clipFromView, 2, 2) = near / (far - near);
     at(clipFromView, 2, 3) = far * near / (far - near);
@@ -91,22 +104,25 @@ Mat4 reversedPerspective(double fovyRadians, double aspect, double near, double 
 }
 
 // Threads of this process now (llvmpipe's rasterizer threads live while its context does).
-int processThreadCount() {
+int processThreadCount()
+{
     std::ifstream status("/proc/self/status");
     for (std::string line; std::getline(status, line);)
         if (line.rfind("Threads:", 0) == 0) return std::atoi(line.c_str() + 8);
     return -1;
 }
 
-double median(std::vector<double> values) {
+double median(std::vector<double> values)
+{
     std::sort(values.begin(), values.end());
     const std::size_t n = values.size();
     return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
-}  // namespace
+} // namespace
 
-int main(int argc, char** argv) {
+int main(int argc, char** argv)
+{
     int gridSize = 709;
     int threads = 2;
     bool reversedZ = false;
@@ -213,11 +229,12 @@ int main(int argc, char** argv) {
         drawing = false;
         if (sampler.joinable()) sampler.join();
         std::printf("\nLP_NUM_THREADS=%d, renderer: %s\n", drawThreads, timing.renderer.c_str());
-        for (std::size_t i = 0; i < timing.drawMs.size(); ++i) std::printf("  draw %zu: %.2f ms\n", i, timing.drawMs[i]);
+        for (std::size_t i = 0; i < timing.drawMs.size(); ++i)
+            std::printf("  draw %zu: %.2f ms\n", i, timing.drawMs[i]);
         std::printf("  median: %.2f ms\n", median(timing.drawMs));
 
-        const auto covered = std::count_if(timing.depth.begin(), timing.depth.end(),
-                                           [&](float depth) { return depth != clearedDepth; });
+        const auto covered =
+            std::count_if(timing.depth.begin(), timing.depth.end(), [&](float depth) { return depth != clearedDepth; });
         const double coverage = double(covered) / double(timing.depth.size());
         const float centreDepth = timing.depth[std::size_t(kHeight / 2) * kWidth + kWidth / 2];
         const double centreError = std::abs(centreDepth - expectedCentreDepth);

@@ -19,7 +19,8 @@ struct RenderResult {
     // (quantized to the depth format). Where nothing was hit: the camera's clear value.
     DepthImage windowDepth;
     std::vector<std::uint32_t> primitiveId;  // index into Scene::triangles, or kNoPrimitive
-    std::vector<glm::dvec3> pEye;            // ray route only: hit point in eye space (double)
+    std::vector<glm::dvec3> pEye;            // ray route, when asked (EyePoints::Keep): hit point in eye
+                                             // space (double); empty otherwise
     double renderMilliseconds = 0;           // wall time of render()
 
     bool hit(std::size_t pixel) const { return primitiveId[pixel] != kNoPrimitive; }
