@@ -72,6 +72,11 @@ TEST_CASE("the folded depth mapping is the inverse-projection module's, and its 
             // The matrices' route (clip_from_eye, viewport), an independent evaluation.
             REQUIRE(window == Approx(windowDepthFromEyeZ(camera, pWindow, eyeZ)).margin(1e-12));
             REQUIRE(rays.eyeZFromWindowDepth(pImage, window) == Approx(eyeZ).epsilon(1e-9));
+            // The relative eye-z difference of a depth one part in 10^4 of the range away.
+            const double other = window + 1e-4 * (camera.depth().rangeMax - camera.depth().rangeMin);
+            const double zOther = rays.eyeZFromWindowDepth(pImage, other);
+            REQUIRE(rays.relativeEyeZDifference(pImage, window, other) ==
+                    Approx(std::abs(zOther - eyeZ) / eyeZ).epsilon(1e-6));
         }
         REQUIRE(rays.windowDepth(pImage, n) == Approx(camera.windowDepthNear()).margin(1e-14));
     });

@@ -299,10 +299,12 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
                         out.errorOverTolerance[i] = static_cast<float>(ratio);
                         blockErrorQuanta[tally.compared] = float(f.errorQuanta);
                         const glm::dvec2 pImage(col + 0.5, row + 0.5);
-                        const double eyeZRay = ray.pEye.empty() ? cameraRays.eyeZFromWindowDepth(pImage, f.rayWindowDepth)
-                                                                : camera.eyeZOf(ray.pEye[i]);
-                        const double eyeZRaster = cameraRays.eyeZFromWindowDepth(pImage, f.rasterWindowDepth);
-                        const double relative = std::abs(eyeZRaster - eyeZRay) / std::abs(eyeZRay);
+                        const double relative =
+                            ray.pEye.empty()
+                                ? cameraRays.relativeEyeZDifference(pImage, f.rayWindowDepth, f.rasterWindowDepth)
+                                : std::abs(cameraRays.eyeZFromWindowDepth(pImage, f.rasterWindowDepth) -
+                                           camera.eyeZOf(ray.pEye[i])) /
+                                      std::abs(camera.eyeZOf(ray.pEye[i]));
                         blockRelativeEyeZ[tally.compared++] = float(relative);
                         r.maxRelativeEyeZError = std::max(r.maxRelativeEyeZError, relative);
                         r.maxErrorQuanta = std::max(r.maxErrorQuanta, f.errorQuanta);

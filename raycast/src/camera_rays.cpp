@@ -132,4 +132,15 @@ double CameraRays::eyeZFromWindowDepth(const glm::dvec2& pImage, double w) const
     return parallel_ ? (w - depthA_) / depthB_ : depthB_ / (w - depthA_);
 }
 
+double CameraRays::relativeEyeZDifference(const glm::dvec2& pImage, double reference, double other) const
+{
+    if (fromMatrix_) {
+        const double zReference = eyeZFromWindowDepth(pImage, reference);
+        return std::abs(eyeZFromWindowDepth(pImage, other) - zReference) / std::abs(zReference);
+    }
+    // Parallel: z = (w − A)/B, so (z_o − z_r)/z_r = (w_o − w_r)/(w_r − A).
+    return parallel_ ? std::abs((other - reference) / (reference - depthA_))
+                     : std::abs((reference - other) / (other - depthA_));
+}
+
 }  // namespace zcheck

@@ -62,6 +62,10 @@ public:
     double windowDepth(const glm::dvec2& pImage, double eyeZ) const;
     // Its inverse: the eye-z at which the ray through pImage has window depth `windowDepth`.
     double eyeZFromWindowDepth(const glm::dvec2& pImage, double windowDepth) const;
+    // |z(other) − z(reference)| / |z(reference)| for two window depths on the ray through
+    // pImage, z being eye-z: with z = B/(w − A) that is |(w_ref − w_other)/(w_other − A)|, one
+    // division where the two conversions take three.
+    double relativeEyeZDifference(const glm::dvec2& pImage, double referenceWindowDepth, double otherWindowDepth) const;
 
 private:
     // The ray through pImage in OpenGL's eye axes: eye-plane origin and direction (z = −1).
