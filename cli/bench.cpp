@@ -18,7 +18,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
-#include <optional>
 #include <thread>
 
 namespace zcheck::cli {
@@ -106,7 +105,7 @@ WholeCheck wholeCheckInChild(const std::string& sceneName, const Camera& camera,
 
 struct BenchOptions {
     SceneAndCamera input{kWorkloadScene, "", ""};
-    std::optional<int> width, height;
+    ImageSize imageSize;
     int repeat = 5;
     int threads = 0;
     bool reference = false;
@@ -144,12 +143,11 @@ int runBenchCommand(const BenchOptions& o)
     // effects are not what this measures). TBB is not started before the children fork.
     CameraSpec spec;
     {
-        const Scene scene = loadScene(o.input.scene);
-        spec = workload ? workloadCamera() : cameraSpecFor(scene, o.input);
-        if (workload && !o.input.convention.empty()) spec.convention = Convention::preset(o.input.convention);
+        Scene scene = loadScene(o.input.scene);
+        if (workload) scene.defaultCamera = workloadCamera();
+        spec = cameraSpecFor(scene, o.input);
     }
-    if (o.width) spec.width = *o.width;
-    if (o.height) spec.height = *o.height;
+    o.imageSize.apply(spec);
     const Camera camera(spec);
     const bool isFile = !isBuiltinSceneName(o.input.scene);
     const double fileMB = isFile ? double(std::filesystem::file_size(o.input.scene)) / 1e6 : 0.0;
@@ -179,15 +177,13 @@ int runBenchCommand(const BenchOptions& o)
     double glAgreement = NAN;
     if (o.reference) {
         const Scene scene = loadScene(o.input.scene);
+        if (progress) std::fprintf(stderr, "\rbench: Embree reference%20s", ""), std::fflush(stderr);
+        for (int r = 1; r < o.repeat; ++r) embreeBuild.ms.push_back(reference::EmbreeReference(scene).buildMilliseconds());
+        const reference::EmbreeReference embree(scene);  // the last build is the one traced
+        embreeBuild.ms.push_back(embree.buildMilliseconds());
         std::vector<std::uint32_t> primitiveId;
-        for (int r = 0; r < o.repeat; ++r) {
-            if (progress) std::fprintf(stderr, "\rbench: Embree reference %d/%d", r + 1, o.repeat), std::fflush(stderr);
-            const reference::EmbreeReference embree(scene);
-            embreeBuild.ms.push_back(embree.buildMilliseconds());
-            if (r + 1 < o.repeat) continue;
-            embree.trace(camera, primitiveId);  // warm-up
-            for (int k = 0; k < o.repeat; ++k) embreeTrace.ms.push_back(embree.trace(camera, primitiveId));
-        }
+        embree.trace(camera, primitiveId);  // warm-up
+        for (int r = 0; r < o.repeat; ++r) embreeTrace.ms.push_back(embree.trace(camera, primitiveId));
         if (progress) std::fprintf(stderr, "\rbench: llvmpipe reference%20s", ""), std::fflush(stderr);
         if (!reference::glReferenceAvailable()) {
             glSkipped = "not built (libegl-dev was missing at build time)";
@@ -302,8 +298,7 @@ Command addBenchCommand(CLI::App& app)
         "bench", "Measure a whole check phase by phase (load, BVH build, trace, raster, compare) and its\n"
                  "peak memory; with --reference, side by side with Embree's best trace and Mesa's llvmpipe.");
     addSceneAndCameraOptions(command, o->input);
-    command->add_option("--width", o->width, "override the image width in pixels (1..16384)")->check(kImageSideRange);
-    command->add_option("--height", o->height, "override the image height in pixels (1..16384)")->check(kImageSideRange);
+    addImageSizeOptions(command, o->imageSize);
     command->add_option("--repeat", o->repeat, "whole checks to time (median and best are reported), 1..1000")
         ->capture_default_str()
         ->check(CLI::Range(1, 1000));

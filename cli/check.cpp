@@ -6,7 +6,6 @@
 #include "zcheck/report.h"
 
 #include <iostream>
-#include <optional>
 
 namespace zcheck::cli {
 
@@ -14,7 +13,7 @@ namespace {
 
 struct CheckCommandOptions {
     SceneAndCamera input;
-    std::optional<int> width, height;
+    ImageSize imageSize;
     std::string depthFormat;
     bool reversedZ = false;
     std::string outDir;
@@ -32,8 +31,7 @@ int runCheckCommand(const CheckCommandOptions& o)
     if (!o.outDir.empty()) folder.plan(outputs);
     Scene scene = loadScene(o.input.scene);
     CameraSpec spec = cameraSpecFor(scene, o.input);
-    if (o.width) spec.width = *o.width;
-    if (o.height) spec.height = *o.height;
+    o.imageSize.apply(spec);
     if (!o.depthFormat.empty()) spec.depth.format = depthFormatFromName(o.depthFormat);
     if (o.reversedZ) spec.depth.reversed = true;
     const Camera camera(spec);  // validated before the BVH is built
@@ -59,8 +57,7 @@ Command addCheckCommand(CLI::App& app)
         "check", "Check one scene through one camera: ray route vs raster route, per pixel.\n"
                  "Exit status 0 consistent, 1 inconsistent, 2 usage or input error.");
     addSceneAndCameraOptions(command, o->input);
-    command->add_option("--width", o->width, "override the image width in pixels (1..16384)")->check(kImageSideRange);
-    command->add_option("--height", o->height, "override the image height in pixels (1..16384)")->check(kImageSideRange);
+    addImageSizeOptions(command, o->imageSize);
     command->add_option("--depth-format", o->depthFormat, "override the depth format: float32 | unorm24 | unorm16");
     command->add_flag("--reversed-z", o->reversedZ, "use reversed-Z (near -> far end of the range, test GREATER)");
     command->add_option("--out", o->outDir,

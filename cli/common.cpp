@@ -56,6 +56,12 @@ void addSceneAndCameraOptions(CLI::App* command, SceneAndCamera& options)
                         "override the convention: opengl | direct3d | vulkan | metal | opencv");
 }
 
+void addImageSizeOptions(CLI::App* command, ImageSize& size)
+{
+    command->add_option("--width", size.width, "override the image width in pixels (1..16384)")->check(kImageSideRange);
+    command->add_option("--height", size.height, "override the image height in pixels (1..16384)")->check(kImageSideRange);
+}
+
 CameraSpec cameraSpecFor(const Scene& scene, const SceneAndCamera& options)
 {
     CameraSpec spec = options.cameraFile.empty() ? scene.defaultCamera : readCameraFile(options.cameraFile);

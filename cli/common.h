@@ -8,6 +8,7 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -54,6 +55,17 @@ void addSceneAndCameraOptions(CLI::App* command, SceneAndCamera& options);
 CameraSpec cameraSpecFor(const Scene& scene, const SceneAndCamera& options);
 // A camera file (required), then --convention.
 CameraSpec cameraSpecFrom(const std::string& cameraFile, const std::string& convention);
+
+// --width and --height, as check and bench take them: they override the camera's image size.
+struct ImageSize {
+    std::optional<int> width, height;
+    void apply(CameraSpec& spec) const
+    {
+        if (width) spec.width = *width;
+        if (height) spec.height = *height;
+    }
+};
+void addImageSizeOptions(CLI::App* command, ImageSize& size);
 
 // "1,2.5,3" → {1, 2.5, 3}; throws Error naming `option` for anything that is not a number.
 std::vector<double> parseNumberList(const std::string& text, const std::string& option);

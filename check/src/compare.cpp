@@ -186,20 +186,26 @@ struct BlockTally {
     std::int64_t quarterCounts[4] = {0, 0, 0, 0};
 };
 
-constexpr int kBlockRows = 8;
-constexpr std::size_t kUnexplainedSamples = 20;  // the first ones in scan order (compare.h)  // rows per block: fixed, so the merge order never depends on threads
+constexpr int kBlockRows = 8;  // rows per block: fixed, so the merge order never depends on threads
+constexpr std::size_t kUnexplainedSamples = 20;  // the first ones in scan order (compare.h)
+
+// Grows the bounding box of the unexplained pixels to hold (col, row).
+void extendUnexplainedBox(ComparisonReport& r, int col, int row)
+{
+    if (r.unexplainedMaxCol < 0) {
+        r.unexplainedMinCol = r.unexplainedMaxCol = col;
+        r.unexplainedMinRow = r.unexplainedMaxRow = row;
+    }
+    r.unexplainedMinCol = std::min(r.unexplainedMinCol, col);
+    r.unexplainedMaxCol = std::max(r.unexplainedMaxCol, col);
+    r.unexplainedMinRow = std::min(r.unexplainedMinRow, row);
+    r.unexplainedMaxRow = std::max(r.unexplainedMaxRow, row);
+}
 
 void noteUnexplained(ComparisonReport& r, const PixelFinding& f)
 {
     if (r.unexplainedSamples.size() < kUnexplainedSamples) r.unexplainedSamples.push_back(f);
-    if (r.unexplainedMaxCol < 0) {
-        r.unexplainedMinCol = r.unexplainedMaxCol = f.col;
-        r.unexplainedMinRow = r.unexplainedMaxRow = f.row;
-    }
-    r.unexplainedMinCol = std::min(r.unexplainedMinCol, f.col);
-    r.unexplainedMaxCol = std::max(r.unexplainedMaxCol, f.col);
-    r.unexplainedMinRow = std::min(r.unexplainedMinRow, f.row);
-    r.unexplainedMaxRow = std::max(r.unexplainedMaxRow, f.row);
+    extendUnexplainedBox(r, f.col, f.row);
 }
 
 // Appends `block` (the rows after those of `total`) to `total`.
@@ -222,11 +228,8 @@ void merge(BlockTally& total, BlockTally& block)
     for (const PixelFinding& f : b.unexplainedSamples)
         if (r.unexplainedSamples.size() < kUnexplainedSamples) r.unexplainedSamples.push_back(f);
     if (b.unexplainedMaxCol >= 0) {  // the box of all of them, not only of the samples
-        const bool first = r.unexplainedMaxCol < 0;
-        r.unexplainedMinCol = first ? b.unexplainedMinCol : std::min(r.unexplainedMinCol, b.unexplainedMinCol);
-        r.unexplainedMinRow = first ? b.unexplainedMinRow : std::min(r.unexplainedMinRow, b.unexplainedMinRow);
-        r.unexplainedMaxCol = first ? b.unexplainedMaxCol : std::max(r.unexplainedMaxCol, b.unexplainedMaxCol);
-        r.unexplainedMaxRow = first ? b.unexplainedMaxRow : std::max(r.unexplainedMaxRow, b.unexplainedMaxRow);
+        extendUnexplainedBox(r, b.unexplainedMinCol, b.unexplainedMinRow);
+        extendUnexplainedBox(r, b.unexplainedMaxCol, b.unexplainedMaxRow);
     }
     total.signedErrorSum += block.signedErrorSum;
     total.compared += block.compared;

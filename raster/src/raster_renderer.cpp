@@ -22,6 +22,11 @@ constexpr std::int64_t kSubpixel = 1 << RasterRenderer::kSubpixelBits;  // fixed
 constexpr std::int64_t kHalfPixel = kSubpixel / 2;
 constexpr double kMaxImageCoordinate = 1 << 20;  // |window coordinate| after guard-band clipping, pixels
 
+// The pixels whose centres a snapped triangle may cover, inclusive and inside the image.
+struct PixelBox {
+    int minCol, maxCol, minRow, maxRow;
+};
+
 // A triangle ready to scan: edge functions in 16.8 fixed point, depth plane in pixels.
 struct TriangleSetup {
     // E_i(P) = A_i·P.x + B_i·P.y + C_i for P in fixed point; the pixel is covered iff all
@@ -29,7 +34,7 @@ struct TriangleSetup {
     std::int64_t A[3], B[3], C[3];
     // Window depth at image point (x, y): z0 + dzdx·(x − x0) + dzdy·(y − y0).
     double x0, y0, z0, dzdx, dzdy;
-    int minCol, maxCol, minRow, maxRow;  // pixel bounding box, inclusive, inside the image
+    PixelBox box;
     std::uint32_t primitive;
 };
 
@@ -110,11 +115,6 @@ SnappedVertex snapVertex(const Viewport& vp, const glm::dvec4& pClip)
     return v;
 }
 
-// The pixels whose centres a snapped triangle may cover, inclusive and inside the image.
-struct PixelBox {
-    int minCol, maxCol, minRow, maxRow;
-};
-
 // The box of a snapped triangle; false when it covers no pixel centre (zero area, outside
 // the image, or a vertex that cannot be snapped). `area2` receives twice its signed area.
 bool coveredBox(const Viewport& vp, const SnappedVertex& v0, const SnappedVertex& v1, const SnappedVertex& v2,
@@ -141,7 +141,7 @@ bool setupFromSnapped(const Viewport& vp, const SnappedVertex& v0, const Snapped
     PixelBox box;
     std::int64_t area2;
     if (!coveredBox(vp, v0, v1, v2, box, area2)) return false;
-    t.minCol = box.minCol, t.maxCol = box.maxCol, t.minRow = box.minRow, t.maxRow = box.maxRow;
+    t.box = box;
     std::int64_t X[3] = {v0.X, v1.X, v2.X}, Y[3] = {v0.Y, v1.Y, v2.Y};
     double z[3] = {v0.z, v1.z, v2.z};
     if (area2 < 0)  // no culling: both windings are drawn, normalised to area2 > 0
@@ -186,7 +186,7 @@ void setupClippedPrimitive(const Viewport& vp, const glm::dvec4& a, const glm::d
 // What binning needs of one entry: its pixel bounding box.
 struct BinItem {
     std::uint32_t entry;
-    int minCol, maxCol, minRow, maxRow;
+    PixelBox box;
 };
 
 void binChunk(const Viewport& vp, const std::vector<BinItem>& items, Chunk& chunk)
@@ -194,9 +194,10 @@ void binChunk(const Viewport& vp, const std::vector<BinItem>& items, Chunk& chun
     const int tiles = vp.tilesX * vp.tilesY;
     const int T = RasterRenderer::kTileSize;
     chunk.tileStart.assign(std::size_t(tiles) + 1, 0);
-    auto forEachTile = [&](const BinItem& t, auto&& visit) {
-        for (int ty = t.minRow / T; ty <= t.maxRow / T; ++ty)
-            for (int tx = t.minCol / T; tx <= t.maxCol / T; ++tx) visit(ty * vp.tilesX + tx);
+    auto forEachTile = [&](const BinItem& item, auto&& visit) {
+        const PixelBox& b = item.box;
+        for (int ty = b.minRow / T; ty <= b.maxRow / T; ++ty)
+            for (int tx = b.minCol / T; tx <= b.maxCol / T; ++tx) visit(ty * vp.tilesX + tx);
     };
     for (const BinItem& item : items) forEachTile(item, [&](int tile) { ++chunk.tileStart[std::size_t(tile) + 1]; });
     for (int tile = 0; tile < tiles; ++tile) chunk.tileStart[tile + 1] += chunk.tileStart[tile];
@@ -230,8 +231,8 @@ void drawInTile(const Viewport& vp, const TriangleSetup& t, int tileCol0, int ti
                 RenderResult& out)
 {
     const Camera& camera = vp.camera;
-    const int col0 = std::max(t.minCol, tileCol0), col1 = std::min(t.maxCol, tileCol1);
-    const int row0 = std::max(t.minRow, tileRow0), row1 = std::min(t.maxRow, tileRow1);
+    const int col0 = std::max(t.box.minCol, tileCol0), col1 = std::min(t.box.maxCol, tileCol1);
+    const int row0 = std::max(t.box.minRow, tileRow0), row1 = std::min(t.box.maxRow, tileRow1);
     const DepthSettings& depth = camera.depth();
     const int W = camera.width();
     for (int row = row0; row <= row1; ++row) {
@@ -305,15 +306,13 @@ RenderResult RasterRenderer::render(const Camera& camera, const RasterFaults& fa
             if (codeA & codeB & codeC) continue;  // wholly outside one plane
             if ((codeA | codeB | codeC) == 0) {
                 if (coveredBox(vp, snapped[tri[0]], snapped[tri[1]], snapped[tri[2]], box, area2))
-                    items.push_back({std::uint32_t(p), box.minCol, box.maxCol, box.minRow, box.maxRow});
+                    items.push_back({std::uint32_t(p), box});
                 continue;
             }
             const std::size_t before = chunk.clipped.size();
             setupClippedPrimitive(vp, clipOf(tri[0]), clipOf(tri[1]), clipOf(tri[2]), std::uint32_t(p), chunk.clipped);
-            for (std::size_t k = before; k < chunk.clipped.size(); ++k) {
-                const TriangleSetup& piece = chunk.clipped[k];
-                items.push_back({kClippedBit | std::uint32_t(k), piece.minCol, piece.maxCol, piece.minRow, piece.maxRow});
-            }
+            for (std::size_t k = before; k < chunk.clipped.size(); ++k)
+                items.push_back({kClippedBit | std::uint32_t(k), chunk.clipped[k].box});
         }
         binChunk(vp, items, chunk);
     });

@@ -188,11 +188,11 @@ RenderResult RayRenderer::render(const Camera& camera, const RayFaults& fault, E
                         if (hitAt(k)) __builtin_prefetch(&scene_.triangles[packet.hit.primID[k]]);
                     for (int k = 0; k < kPacketRays; ++k)
                         if (hitAt(k))
-                            for (const std::uint32_t v : {0, 1, 2})
-                                __builtin_prefetch(&scene_.positions[scene_.triangles[packet.hit.primID[k]][int(v)]]);
+                            for (int corner = 0; corner < 3; ++corner)
+                                __builtin_prefetch(&scene_.positions[scene_.triangles[packet.hit.primID[k]][corner]]);
                     // Neighbouring rays mostly hit the same triangle: its plane is kept.
                     std::uint32_t planeOf = RTC_INVALID_GEOMETRY_ID;
-                    glm::dvec3 a, normal;
+                    glm::dvec3 a(0.0), normal(0.0);
                     for (int k = 0; k < kPacketRays; ++k) {
                         if (!hitAt(k)) continue;
                         const std::uint32_t primitive = packet.hit.primID[k];

@@ -23,6 +23,24 @@ double millisecondsSince(Clock::time_point start)
 constexpr int kTile = 8;    // pixels per tile side
 constexpr int kPacket = 4;  // a packet covers 4×4 pixels
 
+// The ray route's own affine rays (camera_rays.h). A raw matrix has no such form in general:
+// there, the affine rays through three pixels' rays (origin and near-plane point), exact for
+// the usual perspective and orthographic matrices, and all a yardstick needs.
+AffineRays yardstickRays(const Camera& camera)
+{
+    const CameraRays cameraRays(camera);
+    if (const std::optional<AffineRays> rays = cameraRays.affine()) return *rays;
+    auto at = [&](double x, double y, glm::dvec3& origin, glm::dvec3& direction) {
+        const EyePlaneRay r = cameraRays.worldRay({x, y});
+        origin = r.origin, direction = r.tNear * r.direction;
+    };
+    glm::dvec3 o00, d00, o10, d10, o01, d01;
+    at(0.0, 0.0, o00, d00);
+    at(1.0, 0.0, o10, d10);
+    at(0.0, 1.0, o01, d01);
+    return {o00, o10 - o00, o01 - o00, d00, d10 - d00, d01 - d00};
+}
+
 }  // namespace
 
 struct EmbreeReference::Embree {
@@ -73,19 +91,10 @@ double EmbreeReference::trace(const Camera& camera, std::vector<std::uint32_t>& 
 {
     const int W = camera.width(), H = camera.height();
     primitiveId.resize(std::size_t(W) * H);
-    // Origin and near-plane point are affine in the image point for every model but a raw
-    // matrix: three rays fix both (the set-up is outside the timing).
-    const CameraRays cameraRays(camera);
-    auto affine = [&](double x, double y, glm::vec3& origin, glm::vec3& direction) {
-        const EyePlaneRay r = cameraRays.worldRay({x, y});
-        origin = glm::vec3(r.origin - embree_->frameOrigin);
-        direction = glm::vec3(r.tNear * r.direction);
-    };
-    glm::vec3 o00, d00, o10, d10, o01, d01;
-    affine(0.5, 0.5, o00, d00);
-    affine(1.5, 0.5, o10, d10);
-    affine(0.5, 1.5, o01, d01);
-    const glm::vec3 dOdx = o10 - o00, dOdy = o01 - o00, dDdx = d10 - d00, dDdy = d01 - d00;
+    // The rays affine in the pixel (set up outside the timing), in binary32 and the scene-centred frame.
+    const AffineRays rays = yardstickRays(camera);
+    const glm::vec3 o00(rays.originAt({0.5, 0.5}) - embree_->frameOrigin), d00(rays.directionAt({0.5, 0.5}));
+    const glm::vec3 dOdx(rays.originPerX), dOdy(rays.originPerY), dDdx(rays.directionPerX), dDdy(rays.directionPerY);
 
     const int tilesX = (W + kTile - 1) / kTile, tilesY = (H + kTile - 1) / kTile;
     RTCScene scene = embree_->scene;

@@ -169,8 +169,8 @@ private:
 };
 
 // Compares two renders of `scene` through `camera`, rows in parallel (fixed blocks merged in
-// scan order, so the report is the same for any number of threads). `ray` must carry exact depths (the ray
-// route); `raster` holds stored depth-buffer values. `rasterQuantum`, when given, is the
+// scan order, so the report is the same for any number of threads). `ray` must carry exact
+// depths (the ray route); `raster` holds stored depth-buffer values. `rasterQuantum`, when given, is the
 // storage quantum of each raster pixel in window-depth units (a map stored as eye-z or
 // distance, or as scaled integers); otherwise q comes from the camera's depth format.
 // A raster primitive id that is not a triangle of the scene (kUnknownPrimitive) marks a hit

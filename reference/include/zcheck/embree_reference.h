@@ -5,11 +5,11 @@
 // What it does is what an Embree user would write for speed, and nothing zcheck needs:
 //   - its own BVH with the ray route's settings (robust, medium quality), timed;
 //   - one ray per pixel centre, generated in binary32 as an affine function of the pixel
-//     (origin and direction interpolated from the image corners, unnormalised, t ∈ [0, ∞));
+//     (the ray route's AffineRays, camera_rays.h, or for a raw matrix the affine rays through
+//     three pixels' rays; unnormalised, t ∈ [0, ∞));
 //   - 8×8 tiles in parallel with TBB, each traced as four 4×4 packets with rtcIntersect16 and a
 //     coherent context; the primitive id stored per pixel into a buffer allocated beforehand.
-// Not done: no clip planes, no double-precision hit, no depth. The projection must be affine
-// in the pixel (every model but a raw matrix with a perspective term other than w = −z).
+// Not done: no clip planes, no double-precision hit, no depth.
 #include "zcheck/camera.h"
 #include "zcheck/scene.h"
 
