@@ -204,13 +204,24 @@ int runBenchCommand(const BenchOptions& o)
                 const RenderResult lastRaster = RasterRenderer(scene).render(camera);
                 glDraw.ms = gl.drawMs;
                 glRenderer = gl.renderer;
-                // The same picture? Coverage and depth per pixel, the raster's rows being top-down too.
+                // The same picture? Coverage and depth per pixel. OpenGL's window has y up; the
+                // camera's viewport may not (Vulkan, Direct3D, Metal): each pixel is found
+                // through NDC, where both agree.
+                const int W = camera.width(), H = camera.height();
+                auto pixelOf = [&](int glCol, int glRowFromTop) {
+                    const glm::dvec2 pNdc(2.0 * (glCol + 0.5) / W - 1.0, 1.0 - 2.0 * (glRowFromTop + 0.5) / H);
+                    const glm::dvec4 pWindow = camera.windowFromNdc * glm::dvec4(pNdc, 0.0, 1.0);
+                    const int col = int(std::floor(pWindow.x)), row = int(std::floor(camera.imageYFromWindowY(pWindow.y)));
+                    return std::size_t(row) * W + col;
+                };
                 std::size_t same = 0;
-                for (std::size_t i = 0; i < gl.depth.size(); ++i) {
-                    const bool glHit = gl.depth[i] != float(camera.clearDepth());
-                    same += glHit == lastRaster.hit(i) &&
-                            (!glHit || std::abs(gl.depth[i] - lastRaster.windowDepth.value[i]) <= 1e-5);
-                }
+                for (int row = 0; row < H && !gl.depth.empty(); ++row)
+                    for (int col = 0; col < W; ++col) {
+                        const float depth = gl.depth[std::size_t(row) * W + col];
+                        const std::size_t i = pixelOf(col, row);
+                        const bool glHit = depth != float(camera.clearDepth());
+                        same += glHit == lastRaster.hit(i) && (!glHit || std::abs(depth - lastRaster.windowDepth.value[i]) <= 1e-5);
+                    }
                 glAgreement = gl.depth.empty() ? NAN : double(same) / double(gl.depth.size());
             } catch (const std::exception& e) {
                 glSkipped = e.what();
