@@ -166,3 +166,31 @@ TEST_CASE("the comparison's report is the same for 1 and 2 threads, and its p99 
     REQUIRE(one.comparison.errorOverTolerance[std::size_t(a.worst.row) * std::size_t(camera.width()) +
                                               std::size_t(a.worst.col)] == maxRatio);
 }
+
+TEST_CASE("judges of different cameras on one thread never share a slope", "[checker][compare]")
+{
+    // The slope memo is per thread and keyed by judge: two cameras whose slopes differ, asked
+    // in turn about the same triangles (and about triangles that share a memo entry), must
+    // each get their own camera's slope, as must a new judge built where an old one was.
+    const Scene scene = builtinScene("builtin:terrain?n=40");
+    REQUIRE(scene.triangleCount() > 2048);
+    CameraSpec wide = smallCamera(scene), narrow = wide;
+    wide.projection = Projection::perspective(90.0, 0.1, 100.0);
+    narrow.projection = Projection::perspective(20.0, 0.1, 100.0);
+    const Camera wideCamera(wide), narrowCamera(narrow);
+    auto expected = [&](const Camera& camera, std::uint32_t t) {
+        const auto& tri = scene.triangles[t];
+        return windowDepthSlope(camera, glm::dvec3(scene.positions[tri[0]]), glm::dvec3(scene.positions[tri[1]]),
+                                glm::dvec3(scene.positions[tri[2]]));
+    };
+    const std::vector<std::uint32_t> probes = {0, 1, 1024, 1025, 2048, 0, 1024, 7};
+    for (int round = 0; round < 2; ++round) {
+        const PixelJudge a(scene, wideCamera), b(scene, narrowCamera);
+        for (std::uint32_t t : probes) {
+            INFO("triangle " << t << ", round " << round);
+            REQUIRE(expected(wideCamera, t) != expected(narrowCamera, t));
+            REQUIRE(a.slope(t) == expected(wideCamera, t));
+            REQUIRE(b.slope(t) == expected(narrowCamera, t));
+        }
+    }
+}

@@ -6,9 +6,11 @@
 #include "zcheck/inverse_projection.h"
 #include "zcheck/large_buffer.h"
 
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 
@@ -68,33 +70,70 @@ double windowDepthSlope(const Camera& camera, const glm::dvec3& a, const glm::dv
 
 namespace {
 
-// The 99th percentile of non-negative values held in several runs, without joining them:
-// a radix select on the bit patterns (for non-negative floats they order as the values do),
-// the top 16 bits first, then the values that share the chosen prefix.
-// `parts`: (first value, count) pairs.
-double percentile99(const std::vector<std::pair<const float*, std::size_t>>& parts)
+// The 99th percentile of non-negative binary32 values, without storing them: a radix select
+// on their bit patterns (for non-negative floats they order as the values do). A first pass
+// counts the values by their top 16 bits (PrefixCounts); the prefix that holds the
+// percentile is found (PercentileBucket); a second pass regenerates the values and keeps
+// only those with that prefix, a small set, among which the rank is selected. Two 16 MB
+// arrays of values per comparison cost more to fault in than the second pass costs.
+std::uint32_t floatBits(float v)
 {
-    std::size_t count = 0;
-    for (const auto& part : parts) count += part.second;
-    if (count == 0) return 0.0;
-    std::size_t k = std::min(count - 1, static_cast<std::size_t>(std::ceil(0.99 * double(count))) - 1);
-    auto bits = [](float v) {
-        std::uint32_t b;
-        std::memcpy(&b, &v, sizeof b);
-        return b;
-    };
-    std::vector<std::size_t> histogram(std::size_t(1) << 16, 0);
-    for (const auto& [values, n] : parts)
-        for (std::size_t j = 0; j < n; ++j) ++histogram[bits(values[j]) >> 16];
-    std::uint32_t prefix = 0;
-    while (k >= histogram[prefix]) k -= histogram[prefix++];
-    std::vector<float> sharing;
-    for (const auto& [values, n] : parts)
-        for (std::size_t j = 0; j < n; ++j)
-            if (bits(values[j]) >> 16 == prefix) sharing.push_back(values[j]);
-    std::nth_element(sharing.begin(), sharing.begin() + std::ptrdiff_t(k), sharing.end());
-    return sharing[k];
+    std::uint32_t b;
+    std::memcpy(&b, &v, sizeof b);
+    return b;
 }
+
+struct PrefixCounts {
+    std::vector<std::uint32_t> count = std::vector<std::uint32_t>(std::size_t(1) << 16, 0);  // < 2^25 pixels
+    void add(float v) { ++count[floatBits(v) >> 16]; }
+    void add(const PrefixCounts& other)
+    {
+        for (std::size_t b = 0; b < count.size(); ++b) count[b] += other.count[b];
+    }
+};
+
+struct PercentileBucket {
+    std::uint32_t prefix = 0;
+    std::size_t rank = 0;  // of the percentile among the values with this prefix
+    bool empty = true;     // no values at all
+
+    explicit PercentileBucket(const PrefixCounts& counts)
+    {
+        std::size_t n = 0;
+        for (std::uint32_t c : counts.count) n += c;
+        if (n == 0) return;
+        empty = false;
+        rank = std::min(n - 1, static_cast<std::size_t>(std::ceil(0.99 * double(n))) - 1);
+        while (rank >= counts.count[prefix]) rank -= counts.count[prefix++];
+    }
+    bool holds(float v) const { return !empty && floatBits(v) >> 16 == prefix; }
+    double select(std::vector<float>& sharing) const
+    {
+        if (empty) return 0.0;
+        std::nth_element(sharing.begin(), sharing.begin() + std::ptrdiff_t(rank), sharing.end());
+        return sharing[rank];
+    }
+};
+
+}  // namespace
+
+namespace {
+
+// The slopes of the triangles a thread saw last, for any judge: direct-mapped on the
+// primitive, keyed by the judge's serial (0: empty). A triangle covering many pixels costs
+// one slope; a million-triangle scene costs no per-triangle cache (that was 8 MB to fault in
+// for every comparison).
+struct SlopeMemo {
+    static constexpr std::size_t kEntries = 1024;
+    struct Entry {
+        std::uint64_t judge;
+        std::uint32_t primitive;
+        double slope;
+    };
+    Entry entries[kEntries];  // zero-initialised: no judge has serial 0
+};
+thread_local SlopeMemo slopeMemo;
+std::atomic<std::uint64_t> nextJudgeSerial{1};
 
 }  // namespace
 
@@ -105,10 +144,8 @@ PixelJudge::PixelJudge(const Scene& scene, const Camera& camera, const Tolerance
       S_(tolerance.snapPixels()),
       E_(16 * std::ldexp(1.0, -52) * std::max(std::abs(camera.depth().rangeMin), std::abs(camera.depth().rangeMax))),
       slopeFrame_(camera),
-      slopeCache_(new std::atomic<double>[scene.triangleCount()])  // not touched yet
+      serial_(nextJudgeSerial.fetch_add(1, std::memory_order_relaxed))
 {
-    adviseHugePages(slopeCache_.get(), scene.triangleCount() * sizeof(std::atomic<double>));
-    for (std::size_t t = 0; t < scene.triangleCount(); ++t) slopeCache_[t].store(NAN, std::memory_order_relaxed);
 }
 
 glm::dvec3 PixelJudge::vertex(std::uint32_t primitive, int corner) const
@@ -116,17 +153,14 @@ glm::dvec3 PixelJudge::vertex(std::uint32_t primitive, int corner) const
     return glm::dvec3(scene_.positions[scene_.triangles[primitive][corner]]);
 }
 
-// m is a property of the triangle's plane, the same at every pixel: computed once.
+// m is a property of the triangle's plane, the same at every pixel.
 double PixelJudge::slope(std::uint32_t primitive) const
 {
     if (!known(primitive)) return 0.0;
-    std::atomic<double>& cached = slopeCache_[primitive];
-    double m = cached.load(std::memory_order_relaxed);
-    if (std::isnan(m)) {
-        m = slopeFrame_.slope(vertex(primitive, 0), vertex(primitive, 1), vertex(primitive, 2));
-        cached.store(m, std::memory_order_relaxed);
-    }
-    return m;
+    SlopeMemo::Entry& memo = slopeMemo.entries[primitive % SlopeMemo::kEntries];
+    if (memo.judge != serial_ || memo.primitive != primitive)
+        memo = {serial_, primitive, slopeFrame_.slope(vertex(primitive, 0), vertex(primitive, 1), vertex(primitive, 2))};
+    return memo.slope;
 }
 
 double PixelJudge::surfaceTolerance(std::uint32_t primitive, double q) const { return C_ * q + S_ * slope(primitive) + E_; }
@@ -181,7 +215,6 @@ namespace {
 // What one block of rows contributes to the report; blocks are merged in scan order.
 struct BlockTally {
     ComparisonReport report;  // counts, maxima, worst pixel, samples, bounding box, bias samples
-    std::size_t compared = 0;  // pixels compared on depth; their statistics start at the block's first pixel
     double signedErrorSum = 0;
     std::int64_t quarterCounts[4] = {0, 0, 0, 0};
 };
@@ -232,7 +265,6 @@ void merge(BlockTally& total, BlockTally& block)
         extendUnexplainedBox(r, b.unexplainedMaxCol, b.unexplainedMaxRow);
     }
     total.signedErrorSum += block.signedErrorSum;
-    total.compared += block.compared;
     for (int k = 0; k < 4; ++k) total.quarterCounts[k] += block.quarterCounts[k];
 }
 
@@ -249,18 +281,29 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
 
     const PixelJudge judge(scene, camera, tolerance);
     const CameraRays cameraRays(camera);  // eye-z of a window depth in closed form
-    // Per pixel compared on depth, for the 99th percentiles (binary32 suffices for statistics);
-    // each block of rows fills its own rows' range from the start.
-    std::vector<float> errorQuanta, relativeEyeZ;
-    assignLarge(errorQuanta, std::size_t(W) * H, 0.0f);
-    assignLarge(relativeEyeZ, std::size_t(W) * H, 0.0f);
     const DepthFormat format = camera.depth().format;
     const double S = tolerance.snapPixels();
+    auto quantumAt = [&](std::size_t i) {
+        return rasterQuantum ? (*rasterQuantum)[i] : storageQuantum(format, ray.windowDepth.value[i]);
+    };
+    // The relative eye-z error of a pixel compared on depth (both passes use this one).
+    auto relativeEyeZErrorAt = [&](std::size_t i, int col, int row) {
+        const glm::dvec2 pImage(col + 0.5, row + 0.5);
+        const double rayDepth = ray.windowDepth.value[i], rasterDepth = raster.windowDepth.value[i];
+        if (ray.pEye.empty()) return cameraRays.relativeEyeZDifference(pImage, rayDepth, rasterDepth);
+        const double eyeZ = camera.eyeZOf(ray.pEye[i]);
+        return std::abs(cameraRays.eyeZFromWindowDepth(pImage, rasterDepth) - eyeZ) / std::abs(eyeZ);
+    };
+    // The 99th percentiles' first pass: value counts by prefix, per thread (sums do not
+    // depend on the order).
+    struct StatisticCounts {
+        PrefixCounts errorQuanta, relativeEyeZ;
+    };
+    tbb::enumerable_thread_specific<StatisticCounts> statisticCounts;
 
     auto compareBlock = [&](int firstRow, int lastRow, BlockTally& tally) {
         ComparisonReport& r = tally.report;
-        float* const blockErrorQuanta = &errorQuanta[std::size_t(firstRow) * W];
-        float* const blockRelativeEyeZ = &relativeEyeZ[std::size_t(firstRow) * W];
+        StatisticCounts& counts = statisticCounts.local();
         for (int row = firstRow; row < lastRow; ++row) {
             for (int col = 0; col < W; ++col) {
                 const std::size_t i = std::size_t(row) * W + col;
@@ -279,7 +322,7 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
 
                 if (rayHit && rasterHit) {
                     ++r.bothHit;
-                    const double q = rasterQuantum ? (*rasterQuantum)[i] : storageQuantum(format, f.rayWindowDepth);
+                    const double q = quantumAt(i);
                     const double error = std::abs(f.rasterWindowDepth - f.rayWindowDepth);
                     const bool samePrimitive = f.rayPrimitive == f.rasterPrimitive;
                     double bound = 0;
@@ -300,15 +343,9 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
                     } else {
                         f.pixelClass == PixelClass::Agree ? ++r.agree : ++r.depthErrors;
                         out.errorOverTolerance[i] = static_cast<float>(ratio);
-                        blockErrorQuanta[tally.compared] = float(f.errorQuanta);
-                        const glm::dvec2 pImage(col + 0.5, row + 0.5);
-                        const double relative =
-                            ray.pEye.empty()
-                                ? cameraRays.relativeEyeZDifference(pImage, f.rayWindowDepth, f.rasterWindowDepth)
-                                : std::abs(cameraRays.eyeZFromWindowDepth(pImage, f.rasterWindowDepth) -
-                                           camera.eyeZOf(ray.pEye[i])) /
-                                      std::abs(camera.eyeZOf(ray.pEye[i]));
-                        blockRelativeEyeZ[tally.compared++] = float(relative);
+                        const double relative = relativeEyeZErrorAt(i, col, row);
+                        counts.errorQuanta.add(float(f.errorQuanta));
+                        counts.relativeEyeZ.add(float(relative));
                         r.maxRelativeEyeZError = std::max(r.maxRelativeEyeZError, relative);
                         r.maxErrorQuanta = std::max(r.maxErrorQuanta, f.errorQuanta);
                         if (ratio > r.maxErrorOverTolerance || r.agree + r.depthErrors == 1) {
@@ -321,7 +358,7 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
                     // triangle, (ray route only) at the clear value, or on the near/far plane.
                     rayHit ? ++r.rayOnly : ++r.rasterOnly;
                     const std::uint32_t primitive = rayHit ? f.rayPrimitive : f.rasterPrimitive;
-                    const double q = rasterQuantum ? (*rasterQuantum)[i] : storageQuantum(format, f.rayWindowDepth);
+                    const double q = quantumAt(i);
                     const bool atClear =
                         rayHit && std::abs(f.rayWindowDepth - camera.clearDepth()) <= judge.surfaceTolerance(primitive, q);
                     if (judge.nearEdge(primitive, pWindow)) {
@@ -343,29 +380,50 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
         }
     };
 
-    std::vector<BlockTally> blocks(std::size_t((H + kBlockRows - 1) / kBlockRows));
+    const std::size_t blockCount = std::size_t((H + kBlockRows - 1) / kBlockRows);
+    std::vector<BlockTally> blocks(blockCount);
     tbb::parallel_for(std::size_t(0), blocks.size(), [&](std::size_t b) {
         compareBlock(int(b) * kBlockRows, std::min(H, int(b + 1) * kBlockRows), blocks[b]);
     });
     BlockTally total;
     for (BlockTally& block : blocks) merge(total, block);
-    std::vector<std::pair<const float*, std::size_t>> errorQuantaParts, relativeEyeZParts;
-    for (std::size_t b = 0; b < blocks.size(); ++b) {
-        const std::size_t first = b * kBlockRows * std::size_t(W);
-        errorQuantaParts.emplace_back(&errorQuanta[first], blocks[b].compared);
-        relativeEyeZParts.emplace_back(&relativeEyeZ[first], blocks[b].compared);
-    }
     blocks.clear();
+
+    // The 99th percentiles' second pass: the values in the buckets that hold them.
+    StatisticCounts allCounts;
+    for (const StatisticCounts& counts : statisticCounts) {
+        allCounts.errorQuanta.add(counts.errorQuanta);
+        allCounts.relativeEyeZ.add(counts.relativeEyeZ);
+    }
+    const PercentileBucket errorQuantaBucket(allCounts.errorQuanta), relativeEyeZBucket(allCounts.relativeEyeZ);
+    std::vector<std::vector<float>> errorQuantaSharing(blockCount), relativeEyeZSharing(blockCount);
+    tbb::parallel_for(std::size_t(0), blockCount, [&](std::size_t b) {
+        for (int row = int(b) * kBlockRows; row < std::min(H, int(b + 1) * kBlockRows); ++row)
+            for (int col = 0; col < W; ++col) {
+                const std::size_t i = std::size_t(row) * W + col;
+                if (out.pixelClass[i] != PixelClass::Agree && out.pixelClass[i] != PixelClass::DepthError) continue;
+                const auto errorQuanta = float(std::abs(raster.windowDepth.value[i] - ray.windowDepth.value[i]) / quantumAt(i));
+                if (errorQuantaBucket.holds(errorQuanta)) errorQuantaSharing[b].push_back(errorQuanta);
+                const auto relative = float(relativeEyeZErrorAt(i, col, row));
+                if (relativeEyeZBucket.holds(relative)) relativeEyeZSharing[b].push_back(relative);
+            }
+    });
+    auto joined = [](std::vector<std::vector<float>>& parts) {
+        std::vector<float> all;
+        for (const auto& part : parts) all.insert(all.end(), part.begin(), part.end());
+        return all;
+    };
+    std::vector<float> errorQuantaValues = joined(errorQuantaSharing), relativeEyeZValues = joined(relativeEyeZSharing);
 
     out.report = std::move(total.report);
     ComparisonReport& r = out.report;
     r.width = W, r.height = H;
-    r.p99ErrorQuanta = percentile99(errorQuantaParts);
+    r.p99ErrorQuanta = errorQuantaBucket.select(errorQuantaValues);
     if (r.biasSamples > 0) r.meanSignedErrorQuanta = total.signedErrorSum / double(r.biasSamples);
     const bool spread = std::all_of(std::begin(total.quarterCounts), std::end(total.quarterCounts),
                                     [&](std::int64_t n) { return n >= r.biasSamples / 10; });
     r.depthBias = r.biasSamples >= 1000 && spread && std::abs(r.meanSignedErrorQuanta) > 0.25;
-    r.p99RelativeEyeZError = percentile99(relativeEyeZParts);
+    r.p99RelativeEyeZError = relativeEyeZBucket.select(relativeEyeZValues);
     return out;
 }
 

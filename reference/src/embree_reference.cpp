@@ -66,17 +66,16 @@ EmbreeReference::EmbreeReference(const Scene& scene) : embree_(std::make_unique<
     RTCGeometry geometry = rtcNewGeometry(embree_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
     auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                                                  3 * sizeof(float), scene.positions.size()));
-    auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                                   3 * sizeof(unsigned), scene.triangles.size()));
-    if (!vertices || !indices) {
+    // Indices shared, not copied, as the ray route does (the best an Embree user can do).
+    rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, scene.triangles.data(), 0,
+                               sizeof(glm::uvec3), scene.triangles.size());
+    if (!vertices || rtcGetDeviceError(embree_->device) != RTC_ERROR_NONE) {
         rtcReleaseGeometry(geometry);
         throw Error("reference: Embree could not allocate geometry buffers");
     }
     embree_->frameOrigin = glm::dvec3(glm::vec3((scene.boundsMin() + scene.boundsMax()) / 2.0));
     for (std::size_t v = 0; v < scene.positions.size(); ++v)
         for (int k = 0; k < 3; ++k) vertices[3 * v + k] = float(double(scene.positions[v][k]) - embree_->frameOrigin[k]);
-    for (std::size_t t = 0; t < scene.triangles.size(); ++t)
-        for (int k = 0; k < 3; ++k) indices[3 * t + k] = scene.triangles[t][k];
     rtcCommitGeometry(geometry);
     rtcAttachGeometryByID(embree_->scene, geometry, 0);
     rtcReleaseGeometry(geometry);

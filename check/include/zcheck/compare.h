@@ -36,9 +36,7 @@
 #include "zcheck/render.h"
 #include "zcheck/scene.h"
 
-#include <atomic>
 #include <cstdint>
-#include <memory>
 #include <vector>
 
 namespace zcheck {
@@ -137,8 +135,9 @@ struct DepthSlopeFrame {
 // The per-pixel rule above, in one place: the comparison applies it to the raster's surface,
 // and `verify` (which must guess the surface a map saw) applies it to every candidate surface,
 // so that which surfaces a pixel may show and whether its depth agrees are one decision.
-// Thread-safe: const calls may run from several threads at once (each triangle's slope is
-// computed on first use and cached; racing threads store the same value).
+// Thread-safe: const calls may run from several threads at once. Slopes are memoised per
+// thread for the triangles seen last (a pure function of triangle and camera, so the memo
+// never changes a result); a judge allocates nothing per triangle.
 class PixelJudge {
 public:
     PixelJudge(const Scene& scene, const Camera& camera, const ToleranceModel& tolerance = {});
@@ -165,7 +164,7 @@ private:
     const Camera& camera_;
     double C_, S_, E_;
     DepthSlopeFrame slopeFrame_;
-    std::unique_ptr<std::atomic<double>[]> slopeCache_;  // per primitive, NaN until computed
+    std::uint64_t serial_;  // this judge's key in the per-thread slope memo
 };
 
 // Compares two renders of `scene` through `camera`, rows in parallel (fixed blocks merged in

@@ -41,7 +41,9 @@ enum class EyePoints { Omit, Keep };
 
 class RayRenderer {
 public:
-    explicit RayRenderer(const Scene& scene);  // builds the BVH (timed); throws Error; `scene` must outlive it
+    // Builds the BVH (timed); throws Error. `scene` must outlive it: Embree reads its index
+    // buffer in place.
+    explicit RayRenderer(const Scene& scene);
     ~RayRenderer();
     RayRenderer(const RayRenderer&) = delete;
     RayRenderer& operator=(const RayRenderer&) = delete;

@@ -21,7 +21,8 @@ namespace zcheck::reference {
 
 class EmbreeReference {
 public:
-    explicit EmbreeReference(const Scene& scene);  // builds the BVH; throws Error
+    // Builds the BVH; throws Error. `scene` must outlive it (its index buffer is shared).
+    explicit EmbreeReference(const Scene& scene);
     ~EmbreeReference();
     EmbreeReference(const EmbreeReference&) = delete;
     EmbreeReference& operator=(const EmbreeReference&) = delete;
