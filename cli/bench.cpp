@@ -19,6 +19,7 @@
 #include <filesystem>
 #include <iostream>
 #include <thread>
+#include <type_traits>
 
 namespace zcheck::cli {
 
@@ -54,8 +55,42 @@ struct Phase {
     double best() const { return ms.empty() ? 0.0 : *std::min_element(ms.begin(), ms.end()); }
 };
 
-// One whole check as `zcheck check` runs it, in a child process of its own: fresh memory and
-// fresh page tables each time, so that no repeat inherits the warm heap of the one before.
+// Runs `measure` in a child process of its own (fresh memory and page tables, nothing
+// inherited from an earlier repeat's warm heap) with `threads` threads, and returns what it
+// returned (a trivially copyable record) and the child's peak resident set. Throws when the
+// child fails; `what` names it in the message. TBB must not have started in this process.
+template <class Result, class Measure>
+std::pair<Result, double> inChild(int threads, const char* what, Measure measure)
+{
+    static_assert(std::is_trivially_copyable_v<Result>, "the result crosses a pipe");
+    int channel[2];
+    if (pipe(channel) != 0) throw std::runtime_error("bench: cannot create a pipe");
+    const pid_t child = fork();
+    if (child < 0) throw std::runtime_error("bench: cannot fork");
+    if (child == 0) {
+        close(channel[0]);
+        try {
+            const auto threadLimit = limitThreads(threads);
+            const Result result = measure();
+            const bool written = write(channel[1], &result, sizeof result) == ssize_t(sizeof result);
+            _exit(written ? 0 : kExitInternal);
+        } catch (...) {
+            _exit(kExitInternal);
+        }
+    }
+    close(channel[1]);
+    Result result{};
+    const bool complete = read(channel[0], &result, sizeof result) == ssize_t(sizeof result);
+    close(channel[0]);
+    int status = 0;
+    rusage usage{};
+    wait4(child, &status, 0, &usage);
+    if (!complete || !WIFEXITED(status) || WEXITSTATUS(status) != 0)
+        throw std::runtime_error(std::string("bench: ") + what + " in the child process failed");
+    return {result, double(usage.ru_maxrss) / 1024.0};  // KiB on Linux
+}
+
+// One whole check as `zcheck check` runs it.
 struct WholeCheck {
     double loadMs, bvhMs, traceMs, rasterMs, compareMs, wholeMs;
     std::size_t triangles;
@@ -65,41 +100,21 @@ struct WholeCheck {
 
 WholeCheck wholeCheckInChild(const std::string& sceneName, const Camera& camera, int threads)
 {
-    int channel[2];
-    if (pipe(channel) != 0) throw std::runtime_error("bench: cannot create a pipe");
-    const pid_t child = fork();
-    if (child < 0) throw std::runtime_error("bench: cannot fork");
-    if (child == 0) {
-        close(channel[0]);
-        try {
-            const auto threadLimit = limitThreads(threads);
-            WholeCheck w{};
-            const auto start = Clock::now();
-            Scene scene = loadScene(sceneName);
-            w.loadMs = millisecondsSince(start);
-            const Checker checker(std::move(scene));
-            const CheckResult run = checker.check(camera);
-            w.wholeMs = millisecondsSince(start);
-            w.bvhMs = run.report.timings.bvhBuildMs, w.traceMs = run.report.timings.traceMs;
-            w.rasterMs = run.report.timings.rasterMs, w.compareMs = run.report.timings.compareMs;
-            w.triangles = checker.scene().triangleCount();
-            w.consistent = run.report.comparison.consistent();
-            const bool written = write(channel[1], &w, sizeof w) == ssize_t(sizeof w);
-            _exit(written ? 0 : kExitInternal);
-        } catch (...) {
-            _exit(kExitInternal);
-        }
-    }
-    close(channel[1]);
-    WholeCheck w{};
-    const bool complete = read(channel[0], &w, sizeof w) == ssize_t(sizeof w);
-    close(channel[0]);
-    int status = 0;
-    rusage usage{};
-    wait4(child, &status, 0, &usage);
-    if (!complete || !WIFEXITED(status) || WEXITSTATUS(status) != 0)
-        throw std::runtime_error("bench: the check in the child process failed (run `zcheck check` with the same scene and camera)");
-    w.peakMiB = double(usage.ru_maxrss) / 1024.0;  // KiB on Linux
+    auto [w, peakMiB] = inChild<WholeCheck>(threads, "the check (run `zcheck check` with the same scene and camera)", [&] {
+        WholeCheck w{};
+        const auto start = Clock::now();
+        Scene scene = loadScene(sceneName);
+        w.loadMs = millisecondsSince(start);
+        const Checker checker(std::move(scene));
+        const CheckResult run = checker.check(camera);
+        w.wholeMs = millisecondsSince(start);
+        w.bvhMs = run.report.timings.bvhBuildMs, w.traceMs = run.report.timings.traceMs;
+        w.rasterMs = run.report.timings.rasterMs, w.compareMs = run.report.timings.compareMs;
+        w.triangles = checker.scene().triangleCount();
+        w.consistent = run.report.comparison.consistent();
+        return w;
+    });
+    w.peakMiB = peakMiB;
     return w;
 }
 
@@ -171,16 +186,21 @@ int runBenchCommand(const BenchOptions& o)
     const double pixels = double(camera.width()) * camera.height();
     const double budgetMiB = (150.0 * double(triangles) + 32.0 * pixels) / (1024.0 * 1024.0);
 
-    // The references, in this process.
+    // The references: Embree's builds each in a child, as the check's are; its trace and
+    // llvmpipe's draws repeated in this process (their own buffers reused, at their best).
     Phase embreeBuild, embreeTrace, glDraw;
     std::string glRenderer, glSkipped;
     double glAgreement = NAN;
     if (o.reference) {
         const Scene scene = loadScene(o.input.scene);
         if (progress) std::fprintf(stderr, "\rbench: Embree reference%20s", ""), std::fflush(stderr);
-        for (int r = 1; r < o.repeat; ++r) embreeBuild.ms.push_back(reference::EmbreeReference(scene).buildMilliseconds());
-        const reference::EmbreeReference embree(scene);  // the last build is the one traced
-        embreeBuild.ms.push_back(embree.buildMilliseconds());
+        // Embree's build, like the check's, in a fresh process each time: in this process
+        // its repeats ran on memory earlier builds had faulted in (and varied 142-274 ms).
+        for (int r = 0; r < o.repeat; ++r)
+            embreeBuild.ms.push_back(inChild<double>(threads, "Embree's reference build", [&] {
+                return reference::EmbreeReference(scene).buildMilliseconds();
+            }).first);
+        const reference::EmbreeReference embree(scene);  // built here only to be traced
         std::vector<std::uint32_t> primitiveId;
         embree.trace(camera, primitiveId);  // warm-up
         for (int r = 0; r < o.repeat; ++r) embreeTrace.ms.push_back(embree.trace(camera, primitiveId));
