@@ -328,12 +328,17 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
                     double bound = 0;
                     f.pixelClass = judge.bothHit(f.rayWindowDepth, f.rayPrimitive, f.rasterWindowDepth,
                                                  f.rasterPrimitive, q, pWindow, bound);
-                    f.errorQuanta = error / q;
-                    f.toleranceQuanta = bound / q;
+                    // (−x)/q = −(x/q) exactly: one division gives the signed and the absolute error.
+                    const double signedErrorQuanta = (f.rasterWindowDepth - f.rayWindowDepth) / q;
+                    f.errorQuanta = std::abs(signedErrorQuanta);
                     const double ratio = bound > 0 ? error / bound : (error > 0 ? INFINITY : 0.0);
+                    auto withTolerance = [&](PixelFinding& finding) -> PixelFinding& {  // a finding kept
+                        finding.toleranceQuanta = bound / q;
+                        return finding;
+                    };
                     if (samePrimitive && S * judge.slope(f.rayPrimitive) <= 0.1 * q) {
                         // Quantization dominates here: feed the bias test.
-                        tally.signedErrorSum += (f.rasterWindowDepth - f.rayWindowDepth) / q;
+                        tally.signedErrorSum += signedErrorQuanta;
                         const double position = f.rayWindowDepth / q;
                         ++tally.quarterCounts[std::clamp(int(4 * (position - std::floor(position))), 0, 3)];
                         ++r.biasSamples;
@@ -350,9 +355,10 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
                         r.maxErrorQuanta = std::max(r.maxErrorQuanta, f.errorQuanta);
                         if (ratio > r.maxErrorOverTolerance || r.agree + r.depthErrors == 1) {
                             r.maxErrorOverTolerance = std::max(r.maxErrorOverTolerance, ratio);
-                            r.worst = f;
+                            r.worst = withTolerance(f);
                         }
                     }
+                    if (f.pixelClass == PixelClass::DepthError) withTolerance(f);
                 } else {
                     // Coverage mismatch: only one route sees a surface. Explained at an edge of its
                     // triangle, (ray route only) at the clear value, or on the near/far plane.
