@@ -149,37 +149,60 @@ RenderResult RayRenderer::render(const Camera& camera, const RayFaults& fault, E
         alignas(64) RTCRayHit16 packet;
         glm::dvec3 origin[kPacketRays], direction[kPacketRays];
         glm::dvec2 pImage[kPacketRays];
+        alignas(64) double imageX[kPacketRays], imageY[kPacketRays];
+        alignas(64) double lane[6][kPacketRays];  // origin x, y, z and direction x, y, z
 
         for (int tile = tiles.begin(); tile != tiles.end(); ++tile) {
             const int tileX = (tile % tilesX) * kTile, tileY = (tile / tilesX) * kTile;
             for (int py = 0; py < kTile; py += kPacketSide) {
                 for (int px = 0; px < kTile; px += kPacketSide) {
+                    // Lanes as plain arrays, one quantity at a time, so that the compiler can
+                    // compute several lanes per instruction. Every field of every lane is
+                    // initialised, valid or not; an invalid lane is a zero-length ray.
                     for (int k = 0; k < kPacketRays; ++k) {
                         const int col = tileX + px + k % kPacketSide, row = tileY + py + k / kPacketSide;
                         valid[k] = (col < W && row < H) ? -1 : 0;
-                        // Every field of every lane is initialised, valid or not.
                         const int sampleRow = fault.flipRows ? H - 1 - row : row;
                         const int sampleCol = fault.flipCols ? W - 1 - col : col;
                         const glm::dvec2 pWindow = windowFromPixelCentre(camera, sampleCol, sampleRow) + fault.shiftPixels;
-                        pImage[k] = {pWindow.x, camera.imageYFromWindowY(pWindow.y)};
-                        float tNear = float(near), tFar = std::isinf(far) ? INFINITY : float(far);
-                        if (affine) {  // t is eye-z: the near and far planes lie at t = near and far
-                            origin[k] = affine->originAt(pImage[k]);
-                            direction[k] = affine->directionAt(pImage[k]);
-                        } else {
-                            const EyePlaneRay r = cameraRays.worldRay(pImage[k]);
-                            origin[k] = r.origin, direction[k] = r.direction;
-                            tNear = float(r.tNear), tFar = std::isinf(r.tFar) ? INFINITY : float(r.tFar);
+                        imageX[k] = pWindow.x, imageY[k] = camera.imageYFromWindowY(pWindow.y);
+                        pImage[k] = {imageX[k], imageY[k]};
+                    }
+                    float tNear[kPacketRays], tFar[kPacketRays];
+                    if (affine) {  // t is eye-z: the near and far planes lie at t = near and far
+                        for (int c = 0; c < 3; ++c) {
+                            const double o = affine->origin[c], oX = affine->originPerX[c], oY = affine->originPerY[c];
+                            const double d = affine->direction[c], dX = affine->directionPerX[c], dY = affine->directionPerY[c];
+                            for (int k = 0; k < kPacketRays; ++k) {
+                                lane[c][k] = o + imageX[k] * oX + imageY[k] * oY;
+                                lane[3 + c][k] = d + imageX[k] * dX + imageY[k] * dY;
+                            }
                         }
-                        if (!valid[k]) origin[k] = frameOrigin, direction[k] = {0.0, 0.0, 1.0}, tNear = 0, tFar = 0;
-                        packet.ray.org_x[k] = float(origin[k].x - frameOrigin.x);
-                        packet.ray.org_y[k] = float(origin[k].y - frameOrigin.y);
-                        packet.ray.org_z[k] = float(origin[k].z - frameOrigin.z);
-                        packet.ray.dir_x[k] = float(direction[k].x);
-                        packet.ray.dir_y[k] = float(direction[k].y);
-                        packet.ray.dir_z[k] = float(direction[k].z);
-                        packet.ray.tnear[k] = tNear;
-                        packet.ray.tfar[k] = tFar;
+                        const float nearT = float(near), farT = std::isinf(far) ? INFINITY : float(far);
+                        for (int k = 0; k < kPacketRays; ++k) tNear[k] = nearT, tFar[k] = farT;
+                    } else {
+                        for (int k = 0; k < kPacketRays; ++k) {
+                            const EyePlaneRay r = cameraRays.worldRay(pImage[k]);
+                            for (int c = 0; c < 3; ++c) lane[c][k] = r.origin[c], lane[3 + c][k] = r.direction[c];
+                            tNear[k] = float(r.tNear), tFar[k] = std::isinf(r.tFar) ? INFINITY : float(r.tFar);
+                        }
+                    }
+                    for (int k = 0; k < kPacketRays; ++k) {
+                        if (valid[k]) continue;
+                        for (int c = 0; c < 3; ++c) lane[c][k] = frameOrigin[c], lane[3 + c][k] = c == 2 ? 1.0 : 0.0;
+                        tNear[k] = 0, tFar[k] = 0;
+                    }
+                    for (int k = 0; k < kPacketRays; ++k) {
+                        origin[k] = {lane[0][k], lane[1][k], lane[2][k]};
+                        direction[k] = {lane[3][k], lane[4][k], lane[5][k]};
+                        packet.ray.org_x[k] = float(lane[0][k] - frameOrigin.x);
+                        packet.ray.org_y[k] = float(lane[1][k] - frameOrigin.y);
+                        packet.ray.org_z[k] = float(lane[2][k] - frameOrigin.z);
+                        packet.ray.dir_x[k] = float(lane[3][k]);
+                        packet.ray.dir_y[k] = float(lane[4][k]);
+                        packet.ray.dir_z[k] = float(lane[5][k]);
+                        packet.ray.tnear[k] = tNear[k];
+                        packet.ray.tfar[k] = tFar[k];
                         packet.ray.time[k] = 0.0f;
                         packet.ray.mask[k] = 0xFFFFFFFFu;  // Debian's Embree has ray masks on
                         packet.ray.id[k] = unsigned(k);
