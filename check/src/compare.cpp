@@ -13,6 +13,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <stdexcept>
 
 namespace zcheck {
 
@@ -110,6 +111,8 @@ struct PercentileBucket {
     double select(std::vector<float>& sharing) const
     {
         if (empty) return 0.0;
+        // Both passes compute each value with the same code; anything else is a bug here.
+        if (rank >= sharing.size()) throw std::logic_error("percentile: the second pass lost values");
         std::nth_element(sharing.begin(), sharing.begin() + std::ptrdiff_t(rank), sharing.end());
         return sharing[rank];
     }
@@ -286,6 +289,11 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
     auto quantumAt = [&](std::size_t i) {
         return rasterQuantum ? (*rasterQuantum)[i] : storageQuantum(format, ray.windowDepth.value[i]);
     };
+    // (d_raster − d_ray)/q, and its absolute value as the statistics take it: both passes
+    // must produce the same bits (|x|/q and |x/q| differ in the sign of a NaN).
+    auto signedErrorQuantaAt = [&](std::size_t i) {
+        return (raster.windowDepth.value[i] - ray.windowDepth.value[i]) / quantumAt(i);
+    };
     // The relative eye-z error of a pixel compared on depth (both passes use this one).
     auto relativeEyeZErrorAt = [&](std::size_t i, int col, int row) {
         const glm::dvec2 pImage(col + 0.5, row + 0.5);
@@ -328,8 +336,7 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
                     double bound = 0;
                     f.pixelClass = judge.bothHit(f.rayWindowDepth, f.rayPrimitive, f.rasterWindowDepth,
                                                  f.rasterPrimitive, q, pWindow, bound);
-                    // (−x)/q = −(x/q) exactly: one division gives the signed and the absolute error.
-                    const double signedErrorQuanta = (f.rasterWindowDepth - f.rayWindowDepth) / q;
+                    const double signedErrorQuanta = signedErrorQuantaAt(i);
                     f.errorQuanta = std::abs(signedErrorQuanta);
                     const double ratio = bound > 0 ? error / bound : (error > 0 ? INFINITY : 0.0);
                     auto withTolerance = [&](PixelFinding& finding) -> PixelFinding& {  // a finding kept
@@ -408,7 +415,7 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
             for (int col = 0; col < W; ++col) {
                 const std::size_t i = std::size_t(row) * W + col;
                 if (out.pixelClass[i] != PixelClass::Agree && out.pixelClass[i] != PixelClass::DepthError) continue;
-                const auto errorQuanta = float(std::abs(raster.windowDepth.value[i] - ray.windowDepth.value[i]) / quantumAt(i));
+                const auto errorQuanta = float(std::abs(signedErrorQuantaAt(i)));
                 if (errorQuantaBucket.holds(errorQuanta)) errorQuantaSharing[b].push_back(errorQuanta);
                 const auto relative = float(relativeEyeZErrorAt(i, col, row));
                 if (relativeEyeZBucket.holds(relative)) relativeEyeZSharing[b].push_back(relative);
