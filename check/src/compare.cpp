@@ -118,10 +118,6 @@ struct PercentileBucket {
     }
 };
 
-}  // namespace
-
-namespace {
-
 // The slopes of the triangles a thread saw last, for any judge: direct-mapped on the
 // primitive, keyed by the judge's serial (0: empty). A triangle covering many pixels costs
 // one slope; a million-triangle scene costs no per-triangle cache (that was 8 MB to fault in
