@@ -28,8 +28,12 @@ struct DeviceDeleter {
 struct SceneDeleter {
     void operator()(RTCScene scene) const { rtcReleaseScene(scene); }
 };
+struct GeometryDeleter {
+    void operator()(RTCGeometry geometry) const { rtcReleaseGeometry(geometry); }
+};
 using DeviceHandle = std::unique_ptr<RTCDeviceTy, DeviceDeleter>;
 using SceneHandle = std::unique_ptr<RTCSceneTy, SceneDeleter>;
+using GeometryHandle = std::unique_ptr<RTCGeometryTy, GeometryDeleter>;
 
 // The first error Embree reports; checked after every set-up step.
 struct ErrorLog {
@@ -90,35 +94,26 @@ RayRenderer::RayRenderer(const Scene& scene) : embree_(std::make_unique<Embree>(
     rtcSetSceneFlags(embree_->scene.get(), RTC_SCENE_FLAG_ROBUST);
     rtcSetSceneBuildQuality(embree_->scene.get(), RTC_BUILD_QUALITY_MEDIUM);
 
-    RTCGeometry geometry = rtcNewGeometry(embree_->device.get(), RTC_GEOMETRY_TYPE_TRIANGLE);
+    // Released when this scope ends, after the scene has taken its own reference (or on a throw).
+    const GeometryHandle geometry(rtcNewGeometry(embree_->device.get(), RTC_GEOMETRY_TYPE_TRIANGLE));
     embree_->check("creating the triangle geometry");
     // The vertices are Embree's own copy, in a frame centred on the scene, padded as Embree
     // requires (vertex reads may run 16 bytes past the end: rtcSetNewGeometryBuffer pads).
     // The indices are the scene's own (12-byte triples, as Embree reads them; a Scene outlives
     // its renderers): 12 MB less to copy and fault in for a million triangles.
-    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                                 3 * sizeof(float), scene.positions.size()));
+    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geometry.get(), RTC_BUFFER_TYPE_VERTEX, 0,
+                                                                 RTC_FORMAT_FLOAT3, 3 * sizeof(float), scene.positions.size()));
     static_assert(sizeof(glm::uvec3) == 3 * sizeof(unsigned), "indices are shared as tight triples");
-    rtcSetSharedGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, scene.triangles.data(), 0,
+    rtcSetSharedGeometryBuffer(geometry.get(), RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, scene.triangles.data(), 0,
                                sizeof(glm::uvec3), scene.triangles.size());
-    if (!vertices) {
-        rtcReleaseGeometry(geometry);
-        embree_->check("allocating geometry buffers");
-        throw Error("Embree could not allocate geometry buffers");
-    }
-    try {
-        embree_->check("sharing the index buffer");
-    } catch (...) {
-        rtcReleaseGeometry(geometry);
-        throw;
-    }
+    embree_->check("setting the geometry buffers");
+    if (!vertices) throw Error("Embree could not allocate geometry buffers");
     embree_->frameOrigin = glm::dvec3(glm::vec3((scene.boundsMin() + scene.boundsMax()) / 2.0));
     for (std::size_t v = 0; v < scene.positions.size(); ++v)
         for (int k = 0; k < 3; ++k)
             vertices[3 * v + k] = float(double(scene.positions[v][k]) - embree_->frameOrigin[k]);
-    rtcCommitGeometry(geometry);  // commit before attaching, or no intersections
-    rtcAttachGeometryByID(embree_->scene.get(), geometry, 0);
-    rtcReleaseGeometry(geometry);
+    rtcCommitGeometry(geometry.get());  // commit before attaching, or no intersections
+    rtcAttachGeometryByID(embree_->scene.get(), geometry.get(), 0);
     rtcCommitScene(embree_->scene.get());
     embree_->check("building the BVH");
     buildMilliseconds_ = millisecondsSince(start);
@@ -147,10 +142,11 @@ RenderResult RayRenderer::render(const Camera& camera, const RayFaults& fault, E
         context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
         alignas(64) int valid[kPacketRays];
         alignas(64) RTCRayHit16 packet;
-        glm::dvec3 origin[kPacketRays], direction[kPacketRays];
-        glm::dvec2 pImage[kPacketRays];
-        alignas(64) double imageX[kPacketRays], imageY[kPacketRays];
-        alignas(64) double lane[6][kPacketRays];  // origin x, y, z and direction x, y, z
+        alignas(64) double imageX[kPacketRays], imageY[kPacketRays];  // the rays' image points
+        alignas(64) double lane[6][kPacketRays];  // origin x, y, z and direction x, y, z, in double
+        auto originOf = [&](int k) { return glm::dvec3(lane[0][k], lane[1][k], lane[2][k]); };
+        auto directionOf = [&](int k) { return glm::dvec3(lane[3][k], lane[4][k], lane[5][k]); };
+        auto pImageOf = [&](int k) { return glm::dvec2(imageX[k], imageY[k]); };
 
         for (int tile = tiles.begin(); tile != tiles.end(); ++tile) {
             const int tileX = (tile % tilesX) * kTile, tileY = (tile / tilesX) * kTile;
@@ -166,7 +162,6 @@ RenderResult RayRenderer::render(const Camera& camera, const RayFaults& fault, E
                         const int sampleCol = fault.flipCols ? W - 1 - col : col;
                         const glm::dvec2 pWindow = windowFromPixelCentre(camera, sampleCol, sampleRow) + fault.shiftPixels;
                         imageX[k] = pWindow.x, imageY[k] = camera.imageYFromWindowY(pWindow.y);
-                        pImage[k] = {imageX[k], imageY[k]};
                     }
                     float tNear[kPacketRays], tFar[kPacketRays];
                     if (affine) {  // t is eye-z: the near and far planes lie at t = near and far
@@ -182,7 +177,7 @@ RenderResult RayRenderer::render(const Camera& camera, const RayFaults& fault, E
                         for (int k = 0; k < kPacketRays; ++k) tNear[k] = nearT, tFar[k] = farT;
                     } else {
                         for (int k = 0; k < kPacketRays; ++k) {
-                            const EyePlaneRay r = cameraRays.worldRay(pImage[k]);
+                            const EyePlaneRay r = cameraRays.worldRay(pImageOf(k));
                             for (int c = 0; c < 3; ++c) lane[c][k] = r.origin[c], lane[3 + c][k] = r.direction[c];
                             tNear[k] = float(r.tNear), tFar[k] = std::isinf(r.tFar) ? INFINITY : float(r.tFar);
                         }
@@ -193,8 +188,6 @@ RenderResult RayRenderer::render(const Camera& camera, const RayFaults& fault, E
                         tNear[k] = 0, tFar[k] = 0;
                     }
                     for (int k = 0; k < kPacketRays; ++k) {
-                        origin[k] = {lane[0][k], lane[1][k], lane[2][k]};
-                        direction[k] = {lane[3][k], lane[4][k], lane[5][k]};
                         packet.ray.org_x[k] = float(lane[0][k] - frameOrigin.x);
                         packet.ray.org_y[k] = float(lane[1][k] - frameOrigin.y);
                         packet.ray.org_z[k] = float(lane[2][k] - frameOrigin.z);
@@ -234,15 +227,16 @@ RenderResult RayRenderer::render(const Camera& camera, const RayFaults& fault, E
                             planeOf = primitive;
                         }
                         // The hit again, in double: the ray against the hit triangle's plane.
-                        double t = glm::dot(normal, a - origin[k]) / glm::dot(normal, direction[k]);
+                        const glm::dvec3 origin = originOf(k), direction = directionOf(k);
+                        double t = glm::dot(normal, a - origin) / glm::dot(normal, direction);
                         if (!std::isfinite(t)) t = packet.ray.tfar[k];
-                        const glm::dvec3 pWorld = origin[k] + t * direction[k];
+                        const glm::dvec3 pWorld = origin + t * direction;
                         const std::size_t i = std::size_t(tileY + py + k / kPacketSide) * W + tileX + px + k % kPacketSide;
                         result.primitiveId[i] = primitive;
                         if (eyePoints == EyePoints::Keep) result.pEye[i] = cameraRays.eyeFromWorld(pWorld);
                         // The fault "distance as eye-z" takes the distance along the ray for eye-z.
-                        const double eyeZ = fault.distanceAsEyeZ ? t * glm::length(direction[k]) : cameraRays.eyeZ(pWorld);
-                        result.windowDepth.value[i] = cameraRays.windowDepth(pImage[k], eyeZ);
+                        const double eyeZ = fault.distanceAsEyeZ ? t * glm::length(direction) : cameraRays.eyeZ(pWorld);
+                        result.windowDepth.value[i] = cameraRays.windowDepth(pImageOf(k), eyeZ);
                     }
                 }
             }
