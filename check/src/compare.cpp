@@ -285,10 +285,11 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
     auto quantumAt = [&](std::size_t i) {
         return rasterQuantum ? (*rasterQuantum)[i] : storageQuantum(format, ray.windowDepth.value[i]);
     };
-    // (d_raster − d_ray)/q, and its absolute value as the statistics take it: both passes
-    // must produce the same bits (|x|/q and |x/q| differ in the sign of a NaN).
-    auto signedErrorQuantaAt = [&](std::size_t i) {
-        return (raster.windowDepth.value[i] - ray.windowDepth.value[i]) / quantumAt(i);
+    // (d_raster − d_ray)/q at pixel i with q = quantumAt(i), of which the statistics take the
+    // absolute value: both passes must produce the same bits (|x|/q and |x/q| differ in the
+    // sign of a NaN).
+    auto signedErrorQuantaAt = [&](std::size_t i, double q) {
+        return (raster.windowDepth.value[i] - ray.windowDepth.value[i]) / q;
     };
     // The relative eye-z error of a pixel compared on depth (both passes use this one).
     auto relativeEyeZErrorAt = [&](std::size_t i, int col, int row) {
@@ -332,7 +333,7 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
                     double bound = 0;
                     f.pixelClass = judge.bothHit(f.rayWindowDepth, f.rayPrimitive, f.rasterWindowDepth,
                                                  f.rasterPrimitive, q, pWindow, bound);
-                    const double signedErrorQuanta = signedErrorQuantaAt(i);
+                    const double signedErrorQuanta = signedErrorQuantaAt(i, q);
                     f.errorQuanta = std::abs(signedErrorQuanta);
                     const double ratio = bound > 0 ? error / bound : (error > 0 ? INFINITY : 0.0);
                     auto withTolerance = [&](PixelFinding& finding) -> PixelFinding& {  // a finding kept
@@ -411,7 +412,7 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
             for (int col = 0; col < W; ++col) {
                 const std::size_t i = std::size_t(row) * W + col;
                 if (out.pixelClass[i] != PixelClass::Agree && out.pixelClass[i] != PixelClass::DepthError) continue;
-                const auto errorQuanta = float(std::abs(signedErrorQuantaAt(i)));
+                const auto errorQuanta = float(std::abs(signedErrorQuantaAt(i, quantumAt(i))));
                 if (errorQuantaBucket.holds(errorQuanta)) errorQuantaSharing[b].push_back(errorQuanta);
                 const auto relative = float(relativeEyeZErrorAt(i, col, row));
                 if (relativeEyeZBucket.holds(relative)) relativeEyeZSharing[b].push_back(relative);
