@@ -55,6 +55,8 @@ struct Phase {
     double best() const { return ms.empty() ? 0.0 : *std::min_element(ms.begin(), ms.end()); }
 };
 
+double maxResidentMiB(const rusage& usage) { return double(usage.ru_maxrss) / 1024.0; }  // KiB on Linux
+
 // Runs `measure` in a child process of its own (fresh memory and page tables, nothing
 // inherited from an earlier repeat's warm heap) with `threads` threads, and returns what it
 // returned (a trivially copyable record) and the child's peak resident set. Throws when the
@@ -87,7 +89,7 @@ std::pair<Result, double> inChild(int threads, const char* what, Measure measure
     wait4(child, &status, 0, &usage);
     if (!complete || !WIFEXITED(status) || WEXITSTATUS(status) != 0)
         throw std::runtime_error(std::string("bench: ") + what + " in the child process failed");
-    return {result, double(usage.ru_maxrss) / 1024.0};  // KiB on Linux
+    return {result, maxResidentMiB(usage)};
 }
 
 // One whole check as `zcheck check` runs it (cold: every buffer faulted in for the first
@@ -119,7 +121,7 @@ WholeCheck wholeCheckInChild(const std::string& sceneName, const Camera& camera,
         }
         rusage usage{};
         getrusage(RUSAGE_SELF, &usage);
-        w.peakMiB = double(usage.ru_maxrss) / 1024.0;  // KiB on Linux
+        w.peakMiB = maxResidentMiB(usage);
         const CheckResult again = checker.check(camera);
         w.warmTraceMs = again.report.timings.traceMs, w.warmRasterMs = again.report.timings.rasterMs;
         w.warmCompareMs = again.report.timings.compareMs;
