@@ -194,3 +194,22 @@ TEST_CASE("regression: a PLY face repeating one vertex was dropped silently, so 
                              "0 0 0\n1 0 0\n0 1 0\n4 0 0 0 0\n"),
         Catch::Contains("all 2 triangles of its strips repeat a vertex index (degenerate, zero area)"));
 }
+
+TEST_CASE("PLY faces are fans and strips restart their alternating winding at each restart", "[mesh][ply]")
+{
+    // Indices are assembled as they are read (a strip of millions of indices is never copied):
+    // the fan keeps its first vertex, a strip's parity counts from its last restart, and a
+    // face with fewer than 3 vertices is refused after its list.
+    const std::string header = "element vertex 5\nproperty float x\nproperty float y\nproperty float z\n";
+    const std::string vertices = "0 0 0\n1 0 0\n1 1 0\n0 1 0\n0.5 1.5 0\n";
+    const Scene fan = readPly("f.ply", ply("ascii", header + "element face 1\nproperty list uchar int vertex_indices\n") +
+                                           vertices + "5 0 1 2 4 3\n");
+    REQUIRE(fan.triangles == std::vector<glm::uvec3>{{0, 1, 2}, {0, 2, 4}, {0, 4, 3}});
+    const Scene strips = readPly("s.ply", ply("ascii", header + "element tristrips 1\nproperty list int int vertex_indices\n") +
+                                              vertices + "11 0 1 2 -1 1 2 3 4 -1 3 3\n");
+    // (0,1,2); restart: (1,2,3) even, (3,2,4) odd; restart: 3 3 makes no triangle.
+    REQUIRE(strips.triangles == std::vector<glm::uvec3>{{0, 1, 2}, {1, 2, 3}, {3, 2, 4}});
+    REQUIRE_THROWS_WITH(readPly("t.ply", ply("ascii", header + "element face 1\nproperty list uchar int vertex_indices\n") +
+                                             vertices + "2 0 1\n"),
+                        Catch::Contains("face 0: a face needs at least 3 vertices, this one has 2"));
+}

@@ -2,6 +2,7 @@
 // to be seen with. Every scene is deliberately asymmetric (left/right and top/bottom), so a
 // flipped or shifted image can never match the true one.
 #include "zcheck/error.h"
+#include "zcheck/large_buffer.h"
 #include "zcheck/scene.h"
 
 #include <glm/gtc/constants.hpp>
@@ -68,8 +69,8 @@ struct Soup {
     void heightfield(int n, double x0, double x1, double z0, double z1, Height height)
     {
         const auto first = static_cast<std::uint32_t>(positions.size());
-        positions.reserve(positions.size() + std::size_t(n) * n);
-        triangles.reserve(triangles.size() + 2 * std::size_t(n - 1) * (n - 1));
+        reserveLarge(positions, positions.size() + std::size_t(n) * n);
+        reserveLarge(triangles, triangles.size() + 2 * std::size_t(n - 1) * (n - 1));
         for (int i = 0; i < n; ++i)
             for (int j = 0; j < n; ++j) {
                 const double x = x0 + (x1 - x0) * j / (n - 1), z = z0 + (z1 - z0) * i / (n - 1);

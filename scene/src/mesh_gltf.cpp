@@ -33,6 +33,7 @@
 // (nlohmann: a few bytes per JSON byte for real files, up to ~40 for JSON made of empty
 // objects) plus decoded data: URIs and external buffers. Nothing recurses on input structure.
 #include "zcheck/error.h"
+#include "zcheck/large_buffer.h"
 #include "zcheck/mesh_formats.h"
 #include "zcheck/scene.h"
 
@@ -273,8 +274,8 @@ public:
             checkOutputBudget();
             Scene scene;
             scene.name = path_;
-            scene.positions.reserve(std::size_t(vertexTotal_));
-            scene.triangles.reserve(std::size_t(triangleTotal_));
+            reserveLarge(scene.positions, std::size_t(vertexTotal_));
+            reserveLarge(scene.triangles, std::size_t(triangleTotal_));
             traverse(roots, [&](std::size_t node, const glm::dmat4& world) {
                 const std::size_t m = meshOf(node);
                 if (m == kNone) return;

@@ -3,6 +3,7 @@
 // surfaces are not geometry zcheck can draw and are ignored. A statement zcheck does not
 // know is refused, so that a file of some other kind is not read as an empty mesh.
 #include "zcheck/error.h"
+#include "zcheck/large_buffer.h"
 #include "zcheck/mesh_formats.h"
 
 #include <charconv>
@@ -25,8 +26,8 @@ public:
         // Capacity for typical lines (a vertex takes about 30 bytes, a face about 20): reserved
         // address space costs no memory until touched, and the arrays need not move while they
         // grow (beyond it they grow as usual).
-        scene_.positions.reserve(bytes_.size() / 24);
-        scene_.triangles.reserve(bytes_.size() / 16);
+        reserveLarge(scene_.positions, bytes_.size() / 24);
+        reserveLarge(scene_.triangles, bytes_.size() / 16);
         std::size_t position = 0;
         std::string joined;  // a statement continued over several lines with a trailing backslash
         while (position < bytes_.size()) {

@@ -2,6 +2,7 @@
 // `property` lines up to `end_header`, then the items of each element in order, ascii (one
 // item a line) or binary (packed, in the declared byte order).
 #include "zcheck/error.h"
+#include "zcheck/large_buffer.h"
 #include "zcheck/mesh_formats.h"
 
 #include <algorithm>
@@ -284,9 +285,10 @@ private:
                  " items, more than the remaining " + std::to_string(remaining()) + " bytes can hold");
         if (element.kind == ElementKind::Vertex) {
             if (element.count >= 0xFFFFFFFFull) fail("too many vertices for 32-bit indices");
-            scene_.positions.reserve(element.count);
+            reserveLarge(scene_.positions, element.count);
         }
-        std::vector<std::int64_t> indices;
+        // Every face makes at least one triangle (a strip's count is known from its list).
+        if (element.kind == ElementKind::Face) reserveLarge(scene_.triangles, scene_.triangles.size() + element.count);
         for (std::uint64_t item = 0; item < element.count; ++item) {
             Line line{nullptr, nullptr};
             if (ascii_) line = nextAsciiLine(element, item);
@@ -306,12 +308,15 @@ private:
                                                        : remaining() / std::uint64_t(sizeOf(property.type));
                 if (!(length >= 0) || length != std::floor(length) || length > double(available))
                     failItem(element, item, "a list declares " + formatNumber(length) + " entries, more than the data holds");
-                indices.clear();
+                if (property.role == Role::Indices && element.kind == ElementKind::Strips && length > 2)
+                    reserveLarge(scene_.triangles, scene_.triangles.size() + std::size_t(length) - 2);
+                PrimitiveAssembler assemble(element.kind, scene_.triangles, stripJoins_);
                 for (std::uint64_t k = 0; k < std::uint64_t(length); ++k) {
                     const double v = value(property.type);
-                    if (property.role == Role::Indices) indices.push_back(vertexIndex(v, property, element, item));
+                    if (property.role == Role::Indices) assemble.add(vertexIndex(v, property, element, item));
                 }
-                if (property.role == Role::Indices) addPrimitives(element, item, indices);
+                if (property.role == Role::Indices && element.kind == ElementKind::Face && length < 3)
+                    failItem(element, item, "a face needs at least 3 vertices, this one has " + formatNumber(length));
             }
             if (ascii_) {
                 while (line.at < line.end && (*line.at == ' ' || *line.at == '\t' || *line.at == '\r')) ++line.at;
@@ -326,36 +331,42 @@ private:
         }
     }
 
-    // Faces are fans, kept as the file gives them (loadMesh judges degenerate ones). Strips
-    // alternate winding and restart at kRestart; their triangles that repeat an index are the
-    // joins between strips, an artefact of the encoding, and are skipped (and counted).
-    void addPrimitives(const Element& element, std::uint64_t item, const std::vector<std::int64_t>& list)
-    {
-        auto add = [&](std::int64_t a, std::int64_t b, std::int64_t c) {
-            scene_.triangles.push_back({std::uint32_t(a), std::uint32_t(b), std::uint32_t(c)});
-        };
-        if (element.kind == ElementKind::Face) {
-            if (list.size() < 3) failItem(element, item, "a face needs at least 3 vertices, this one has " + std::to_string(list.size()));
-            for (std::size_t i = 1; i + 1 < list.size(); ++i) add(list[0], list[i], list[i + 1]);
-            return;
-        }
-        auto addStripTriangle = [&](std::int64_t a, std::int64_t b, std::int64_t c) {
-            if (a == b || b == c || a == c) {
-                ++stripJoins_;
+    // Turns one face's or strip's index list into triangles as its indices arrive, so a strip
+    // of millions of indices is never copied. Faces are fans, kept as the file gives them
+    // (loadMesh judges degenerate ones). Strips alternate winding and restart at kRestart;
+    // their triangles that repeat an index are the joins between strips, an artefact of the
+    // encoding, and are skipped (and counted).
+    class PrimitiveAssembler {
+    public:
+        PrimitiveAssembler(ElementKind kind, std::vector<glm::uvec3>& triangles, std::uint64_t& stripJoins)
+            : strips_(kind == ElementKind::Strips), triangles_(triangles), stripJoins_(stripJoins) {}
+
+        void add(std::int64_t index)
+        {
+            if (strips_ && index == kRestart) {
+                count_ = 0;
                 return;
             }
-            add(a, b, c);
-        };
-        std::size_t start = 0;
-        for (std::size_t k = 0; k <= list.size(); ++k) {
-            if (k < list.size() && list[k] != kRestart) continue;
-            for (std::size_t i = start; i + 2 < k; ++i) {
-                const bool even = (i - start) % 2 == 0;
-                addStripTriangle(list[even ? i : i + 1], list[even ? i + 1 : i], list[i + 2]);
+            const auto i = std::uint32_t(index);
+            if (count_ == 0) first_ = i;
+            if (count_ >= 2) {
+                if (!strips_) triangles_.push_back({first_, previous_, i});
+                else if (older_ == previous_ || previous_ == i || older_ == i) ++stripJoins_;
+                else if (count_ % 2 == 0) triangles_.push_back({older_, previous_, i});
+                else triangles_.push_back({previous_, older_, i});
             }
-            start = k + 1;
+            older_ = previous_;
+            previous_ = i;
+            ++count_;
         }
-    }
+
+    private:
+        bool strips_;
+        std::vector<glm::uvec3>& triangles_;
+        std::uint64_t& stripJoins_;
+        std::uint64_t count_ = 0;  // indices since the list's start or the last restart
+        std::uint32_t first_ = 0, older_ = 0, previous_ = 0;
+    };
 
     std::string path_;
     std::string_view bytes_;

@@ -2,6 +2,7 @@
 // three vertices as binary32, a 16-bit attribute) or ascii (solid … facet … outer loop,
 // three `vertex x y z`, endloop, endfacet … endsolid). Vertices are not shared.
 #include "zcheck/error.h"
+#include "zcheck/large_buffer.h"
 #include "zcheck/mesh_formats.h"
 
 #include <algorithm>
@@ -44,8 +45,8 @@ Scene readBinary(const std::string& path, std::string_view bytes)
     if (count > 0x55555554u) fail(path, "too many triangles for 32-bit vertex indices");
     Scene scene;
     scene.name = path;
-    scene.positions.reserve(std::size_t(count) * 3);
-    scene.triangles.reserve(count);
+    reserveLarge(scene.positions, std::size_t(count) * 3);
+    reserveLarge(scene.triangles, count);
     for (std::uint32_t t = 0; t < count; ++t) {
         const char* record = bytes.data() + 84 + 50 * std::size_t(t);
         for (int k = 0; k < 3; ++k) {

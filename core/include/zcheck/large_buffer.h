@@ -10,6 +10,7 @@
 //
 //   std::vector<double> depth;
 //   zcheck::assignLarge(depth, width * height, clearValue);  // = depth.assign(n, clearValue)
+//   zcheck::reserveLarge(scene.triangles, faceCount);        // = triangles.reserve(faceCount)
 #include <cstddef>
 #include <vector>
 
@@ -26,6 +27,20 @@ void assignLarge(std::vector<T>& v, std::size_t n, const T& value)
     v.reserve(n);  // allocates, touches nothing
     adviseHugePages(v.data(), n * sizeof(T));
     v.assign(n, value);
+}
+
+// v.reserve(n), with the new storage (if any) advised huge pages before it is first touched.
+// For a reader that knows its item count up front: one allocation, no growth by copying into
+// fresh pages. n must be a count the input has been checked to hold, not one it merely declares.
+template <class T>
+void reserveLarge(std::vector<T>& v, std::size_t n)
+{
+    if (n <= v.capacity()) return;
+    std::vector<T> bigger;
+    bigger.reserve(n);
+    adviseHugePages(bigger.data(), n * sizeof(T));
+    bigger.insert(bigger.end(), v.begin(), v.end());
+    v.swap(bigger);
 }
 
 }  // namespace zcheck
