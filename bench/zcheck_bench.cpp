@@ -3,6 +3,7 @@
 // For each named workload: scene load, BVH build, trace (ray generation + Embree + depth
 // in double), raster (transform, clip, bin, scan), compare; each render repeated and the
 // median and best reported. Peak memory is the process's maximum resident set size.
+#include "zcheck/camera_file.h"
 #include "zcheck/checker.h"
 
 #include "zcheck/error.h"
@@ -41,13 +42,14 @@ Stats timeRepeated(int repeats, F&& run)
     return {ms[ms.size() / 2], ms.front()};
 }
 
-void runWorkload(const std::string& label, const std::string& sceneName, int width, int height, int repeats)
+void runWorkload(const std::string& label, const std::string& sceneName, const std::string& cameraFile, int width,
+                 int height, int repeats)
 {
     const auto loadStart = std::chrono::steady_clock::now();
     const Scene scene = loadScene(sceneName);
     const double loadMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - loadStart).count();
-    CameraSpec spec = scene.defaultCamera;
-    spec.width = width, spec.height = height;
+    CameraSpec spec = cameraFile.empty() ? scene.defaultCamera : readCameraFile(cameraFile);
+    if (cameraFile.empty()) spec.width = width, spec.height = height;
     const Camera camera(spec);
 
     const RayRenderer rays(scene);
@@ -83,12 +85,14 @@ int main(int argc, char** argv)
 {
     CLI::App app{"zcheck_bench: throughput of the ray and raster routes on named workloads"};
     int width = 1920, height = 1080, repeats = 5, threads = 0;
-    std::string only;
+    std::string only, sceneName, cameraFile;
     app.add_option("--width", width, "image width")->capture_default_str();
     app.add_option("--height", height, "image height")->capture_default_str();
     app.add_option("--repeat", repeats, "renders per measurement (median and best reported)")->capture_default_str();
     app.add_option("--threads", threads, "worker threads (default: all cores)");
     app.add_option("--only", only, "run only workloads whose label contains this text");
+    app.add_option("--scene", sceneName, "one workload: this scene (a built-in name or a mesh file) instead of the named ones");
+    app.add_option("--camera", cameraFile, "with --scene: a camera file (its size overrides --width/--height)");
     CLI11_PARSE(app, argc, argv);
 
     std::unique_ptr<tbb::global_control> limit;
@@ -101,8 +105,10 @@ int main(int argc, char** argv)
         {"default", "builtin:default"},
     };
     try {
+        if (!sceneName.empty()) runWorkload("scene", sceneName, cameraFile, width, height, std::max(1, repeats));
         for (const auto& [label, scene] : workloads)
-            if (only.empty() || label.find(only) != std::string::npos) runWorkload(label, scene, width, height, std::max(1, repeats));
+            if (sceneName.empty() && (only.empty() || label.find(only) != std::string::npos))
+                runWorkload(label, scene, "", width, height, std::max(1, repeats));
     } catch (const Error& e) {
         std::fprintf(stderr, "zcheck_bench: error: %s\n", e.what());
         return 2;

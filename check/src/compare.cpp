@@ -57,11 +57,13 @@ DepthSlopeFrame::DepthSlopeFrame(const Camera& camera)
 double DepthSlopeFrame::slope(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) const
 {
     const glm::dvec3 normal = glm::cross(b - a, c - a);
-    const glm::dvec4 planeClip = clipPlaneFromWorldPlane * glm::dvec4(normal, -glm::dot(normal, a));
-    if (planeClip.z == 0) return INFINITY;
-    const double dzdx = zWindowPerZNdc * std::abs(planeClip.x / planeClip.z) * ndcPerPixelX;
-    const double dzdy = zWindowPerZNdc * std::abs(planeClip.y / planeClip.z) * ndcPerPixelY;
-    return std::max(dzdx, dzdy);
+    const glm::dvec4 plane(normal, -glm::dot(normal, a));
+    // The clip-space plane's x, y and z (its w is not needed): rows 0-2 of the product.
+    const glm::dmat4& m = clipPlaneFromWorldPlane;
+    auto row = [&](int k) { return m[0][k] * plane.x + m[1][k] * plane.y + m[2][k] * plane.z + m[3][k] * plane.w; };
+    const double x = row(0), y = row(1), z = row(2);
+    if (z == 0) return INFINITY;
+    return zWindowPerZNdc * std::max(std::abs(x) * ndcPerPixelX, std::abs(y) * ndcPerPixelY) / std::abs(z);
 }
 
 double windowDepthSlope(const Camera& camera, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c)
@@ -152,17 +154,24 @@ glm::dvec3 PixelJudge::vertex(std::uint32_t primitive, int corner) const
     return glm::dvec3(scene_.positions[scene_.triangles[primitive][corner]]);
 }
 
+double PixelJudge::computeSlope(std::uint32_t primitive) const
+{
+    const glm::uvec3& t = scene_.triangles[primitive];
+    return slopeFrame_.slope(glm::dvec3(scene_.positions[t[0]]), glm::dvec3(scene_.positions[t[1]]),
+                             glm::dvec3(scene_.positions[t[2]]));
+}
+
 // m is a property of the triangle's plane, the same at every pixel.
 double PixelJudge::slope(std::uint32_t primitive) const
 {
     if (!known(primitive)) return 0.0;
     SlopeMemo::Entry& memo = slopeMemo.entries[primitive % SlopeMemo::kEntries];
     if (memo.judge != serial_ || memo.primitive != primitive)
-        memo = {serial_, primitive, slopeFrame_.slope(vertex(primitive, 0), vertex(primitive, 1), vertex(primitive, 2))};
+        memo = {serial_, primitive, computeSlope(primitive)};
     return memo.slope;
 }
 
-double PixelJudge::surfaceTolerance(std::uint32_t primitive, double q) const { return C_ * q + S_ * slope(primitive) + E_; }
+double PixelJudge::surfaceTolerance(std::uint32_t primitive, double q) const { return toleranceForSlope(slope(primitive), q); }
 
 // Does the primitive's plane cross the pixel's ray at the near or far plane, to within
 // binary32 rounding (2^-20 relative) of the distances where the routes clip?
@@ -317,6 +326,49 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
                     ++r.bothMiss;  // pixelClass is BothMiss already
                     continue;
                 }
+                if (rayHit && rasterHit && ray.primitiveId[i] == raster.primitiveId[i]) {
+                    // The common case, kept lean: one surface, so one slope, and no edge or
+                    // clip-plane question (PixelJudge::bothHit's rule for a single surface).
+                    ++r.bothHit;
+                    const std::uint32_t primitive = ray.primitiveId[i];
+                    const double rayDepth = ray.windowDepth.value[i], rasterDepth = raster.windowDepth.value[i];
+                    const double q = quantumAt(i), m = judge.slope(primitive);
+                    const double bound = judge.toleranceForSlope(m, q);
+                    const double error = std::abs(rasterDepth - rayDepth);
+                    const double signedErrorQuanta = signedErrorQuantaAt(i, q), errorQuanta = std::abs(signedErrorQuanta);
+                    const double ratio = bound > 0 ? error / bound : (error > 0 ? INFINITY : 0.0);
+                    const bool agree = error <= bound;
+                    if (S * m <= 0.1 * q) {
+                        // Quantization dominates here: feed the bias test.
+                        tally.signedErrorSum += signedErrorQuanta;
+                        const double position = rayDepth / q;
+                        ++tally.quarterCounts[std::clamp(int(4 * (position - std::floor(position))), 0, 3)];
+                        ++r.biasSamples;
+                    }
+                    agree ? ++r.agree : ++r.depthErrors;
+                    out.errorOverTolerance[i] = static_cast<float>(ratio);
+                    const double relative = relativeEyeZErrorAt(i, col, row);
+                    counts.errorQuanta.add(float(errorQuanta));
+                    counts.relativeEyeZ.add(float(relative));
+                    r.maxRelativeEyeZError = std::max(r.maxRelativeEyeZError, relative);
+                    r.maxErrorQuanta = std::max(r.maxErrorQuanta, errorQuanta);
+                    out.pixelClass[i] = agree ? PixelClass::Agree : PixelClass::DepthError;
+                    const bool worst = ratio > r.maxErrorOverTolerance || r.agree + r.depthErrors == 1;
+                    if (agree && !worst) continue;  // nothing to note: no finding is built
+                    PixelFinding f;
+                    f.col = col, f.row = row;
+                    f.rayWindowDepth = rayDepth, f.rasterWindowDepth = rasterDepth;
+                    f.rayPrimitive = f.rasterPrimitive = primitive;
+                    f.pixelClass = agree ? PixelClass::Agree : PixelClass::DepthError;
+                    f.errorQuanta = errorQuanta;
+                    f.toleranceQuanta = bound / q;
+                    if (worst) {
+                        r.maxErrorOverTolerance = std::max(r.maxErrorOverTolerance, ratio);
+                        r.worst = f;
+                    }
+                    if (!agree) noteUnexplained(r, f);
+                    continue;
+                }
                 const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
                 PixelFinding f;
                 f.col = col, f.row = row;
@@ -326,27 +378,19 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
                 f.rasterPrimitive = raster.primitiveId[i];
 
                 if (rayHit && rasterHit) {
+                    // Different surfaces: the raster's may legitimately win near an edge or a clip plane.
                     ++r.bothHit;
                     const double q = quantumAt(i);
                     const double error = std::abs(f.rasterWindowDepth - f.rayWindowDepth);
-                    const bool samePrimitive = f.rayPrimitive == f.rasterPrimitive;
                     double bound = 0;
                     f.pixelClass = judge.bothHit(f.rayWindowDepth, f.rayPrimitive, f.rasterWindowDepth,
                                                  f.rasterPrimitive, q, pWindow, bound);
-                    const double signedErrorQuanta = signedErrorQuantaAt(i, q);
-                    f.errorQuanta = std::abs(signedErrorQuanta);
+                    f.errorQuanta = std::abs(signedErrorQuantaAt(i, q));
                     const double ratio = bound > 0 ? error / bound : (error > 0 ? INFINITY : 0.0);
                     auto withTolerance = [&](PixelFinding& finding) -> PixelFinding& {  // a finding kept
                         finding.toleranceQuanta = bound / q;
                         return finding;
                     };
-                    if (samePrimitive && S * judge.slope(f.rayPrimitive) <= 0.1 * q) {
-                        // Quantization dominates here: feed the bias test.
-                        tally.signedErrorSum += signedErrorQuanta;
-                        const double position = f.rayWindowDepth / q;
-                        ++tally.quarterCounts[std::clamp(int(4 * (position - std::floor(position))), 0, 3)];
-                        ++r.biasSamples;
-                    }
                     if (f.pixelClass == PixelClass::EdgeSurface) {
                         ++r.edgeSurface;
                     } else {

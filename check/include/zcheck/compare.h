@@ -145,6 +145,8 @@ public:
     // One surface's tolerance at depth-storage quantum q, in window-depth units:
     // C·q + S·m + E (m = 0 for kUnknownPrimitive, which earns no slope credit).
     double surfaceTolerance(std::uint32_t primitive, double q) const;
+    // The same for a surface whose slope m = slope(primitive) is known already.
+    double toleranceForSlope(double m, double q) const { return C_ * q + S_ * m + E_; }
     // Both routes hit: d_ray on `rayPrimitive`, d_raster on `rasterPrimitive`, at window point
     // pWindow. Returns Agree, EdgeSurface or DepthError; `bound` receives the tolerance used.
     PixelClass bothHit(double rayDepth, std::uint32_t rayPrimitive, double rasterDepth,
@@ -159,6 +161,7 @@ public:
 private:
     bool known(std::uint32_t primitive) const { return primitive < scene_.triangles.size(); }
     glm::dvec3 vertex(std::uint32_t primitive, int corner) const;
+    double computeSlope(std::uint32_t primitive) const;  // slope() without the memo
 
     const Scene& scene_;
     const Camera& camera_;
