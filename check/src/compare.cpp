@@ -125,7 +125,7 @@ struct PercentileBucket {
 // one slope; a million-triangle scene costs no per-triangle cache (that was 8 MB to fault in
 // for every comparison).
 struct SlopeMemo {
-    static constexpr std::size_t kEntries = 1024;
+    static constexpr std::size_t kEntries = 4096;
     struct Entry {
         std::uint64_t judge;
         std::uint32_t primitive;
