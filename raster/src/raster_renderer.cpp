@@ -242,15 +242,23 @@ double faultyStoredDepth(const Viewport& vp, double interpolated, int col, int r
     return quantizeDepth(depth.format, windowDepth);
 }
 
+// One tile's depth and primitive ids while it is drawn: kept in the worker's cache (48 KB),
+// then copied into the frame once.
+struct TileBuffer {
+    static constexpr int kSide = RasterRenderer::kTileSize;
+    int col0, row0;  // the tile's top-left pixel in the frame
+    double depth[kSide * kSide];
+    std::uint32_t primitive[kSide * kSide];
+};
+
 // Scan one triangle inside one tile.
 void drawInTile(const Viewport& vp, const TriangleSetup& t, int tileCol0, int tileRow0, int tileCol1, int tileRow1,
-                RenderResult& out)
+                TileBuffer& out)
 {
     const Camera& camera = vp.camera;
     const int col0 = std::max(t.box.minCol, tileCol0), col1 = std::min(t.box.maxCol, tileCol1);
     const int row0 = std::max(t.box.minRow, tileRow0), row1 = std::min(t.box.maxRow, tileRow1);
     const DepthSettings& depth = camera.depth();
-    const int W = camera.width();
     for (int row = row0; row <= row1; ++row) {
         const std::int64_t py = row * kSubpixel + kHalfPixel, px = col0 * kSubpixel + kHalfPixel;
         std::int64_t e0 = t.A[0] * px + t.B[0] * py + t.C[0];
@@ -263,10 +271,10 @@ void drawInTile(const Viewport& vp, const TriangleSetup& t, int tileCol0, int ti
             const double interpolated = rowDepth + t.dzdx * (col + 0.5 - t.x0);
             const double stored = vp.pixelFaults ? faultyStoredDepth(vp, interpolated, col, row)
                                                  : quantizeDepth(depth.format, std::clamp(interpolated, depth.rangeMin, depth.rangeMax));
-            const std::size_t i = std::size_t(row) * W + col;
-            if (camera.passesDepthTest(stored, out.windowDepth.value[i])) {
-                out.windowDepth.value[i] = stored;
-                out.primitiveId[i] = t.primitive;
+            const int i = (row - out.row0) * TileBuffer::kSide + (col - out.col0);
+            if (camera.passesDepthTest(stored, out.depth[i])) {
+                out.depth[i] = stored;
+                out.primitive[i] = t.primitive;
             }
         }
     }
@@ -288,7 +296,8 @@ RenderResult RasterRenderer::render(const Camera& camera, const RasterFaults& fa
     const auto start = std::chrono::steady_clock::now();
     const Viewport vp(camera, faults);
     const int W = camera.width(), H = camera.height();
-    RenderResult result = RenderResult::cleared(W, H, camera.clearDepth());
+    const double clearDepth = camera.clearDepth();
+    RenderResult result = RenderResult::cleared(W, H, clearDepth);
 
     // Vertices to clip space in double, their outcodes, and those inside every clip plane
     // snapped once (a vertex outside one is snapped only where clipping made it).
@@ -339,18 +348,28 @@ RenderResult RasterRenderer::render(const Camera& camera, const RasterFaults& fa
         const int col0 = (tile % vp.tilesX) * kTileSize, row0 = (tile / vp.tilesX) * kTileSize;
         const int col1 = std::min(W, col0 + kTileSize) - 1, row1 = std::min(H, row0 + kTileSize) - 1;
         TriangleSetup t;
+        TileBuffer tileBuffer;
+        tileBuffer.col0 = col0, tileBuffer.row0 = row0;
+        std::fill(std::begin(tileBuffer.depth), std::end(tileBuffer.depth), clearDepth);
+        std::fill(std::begin(tileBuffer.primitive), std::end(tileBuffer.primitive), kNoPrimitive);
         for (const Chunk& chunk : chunks)
             for (std::uint32_t k = chunk.tileStart[tile]; k < chunk.tileStart[tile + 1]; ++k) {
                 const std::uint32_t entry = chunk.binned[k];
                 if (entry & kClippedBit) {
-                    drawInTile(vp, chunk.clipped[entry & ~kClippedBit], col0, row0, col1, row1, result);
+                    drawInTile(vp, chunk.clipped[entry & ~kClippedBit], col0, row0, col1, row1, tileBuffer);
                 } else {
                     const glm::uvec3& tri = scene_.triangles[entry];
                     setupFromSnapped(vp, snapped[tri[0]].snapped(), snapped[tri[1]].snapped(), snapped[tri[2]].snapped(),
                                      entry, t);
-                    drawInTile(vp, t, col0, row0, col1, row1, result);
+                    drawInTile(vp, t, col0, row0, col1, row1, tileBuffer);
                 }
             }
+        for (int row = row0; row <= row1; ++row) {
+            const int from = (row - row0) * TileBuffer::kSide, count = col1 - col0 + 1;
+            const std::size_t to = std::size_t(row) * W + col0;
+            std::copy_n(tileBuffer.depth + from, count, result.windowDepth.value.begin() + std::ptrdiff_t(to));
+            std::copy_n(tileBuffer.primitive + from, count, result.primitiveId.begin() + std::ptrdiff_t(to));
+        }
     });
     result.renderMilliseconds =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
