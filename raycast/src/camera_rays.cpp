@@ -120,27 +120,14 @@ std::optional<AffineRays> CameraRays::affine() const
     return rays;
 }
 
-double CameraRays::windowDepth(const glm::dvec2& pImage, double d) const
+double CameraRays::matrixWindowDepth(const glm::dvec2& pImage, double d) const
 {
-    if (fromMatrix_) return windowDepthFromEyeZ(camera_, {pImage.x, camera_.windowYFromImageY(pImage.y)}, d);
-    return depthA_ + (parallel_ ? depthB_ * d : depthB_ / d);
+    return windowDepthFromEyeZ(camera_, {pImage.x, camera_.windowYFromImageY(pImage.y)}, d);
 }
 
-double CameraRays::eyeZFromWindowDepth(const glm::dvec2& pImage, double w) const
+double CameraRays::matrixEyeZFromWindowDepth(const glm::dvec2& pImage, double w) const
 {
-    if (fromMatrix_) return zcheck::eyeZFromWindowDepth(camera_, {pImage.x, camera_.windowYFromImageY(pImage.y)}, w);
-    return parallel_ ? (w - depthA_) / depthB_ : depthB_ / (w - depthA_);
-}
-
-double CameraRays::relativeEyeZDifference(const glm::dvec2& pImage, double reference, double other) const
-{
-    if (fromMatrix_) {
-        const double zReference = eyeZFromWindowDepth(pImage, reference);
-        return std::abs(eyeZFromWindowDepth(pImage, other) - zReference) / std::abs(zReference);
-    }
-    // Parallel: z = (w − A)/B, so (z_o − z_r)/z_r = (w_o − w_r)/(w_r − A).
-    return parallel_ ? std::abs((other - reference) / (reference - depthA_))
-                     : std::abs((reference - other) / (other - depthA_));
+    return zcheck::eyeZFromWindowDepth(camera_, {pImage.x, camera_.windowYFromImageY(pImage.y)}, w);
 }
 
 }  // namespace zcheck

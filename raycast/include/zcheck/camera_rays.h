@@ -26,6 +26,7 @@
 #include "zcheck/camera.h"
 #include "zcheck/inverse_projection.h"
 
+#include <cmath>
 #include <optional>
 
 namespace zcheck {
@@ -59,15 +60,36 @@ public:
     double eyeZ(const glm::dvec3& pWorld) const { return glm::dot(pWorld - eye_, forward_); }
     // The window depth of the point at eye-z `eyeZ` on the ray through image point pImage, in
     // closed form (exact, not quantized); a raw-matrix camera's through its matrix.
-    double windowDepth(const glm::dvec2& pImage, double eyeZ) const;
+    // (Inline: the trace and the comparison call these per pixel.)
+    double windowDepth(const glm::dvec2& pImage, double eyeZ) const
+    {
+        if (fromMatrix_) return matrixWindowDepth(pImage, eyeZ);
+        return depthA_ + (parallel_ ? depthB_ * eyeZ : depthB_ / eyeZ);
+    }
     // Its inverse: the eye-z at which the ray through pImage has window depth `windowDepth`.
-    double eyeZFromWindowDepth(const glm::dvec2& pImage, double windowDepth) const;
+    double eyeZFromWindowDepth(const glm::dvec2& pImage, double windowDepth) const
+    {
+        if (fromMatrix_) return matrixEyeZFromWindowDepth(pImage, windowDepth);
+        return parallel_ ? (windowDepth - depthA_) / depthB_ : depthB_ / (windowDepth - depthA_);
+    }
     // |z(other) − z(reference)| / |z(reference)| for two window depths on the ray through
     // pImage, z being eye-z: with z = B/(w − A) that is |(w_ref − w_other)/(w_other − A)|, one
     // division where the two conversions take three.
-    double relativeEyeZDifference(const glm::dvec2& pImage, double referenceWindowDepth, double otherWindowDepth) const;
+    double relativeEyeZDifference(const glm::dvec2& pImage, double reference, double other) const
+    {
+        if (fromMatrix_) {
+            const double zReference = eyeZFromWindowDepth(pImage, reference);
+            return std::abs(eyeZFromWindowDepth(pImage, other) - zReference) / std::abs(zReference);
+        }
+        // Parallel: z = (w − A)/B, so (z_o − z_r)/z_r = (w_o − w_r)/(w_r − A).
+        return parallel_ ? std::abs((other - reference) / (reference - depthA_))
+                         : std::abs((reference - other) / (other - depthA_));
+    }
 
 private:
+    // A raw-matrix camera's depth mapping, through the inverse-projection module.
+    double matrixWindowDepth(const glm::dvec2& pImage, double eyeZ) const;
+    double matrixEyeZFromWindowDepth(const glm::dvec2& pImage, double windowDepth) const;
     // The ray through pImage in OpenGL's eye axes: eye-plane origin and direction (z = −1).
     void eyeRay(const glm::dvec2& pImage, glm::dvec3& origin, glm::dvec3& direction) const;
     glm::dvec3 worldFromEyeVector(const glm::dvec3& v) const { return v.x * right_ + v.y * up_ - v.z * forward_; }
