@@ -93,4 +93,29 @@ std::vector<double> parseNumberList(const std::string& text, const std::string& 
     return values;
 }
 
+void addDepthMapOptions(CLI::App* command, DepthMapOptions& options)
+{
+    command->add_option("--channel", options.channel,
+                        "the channel to read (default: the only one, else the one named as depth: Z, depth,\n"
+                        "*.Z as in Blender's ViewLayer.Depth.Z, *.depth; several or none is an error that lists them)");
+    command->add_option("--scale", options.scale,
+                        "stored value = (depth - offset) x scale: required for integer files (1000 for millimetres,\n"
+                        "5000 for many RGB-D sets, 256 for KITTI); float files are divided by it")
+        ->check(kPositiveFinite);
+    command->add_option("--offset", options.offset, "added to every depth after --scale (default 0)");
+    command->add_option("--miss", options.miss,
+                        "the stored value that means 'no surface', or a comparison: 0, 65535, 1e10, nan, inf, '>=1e9'\n"
+                        "(default: 0 in integer files; NaN is always a miss)");
+}
+
+DepthMapReading DepthMapOptions::reading(const std::string& quantityName) const
+{
+    DepthMapReading r;
+    r.channel = channel;
+    r.quantityChannel = channelNameOf(exportQuantitiesFromList(quantityName).front());
+    r.scale = scale, r.offset = offset;
+    if (!miss.empty()) r.miss = MissRule::parse(miss);
+    return r;
+}
+
 }  // namespace zcheck::cli

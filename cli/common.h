@@ -2,6 +2,7 @@
 // What every subcommand shares: exit statuses, option validators, the scene-and-camera
 // options, the thread limit, and the check/verify --out folder.
 #include "zcheck/checker.h"
+#include "zcheck/depth_map_reading.h"
 
 #include <CLI/CLI.hpp>
 #include <tbb/global_control.h>
@@ -66,6 +67,15 @@ struct ImageSize {
     }
 };
 void addImageSizeOptions(CLI::App* command, ImageSize& size);
+
+// --channel, --scale, --offset and --miss, as verify and unproject read a depth map.
+struct DepthMapOptions {
+    std::string channel, miss;
+    double scale = 0, offset = 0;
+    // The reading for a map of quantity `quantityName`; throws Error naming a bad --miss.
+    DepthMapReading reading(const std::string& quantityName) const;
+};
+void addDepthMapOptions(CLI::App* command, DepthMapOptions& options);
 
 // "1,2.5,3" → {1, 2.5, 3}; throws Error naming `option` for anything that is not a number.
 std::vector<double> parseNumberList(const std::string& text, const std::string& option);

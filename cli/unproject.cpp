@@ -21,7 +21,7 @@ namespace {
 struct UnprojectOptions {
     std::string cameraFile, convention, pixel, depthMap, quantity = "window", output, space = "world";
     std::optional<double> depth;
-    double scale = 0;
+    DepthMapOptions reading;
     int stride = 1;
     bool ascii = false;
 };
@@ -85,8 +85,7 @@ int runUnprojectCommand(const UnprojectOptions& o)
     outputs.addInput(o.cameraFile);
     outputs.addInput(o.depthMap);
     outputs.add(o.output, "-o");
-    const DepthMapFile map = images().readDepthMap(o.depthMap, channelNameOf(exportQuantitiesFromList(o.quantity).front()), o.scale,
-                                          camera.width(), camera.height());
+    const DepthMapFile map = images().readDepthMap(o.depthMap, o.reading.reading(o.quantity), camera.width(), camera.height());
     const UnprojectedMap cloud =
         unprojectMap(camera, map.value, quantity, o.space == "eye" ? PointSpace::Eye : PointSpace::World, o.stride);
     outputs.write(o.output, [&](const std::string& temporary) {
@@ -118,8 +117,7 @@ Command addUnprojectCommand(CLI::App& app)
     command->add_option("--quantity", o->quantity, "what --depth / the map holds: window | ndc | eye-z | distance")
         ->capture_default_str();
     command->add_option("--depth-map", o->depthMap, "a depth map to turn into a point cloud")->check(kNonEmptyPath);
-    command->add_option("--scale", o->scale, "stored value = depth x scale (required for 16-bit PNG)")
-        ->check(kPositiveFinite);
+    addDepthMapOptions(command, o->reading);
     command->add_option("-o,--output", o->output, "the PLY file to write (atomically)")->check(kNonEmptyPath);
     command->add_option("--space", o->space, "eye | world coordinates for points")->capture_default_str();
     command->add_option("--stride", o->stride, "use every K-th pixel in x and y, 1..16384")

@@ -15,7 +15,7 @@ namespace {
 struct VerifyOptions {
     SceneAndCamera input;
     std::string depthMap, quantity = "window", outDir;
-    double scale = 0;
+    DepthMapOptions reading;
     bool diagnose = false, json = false;
     int threads = 0;
 };
@@ -32,11 +32,12 @@ int runVerifyCommand(const VerifyOptions& o)
     if (!o.outDir.empty()) folder.plan(outputs);
     Scene scene = loadScene(o.input.scene);
     const Camera camera(cameraSpecFor(scene, o.input));
-    const DepthMapFile file = images().readDepthMap(o.depthMap, channelNameOf(exportQuantitiesFromList(o.quantity).front()), o.scale,
-                                           camera.width(), camera.height());
+    const DepthMapReading reading = o.reading.reading(o.quantity);
+    const DepthMapFile file = images().readDepthMap(o.depthMap, reading, camera.width(), camera.height());
     const DepthMap map{file.width, file.height, quantity, file.value, file.valueQuantum};
     const Checker checker(std::move(scene));
-    const VerifyOutcome verified = verifyAndReport(checker, camera, map, {o.depthMap, o.quantity, file.channel, o.scale}, o.diagnose);
+    const VerifyOutcome verified =
+        verifyAndReport(checker, camera, map, {o.depthMap, o.quantity, file.channel, reading}, o.diagnose);
     const VerifyResult& run = verified.run;
     if (!o.outDir.empty()) {
         folder.write(outputs, run.truth, run.map, run.comparison, verified.json);
@@ -56,13 +57,12 @@ Command addVerifyCommand(CLI::App& app)
                   "ground truth for the same scene and camera, with the same tolerance model, report and exit codes\n"
                   "as check; --diagnose names the classic mistake that explains an inconsistent map.");
     addSceneAndCameraOptions(command, o->input);
-    command->add_option("--depth-map", o->depthMap, "EXR, PFM, TIFF, or 16-bit PNG with --scale")
+    command->add_option("--depth-map", o->depthMap, "EXR (multi-layer too), PFM, TIFF, or 16-bit PNG with --scale")
         ->required()
         ->check(kNonEmptyPath);
     command->add_option("--quantity", o->quantity, "what the map holds: window | ndc | eye-z | distance")
         ->capture_default_str();
-    command->add_option("--scale", o->scale, "stored value = depth x scale (required for integer files)")
-        ->check(kPositiveFinite);
+    addDepthMapOptions(command, o->reading);
     command->add_flag("--diagnose", o->diagnose, "when inconsistent, test the classic hypotheses and name the one that fits");
     command->add_option("--out", o->outDir, "write truth and map depth EXRs, heatmap, classes and report.json")
         ->check(kNonEmptyPath);

@@ -19,10 +19,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (!file) return 0;
     std::fwrite(data + 2, 1, size - 2, file);
     std::fclose(file);
+    // Both channel choices (automatic, and a named one), with and without a scale, offset and miss rule.
     for (double scale : {0.0, 1000.0}) {
-        try {
-            zcheck::readDepthMap(path, "Z", scale, width, height);
-        } catch (const zcheck::Error&) {
+        zcheck::DepthMapReading reading;
+        reading.quantityChannel = "Z";
+        reading.scale = scale;
+        if (scale > 0) reading.offset = 0.5, reading.miss = zcheck::MissRule::parse(">=65535");
+        for (const char* channel : {"", "Y"}) {
+            reading.channel = channel;
+            try {
+                zcheck::readDepthMap(path, reading, width, height);
+            } catch (const zcheck::Error&) {
+            }
         }
     }
     std::remove(path.c_str());

@@ -29,6 +29,39 @@ import json; r = json.load(open('out/report.json'))
 assert r['consistent'] is False and r['depth_map']['quantity'] == 'eye-z'
 assert any(h['consistent'] and h['hypothesis'] == 'distance-as-eye-z' for h in r['diagnosis'])"
 
+# Real renderers' files: a multi-layer EXR with the depth pass beside the colour (as Blender
+# writes it) is read from its depth channel, which the report names.
+oiiotool render.exr --ch "ViewLayer.Combined.R=window,ViewLayer.Combined.G=window,ViewLayer.Depth.Z=Z" -o layers.exr
+"$zcheck" verify --depth-map layers.exr --quantity eye-z > layers.txt
+grep -q "verdict    CONSISTENT" layers.txt
+grep -q "channel 'ViewLayer.Depth.Z' (eye-z)" layers.txt
+"$zcheck" verify --depth-map layers.exr --quantity eye-z --json | python3 -c "
+import json, sys; d = json.load(sys.stdin)['depth_map']
+assert d['channel'] == 'ViewLayer.Depth.Z' and d['miss'] is None and d['offset'] == 0, d"
+# No channel named as depth: refused with the list; --channel names it.
+oiiotool render.exr --ch "R=Z,G=Z,B=Z" -o rgb.exr
+expect_error 2 "none of its 3 channels \\('R', 'G', 'B'\\) is named as depth" verify --depth-map rgb.exr --quantity eye-z
+"$zcheck" verify --depth-map rgb.exr --channel G --quantity eye-z | grep -q "verdict    CONSISTENT"
+expect_error 2 "it has no channel 'Depth'; its channels are 'R', 'G', 'B'" verify --depth-map rgb.exr --channel Depth --quantity eye-z
+# --offset: a map stored as eye-z - 0.5 reads back with --offset 0.5 (and not without).
+oiiotool render.exr --ch Z --subc 0.5 -o minus_half.exr
+"$zcheck" verify --depth-map minus_half.exr --offset 0.5 --quantity eye-z | grep -q "verdict    CONSISTENT"
+set +e
+"$zcheck" verify --depth-map minus_half.exr --quantity eye-z > /dev/null
+status=$?
+set -e
+[[ $status -eq 1 ]]
+# --miss: a renderer that marks "no surface" as 1e10 is inconsistent read as depth, consistent
+# with --miss '>=1e9'.
+oiiotool render.exr --ch Z --clamp:max=1e10 -o far_misses.exr
+set +e
+"$zcheck" verify --depth-map far_misses.exr --quantity eye-z > far.txt
+status=$?
+set -e
+[[ $status -eq 1 ]]
+"$zcheck" verify --depth-map far_misses.exr --quantity eye-z --miss '>=1e9' | grep -q "verdict    CONSISTENT"
+expect_error 2 "miss value 'abc' is neither a number" verify --depth-map render.exr --quantity eye-z --miss abc
+
 # Bad input exits 2.
 expect_error 2 "cannot read depth map" verify --depth-map missing.exr
 expect_error 2 "scale" verify --depth-map render_mm.png --quantity eye-z

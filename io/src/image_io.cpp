@@ -58,10 +58,7 @@ void writeExr(const std::string& path, int width, int height, const std::vector<
 
 namespace {
 
-[[noreturn]] void refuseMap(const std::string& path, const std::string& why)
-{
-    throw Error("cannot read depth map '" + path + "': " + why);
-}
+[[noreturn]] void refuseMap(const std::string& path, const std::string& why) { refuseDepthMap(path, why); }
 
 void requireSize(const std::string& path, long long width, long long height, int expectedWidth, int expectedHeight)
 {
@@ -74,7 +71,8 @@ void requireSize(const std::string& path, long long width, long long height, int
 // height, scale (negative: little-endian), one whitespace byte, then float32 rows from the
 // bottom row of the picture to the top. Read here, strictly: the size is compared with the
 // camera's before anything is allocated, and the data must be exactly as long as declared.
-DepthMapFile readPfm(const std::string& path, const std::string& bytes, int expectedWidth, int expectedHeight)
+DepthMapFile readPfm(const std::string& path, const std::string& bytes, const DepthMapReading& reading, int expectedWidth,
+                     int expectedHeight)
 {
     std::size_t at = 2;
     auto field = [&](const char* what) {
@@ -105,15 +103,17 @@ DepthMapFile readPfm(const std::string& path, const std::string& bytes, int expe
         refuseMap(path, "the PFM data holds " + std::to_string(bytes.size() - at) + " bytes, but " +
                             std::to_string(width) + "x" + std::to_string(height) + "x" + std::to_string(channels) +
                             " float32 values need " + std::to_string(expectedBytes) + (bytes.size() - at < expectedBytes ? " (truncated)" : ""));
+    const std::vector<std::string> names = channels == 1 ? std::vector<std::string>{"Y"} : std::vector<std::string>{"R", "G", "B"};
     DepthMapFile map;
     map.width = int(width), map.height = int(height);
-    map.channel = channels == 1 ? "Y" : "R";
+    map.channel = chooseDepthChannel(path, names, reading.channel, reading.quantityChannel);
+    const std::size_t channel = std::size_t(std::find(names.begin(), names.end(), map.channel) - names.begin());
     map.value.resize(std::size_t(width) * std::size_t(height));
     const bool bigEndian = scale > 0;
     for (long long row = 0; row < height; ++row)
         for (long long col = 0; col < width; ++col) {
             unsigned char raw[4];
-            std::memcpy(raw, bytes.data() + at + 4 * ((std::size_t(row) * std::size_t(width) + std::size_t(col)) * std::size_t(channels)), 4);
+            std::memcpy(raw, bytes.data() + at + 4 * ((std::size_t(row) * std::size_t(width) + std::size_t(col)) * std::size_t(channels) + channel), 4);
             if (bigEndian) std::reverse(raw, raw + 4);
             float v;
             std::memcpy(&v, raw, 4);
@@ -187,12 +187,14 @@ void preflightExr(const std::string& path, int expectedWidth, int expectedHeight
 
 }  // namespace
 
-DepthMapFile readDepthMap(const std::string& path, const std::string& preferredChannel, double scale, int expectedWidth,
-                          int expectedHeight)
+DepthMapFile readDepthMap(const std::string& path, const DepthMapReading& reading, int expectedWidth, int expectedHeight)
 {
+    const double scale = reading.scale;
     if (scale != 0 && !(scale > 0 && std::isfinite(scale)))
         throw Error("--scale must be a positive finite number, got " + formatNumber(scale));
+    if (!std::isfinite(reading.offset)) throw Error("--offset must be a finite number, got " + formatNumber(reading.offset));
     checkInputFile(path, kDepthMapInput);
+    auto depthOf = [&](double stored, bool integer) { return reading.depthOf(stored, integer); };
     // The format is decided by the file's first bytes, and only that format's reader sees it:
     // OpenImageIO would otherwise offer unknown bytes to every plugin it has (video, camera
     // raw, DICOM, ...). PFM is read by zcheck itself (see readPfm).
@@ -202,9 +204,8 @@ DepthMapFile readDepthMap(const std::string& path, const std::string& preferredC
         probe.read(reinterpret_cast<char*>(magic), 4);
     }
     if (magic[0] == 'P' && (magic[1] == 'f' || magic[1] == 'F') && std::isspace(magic[2])) {
-        DepthMapFile map = readPfm(path, readInputFile(path, kDepthMapInput), expectedWidth, expectedHeight);
-        if (scale > 0)
-            for (double& v : map.value) v /= scale;
+        DepthMapFile map = readPfm(path, readInputFile(path, kDepthMapInput), reading, expectedWidth, expectedHeight);
+        for (double& v : map.value) v = depthOf(v, false);
         return map;
     }
     const char* plugin = magic[0] == 0x76 && magic[1] == 0x2f && magic[2] == 0x31 && magic[3] == 0x01 ? "openexr"
@@ -214,11 +215,15 @@ DepthMapFile readDepthMap(const std::string& path, const std::string& preferredC
                          : magic[0] == 0x89 && magic[1] == 'P' && magic[2] == 'N' && magic[3] == 'G' ? "png"
                                                                                                       : nullptr;
     if (!plugin) refuseMap(path, "not an EXR, TIFF, PNG or PFM file (judged by its first bytes)");
+    auto requireScale = [&](const std::string& what) {
+        if (!(scale > 0))
+            throw Error("depth map '" + path + "' stores integers (" + what +
+                        "): give --scale (stored value = depth × scale, e.g. 1000 for millimetres, 5000 for many RGB-D "
+                        "sets, 256 for KITTI)");
+    };
     if (plugin == std::string("png")) {
         // zcheck's own libpng reader (OpenImageIO's leaks on libpng's error path).
-        if (!(scale > 0))
-            throw Error("depth map '" + path + "' stores integers (16-bit PNG): give --scale (stored value = depth × scale, "
-                        "e.g. 1000 for millimetres)");
+        requireScale("16-bit PNG");
         Png16 png;
         try {
             png = decodePng16(readInputFile(path, kDepthMapInput), [&](long long width, long long height) {
@@ -230,9 +235,10 @@ DepthMapFile readDepthMap(const std::string& path, const std::string& preferredC
             refuseMap(path, what);
         }
         DepthMapFile map;
-        map.width = png.width, map.height = png.height, map.channel = "Y", map.valueQuantum = 1.0 / scale;
+        map.width = png.width, map.height = png.height, map.valueQuantum = 1.0 / scale;
+        map.channel = chooseDepthChannel(path, {"Y"}, reading.channel, reading.quantityChannel);
         map.value.resize(png.codes.size());
-        for (std::size_t i = 0; i < png.codes.size(); ++i) map.value[i] = png.codes[i] == 0 ? NAN : png.codes[i] / scale;
+        for (std::size_t i = 0; i < png.codes.size(); ++i) map.value[i] = depthOf(png.codes[i], true);
         return map;
     }
     if (plugin == std::string("openexr")) preflightExr(path, expectedWidth, expectedHeight);
@@ -249,16 +255,21 @@ DepthMapFile readDepthMap(const std::string& path, const std::string& preferredC
     if (spec.width < 1 || spec.height < 1 || spec.depth > 1 || spec.nchannels < 1) refuseMap(path, "not a 2-D image");
     // Compared with the camera before a pixel is allocated: a header may declare anything.
     requireSize(path, spec.width, spec.height, expectedWidth, expectedHeight);
-    int channel = 0;
-    if (spec.channelindex(preferredChannel) >= 0) channel = spec.channelindex(preferredChannel);
-    const OIIO::TypeDesc format = spec.channelformat(channel);
-    const bool integer = !format.is_floating_point();
-    if (integer && !(scale > 0))
-        throw Error("depth map '" + path + "' stores integers (" + std::string(format.c_str()) +
-                    "): give --scale (stored value = depth × scale, e.g. 1000 for millimetres)");
+    std::vector<std::string> names;
+    for (int c = 0; c < spec.nchannels; ++c)
+        names.push_back(c < int(spec.channelnames.size()) && !spec.channelnames[std::size_t(c)].empty()
+                            ? spec.channelnames[std::size_t(c)]
+                            : std::to_string(c));
     DepthMapFile map;
     map.width = spec.width, map.height = spec.height;
-    map.channel = spec.channelnames.empty() ? "0" : spec.channelnames[std::size_t(channel)];
+    map.channel = chooseDepthChannel(path, names, reading.channel, reading.quantityChannel);
+    const int channel = int(std::find(names.begin(), names.end(), map.channel) - names.begin());
+    const OIIO::TypeDesc format = spec.channelformat(channel);
+    const bool integer = !format.is_floating_point();
+    if (integer && format.size() < 2)
+        refuseMap(path, "channel '" + map.channel + "' stores " + std::to_string(8 * format.size()) +
+                            "-bit integers, which cannot hold depth (a picture, not a depth map?)");
+    if (integer) requireScale(format.c_str());
     std::vector<double> pixels(std::size_t(spec.width) * std::size_t(spec.height));
     if (!in->read_image(0, 0, channel, channel + 1, OIIO::TypeDesc::DOUBLE, pixels.data())) {
         std::string reason = in->geterror();
@@ -266,17 +277,10 @@ DepthMapFile readDepthMap(const std::string& path, const std::string& preferredC
             if (c == '\n') c = ' ';
         refuseMap(path, reason.empty() ? "the pixel data is truncated or corrupt" : reason);
     }
-    if (integer) {
-        map.valueQuantum = 1.0 / scale;
-        // read_image scales integers to [0,1]; undo it to get the stored code.
-        const double maxCode = std::pow(2.0, double(format.size() * 8)) - 1;
-        for (double& v : pixels) {
-            const double code = std::round(v * maxCode);
-            v = code == 0 ? NAN : code / scale;
-        }
-    } else if (scale > 0) {
-        for (double& v : pixels) v /= scale;
-    }
+    // read_image scales integers to [0,1]; undo it to get the stored code.
+    const double maxCode = integer ? std::pow(2.0, double(format.size() * 8)) - 1 : 1.0;
+    for (double& v : pixels) v = depthOf(integer ? std::round(v * maxCode) : v, integer);
+    if (integer) map.valueQuantum = 1.0 / scale;
     map.value = std::move(pixels);
     return map;
 }

@@ -41,4 +41,17 @@ void fillVerification(PyReport& r, VerifyOutcome verified)
     fillComparison(r, verified.run.comparison, verified.run.truth, verified.run.map);
 }
 
+DepthMapReading readingOf(const py::object& miss, std::optional<double> scale, std::optional<double> offset)
+{
+    DepthMapReading reading;
+    if (scale && !(std::isfinite(*scale) && *scale > 0))
+        fail("scale must be a positive finite number, got " + formatNumber(*scale));
+    if (offset && !std::isfinite(*offset)) fail("offset must be a finite number, got " + formatNumber(*offset));
+    reading.scale = scale ? *scale : 0.0;
+    reading.offset = offset ? *offset : 0.0;
+    if (py::isinstance<py::str>(miss)) reading.miss = MissRule::parse(miss.cast<std::string>());
+    else if (!miss.is_none()) reading.miss = MissRule::parse(formatNumber(miss.cast<double>()));
+    return reading;
+}
+
 }  // namespace zcheck::python

@@ -3,6 +3,7 @@
 // zcheck._zcheck_files (depth-map files through OpenImageIO, imported on first use so that
 // `import zcheck` does not pay OpenImageIO's start-up).
 #include "zcheck/checker.h"
+#include "zcheck/depth_map_reading.h"
 #include "zcheck/error.h"
 #include "zcheck/quantity.h"
 #include "zcheck/report.h"
@@ -28,6 +29,11 @@ namespace py = pybind11;
 ExportQuantity exportOf(DepthQuantity q);
 // At most N worker threads for one call (TBB's limit is process-wide while it lives); none: all.
 std::unique_ptr<tbb::global_control> threadLimit(std::optional<int> threads);
+
+// The keyword arguments miss=, scale= and offset= as a reading (depth_map_reading.h), checked
+// as the command line checks --miss, --scale and --offset. `miss` is None, a number, or a
+// string ("65535", "nan", ">=1e9").
+DepthMapReading readingOf(const py::object& miss, std::optional<double> scale, std::optional<double> offset);
 
 // zcheck.Report: the result of Checker.check, Checker.verify or Checker.verify_file.
 struct PyReport {

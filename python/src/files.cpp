@@ -20,49 +20,47 @@ PYBIND11_MODULE(_zcheck_files, m)
     m.def(
         "verify_file",
         [](const Checker& checker, const Camera& camera, const std::string& path, const std::string& quantityName,
-           std::optional<double> scale, bool diagnose, std::optional<int> threads) {
-            // Exactly `zcheck verify --depth-map PATH --quantity Q [--scale S] [--diagnose]`
-            // (cli/verify.cpp): the quantity's channel, the file's own storage quantum.
+           std::optional<std::string> channel, const py::object& miss, std::optional<double> scale,
+           std::optional<double> offset, bool diagnose, std::optional<int> threads) {
+            // Exactly `zcheck verify --depth-map PATH --quantity Q [--channel C] [--scale S]
+            // [--offset O] [--miss M] [--diagnose]` (cli/verify.cpp).
             const DepthQuantity quantity = depthQuantityFromName(quantityName);
-            if (scale && !(std::isfinite(*scale) && *scale > 0))
-                fail("scale must be a positive finite number, got " + formatNumber(*scale));
-            const double s = scale ? *scale : 0.0;
+            DepthMapReading reading = readingOf(miss, scale, offset);
+            reading.channel = channel ? *channel : "";
+            reading.quantityChannel = channelNameOf(exportOf(quantity));
             auto r = std::make_unique<PyReport>();
             r->verify = true;
             {
                 py::gil_scoped_release release;
                 const auto limit = threadLimit(threads);
-                const DepthMapFile file =
-                    readDepthMap(path, channelNameOf(exportOf(quantity)), s, camera.width(), camera.height());
+                const DepthMapFile file = readDepthMap(path, reading, camera.width(), camera.height());
                 const DepthMap map{file.width, file.height, quantity, file.value, file.valueQuantum};
-                fillVerification(*r, verifyAndReport(checker, camera, map, {path, quantityName, file.channel, s}, diagnose));
+                fillVerification(*r, verifyAndReport(checker, camera, map, {path, quantityName, file.channel, reading}, diagnose));
             }
             return r;
         },
-        py::arg("checker"), py::arg("camera"), py::arg("path"), py::arg("quantity"), py::kw_only(), py::arg("scale") = py::none(),
-        py::arg("diagnose") = false, py::arg("threads") = py::none(),
+        py::arg("checker"), py::arg("camera"), py::arg("path"), py::arg("quantity"), py::kw_only(),
+        py::arg("channel") = py::none(), py::arg("miss") = py::none(), py::arg("scale") = py::none(),
+        py::arg("offset") = py::none(), py::arg("diagnose") = false, py::arg("threads") = py::none(),
         R"doc(See zcheck.Checker.verify_file.)doc");
 
     m.def(
         "read_depth_map",
         [](const std::string& path, const Camera& camera, std::optional<std::string> quantity,
-           std::optional<std::string> channel, std::optional<double> scale) {
+           std::optional<std::string> channel, const py::object& miss, std::optional<double> scale,
+           std::optional<double> offset) {
             if (quantity && channel) fail("read_depth_map: give quantity or channel, not both");
-            const std::string preferred =
-                channel ? *channel : quantity ? channelNameOf(exportOf(depthQuantityFromName(*quantity))) : std::string();
-            if (scale && !(std::isfinite(*scale) && *scale > 0))
-                fail("scale must be a positive finite number, got " + formatNumber(*scale));
+            DepthMapReading reading = readingOf(miss, scale, offset);
+            reading.channel = channel ? *channel : "";
+            if (quantity) reading.quantityChannel = channelNameOf(exportOf(depthQuantityFromName(*quantity)));
             DepthMapFile file;
             {
                 py::gil_scoped_release release;
-                file = readDepthMap(path, preferred, scale ? *scale : 0.0, camera.width(), camera.height());
+                file = readDepthMap(path, reading, camera.width(), camera.height());
             }
-            if (channel && file.channel != *channel)
-                fail("depth map '" + path + "' has no channel '" + *channel + "' (the first channel is '" + file.channel +
-                     "')");
             return image(file.value, file.width, file.height);
         },
         py::arg("path"), py::arg("camera"), py::kw_only(), py::arg("quantity") = py::none(),
-        py::arg("channel") = py::none(), py::arg("scale") = py::none(),
-        R"doc(See zcheck.read_depth_map.)doc");
+        py::arg("channel") = py::none(), py::arg("miss") = py::none(), py::arg("scale") = py::none(),
+        py::arg("offset") = py::none(), R"doc(See zcheck.read_depth_map.)doc");
 }

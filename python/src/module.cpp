@@ -478,32 +478,22 @@ struct MapInput {
 };
 
 // `depth` (height × width, any float or integer dtype) → values as verify and unproject take
-// them: entries equal to `miss` become NaN (a miss for every quantity); integer maps need
-// `scale` (value = stored / scale, 0 = miss, as for 16-bit PNG files); float maps are divided by
-// `scale` when it is given.
-MapInput mapFromArray(py::handle depth, const Camera& camera, std::optional<double> miss, std::optional<double> scale)
+// them, converted as a file's are (DepthMapReading::depthOf): integer maps need a scale.
+MapInput mapFromArray(py::handle depth, const Camera& camera, const DepthMapReading& reading)
 {
     const py::array a = numericArray(depth, "depth");
     if (a.ndim() != 2 || a.shape(0) != camera.height() || a.shape(1) != camera.width())
         fail("depth must have shape (" + std::to_string(camera.height()) + ", " + std::to_string(camera.width()) +
              ") = (camera.height, camera.width), got " + shapeText(a));
-    if (scale && !(std::isfinite(*scale) && *scale > 0))
-        fail("scale must be a positive finite number, got " + formatNumber(*scale));
     const bool integer = a.dtype().kind() != 'f';
-    if (integer && !scale)
+    if (integer && !(reading.scale > 0))
         fail("depth is an integer array (" + dtypeText(a) +
              "): give scale= (stored value = depth × scale, e.g. 1000 for millimetres; 0 = miss)");
     const DoubleArray d = asDoubles(a);
     MapInput out;
     out.values.assign(d.data(), d.data() + d.size());
-    const bool missGiven = miss && !std::isnan(*miss);
-    for (double& v : out.values) {
-        if ((missGiven && v == *miss) || (integer && v == 0))
-            v = NAN;
-        else if (scale)
-            v /= *scale;
-    }
-    out.quantum = integer ? 1.0 / *scale : 0.0;
+    for (double& v : out.values) v = reading.depthOf(v, integer);
+    out.quantum = integer ? 1.0 / reading.scale : 0.0;
     return out;
 }
 
@@ -930,39 +920,45 @@ Misses hold the quantity's miss value: the clear value (window), NDC z of the fa
         .def(
             "verify",
             [](const Checker& checker, const Camera& camera, py::object depth, const std::string& quantityName,
-               std::optional<double> miss, std::optional<double> scale, bool diagnose, std::optional<int> threads) {
+               const py::object& miss, std::optional<double> scale, std::optional<double> offset, bool diagnose,
+               std::optional<int> threads) {
                 const DepthQuantity quantity = depthQuantityFromName(quantityName);
-                MapInput input = mapFromArray(depth, camera, miss, scale);
+                const DepthMapReading reading = readingOf(miss, scale, offset);
+                MapInput input = mapFromArray(depth, camera, reading);
                 auto r = std::make_unique<PyReport>();
                 r->verify = true;
                 {
                     py::gil_scoped_release release;
                     const auto limit = threadLimit(threads);
                     const DepthMap map{camera.width(), camera.height(), quantity, std::move(input.values), input.quantum};
-                    fillVerification(*r, verifyAndReport(checker, camera, map,
-                                                         {"<array>", quantityName, "", scale ? *scale : 0.0}, diagnose));
+                    fillVerification(*r, verifyAndReport(checker, camera, map, {"<array>", quantityName, "", reading}, diagnose));
                 }
                 return r;
             },
             py::arg("camera"), py::arg("depth"), py::arg("quantity"), py::kw_only(), py::arg("miss") = py::none(),
-            py::arg("scale") = py::none(), py::arg("diagnose") = false, py::arg("threads") = py::none(),
+            py::arg("scale") = py::none(), py::arg("offset") = py::none(), py::arg("diagnose") = false,
+            py::arg("threads") = py::none(),
             R"doc(A depth map rendered elsewhere against the ray route's ground truth: what `zcheck verify` does.
 
 depth:    (camera.height, camera.width) array, row 0 at the top, any float or integer dtype.
 quantity: what it holds: "window", "ndc", "eye-z" or "distance" (required: mixing them up is the
           mistake zcheck exists to catch).
-miss:     a value that marks "no surface" (e.g. 0 or 65535); NaN and +inf are misses anyway,
-          as are the clear value (window, ndc) and values <= 0 (eye-z, distance).
-scale:    stored value = depth x scale. Integer arrays need it (value = stored / scale, 0 = miss,
-          quantum 1/scale, like a 16-bit PNG); float arrays are divided by it.
+miss:     the stored value that marks "no surface" (0, 65535, 1e10, float("inf")), or a comparison
+          as a string (">=1e9", "<=0"); compared with the value as stored, before scale and offset.
+          Without it, 0 is a miss in integer arrays. NaN is always a miss; so are non-finite
+          values, the clear value (window, ndc) and values <= 0 (eye-z, distance).
+scale:    stored value = (depth - offset) x scale. Integer arrays need it (quantum 1/scale, like a
+          16-bit PNG); float arrays are divided by it.
+offset:   added to every depth after scale (default 0).
 diagnose: when inconsistent, also run diagnose() and put it in the report (`--diagnose`).
 Returns a Report whose to_dict() is `zcheck verify --json`'s document (depth_map.file "<array>").)doc")
         .def(
             "diagnose",
             [](const Checker& checker, const Camera& camera, py::object depth, const std::string& quantityName,
-               std::optional<double> miss, std::optional<double> scale, std::optional<int> threads) {
+               const py::object& miss, std::optional<double> scale, std::optional<double> offset,
+               std::optional<int> threads) {
                 const DepthQuantity quantity = depthQuantityFromName(quantityName);
-                MapInput input = mapFromArray(depth, camera, miss, scale);
+                MapInput input = mapFromArray(depth, camera, readingOf(miss, scale, offset));
                 std::vector<Hypothesis> hypotheses;
                 {
                     py::gil_scoped_release release;
@@ -973,7 +969,7 @@ Returns a Report whose to_dict() is `zcheck verify --json`'s document (depth_map
                 return diagnosisList(hypotheses);
             },
             py::arg("camera"), py::arg("depth"), py::arg("quantity"), py::kw_only(), py::arg("miss") = py::none(),
-            py::arg("scale") = py::none(), py::arg("threads") = py::none(),
+            py::arg("scale") = py::none(), py::arg("offset") = py::none(), py::arg("threads") = py::none(),
             R"doc(Every hypothesis of the mistake catalogue that applies to this camera and map, in catalogue
 order, as dicts {hypothesis, variant, explanation, consistent, unexplained}: the consistent ones
 name what explains the map (e.g. "y-flip", "distance-as-eye-z"). Arguments as for verify().)doc")
@@ -986,11 +982,11 @@ name what explains the map (e.g. "y-flip", "distance-as-eye-z"). Arguments as fo
     m.def(
         "unproject",
         [](const Camera& camera, py::object depth, const std::string& quantityName, const std::string& space,
-           int stride, std::optional<double> miss, std::optional<double> scale) {
+           int stride, const py::object& miss, std::optional<double> scale, std::optional<double> offset) {
             if (space != "eye" && space != "world") fail("space must be eye or world, got '" + space + "'");
             if (stride < 1 || stride > 16384) fail("stride must be in 1..16384, got " + std::to_string(stride));
             const DepthQuantity quantity = depthQuantityFromName(quantityName);
-            MapInput input = mapFromArray(depth, camera, miss, scale);
+            MapInput input = mapFromArray(depth, camera, readingOf(miss, scale, offset));
             UnprojectedMap cloud;
             {
                 py::gil_scoped_release release;
@@ -1010,10 +1006,11 @@ name what explains the map (e.g. "y-flip", "distance-as-eye-z"). Arguments as fo
             return py::make_tuple(points, pixels);
         },
         py::arg("camera"), py::arg("depth"), py::arg("quantity"), py::kw_only(), py::arg("space") = "world",
-        py::arg("stride") = 1, py::arg("miss") = py::none(), py::arg("scale") = py::none(),
+        py::arg("stride") = 1, py::arg("miss") = py::none(), py::arg("scale") = py::none(), py::arg("offset") = py::none(),
         R"doc(A whole depth map back to 3-D points: what `zcheck unproject --depth-map` does.
 
-depth:    (camera.height, camera.width) array, row 0 at the top (miss, scale as for Checker.verify).
+depth:    (camera.height, camera.width) array, row 0 at the top (miss, scale, offset as for
+          Checker.verify).
 quantity: "window", "ndc", "eye-z" or "distance".
 space:    "world" or "eye" (the camera's convention's eye axes).
 stride:   every stride-th pixel in x and y from (0, 0).

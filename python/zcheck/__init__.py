@@ -126,28 +126,37 @@ def _files():
     return _zcheck_files
 
 
-def read_depth_map(path, camera, *, quantity=None, channel=None, scale=None):
-    """Read a depth map file as `zcheck verify` and `zcheck unproject` do: EXR, PFM, TIFF, or a 16-bit
-PNG with scale (value = stored / scale, 0 = miss -> NaN), told apart by their first bytes. Returns
-an (H, W) float64 array, row 0 at the top (PFM's bottom-to-top rows are flipped).
+def read_depth_map(path, camera, *, quantity=None, channel=None, scale=None, offset=None, miss=None):
+    """Read a depth map file as `zcheck verify` and `zcheck unproject` do: EXR (multi-layer too), PFM,
+TIFF, or a 16-bit PNG with scale, told apart by their first bytes. Returns an (H, W) float64 array,
+row 0 at the top (PFM's bottom-to-top rows are flipped), NaN where the file marks a miss.
 
 camera:   the map must have the camera's size.
-quantity: read that quantity's channel if the file has it (window, ndc, Z for eye-z, distance),
-          else the first channel, as the command line does; or
-channel:  read exactly this channel (an error if the file has none of that name).
-scale:    stored value = depth x scale; float files are divided by it.
+quantity: prefer that quantity's channel (window, ndc, Z for eye-z, distance) when the file has it;
+channel:  or read exactly this channel (an error listing the channels if there is none of that
+          name). Without either: the only channel, else the one named as depth (Z, depth, *.Z as in
+          Blender's ViewLayer.Depth.Z, *.depth); several or none is an error that lists them.
+scale:    stored value = (depth - offset) x scale; integer files need it (1000 for millimetres,
+          5000 for many RGB-D sets, 256 for KITTI), float files are divided by it.
+offset:   added to every depth after scale (default 0).
+miss:     the stored value that marks "no surface" (0, 65535, 1e10, float("inf"), "nan") or a
+          comparison as a string (">=1e9"), compared before scale and offset. Without it, 0 is a
+          miss in integer files; NaN always is. 8-bit files are refused (8 bits cannot hold depth).
     """
-    return _files().read_depth_map(str(path), camera, quantity=quantity, channel=channel, scale=scale)
+    return _files().read_depth_map(str(path), camera, quantity=quantity, channel=channel, scale=scale, offset=offset,
+                                   miss=miss)
 
 
-def _verify_file(self, camera, path, quantity, *, scale=None, diagnose=False, threads=None):
+def _verify_file(self, camera, path, quantity, *, channel=None, scale=None, offset=None, miss=None, diagnose=False,
+                 threads=None):
     """A depth map file against the ground truth, exactly as `zcheck verify --depth-map PATH --quantity Q
-[--scale S] [--diagnose]` does it: EXR, PFM, TIFF or 16-bit PNG (scale required: value = stored /
-scale, 0 = miss), the quantity's channel (window, ndc, Z, distance) or else the first, and the
-file's storage quantum (1/scale for integer files, binary32's own step for float files). to_dict() equals `zcheck verify --json`'s
-document but for timings.
+[--channel C] [--scale S] [--offset O] [--miss M] [--diagnose]` does it: the file read as
+read_depth_map reads it (channel, scale, offset, miss), with the file's storage quantum (1/scale
+for integer files, binary32's own step for float files). to_dict() equals `zcheck verify --json`'s
+document but for timings; its depth_map entry names the channel read.
     """
-    return _files().verify_file(self, camera, str(path), quantity, scale=scale, diagnose=diagnose, threads=threads)
+    return _files().verify_file(self, camera, str(path), quantity, channel=channel, miss=miss, scale=scale,
+                                offset=offset, diagnose=diagnose, threads=threads)
 
 
 _verify_file.__name__ = _verify_file.__qualname__ = "verify_file"

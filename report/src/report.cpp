@@ -181,8 +181,13 @@ std::string verifyReportJson(const CheckReport& report, const DepthMapSource& so
                              const std::vector<Hypothesis>* diagnosis)
 {
     nlohmann::json document = toJson(report);
-    document["depth_map"] = {{"file", source.file}, {"quantity", source.quantity}, {"channel", source.channel},
-                             {"scale", source.scale}};
+    const DepthMapReading& r = source.reading;
+    document["depth_map"] = {{"file", source.file},
+                             {"quantity", source.quantity},
+                             {"channel", source.channel},
+                             {"scale", r.scale},
+                             {"offset", r.offset},
+                             {"miss", r.miss.given() ? nlohmann::json(r.miss.text()) : nlohmann::json(nullptr)}};
     if (diagnosis) {
         nlohmann::json list = nlohmann::json::array();
         for (const auto& h : *diagnosis)
@@ -202,8 +207,8 @@ VerifyOutcome verifyAndReport(const Checker& checker, const Camera& camera, cons
     out.diagnosed = diagnose && !out.run.comparison.report.consistent();
     if (out.diagnosed) out.diagnosis = checker.diagnose(camera, map);
     out.json = verifyReportJson(out.run.report, source, out.diagnosed ? &out.diagnosis : nullptr);
-    out.summary = formatSummary(out.run.report, "ground truth (Embree) vs depth map '" + source.file + "' (" +
-                                                    source.quantity + ")");
+    out.summary = formatSummary(out.run.report, "ground truth (Embree) vs depth map '" + source.file + "' channel '" +
+                                                    source.channel + "' (" + source.quantity + ")");
     if (out.diagnosed) out.summary += "\n" + formatDiagnosis(out.diagnosis);
     return out;
 }

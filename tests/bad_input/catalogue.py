@@ -768,6 +768,12 @@ map_case("scale-negative", {"m.pfm": GOOD_MAP}, r"--scale.*-1", extra=["--scale"
 map_case("scale-nan", {"m.pfm": GOOD_MAP}, r"--scale.*nan", extra=["--scale", "nan"])
 map_case("scale-0", {"m.pfm": GOOD_MAP}, r"--scale.*\b0\b", extra=["--scale", "0"])
 map_case("scale-inf", {"m.pfm": GOOD_MAP}, r"--scale.*inf", extra=["--scale", "inf"])
+map_case("miss-not-a-number", {"m.pfm": GOOD_MAP}, r"miss value 'abc' is neither a number", extra=["--miss", "abc"])
+map_case("miss-comparison-with-inf", {"m.pfm": GOOD_MAP}, r"miss value '>=inf'", extra=["--miss", ">=inf"])
+map_case("offset-nan", {"m.pfm": GOOD_MAP}, r"--offset.*nan", extra=["--offset", "nan"])
+map_case("channel-absent", {"m.pfm": GOOD_MAP}, rf"'{M}'.*no channel 'Depth\.Z'.*'Y'", extra=["--channel", "Depth.Z"])
+map_case("pfm-rgb-no-depth-channel", {"m.pfm": pfm(64, 48, channels=3)},
+         rf"'{M}'.*none of its 3 channels.*--channel")
 case("depth-map", "verify-depth-map-empty-path", ["verify", "--camera", "cam.json", "--depth-map", "",
                                                   "--quantity", "eye-z"], r"depth.map.*empty", files=dict(MAP_CAM))
 

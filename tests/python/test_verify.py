@@ -17,7 +17,8 @@ def test_ray_render_verifies_and_its_flip_does_not(default_checker, small_camera
     report = default_checker.verify(small_camera, z, "eye-z")
     assert report.consistent and report.unexplained == 0 and report.both_hit > 0.5 * W * H
     doc = report.to_dict()
-    assert doc["depth_map"] == {"file": "<array>", "quantity": "eye-z", "channel": "", "scale": 0.0}
+    assert doc["depth_map"] == {"file": "<array>", "quantity": "eye-z", "channel": "", "scale": 0.0, "offset": 0.0,
+                                "miss": None}
     assert "diagnosis" not in doc
 
     flipped = z[::-1]
@@ -149,3 +150,31 @@ def test_regression_verify_scale_on_a_float_map_kept_the_integer_quantum(tmp_pat
     # The module's file reader takes the same quantum.
     assert default_checker.verify_file(small_camera, str(good), "eye-z", scale=1000).consistent
     assert not default_checker.verify_file(small_camera, str(bad), "eye-z", scale=1000).consistent
+
+
+def test_miss_rules_offset_and_channels(tmp_path, default_checker, small_camera, small_camera_file):
+    z = default_checker.render(small_camera, "eye-z", dtype=np.float64)
+    hit = np.isfinite(z)
+    # "no surface" as 1e10, matched by a comparison
+    far = np.where(hit, z, 1e10)
+    report = default_checker.verify(small_camera, far, "eye-z", miss=">=1e9")
+    assert report.consistent and report.to_dict()["depth_map"]["miss"] == ">=1e9"
+    # a depth-buffer dump where 0 is a real value and 65535 the miss: miss= replaces integer 0
+    mm = np.where(hit, np.round(z * 1000), 65535).astype(np.uint16)
+    assert default_checker.verify(small_camera, mm, "eye-z", scale=1000, miss=65535).consistent
+    assert not default_checker.verify(small_camera, mm, "eye-z", scale=1000).consistent
+    # depth = stored / scale + offset
+    assert default_checker.verify(small_camera, z - 0.5, "eye-z", offset=0.5).consistent
+    assert default_checker.verify(small_camera, (z - 0.5) * 4, "eye-z", scale=4, offset=0.5).consistent
+    with pytest.raises(zcheck.Error, match="miss value 'abc' is neither a number"):
+        default_checker.verify(small_camera, z, "eye-z", miss="abc")
+    with pytest.raises(zcheck.Error, match="offset must be a finite number"):
+        default_checker.verify(small_camera, z, "eye-z", offset=float("inf"))
+    # files: several channels named as depth need the quantity or a channel
+    path = tmp_path / "both.exr"
+    run_cli("export", "--camera", small_camera_file, "--quantity", "eye-z,distance", "-o", path, check_rc=0)
+    with pytest.raises(zcheck.Error, match=r"several of its channels are named as depth \('Z', 'distance'\)"):
+        zcheck.read_depth_map(str(path), small_camera)
+    assert default_checker.verify_file(small_camera, str(path), "eye-z").to_dict()["depth_map"]["channel"] == "Z"
+    wrong = default_checker.verify_file(small_camera, str(path), "eye-z", channel="distance")
+    assert not wrong.consistent and wrong.to_dict()["depth_map"]["channel"] == "distance"

@@ -4,6 +4,7 @@
 // encoded by zcheck and written with writeFileBytes; EXR and TIFF by OpenImageIO); a
 // command makes its outputs atomic with OutputFiles (atomic_file.h). Row 0 of every image is
 // the top row as seen.
+#include "zcheck/depth_map_reading.h"
 #include "zcheck/quantity.h"
 
 #include <cstdint>
@@ -22,20 +23,19 @@ void writeExr(const std::string& path, int width, int height, const std::vector<
 struct DepthMapFile {
     int width = 0, height = 0;
     std::string channel;          // the channel read
-    std::vector<double> value;    // width·height; NaN where an integer file stores 0 (a miss)
+    std::vector<double> value;    // width·height; NaN where the file marks a miss
     double valueQuantum = 0;      // the storage step of `value`: 1/scale for integer files, 0 for
                                   // float files (binary32: the step depends on the value)
 };
-// The channel named `preferredChannel` if there is one, else the first. Integer
-// files (16-bit PNG) need `scale`: value = stored / scale, 0 = miss. Float files are divided
-// by `scale` when it is given (0: not given; otherwise it must be positive and finite).
+
+// Reads a map as `reading` says (depth_map_reading.h): its channel, scale, offset and misses.
 // The file must be a regular file of at most 2 GiB, and its declared size must be
 // expectedWidth × expectedHeight, checked before any pixel is allocated (for EXR after
-// walking its header, whose attribute sizes must fit in the file). PFM is read by zcheck
-// itself; EXR, TIFF and PNG by OpenImageIO, each only by its own reader (unknown bytes are
-// never offered to OpenImageIO's other plugins). Throws Error naming the file and the rule.
-DepthMapFile readDepthMap(const std::string& path, const std::string& preferredChannel, double scale, int expectedWidth,
-                          int expectedHeight);
+// walking its header, whose attribute sizes must fit in the file). Integer files of 8 bits
+// are refused (8 bits cannot hold depth). PFM is read by zcheck itself; EXR, TIFF and PNG by
+// OpenImageIO, each only by its own reader (unknown bytes are never offered to OpenImageIO's
+// other plugins). Throws Error naming the file and the rule.
+DepthMapFile readDepthMap(const std::string& path, const DepthMapReading& reading, int expectedWidth, int expectedHeight);
 
 // Writes exported quantities by the file's extension:
 //   .exr  any quantities, one channel each (names in export.h), float32 (id: uint32), ZIP

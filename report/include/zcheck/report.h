@@ -4,6 +4,7 @@
 // one line; invalid UTF-8 in strings (file names) is replaced, never thrown over. The keys
 // are those the README documents for `--json`.
 #include "zcheck/checker.h"
+#include "zcheck/depth_map_reading.h"
 #include "zcheck/precision.h"
 #include "zcheck/suite.h"
 
@@ -20,8 +21,8 @@ std::string formatSummary(const CheckReport& report,
 
 // Where a verified map came from, for its report.
 struct DepthMapSource {
-    std::string file, quantity, channel;
-    double scale = 0;  // 0: not given
+    std::string file, quantity, channel;  // channel: the one read
+    DepthMapReading reading;               // as asked (scale 0: not given)
 };
 // `zcheck verify --json`: the check report plus the map's source and, when given, the diagnosis.
 std::string verifyReportJson(const CheckReport& report, const DepthMapSource& source,

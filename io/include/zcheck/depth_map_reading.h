@@ -1,0 +1,60 @@
+#pragma once
+// How a depth map file is to be read — which channel, what scale and offset, which stored
+// values mean "no surface" — decided here, in zcheck::io, so that command lines and the
+// Python module can check the options without loading the image library (image_io.h reads).
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace zcheck {
+
+// The stored values that mark "no surface" (renderers use 0, 65535, 1e10, NaN or +inf),
+// compared with the value as the file stores it, before scale and offset. Written as a number
+// ("0", "65535", "1e10", "nan", "inf") for equality, or as a comparison (">=1e9", ">1e9",
+// "<=0", "<0").
+struct MissRule {
+    enum class Test : std::uint8_t { None, Equal, IsNan, Greater, GreaterEqual, Less, LessEqual };
+    Test test = Test::None;
+    double value = 0;
+
+    // Throws Error naming the text and the accepted forms.
+    static MissRule parse(const std::string& text);
+    bool given() const { return test != Test::None; }
+    bool matches(double stored) const;
+    std::string text() const { return written_; }  // as given to parse ("" when not given)
+
+private:
+    std::string written_;
+};
+
+// How to read a depth map. The depth of a stored value v is v / scale + offset (scale 1 and
+// offset 0 when not given); integer files need a scale.
+struct DepthMapReading {
+    std::string channel;          // the channel to read; "" chooses one (chooseDepthChannel)
+    std::string quantityChannel;  // zcheck's own name for the declared quantity's channel
+                                  // (export.h), preferred when several channels name depth
+    double scale = 0;             // 0: not given
+    double offset = 0;
+    MissRule miss;                // not given: integer files' 0 is a miss; NaN always is
+
+    // The depth of a value as the file stores it: NaN for a miss, else stored / scale + offset.
+    double depthOf(double stored, bool integerFile) const
+    {
+        if (std::isnan(stored) || (miss.given() ? miss.matches(stored) : integerFile && stored == 0)) return NAN;
+        return (scale > 0 ? stored / scale : stored) + offset;
+    }
+};
+
+// The channel of a file with channels `names` that holds depth: `wanted` when given (Error
+// listing the channels when there is none of that name); the only channel; `quantityChannel`
+// when present; else the one channel named as depth — Z, depth, a layer's *.Z or *.depth
+// (Blender's ViewLayer.Depth.Z), or zcheck's window, ndc, distance. Several such channels, or
+// none, is an Error that lists them and asks for --channel.
+std::string chooseDepthChannel(const std::string& path, const std::vector<std::string>& names, const std::string& wanted,
+                               const std::string& quantityChannel);
+
+// Throws Error "cannot read depth map '<path>': <why>".
+[[noreturn]] void refuseDepthMap(const std::string& path, const std::string& why);
+
+}  // namespace zcheck
