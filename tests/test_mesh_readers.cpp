@@ -213,3 +213,28 @@ TEST_CASE("PLY faces are fans and strips restart their alternating winding at ea
                                              vertices + "2 0 1\n"),
                         Catch::Contains("face 0: a face needs at least 3 vertices, this one has 2"));
 }
+
+TEST_CASE("polygons of more than 3 corners: non-planar ones are counted and measured for the warning", "[mesh]")
+{
+    // A saddle quad: corners at heights 0, h, 0, h. Newell's normal is +z, the centroid at h/2,
+    // so every corner is h/2 off the plane; the size is the diagonal √2: h/(2√2) relative.
+    const double h = 0.1, expected = h / (2 * std::sqrt(2.0));
+    const std::string saddle = "v 0 0 0\nv 1 0 0.1\nv 1 1 0\nv 0 1 0.1\n";
+    const Scene quad = readObj("q.obj", saddle + "f 1 2 3 4\n");
+    REQUIRE(quad.planarity.polygons == 1);
+    REQUIRE(quad.planarity.nonPlanar == 1);
+    REQUIRE(quad.planarity.worst == Approx(expected).epsilon(1e-6));
+    REQUIRE_THAT(quad.planarity.warning("q.obj"),
+                 Catch::Contains("mesh 'q.obj': 1 of its 1 polygons of more than 3 corners are not planar") &&
+                     Catch::Contains("3.54 %") && Catch::Contains("triangulate the mesh before rendering"));
+    // The same as a PLY face; triangles and planar polygons are not counted or are planar.
+    const std::string header = "element vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+                               "element face 1\nproperty list uchar int vertex_indices\n";
+    const Scene plyQuad = readPly("q.ply", ply("ascii", header) + "0 0 0\n1 0 0.1\n1 1 0\n0 1 0.1\n4 0 1 2 3\n");
+    REQUIRE(plyQuad.planarity.nonPlanar == 1);
+    REQUIRE(plyQuad.planarity.worst == Approx(expected).epsilon(1e-6));
+    const Scene flat = readObj("f.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 1.5 0\nf 1 2 3 4 5\nf 1 2 3\n");
+    REQUIRE(flat.planarity.polygons == 1);
+    REQUIRE(flat.planarity.nonPlanar == 0);
+    REQUIRE(flat.planarity.warning("f.obj").empty());
+}

@@ -41,6 +41,7 @@ CheckResult Checker::check(const Camera& camera, const CheckOptions& options) co
     run.report.timings.traceMs = run.ray.renderMilliseconds;
     run.report.timings.rasterMs = run.raster.renderMilliseconds;
     run.report.scene = scene_.name;
+    if (const std::string w = scene_.planarity.warning(scene_.name); !w.empty()) run.report.warnings.push_back(w);
     run.report.triangles = scene_.triangleCount();
     run.report.camera = camera.spec();
     run.report.tolerance = options.tolerance;

@@ -155,6 +155,7 @@ VerifyResult verifyAgainst(const Scene& scene, const Camera& camera, const Depth
     run.report.timings.compareMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     run.report.timings.traceMs = run.truth.renderMilliseconds;
     run.report.scene = scene.name;
+    if (const std::string w = scene.planarity.warning(scene.name); !w.empty()) run.report.warnings.push_back(w);
     run.report.triangles = scene.triangleCount();
     run.report.camera = camera.spec();
     run.report.comparison = run.comparison.report;

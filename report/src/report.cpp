@@ -56,6 +56,7 @@ nlohmann::json toJson(const CheckReport& report)
         {"zcheck_version", kVersion},
         {"scene", report.scene},
         {"triangles", report.triangles},
+        {"warnings", report.warnings},
         {"camera", toJson(report.camera)},
         {"tolerance",
          {{"subpixel_bits", report.tolerance.subpixelBits},
@@ -107,6 +108,7 @@ std::string formatSummary(const CheckReport& report, const std::string& comparin
     char line[256];
     out << "zcheck " << kVersion << " — " << comparing << "\n";
     out << "scene      " << report.scene << "  (" << report.triangles << " triangles)\n";
+    for (const std::string& warning : report.warnings) out << "warning    " << warning << "\n";
     std::snprintf(line, sizeof line, "camera     %s, %s, %dx%d, near %g, far %g\n", cam.convention.name.c_str(),
                   toString(cam.projection.type).c_str(), cam.width, cam.height, cam.projection.near,
                   cam.projection.far);

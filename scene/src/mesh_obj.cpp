@@ -56,6 +56,8 @@ public:
                     throw Error("cannot load mesh '" + path_ + "': malformed OBJ: a face refers to vertex " +
                                 std::to_string(t[k] + 1) + " but the file defines " +
                                 std::to_string(scene_.positions.size()));
+        for (const auto& [firstTriangle, corners] : fans_)
+            scene_.planarity.addFan(scene_.positions, scene_.triangles, firstTriangle, corners);
         return std::move(scene_);
     }
 
@@ -147,6 +149,7 @@ private:
         std::size_t first = 0;
         if (corners_.size() == 4) first = reflexCorner();
         const std::size_t n = corners_.size();
+        if (n > 3) fans_.emplace_back(scene_.triangles.size(), n);
         for (std::size_t i = 1; i + 1 < n; ++i)
             scene_.triangles.push_back({corners_[first], corners_[(first + i) % n], corners_[(first + i + 1) % n]});
     }
@@ -172,6 +175,7 @@ private:
     std::string_view bytes_;
     std::size_t lineNumber_ = 0;
     std::vector<std::uint32_t> corners_;
+    std::vector<std::pair<std::size_t, std::size_t>> fans_;  // (first triangle, corners) of polygons of > 3 corners
     Scene scene_;
 };
 

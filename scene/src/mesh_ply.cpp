@@ -70,6 +70,8 @@ public:
                 if (t[k] >= scene_.positions.size())
                     fail("a face refers to vertex " + std::to_string(t[k]) + " but the file has " +
                          std::to_string(scene_.positions.size()) + " vertices");
+        for (const auto& [firstTriangle, corners] : fans_)
+            scene_.planarity.addFan(scene_.positions, scene_.triangles, firstTriangle, corners);
         return std::move(scene_);
     }
 
@@ -317,6 +319,8 @@ private:
                 }
                 if (property.role == Role::Indices && element.kind == ElementKind::Face && length < 3)
                     failItem(element, item, "a face needs at least 3 vertices, this one has " + formatNumber(length));
+                if (property.role == Role::Indices && element.kind == ElementKind::Face && length > 3)
+                    fans_.emplace_back(scene_.triangles.size() - (std::size_t(length) - 2), std::size_t(length));
             }
             if (ascii_) {
                 while (line.at < line.end && (*line.at == ' ' || *line.at == '\t' || *line.at == '\r')) ++line.at;
@@ -374,6 +378,7 @@ private:
     std::vector<Element> elements_;
     bool ascii_ = false, bigEndian_ = false;
     std::uint64_t stripJoins_ = 0;  // strip triangles skipped for repeating an index
+    std::vector<std::pair<std::size_t, std::size_t>> fans_;  // (first triangle, corners) of faces of > 3 corners
     Scene scene_;
 };
 

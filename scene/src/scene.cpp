@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace zcheck {
 
@@ -26,6 +27,49 @@ void Scene::append(const std::vector<glm::vec3>& morePositions, const std::vecto
     const auto offset = static_cast<std::uint32_t>(positions.size());
     positions.insert(positions.end(), morePositions.begin(), morePositions.end());
     for (const auto& t : moreTriangles) triangles.push_back(t + glm::uvec3(offset));
+}
+
+void PolygonPlanarity::addFan(const std::vector<glm::vec3>& positions, const std::vector<glm::uvec3>& triangles,
+                              std::size_t firstTriangle, std::size_t cornerCount)
+{
+    if (cornerCount <= 3) return;
+    std::vector<glm::dvec3> corners;
+    const glm::uvec3& first = triangles[firstTriangle];
+    for (int k = 0; k < 3; ++k) corners.emplace_back(positions[first[k]]);
+    for (std::size_t t = firstTriangle + 1; t < firstTriangle + cornerCount - 2; ++t)
+        corners.emplace_back(positions[triangles[t][2]]);
+    ++polygons;
+    // Newell's normal (robust for any simple polygon) through the centroid.
+    glm::dvec3 normal(0.0), centroid(0.0);
+    for (std::size_t k = 0; k < corners.size(); ++k) {
+        const glm::dvec3& a = corners[k];
+        const glm::dvec3& b = corners[(k + 1) % corners.size()];
+        normal += glm::dvec3((a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y));
+        centroid += a;
+    }
+    centroid /= double(corners.size());
+    double size = 0, off = 0;
+    for (const glm::dvec3& a : corners)
+        for (const glm::dvec3& b : corners) size = std::max(size, glm::length(a - b));
+    if (!(glm::length(normal) > 0) || !(size > 0)) return;  // degenerate: no plane to be off
+    normal = glm::normalize(normal);
+    for (const glm::dvec3& a : corners) off = std::max(off, std::abs(glm::dot(normal, a - centroid)));
+    const double relative = off / size;
+    if (relative > kTolerance) {
+        ++nonPlanar;
+        worst = std::max(worst, relative);
+    }
+}
+
+std::string PolygonPlanarity::warning(const std::string& mesh) const
+{
+    if (nonPlanar == 0) return "";
+    char worstText[32];
+    std::snprintf(worstText, sizeof worstText, "%.3g", 100 * worst);
+    return "mesh '" + mesh + "': " + std::to_string(nonPlanar) + " of its " + std::to_string(polygons) +
+           " polygons of more than 3 corners are not planar (corners up to " + worstText +
+           " % of the polygon's size off its plane); renderers split such polygons along different diagonals, so "
+           "their depth depends on the split: triangulate the mesh before rendering it";
 }
 
 void validateScene(const Scene& scene)

@@ -55,6 +55,7 @@ struct CheckReport {
     ToleranceModel tolerance;
     ComparisonReport comparison;
     Timings timings;
+    std::vector<std::string> warnings;  // about the inputs (PolygonPlanarity::warning), in the report
 };
 
 struct CheckResult {

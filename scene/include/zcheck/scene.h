@@ -14,11 +14,31 @@
 
 namespace zcheck {
 
+// How far the polygons of more than 3 corners that a mesh file held lie from one plane. A
+// reader splits such a polygon into a fan; a renderer may split it along other diagonals, and
+// where the polygon is not planar its depth then depends on the split.
+struct PolygonPlanarity {
+    // Corners off the polygon's plane by more than this fraction of its size count as non-planar
+    // (binary32 positions alone stay near 1e-7).
+    static constexpr double kTolerance = 1e-5;
+    std::uint64_t polygons = 0;   // polygons of more than 3 corners
+    std::uint64_t nonPlanar = 0;  // of those, not planar
+    double worst = 0;             // the largest corner distance from the plane, relative to the polygon's size
+
+    // A polygon split by a reader into the fan of `cornerCount` − 2 consecutive triangles of
+    // `scene` from `firstTriangle` (each sharing its first corner with the first triangle).
+    void addFan(const std::vector<glm::vec3>& positions, const std::vector<glm::uvec3>& triangles,
+                std::size_t firstTriangle, std::size_t cornerCount);
+    // "" when every polygon is planar; else one sentence naming `mesh`, the count and the worst.
+    std::string warning(const std::string& mesh) const;
+};
+
 struct Scene {
     std::string name;                     // as addressed: "builtin:default", a file path
     std::vector<glm::vec3> positions;     // world space
     std::vector<glm::uvec3> triangles;    // indices into positions; the index is the primitive id
     CameraSpec defaultCamera;             // used when the user gives no camera file
+    PolygonPlanarity planarity;           // of the file's polygons (mesh files; none built in)
 
     std::size_t triangleCount() const { return triangles.size(); }
     glm::dvec3 boundsMin() const;
