@@ -6,6 +6,8 @@
 
 #include "zcheck/inverse_projection.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <chrono>
 #include <unordered_map>
@@ -59,7 +61,9 @@ RenderResult renderResultFromMap(const Scene& scene, const Camera& camera, const
     out.primitiveId.assign(std::size_t(W) * H, kNoPrimitive);
     quantum.assign(std::size_t(W) * H, 0.0);
     const PixelJudge judge(scene, camera);
-    for (int row = 0; row < H; ++row)
+    // Rows in parallel: each pixel's choice reads only the truth and the map.
+    tbb::parallel_for(0, H, [&](int row) {
+        std::vector<std::uint32_t> considered, seen;  // per pixel, reused along the row
         for (int col = 0; col < W; ++col) {
             const std::size_t i = std::size_t(row) * W + col;
             const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
@@ -99,7 +103,7 @@ RenderResult renderResultFromMap(const Scene& scene, const Camera& camera, const
             std::uint32_t primitive = here != kNoPrimitive ? here : kUnknownPrimitive;
             double closest = INFINITY;
             const EyePlaneRay ray = worldEyePlaneRayThroughWindow(camera, pWindow);
-            std::vector<std::uint32_t> considered;
+            considered.clear();
             auto consider = [&](std::uint32_t candidate) {
                 if (candidate == here || std::find(considered.begin(), considered.end(), candidate) != considered.end())
                     return;
@@ -123,7 +127,7 @@ RenderResult renderResultFromMap(const Scene& scene, const Camera& camera, const
                                            : judge.nearEdge(candidate, pWindow) || judge.atClipPlane(candidate, pWindow);
                 if (explained) closest = gap, primitive = candidate;
             };
-            std::vector<std::uint32_t> seen;
+            seen.clear();
             for (int dy = -2; dy <= 2; ++dy)
                 for (int dx = -2; dx <= 2; ++dx) {
                     const int c = col + dx, r = row + dy;
@@ -135,6 +139,7 @@ RenderResult renderResultFromMap(const Scene& scene, const Camera& camera, const
                 }
             out.primitiveId[i] = primitive;
         }
+    });
     return out;
 }
 
