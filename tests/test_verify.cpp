@@ -237,3 +237,41 @@ TEST_CASE("the comparison accepts a depth exactly at its tolerance and rejects t
                               bound) == PixelClass::DepthError);
     }
 }
+
+TEST_CASE("every swap of the four quantities is diagnosed by its own name", "[verify][diagnose]")
+{
+    // A map of one quantity declared as another: the hypothesis "<delivered>-as-<declared>"
+    // explains it (window read as eye-z or distance had none before), in two conventions whose
+    // window and NDC ranges differ.
+    Setup s;
+    s.spec.width = 96, s.spec.height = 72;
+    const Checker checker(s.scene);
+    const std::pair<ExportQuantity, DepthQuantity> quantities[] = {{ExportQuantity::Window, DepthQuantity::Window},
+                                                                   {ExportQuantity::Ndc, DepthQuantity::Ndc},
+                                                                   {ExportQuantity::EyeZ, DepthQuantity::EyeZ},
+                                                                   {ExportQuantity::Distance, DepthQuantity::Distance}};
+    for (const std::string convention : {"opengl", "direct3d"}) {
+        CameraSpec spec = s.spec;
+        spec.convention = Convention::preset(convention);
+        const Camera camera(spec);
+        const RenderResult drawn = checker.renderRaster(camera);
+        for (const auto& [delivered, deliveredQuantity] : quantities)
+            for (const auto& [unused, declared] : quantities) {
+                if (deliveredQuantity == declared) continue;
+                const QuantityImage image = quantityImage(s.scene, camera, drawn, delivered);
+                DepthMap map{image.width, image.height, declared, image.value, 0.0};
+                for (double& v : map.value) v = double(float(v));  // as stored in a float32 file
+                const std::string name = toString(deliveredQuantity) + "-as-" + toString(declared);
+                INFO(convention << ": " << name);
+                if (checker.verify(camera, map).comparison.report.consistent()) {
+                    // No mistake here: Direct3D's window depth is its NDC z.
+                    REQUIRE((convention == "direct3d" && name.find("window") != std::string::npos &&
+                             name.find("ndc") != std::string::npos));
+                    continue;
+                }
+                bool named = false;
+                for (const Hypothesis& h : checker.diagnose(camera, map)) named = named || (h.consistent && h.name == name);
+                REQUIRE(named);
+            }
+    }
+}

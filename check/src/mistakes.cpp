@@ -282,6 +282,19 @@ std::vector<Mistake> buildCatalogue()
                     DepthQuantity::Window, DepthQuantity::EyeZ, "consistent if read as eye-z (linear, scene units) instead of window depth");
     quantityMistake("distance-as-window", "ray distance delivered where window depth was declared", DepthQuantity::Window,
                     DepthQuantity::Distance, "consistent if read as ray distance instead of window depth");
+    // Every other swap of the four quantities, by the same rule: "<delivered>-as-<declared>".
+    const std::pair<DepthQuantity, const char*> quantities[] = {{DepthQuantity::Window, "window depth"},
+                                                                {DepthQuantity::Ndc, "NDC z"},
+                                                                {DepthQuantity::EyeZ, "eye-z (planar depth)"},
+                                                                {DepthQuantity::Distance, "ray distance"}};
+    for (const auto& [declared, declaredText] : quantities)
+        for (const auto& [actual, actualText] : quantities) {
+            const std::string name = toString(actual) + "-as-" + toString(declared);
+            const bool named = std::any_of(all.begin(), all.end(), [&](const Mistake& m) { return m.name == name; });
+            if (actual == declared || named) continue;
+            quantityMistake(name, std::string(actualText) + " delivered where " + declaredText + " was declared", declared,
+                            actual, std::string("consistent if read as ") + actualText + " instead of " + declaredText);
+        }
 
     // The rasterizer's own mistakes: nothing to re-read in a finished map.
     auto rasterOnly = [&](std::string name, std::string description, std::function<bool(const Camera&, RasterFaults&)> set) {
