@@ -56,6 +56,20 @@ std::string tiffWith(const std::string& name, OIIO::TypeDesc type, const std::ve
 
 DepthMapFile read(const std::string& path, const DepthMapReading& reading = {}) { return readDepthMap(path, reading, W, H); }
 
+DepthMapReading channelNamed(const std::string& channel)
+{
+    DepthMapReading r;
+    r.channel = channel;
+    return r;
+}
+
+DepthMapReading declaredChannel(const std::string& quantityChannel)  // zcheck's name for the declared quantity
+{
+    DepthMapReading r;
+    r.quantityChannel = quantityChannel;
+    return r;
+}
+
 bool same(double read, double expected) { return (std::isnan(read) && std::isnan(expected)) || read == expected; }
 
 void requireValues(const DepthMapFile& map, const std::vector<double>& expected)
@@ -83,14 +97,11 @@ TEST_CASE("regression: a multi-layer EXR was read from its first channel, the co
     REQUIRE(map.channel == "ViewLayer.Depth.Z");
     requireValues(map, {1.5, 2.5, 3.5, 4.5, 5.5, 6.5});
     // The declared quantity's own channel name does not mislead the choice when it is absent.
-    DepthMapReading asWindow;
-    asWindow.quantityChannel = "window";
-    REQUIRE(read(path, asWindow).channel == "ViewLayer.Depth.Z");
+    REQUIRE(read(path, declaredChannel("window")).channel == "ViewLayer.Depth.Z");
     // --channel reads exactly the one named.
-    DepthMapReading colour;
-    colour.channel = "ViewLayer.Combined.G";
-    REQUIRE(read(path, colour).channel == "ViewLayer.Combined.G");
-    requireValues(read(path, colour), {0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.6f});
+    const DepthMapFile colour = read(path, channelNamed("ViewLayer.Combined.G"));
+    REQUIRE(colour.channel == "ViewLayer.Combined.G");
+    requireValues(colour, {0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.6f});
 }
 
 TEST_CASE("channels: the only one, the quantity's own, one named as depth; else refused with the list", "[depthmap]")
@@ -98,12 +109,8 @@ TEST_CASE("channels: the only one, the quantity's own, one named as depth; else 
     REQUIRE(read(exrWith("one.exr", {"Y"}, {kDepth})).channel == "Y");
     // zcheck's own export of several quantities: the declared quantity's channel.
     const std::string zcheckExport = exrWith("ours.exr", {"window", "Z", "distance"}, {kColour, kDepth, kDepth});
-    DepthMapReading eyeZ;
-    eyeZ.quantityChannel = "Z";
-    REQUIRE(read(zcheckExport, eyeZ).channel == "Z");
-    DepthMapReading window;
-    window.quantityChannel = "window";
-    REQUIRE(read(zcheckExport, window).channel == "window");
+    REQUIRE(read(zcheckExport, declaredChannel("Z")).channel == "Z");
+    REQUIRE(read(zcheckExport, declaredChannel("window")).channel == "window");
     // Names as other tools write them.
     REQUIRE(read(exrWith("depth.exr", {"R", "G", "B", "depth"}, {kColour, kColour, kColour, kDepth})).channel == "depth");
     REQUIRE(read(exrWith("layer.exr", {"rgba.R", "pass.Depth"}, {kColour, kDepth})).channel == "pass.Depth");
@@ -114,9 +121,7 @@ TEST_CASE("channels: the only one, the quantity's own, one named as depth; else 
     const std::string two = exrWith("two.exr", {"a.Z", "b.depth", "c.R"}, {kDepth, kDepth, kColour});
     REQUIRE_THROWS_WITH(read(two), Catch::Contains("several of its channels are named as depth ('a.Z', 'b.depth')") &&
                                        Catch::Contains("--channel"));
-    DepthMapReading missing;
-    missing.channel = "Depth.Z";
-    REQUIRE_THROWS_WITH(read(rgb, missing), Catch::Contains("it has no channel 'Depth.Z'; its channels are 'R', 'G', 'B'"));
+    REQUIRE_THROWS_WITH(read(rgb, channelNamed("Depth.Z")), Catch::Contains("it has no channel 'Depth.Z'; its channels are 'R', 'G', 'B'"));
 }
 
 TEST_CASE("a 3-channel PFM is refused without --channel and read from the channel named", "[depthmap]")
@@ -131,10 +136,8 @@ TEST_CASE("a 3-channel PFM is refused without --channel and read from the channe
         }
     }
     REQUIRE_THROWS_WITH(read(path), Catch::Contains("none of its 3 channels ('R', 'G', 'B')"));
-    DepthMapReading green;
-    green.channel = "G";
     // PFM rows run bottom to top: the file's first row (0, 1, 2) is the picture's last.
-    requireValues(read(path, green), {3, 4, 5, 0, 1, 2});
+    requireValues(read(path, channelNamed("G")), {3, 4, 5, 0, 1, 2});
 }
 
 TEST_CASE("miss values: a number, nan, inf or a comparison, matched on the stored value before scale", "[depthmap]")
