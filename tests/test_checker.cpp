@@ -76,7 +76,7 @@ TEST_CASE("one mistake catalogue: unique names, each injectable or re-readable, 
         both += mistake.inject && mistake.reread ? 1 : 0;
     }
     REQUIRE(both >= 12);
-    REQUIRE(injectableMistakes().size() == 17);
+    REQUIRE(injectableMistakes().size() == 19);
     // The names the suite and the diagnosis used to spell differently are one name now.
     for (const char* gone : {"vertical-flip", "other-handed", "other-ndc-range"}) REQUIRE(names.count(gone) == 0);
     for (const char* kept : {"y-flip", "handedness", "ndc-range"}) REQUIRE(names.count(kept) == 1);
@@ -95,6 +95,10 @@ TEST_CASE("a map rendered under a mistake is diagnosed as that mistake, for ever
         if (!mistake.inject || !mistake.reread || !mistake.inject(camera, faults)) continue;
         // The mistaken route stands in for a renderer that made the mistake.
         const RenderResult wrong = checker.render(camera, mistake.route, faults);
+        // A map with no surface at all is no evidence for one mistake over another (a view
+        // turned away, a transposed projection): the diagnosis names none (test below).
+        if (std::none_of(wrong.primitiveId.begin(), wrong.primitiveId.end(), [](std::uint32_t id) { return id != kNoPrimitive; }))
+            continue;
         std::vector<double> value = wrong.windowDepth.value;
         for (double& v : value) v = double(float(v));  // as a float32 file stores it
         const DepthMap map{camera.width(), camera.height(), DepthQuantity::Window, value, 0};
@@ -192,5 +196,49 @@ TEST_CASE("judges of different cameras on one thread never share a slope", "[che
             REQUIRE(a.slope(t) == expected(wideCamera, t));
             REQUIRE(b.slope(t) == expected(narrowCamera, t));
         }
+    }
+}
+
+TEST_CASE("camera-pose mistakes: an inverted extrinsic and OpenCV axes used as OpenGL's are diagnosed by name", "[checker][mistakes][diagnose]")
+{
+    // builtin:near-crossing has geometry all around its eye, so a camera turned 180° about its
+    // x axis, or placed by the inverse of its view, still sees surfaces.
+    const Checker checker(builtinScene("builtin:near-crossing"));
+    for (const std::string convention : {"opengl", "opencv"}) {
+        CameraSpec spec = smallCamera(checker.scene());
+        spec.convention = Convention::preset(convention);
+        spec.view.eye = {0.3, 0.4, 0.2};  // off the origin, so that the inverse view is another pose
+        const Camera camera(spec);
+        for (const char* name : {"inverted-extrinsic", "opencv-opengl-axes"}) {
+            INFO(convention << ": " << name);
+            const Mistake& mistake =
+                *std::find_if(mistakeCatalogue().begin(), mistakeCatalogue().end(), [&](const Mistake& m) { return m.name == name; });
+            RouteFaults faults;
+            REQUIRE(mistake.inject(camera, faults));
+            const RenderResult wrong = checker.render(camera, mistake.route, faults);
+            std::vector<double> value = wrong.windowDepth.value;
+            for (double& v : value) v = double(float(v));
+            const DepthMap map{camera.width(), camera.height(), DepthQuantity::Window, value, 0};
+            const auto hits = std::count_if(wrong.primitiveId.begin(), wrong.primitiveId.end(),
+                                            [](std::uint32_t id) { return id != kNoPrimitive; });
+            REQUIRE(hits > camera.width() * camera.height() / 10);
+            REQUIRE_FALSE(checker.verify(camera, map).comparison.report.consistent());
+            std::vector<std::string> consistent;
+            for (const Hypothesis& h : checker.diagnose(camera, map))
+                if (h.consistent) consistent.push_back(h.name);
+            REQUIRE(std::find(consistent.begin(), consistent.end(), name) != consistent.end());
+        }
+    }
+}
+
+TEST_CASE("a map with no surface is explained by no hypothesis (a view that sees nothing explains nothing)", "[checker][diagnose]")
+{
+    const Checker checker(builtinScene("builtin:default"));
+    const Camera camera(smallCamera(checker.scene()));
+    const DepthMap empty{camera.width(), camera.height(), DepthQuantity::Window,
+                         std::vector<double>(std::size_t(camera.width()) * camera.height(), camera.clearDepth()), 0};
+    for (const Hypothesis& h : checker.diagnose(camera, empty)) {
+        INFO(h.name << " " << h.variant);
+        REQUIRE_FALSE(h.consistent);
     }
 }

@@ -36,6 +36,41 @@ Mistake wrongProjection(std::string name, std::string description, std::string e
     return mistake;
 }
 
+// A view (extrinsic) built wrongly: the raster route draws through it (inject), and the truth
+// is rendered through a camera holding it as its raw view matrix (reread). `build` returns
+// false where the mistake has no meaning or changes nothing.
+Mistake wrongView(std::string name, std::string description, std::string explanation,
+                  std::function<bool(const Camera&, glm::dmat4& eyeFromWorld)> build)
+{
+    Mistake mistake{std::move(name), std::move(description), Route::Raster, {}, {}};
+    mistake.inject = [build](const Camera& camera, RouteFaults& faults) {
+        glm::dmat4 eyeFromWorld;
+        if (!build(camera, eyeFromWorld)) return false;
+        faults.raster.overrideClipFromWorld = true;
+        faults.raster.clipFromWorld = camera.clipFromEye * eyeFromWorld;
+        return true;
+    };
+    mistake.reread = [build, explanation](const Camera& camera, const DepthMap&) {
+        glm::dmat4 eyeFromWorld;
+        if (!build(camera, eyeFromWorld)) return Rereadings{};
+        CameraSpec spec = camera.spec();
+        spec.view.hasMatrix = true;
+        spec.view.eyeFromWorld = eyeFromWorld;
+        return Rereadings{{"", explanation, spec, {}, {}}};
+    };
+    return mistake;
+}
+
+// Whether two rigid transforms differ by more than rounding.
+bool differ(const glm::dmat4& a, const glm::dmat4& b)
+{
+    double scale = 1, difference = 0;
+    for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 4; ++r)
+            scale = std::max(scale, std::abs(a[c][r])), difference = std::max(difference, std::abs(a[c][r] - b[c][r]));
+    return difference > 1e-9 * scale;
+}
+
 // A sampling mistake of the renderer: the ray route samples wrongly (inject), and the truth is
 // rendered with the same wrong sampling (reread).
 Mistake wrongSampling(std::string name, std::string description, std::string explanation, RayFaults faults)
@@ -150,6 +185,25 @@ std::vector<Mistake> buildCatalogue()
         return out;
     };
     all.push_back(half);
+
+    // The view: the camera-pose mistakes public issue trackers show most.
+    all.push_back(wrongView("inverted-extrinsic",
+                            "the view inverted: world-from-camera used as camera-from-world (or the reverse)",
+                            "consistent if the view matrix is inverted (camera-to-world used as world-to-camera)",
+                            [](const Camera& camera, glm::dmat4& m) {
+                                m = camera.worldFromEye;
+                                return differ(m, camera.eyeFromWorld);
+                            }));
+    all.push_back(wrongView("opencv-opengl-axes",
+                            "an OpenCV camera pose used as an OpenGL one (or the reverse): turned 180° about its x axis",
+                            "consistent if the camera is turned 180° about its x axis (OpenCV's y down, z forward "
+                            "vs OpenGL's y up, z back)",
+                            [](const Camera& camera, glm::dmat4& m) {
+                                glm::dmat4 turn(1.0);
+                                turn[1][1] = turn[2][2] = -1;
+                                m = turn * camera.eyeFromWorld;
+                                return true;
+                            }));
 
     // The projection matrix.
     all.push_back(wrongProjection(

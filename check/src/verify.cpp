@@ -191,8 +191,11 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
                 const VerifyResult run =
                     verifyAgainst(scene_, hypothesisCamera, hypothesisMap,
                                   sameTruth ? *truth : renderRay(hypothesisCamera, reading.truthFaults), neighbours());
-                out.push_back({mistake.name, reading.variant, reading.explanation, run.comparison.report.consistent(),
-                               run.comparison.report.unexplained()});
+                // Consistent only where something is compared: a view that sees nothing does not
+                // explain a map that holds nothing.
+                const ComparisonReport& r = run.comparison.report;
+                out.push_back({mistake.name, reading.variant, reading.explanation, r.consistent() && r.bothHit > 0,
+                               r.unexplained()});
             } catch (const Error&) {
             }
         }
