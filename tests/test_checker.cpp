@@ -4,6 +4,8 @@
 #include "zcheck/error.h"
 #include "zcheck/mistakes.h"
 
+#include "diagnosis_helpers.h"
+
 #include <catch2/catch.hpp>
 #include <tbb/global_control.h>
 
@@ -97,14 +99,10 @@ TEST_CASE("a map rendered under a mistake is diagnosed as that mistake, for ever
         const RenderResult wrong = checker.render(camera, mistake.route, faults);
         // A map with no surface at all is no evidence for one mistake over another (a view
         // turned away, a transposed projection): the diagnosis names none (test below).
-        if (std::none_of(wrong.primitiveId.begin(), wrong.primitiveId.end(), [](std::uint32_t id) { return id != kNoPrimitive; }))
-            continue;
-        std::vector<double> value = wrong.windowDepth.value;
-        for (double& v : value) v = double(float(v));  // as a float32 file stores it
-        const DepthMap map{camera.width(), camera.height(), DepthQuantity::Window, value, 0};
+        if (!testing::anyHit(wrong)) continue;
+        const DepthMap map = testing::windowMapOf(camera, wrong);
         if (checker.verify(camera, map).comparison.report.consistent()) continue;  // invisible here
-        bool named = false;
-        for (const Hypothesis& h : checker.diagnose(camera, map)) named = named || (h.consistent && h.name == mistake.name);
+        const bool named = testing::diagnosedAs(checker, camera, map, mistake.name);
         INFO(mistake.name);
         CHECK(named);
         diagnosed += named ? 1 : 0;
@@ -211,22 +209,16 @@ TEST_CASE("camera-pose mistakes: an inverted extrinsic and OpenCV axes used as O
         const Camera camera(spec);
         for (const char* name : {"inverted-extrinsic", "opencv-opengl-axes"}) {
             INFO(convention << ": " << name);
-            const Mistake& mistake =
-                *std::find_if(mistakeCatalogue().begin(), mistakeCatalogue().end(), [&](const Mistake& m) { return m.name == name; });
+            const Mistake& mistake = testing::mistakeNamed(name);
             RouteFaults faults;
             REQUIRE(mistake.inject(camera, faults));
             const RenderResult wrong = checker.render(camera, mistake.route, faults);
-            std::vector<double> value = wrong.windowDepth.value;
-            for (double& v : value) v = double(float(v));
-            const DepthMap map{camera.width(), camera.height(), DepthQuantity::Window, value, 0};
             const auto hits = std::count_if(wrong.primitiveId.begin(), wrong.primitiveId.end(),
                                             [](std::uint32_t id) { return id != kNoPrimitive; });
             REQUIRE(hits > camera.width() * camera.height() / 10);
+            const DepthMap map = testing::windowMapOf(camera, wrong);
             REQUIRE_FALSE(checker.verify(camera, map).comparison.report.consistent());
-            std::vector<std::string> consistent;
-            for (const Hypothesis& h : checker.diagnose(camera, map))
-                if (h.consistent) consistent.push_back(h.name);
-            REQUIRE(std::find(consistent.begin(), consistent.end(), name) != consistent.end());
+            REQUIRE(testing::diagnosedAs(checker, camera, map, name));
         }
     }
 }

@@ -2,12 +2,17 @@
 #include "zcheck/mistakes.h"
 #include "zcheck/verify.h"
 
+#include "zcheck/camera_file.h"
 #include "zcheck/export.h"
 #include "zcheck/inverse_projection.h"
 
+#include "diagnosis_helpers.h"
+
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 using namespace zcheck;
 
@@ -269,9 +274,71 @@ TEST_CASE("every swap of the four quantities is diagnosed by its own name", "[ve
                              name.find("ndc") != std::string::npos));
                     continue;
                 }
-                bool named = false;
-                for (const Hypothesis& h : checker.diagnose(camera, map)) named = named || (h.consistent && h.name == name);
-                REQUIRE(named);
+                REQUIRE(testing::diagnosedAs(checker, camera, map, name));
             }
     }
+}
+
+TEST_CASE("a field of view off by 2 % is diagnosed with the value it had, for every model that has one", "[verify][diagnose]")
+{
+    // The map is drawn with the mistaken camera and declared with the camera file's: the
+    // hypothesis "fovy-error" re-renders the truth with the field of view off by the same
+    // factor, in each model's own parameter (fovy, focal length, fx and fy, frustum bounds).
+    Setup s;
+    const Checker checker(s.scene);
+    const std::string examples = std::string(ZCHECK_TESTS_DIR) + "/../examples/";
+    const std::pair<const char*, const char*> cases[] = {{"perspective.json", "fovy 56.1°"},
+                                                         {"lens.json", "focal 34.31 mm"},
+                                                         {"pinhole.json", ""},
+                                                         {"frustum.json", "frustum x 1.02"}};
+    for (const auto& [file, expectedVariant] : cases) {
+        INFO(file);
+        CameraSpec declared = readCameraFile(examples + file);
+        declared.view = s.spec.view;  // the default scene's view: the models differ, the scene is in sight
+        declared.width /= 4, declared.height /= 4;  // quicker; a pinhole's intrinsics scale with the image
+        Projection& k = declared.projection;
+        k.fx /= 4, k.fy /= 4, k.cx = (k.cx + 0.5) / 4 - 0.5, k.cy = (k.cy + 0.5) / 4 - 0.5;
+        CameraSpec drawn = declared;
+        Projection& p = drawn.projection;
+        p.fovyDeg *= 1.02, p.focalMm /= 1.02, p.fx /= 1.02, p.fy /= 1.02;
+        p.left *= 1.02, p.right *= 1.02, p.bottom *= 1.02, p.top *= 1.02;
+        const Camera camera(declared);
+        const QuantityImage image = quantityImage(s.scene, Camera(drawn), checker.renderRaster(Camera(drawn)), ExportQuantity::Window);
+        DepthMap map{image.width, image.height, DepthQuantity::Window, image.value, 0.0};
+        for (double& v : map.value) v = double(float(v));
+        REQUIRE_FALSE(checker.verify(camera, map).comparison.report.consistent());
+        std::string variant = "none";
+        for (const Hypothesis& h : checker.diagnose(camera, map))
+            if (h.consistent && h.name == "fovy-error") variant = h.variant;
+        char pinhole[64];
+        std::snprintf(pinhole, sizeof pinhole, "fx %.6g, fy %.6g", p.fx, p.fy);
+        const std::string expected = *expectedVariant ? expectedVariant : pinhole;
+        INFO("expected " << expected);
+        REQUIRE(variant == expected);
+    }
+}
+
+TEST_CASE("regression: the other NDC range was never tried for a raw-matrix camera; parallel ones are covered too", "[verify][diagnose][regression]")
+{
+    // The hypothesis rebuilt the camera from its spec with the other range, which a raw matrix
+    // has no spec for (and which could fail for cameras the rebuild refused), so it was
+    // silently skipped. The z row is now remapped directly: injected and re-read, every model.
+    Setup s;
+    const Checker checker(s.scene);
+    const Mistake& ndcRange = testing::mistakeNamed("ndc-range");
+    // (A raw matrix keeps its own convention: its depth row is written for it.)
+    for (const char* file : {"matrix-direct3d.json", "orthographic.json", "oblique-cabinet.json"})
+        for (const std::string convention : {"own", "opengl", "vulkan"}) {
+            INFO(file << ", " << convention);
+            CameraSpec spec = readCameraFile(std::string(ZCHECK_TESTS_DIR) + "/../examples/" + file);
+            if ((convention == "own") == (spec.projection.type != ProjectionType::Matrix)) continue;
+            if (convention != "own") spec.convention = Convention::preset(convention);
+            spec.width = 160, spec.height = 120;
+            const Camera camera(spec);
+            RouteFaults faults;
+            REQUIRE(ndcRange.inject(camera, faults));
+            const DepthMap map = testing::windowMapOf(camera, checker.render(camera, ndcRange.route, faults));
+            REQUIRE_FALSE(checker.verify(camera, map).comparison.report.consistent());
+            REQUIRE(testing::diagnosedAs(checker, camera, map, "ndc-range"));
+        }
 }

@@ -144,20 +144,6 @@ glm::dmat4 nearFarSwapped(const Camera& camera)
     return m;
 }
 
-// The projection the camera would have with `change` applied to its spec (false if invalid).
-bool projectionOf(const Camera& camera, const std::function<void(CameraSpec&)>& change, glm::dmat4& clipFromEye)
-{
-    if (isRawMatrix(camera)) return false;
-    CameraSpec other = camera.spec();
-    change(other);
-    try {
-        clipFromEye = Camera(other).clipFromEye;
-    } catch (const std::exception&) {
-        return false;
-    }
-    return true;
-}
-
 std::vector<Mistake> buildCatalogue()
 {
     std::vector<Mistake> all;
@@ -210,10 +196,12 @@ std::vector<Mistake> buildCatalogue()
         "ndc-range", "a [-1,1] depth matrix used with a [0,1] convention, or the reverse",
         "consistent if the projection maps depth to the other NDC range ([-1,1] vs [0,1]) than the viewport expects",
         [](const Camera& camera, glm::dmat4& m) {
-            return projectionOf(camera, [](CameraSpec& spec) {
-                spec.convention.ndcDepth = spec.convention.ndcDepth == NdcDepthRange::ZeroToOne ? NdcDepthRange::MinusOneToOne
-                                                                                                : NdcDepthRange::ZeroToOne;
-            }, m);
+            // The z row remapped directly, for every model (a raw matrix and the parallel ones
+            // too): [0,1] → [−1,1] is z' = 2z − w, [−1,1] → [0,1] is z' = (z + w)/2.
+            m = camera.clipFromEye;
+            const bool zeroToOne = camera.convention().ndcDepth == NdcDepthRange::ZeroToOne;
+            for (int c = 0; c < 4; ++c) m[c][2] = zeroToOne ? 2 * m[c][2] - m[c][3] : (m[c][2] + m[c][3]) / 2;
+            return true;
         }));
     // A correct reversed-Z renderer where standard depth was declared (or the reverse): the
     // raster route draws with the other depth mapping whole (projection, depth test, clear
@@ -280,17 +268,45 @@ std::vector<Mistake> buildCatalogue()
                                       });
     swapped.reread = nullptr;
     all.push_back(swapped);
-    Mistake fovy{"fovy-error", "the vertical field of view off by a small factor (0.98 to 1.02)", Route::Raster, {}, {}};
+    Mistake fovy{"fovy-error",
+                 "the field of view off by a small factor (0.98 to 1.02): fovy, a lens's focal length, a pinhole's fx "
+                 "and fy, or a frustum's bounds",
+                 Route::Raster, {}, {}};
     fovy.reread = [](const Camera& camera, const DepthMap&) {
         Rereadings out;
-        if (!hasFovy(camera)) return out;
+        const Projection& p = camera.spec().projection;
         for (double factor : {0.98, 0.99, 0.995, 1.005, 1.01, 1.02}) {
             CameraSpec spec = camera.spec();
-            spec.projection.fovyDeg *= factor;
-            char variant[64], text[160];
-            std::snprintf(variant, sizeof variant, "fovy %.4g°", spec.projection.fovyDeg);
-            std::snprintf(text, sizeof text, "consistent with a vertical field of view of %.4g° instead of %.4g°",
-                          spec.projection.fovyDeg, camera.spec().projection.fovyDeg);
+            Projection& q = spec.projection;
+            char variant[96], text[200];
+            switch (p.type) {
+            case ProjectionType::Perspective:
+                q.fovyDeg *= factor;
+                std::snprintf(variant, sizeof variant, "fovy %.4g°", q.fovyDeg);
+                std::snprintf(text, sizeof text, "consistent with a vertical field of view of %.4g° instead of %.4g°",
+                              q.fovyDeg, p.fovyDeg);
+                break;
+            case ProjectionType::Lens:  // a wider view is a shorter focal length
+                q.focalMm /= factor;
+                std::snprintf(variant, sizeof variant, "focal %.4g mm", q.focalMm);
+                std::snprintf(text, sizeof text, "consistent with a focal length of %.4g mm instead of %.4g mm", q.focalMm,
+                              p.focalMm);
+                break;
+            case ProjectionType::Pinhole:
+                q.fx /= factor, q.fy /= factor;
+                std::snprintf(variant, sizeof variant, "fx %.6g, fy %.6g", q.fx, q.fy);
+                std::snprintf(text, sizeof text, "consistent with focal lengths fx %.6g, fy %.6g px instead of %.6g, %.6g",
+                              q.fx, q.fy, p.fx, p.fy);
+                break;
+            case ProjectionType::Frustum:
+                q.left *= factor, q.right *= factor, q.bottom *= factor, q.top *= factor;
+                std::snprintf(variant, sizeof variant, "frustum x %.4g", factor);
+                std::snprintf(text, sizeof text,
+                              "consistent with the frustum's left, right, bottom and top %.4g times what the camera says",
+                              factor);
+                break;
+            default: return out;  // parallel projections and raw matrices have no field of view
+            }
             out.push_back({variant, text, spec, {}, {}});
         }
         return out;
