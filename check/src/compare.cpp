@@ -315,6 +315,24 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
     };
     tbb::enumerable_thread_specific<StatisticCounts> statisticCounts;
 
+    // |Δ| / tolerance, as the report and the heatmap give it.
+    auto ratioOf = [](double error, double bound) { return bound > 0 ? error / bound : (error > 0 ? INFINITY : 0.0); };
+    // A pixel compared on depth (agree or depth error), whichever path judged it: its count, its
+    // ratio, the statistics. Returns whether it is the worst so far (its finding is then r.worst).
+    auto noteCompared = [&](ComparisonReport& r, StatisticCounts& counts, std::size_t i, int col, int row, bool agree,
+                            double ratio, double errorQuanta) {
+        agree ? ++r.agree : ++r.depthErrors;
+        out.errorOverTolerance[i] = static_cast<float>(ratio);
+        const double relative = relativeEyeZErrorAt(i, col, row);
+        counts.errorQuanta.add(float(errorQuanta));
+        counts.relativeEyeZ.add(float(relative));
+        r.maxRelativeEyeZError = std::max(r.maxRelativeEyeZError, relative);
+        r.maxErrorQuanta = std::max(r.maxErrorQuanta, errorQuanta);
+        const bool worst = ratio > r.maxErrorOverTolerance || r.agree + r.depthErrors == 1;
+        if (worst) r.maxErrorOverTolerance = std::max(r.maxErrorOverTolerance, ratio);
+        return worst;
+    };
+
     auto compareBlock = [&](int firstRow, int lastRow, BlockTally& tally) {
         ComparisonReport& r = tally.report;
         StatisticCounts& counts = statisticCounts.local();
@@ -336,7 +354,7 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
                     const double bound = judge.toleranceForSlope(m, q);
                     const double error = std::abs(rasterDepth - rayDepth);
                     const double signedErrorQuanta = signedErrorQuantaAt(i, q), errorQuanta = std::abs(signedErrorQuanta);
-                    const double ratio = bound > 0 ? error / bound : (error > 0 ? INFINITY : 0.0);
+                    const double ratio = ratioOf(error, bound);
                     const bool agree = error <= bound;
                     if (S * m <= 0.1 * q) {
                         // Quantization dominates here: feed the bias test.
@@ -345,15 +363,8 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
                         ++tally.quarterCounts[std::clamp(int(4 * (position - std::floor(position))), 0, 3)];
                         ++r.biasSamples;
                     }
-                    agree ? ++r.agree : ++r.depthErrors;
-                    out.errorOverTolerance[i] = static_cast<float>(ratio);
-                    const double relative = relativeEyeZErrorAt(i, col, row);
-                    counts.errorQuanta.add(float(errorQuanta));
-                    counts.relativeEyeZ.add(float(relative));
-                    r.maxRelativeEyeZError = std::max(r.maxRelativeEyeZError, relative);
-                    r.maxErrorQuanta = std::max(r.maxErrorQuanta, errorQuanta);
                     out.pixelClass[i] = agree ? PixelClass::Agree : PixelClass::DepthError;
-                    const bool worst = ratio > r.maxErrorOverTolerance || r.agree + r.depthErrors == 1;
+                    const bool worst = noteCompared(r, counts, i, col, row, agree, ratio, errorQuanta);
                     if (agree && !worst) continue;  // nothing to note: no finding is built
                     PixelFinding f;
                     f.col = col, f.row = row;
@@ -362,10 +373,7 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
                     f.pixelClass = agree ? PixelClass::Agree : PixelClass::DepthError;
                     f.errorQuanta = errorQuanta;
                     f.toleranceQuanta = bound / q;
-                    if (worst) {
-                        r.maxErrorOverTolerance = std::max(r.maxErrorOverTolerance, ratio);
-                        r.worst = f;
-                    }
+                    if (worst) r.worst = f;
                     if (!agree) noteUnexplained(r, f);
                     continue;
                 }
@@ -386,25 +394,15 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
                     f.pixelClass = judge.bothHit(f.rayWindowDepth, f.rayPrimitive, f.rasterWindowDepth,
                                                  f.rasterPrimitive, q, pWindow, bound);
                     f.errorQuanta = std::abs(signedErrorQuantaAt(i, q));
-                    const double ratio = bound > 0 ? error / bound : (error > 0 ? INFINITY : 0.0);
+                    const double ratio = ratioOf(error, bound);
                     auto withTolerance = [&](PixelFinding& finding) -> PixelFinding& {  // a finding kept
                         finding.toleranceQuanta = bound / q;
                         return finding;
                     };
                     if (f.pixelClass == PixelClass::EdgeSurface) {
                         ++r.edgeSurface;
-                    } else {
-                        f.pixelClass == PixelClass::Agree ? ++r.agree : ++r.depthErrors;
-                        out.errorOverTolerance[i] = static_cast<float>(ratio);
-                        const double relative = relativeEyeZErrorAt(i, col, row);
-                        counts.errorQuanta.add(float(f.errorQuanta));
-                        counts.relativeEyeZ.add(float(relative));
-                        r.maxRelativeEyeZError = std::max(r.maxRelativeEyeZError, relative);
-                        r.maxErrorQuanta = std::max(r.maxErrorQuanta, f.errorQuanta);
-                        if (ratio > r.maxErrorOverTolerance || r.agree + r.depthErrors == 1) {
-                            r.maxErrorOverTolerance = std::max(r.maxErrorOverTolerance, ratio);
-                            r.worst = withTolerance(f);
-                        }
+                    } else if (noteCompared(r, counts, i, col, row, f.pixelClass == PixelClass::Agree, ratio, f.errorQuanta)) {
+                        r.worst = withTolerance(f);
                     }
                     if (f.pixelClass == PixelClass::DepthError) withTolerance(f);
                 } else {
