@@ -40,13 +40,19 @@ CheckResult Checker::check(const Camera& camera, const CheckOptions& options) co
     run.report.timings.bvhBuildMs = rays_.buildMilliseconds();
     run.report.timings.traceMs = run.ray.renderMilliseconds;
     run.report.timings.rasterMs = run.raster.renderMilliseconds;
-    run.report.scene = scene_.name;
-    if (const std::string w = scene_.planarity.warning(scene_.name); !w.empty()) run.report.warnings.push_back(w);
-    run.report.triangles = scene_.triangleCount();
-    run.report.camera = camera.spec();
-    run.report.tolerance = options.tolerance;
+    run.report.describeInputs(scene_, camera, options.tolerance);
     run.report.comparison = run.comparison.report;
     return run;
+}
+
+void CheckReport::describeInputs(const Scene& checked, const Camera& used, const ToleranceModel& model)
+{
+    scene = checked.name;
+    triangles = checked.triangleCount();
+    warnings.clear();
+    if (const std::string w = checked.planarity.warning(checked.name); !w.empty()) warnings.push_back(w);
+    camera = used.spec();
+    tolerance = model;
 }
 
 RenderResult Checker::renderRay(const Camera& camera, const RayFaults& faults, EyePoints eyePoints) const

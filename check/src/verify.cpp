@@ -159,10 +159,7 @@ VerifyResult verifyAgainst(const Scene& scene, const Camera& camera, const Depth
     run.comparison = compareRoutes(scene, camera, run.truth, run.map, {}, &quantum);
     run.report.timings.compareMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     run.report.timings.traceMs = run.truth.renderMilliseconds;
-    run.report.scene = scene.name;
-    if (const std::string w = scene.planarity.warning(scene.name); !w.empty()) run.report.warnings.push_back(w);
-    run.report.triangles = scene.triangleCount();
-    run.report.camera = camera.spec();
+    run.report.describeInputs(scene, camera, {});  // compareRoutes ran with the default tolerance
     run.report.comparison = run.comparison.report;
     return run;
 }

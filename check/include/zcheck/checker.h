@@ -56,6 +56,10 @@ struct CheckReport {
     ComparisonReport comparison;
     Timings timings;
     std::vector<std::string> warnings;  // about the inputs (PolygonPlanarity::warning), in the report
+
+    // Fills what the report says of its inputs: the scene (name, triangles, warnings), the
+    // camera and the tolerance. Checker::check and verify share it.
+    void describeInputs(const Scene& checked, const Camera& used, const ToleranceModel& model);
 };
 
 struct CheckResult {
