@@ -58,8 +58,6 @@ void writeExr(const std::string& path, int width, int height, const std::vector<
 
 namespace {
 
-[[noreturn]] void refuseMap(const std::string& path, const std::string& why) { refuseDepthMap(path, why); }
-
 void requireSize(const std::string& path, long long width, long long height, int expectedWidth, int expectedHeight)
 {
     if (width != expectedWidth || height != expectedHeight)
@@ -79,7 +77,7 @@ DepthMapFile readPfm(const std::string& path, const std::string& bytes, const De
         while (at < bytes.size() && std::isspace(static_cast<unsigned char>(bytes[at]))) ++at;
         const std::size_t start = at;
         while (at < bytes.size() && at - start < 40 && !std::isspace(static_cast<unsigned char>(bytes[at]))) ++at;
-        if (at == start || at >= bytes.size()) refuseMap(path, std::string("malformed PFM header: no ") + what);
+        if (at == start || at >= bytes.size()) refuseDepthMap(path, std::string("malformed PFM header: no ") + what);
         return bytes.substr(start, at - start);
     };
     const int channels = bytes[1] == 'f' ? 1 : 3;
@@ -88,19 +86,19 @@ DepthMapFile readPfm(const std::string& path, const std::string& bytes, const De
         long long v = -1;
         const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), v);
         if (error != std::errc() || end != text.data() + text.size() || v < 1)
-            refuseMap(path, std::string("malformed PFM header: ") + what + " '" + text + "' is not a positive whole number");
+            refuseDepthMap(path, std::string("malformed PFM header: ") + what + " '" + text + "' is not a positive whole number");
         return v;
     };
     const long long width = whole(widthText, "width"), height = whole(heightText, "height");
     double scale = 0;
     const auto [end, error] = std::from_chars(scaleText.data(), scaleText.data() + scaleText.size(), scale);
     if (error != std::errc() || end != scaleText.data() + scaleText.size() || !std::isfinite(scale) || scale == 0)
-        refuseMap(path, "malformed PFM header: scale '" + scaleText + "' must be a nonzero number");
+        refuseDepthMap(path, "malformed PFM header: scale '" + scaleText + "' must be a nonzero number");
     ++at;  // the single whitespace byte that ends the header
     requireSize(path, width, height, expectedWidth, expectedHeight);
     const std::uint64_t expectedBytes = std::uint64_t(width) * std::uint64_t(height) * std::uint64_t(channels) * 4;
     if (bytes.size() - at != expectedBytes)
-        refuseMap(path, "the PFM data holds " + std::to_string(bytes.size() - at) + " bytes, but " +
+        refuseDepthMap(path, "the PFM data holds " + std::to_string(bytes.size() - at) + " bytes, but " +
                             std::to_string(width) + "x" + std::to_string(height) + "x" + std::to_string(channels) +
                             " float32 values need " + std::to_string(expectedBytes) + (bytes.size() - at < expectedBytes ? " (truncated)" : ""));
     const std::vector<std::string> names = channels == 1 ? std::vector<std::string>{"Y"} : std::vector<std::string>{"R", "G", "B"};
@@ -135,9 +133,9 @@ void preflightExr(const std::string& path, int expectedWidth, int expectedHeight
     {
         std::ifstream in(path, std::ios::binary);
         in.read(head.data(), std::streamsize(head.size()));
-        if (std::uint64_t(in.gcount()) != head.size()) refuseMap(path, "the file could not be read whole");
+        if (std::uint64_t(in.gcount()) != head.size()) refuseDepthMap(path, "the file could not be read whole");
     }
-    auto malformed = [&](const std::string& why) { refuseMap(path, "malformed EXR header: " + why); };
+    auto malformed = [&](const std::string& why) { refuseDepthMap(path, "malformed EXR header: " + why); };
     if (head.size() < 8) malformed("shorter than 8 bytes");
     std::uint32_t version = 0;
     std::memcpy(&version, head.data() + 4, 4);
@@ -194,7 +192,6 @@ DepthMapFile readDepthMap(const std::string& path, const DepthMapReading& readin
         throw Error("--scale must be a positive finite number, got " + formatNumber(scale));
     if (!std::isfinite(reading.offset)) throw Error("--offset must be a finite number, got " + formatNumber(reading.offset));
     checkInputFile(path, kDepthMapInput);
-    auto depthOf = [&](double stored, bool integer) { return reading.depthOf(stored, integer); };
     // The format is decided by the file's first bytes, and only that format's reader sees it:
     // OpenImageIO would otherwise offer unknown bytes to every plugin it has (video, camera
     // raw, DICOM, ...). PFM is read by zcheck itself (see readPfm).
@@ -205,7 +202,7 @@ DepthMapFile readDepthMap(const std::string& path, const DepthMapReading& readin
     }
     if (magic[0] == 'P' && (magic[1] == 'f' || magic[1] == 'F') && std::isspace(magic[2])) {
         DepthMapFile map = readPfm(path, readInputFile(path, kDepthMapInput), reading, expectedWidth, expectedHeight);
-        for (double& v : map.value) v = depthOf(v, false);
+        for (double& v : map.value) v = reading.depthOf(v, false);
         return map;
     }
     const char* plugin = magic[0] == 0x76 && magic[1] == 0x2f && magic[2] == 0x31 && magic[3] == 0x01 ? "openexr"
@@ -214,7 +211,7 @@ DepthMapFile readDepthMap(const std::string& path, const DepthMapReading& readin
                              ? "tiff"
                          : magic[0] == 0x89 && magic[1] == 'P' && magic[2] == 'N' && magic[3] == 'G' ? "png"
                                                                                                       : nullptr;
-    if (!plugin) refuseMap(path, "not an EXR, TIFF, PNG or PFM file (judged by its first bytes)");
+    if (!plugin) refuseDepthMap(path, "not an EXR, TIFF, PNG or PFM file (judged by its first bytes)");
     auto requireScale = [&](const std::string& what) {
         if (!(scale > 0))
             throw Error("depth map '" + path + "' stores integers (" + what +
@@ -232,13 +229,13 @@ DepthMapFile readDepthMap(const std::string& path, const DepthMapReading& readin
         } catch (const Error& e) {
             const std::string what = e.what();
             if (what.rfind("depth map '", 0) == 0) throw;  // the size message names the file already
-            refuseMap(path, what);
+            refuseDepthMap(path, what);
         }
         DepthMapFile map;
         map.width = png.width, map.height = png.height, map.valueQuantum = 1.0 / scale;
         map.channel = chooseDepthChannel(path, {"Y"}, reading.channel, reading.quantityChannel);
         map.value.resize(png.codes.size());
-        for (std::size_t i = 0; i < png.codes.size(); ++i) map.value[i] = depthOf(png.codes[i], true);
+        for (std::size_t i = 0; i < png.codes.size(); ++i) map.value[i] = reading.depthOf(png.codes[i], true);
         return map;
     }
     if (plugin == std::string("openexr")) preflightExr(path, expectedWidth, expectedHeight);
@@ -248,11 +245,11 @@ DepthMapFile readDepthMap(const std::string& path, const DepthMapReading& readin
         std::string reason = in ? in->geterror() : OIIO::geterror();
         for (char& c : reason)
             if (c == '\n') c = ' ';
-        refuseMap(path, "malformed " + std::string(plugin == std::string("openexr") ? "EXR" : plugin == std::string("tiff") ? "TIFF" : "PNG") +
+        refuseDepthMap(path, "malformed " + std::string(plugin == std::string("openexr") ? "EXR" : plugin == std::string("tiff") ? "TIFF" : "PNG") +
                             (reason.empty() ? "" : ": " + reason));
     }
     const OIIO::ImageSpec& spec = in->spec();
-    if (spec.width < 1 || spec.height < 1 || spec.depth > 1 || spec.nchannels < 1) refuseMap(path, "not a 2-D image");
+    if (spec.width < 1 || spec.height < 1 || spec.depth > 1 || spec.nchannels < 1) refuseDepthMap(path, "not a 2-D image");
     // Compared with the camera before a pixel is allocated: a header may declare anything.
     requireSize(path, spec.width, spec.height, expectedWidth, expectedHeight);
     std::vector<std::string> names;
@@ -267,7 +264,7 @@ DepthMapFile readDepthMap(const std::string& path, const DepthMapReading& readin
     const OIIO::TypeDesc format = spec.channelformat(channel);
     const bool integer = !format.is_floating_point();
     if (integer && format.size() < 2)
-        refuseMap(path, "channel '" + map.channel + "' stores " + std::to_string(8 * format.size()) +
+        refuseDepthMap(path, "channel '" + map.channel + "' stores " + std::to_string(8 * format.size()) +
                             "-bit integers, which cannot hold depth (a picture, not a depth map?)");
     if (integer) requireScale(format.c_str());
     std::vector<double> pixels(std::size_t(spec.width) * std::size_t(spec.height));
@@ -275,11 +272,11 @@ DepthMapFile readDepthMap(const std::string& path, const DepthMapReading& readin
         std::string reason = in->geterror();
         for (char& c : reason)
             if (c == '\n') c = ' ';
-        refuseMap(path, reason.empty() ? "the pixel data is truncated or corrupt" : reason);
+        refuseDepthMap(path, reason.empty() ? "the pixel data is truncated or corrupt" : reason);
     }
     // read_image scales integers to [0,1]; undo it to get the stored code.
     const double maxCode = integer ? std::pow(2.0, double(format.size() * 8)) - 1 : 1.0;
-    for (double& v : pixels) v = depthOf(integer ? std::round(v * maxCode) : v, integer);
+    for (double& v : pixels) v = reading.depthOf(integer ? std::round(v * maxCode) : v, integer);
     if (integer) map.valueQuantum = 1.0 / scale;
     map.value = std::move(pixels);
     return map;
