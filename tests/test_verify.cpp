@@ -342,3 +342,34 @@ TEST_CASE("regression: the other NDC range was never tried for a raw-matrix came
             REQUIRE(testing::diagnosedAs(checker, camera, map, "ndc-range"));
         }
 }
+
+TEST_CASE("the diagnosis's sampled screen never rules out a consistent reading, and estimates the others",
+          "[verify][diagnose]")
+{
+    Setup s;
+    s.spec.width = 320, s.spec.height = 240;
+    const Checker checker(s.scene);
+    const Camera camera(s.spec);
+    const RenderResult truth = checker.renderRay(camera);
+    const DepthMap correct = mapOf(s.scene, camera, checker.renderRaster(camera), ExportQuantity::EyeZ);
+    REQUIRE_FALSE(screenUnexplained(s.scene, camera, correct, truth, checker.neighbours()));
+    // Wrong by 1 % over one half of the image, and by far more elsewhere: the screen
+    // rules it out, and its estimate is near the full comparison's count.
+    for (double factor : {1.01, 1.5}) {
+        DepthMap wrong = correct;
+        for (std::size_t i = 0; i < wrong.value.size(); ++i)
+            if (std::isfinite(wrong.value[i]) && i % 320 < 160) wrong.value[i] *= factor;
+        const std::int64_t full = checker.verify(camera, wrong).comparison.report.unexplained();
+        const auto estimate = screenUnexplained(s.scene, camera, wrong, truth, checker.neighbours());
+        INFO("factor " << factor << ": full " << full);
+        REQUIRE(full > 10000);
+        REQUIRE(estimate);
+        REQUIRE(std::abs(double(*estimate - full)) <= 0.1 * double(full));
+    }
+    // Wrong in a handful of pixels only: too few suspects to sample, the full comparison decides.
+    DepthMap few = correct;
+    for (std::size_t i = 0, changed = 0; i < few.value.size() && changed < 50; ++i)
+        if (std::isfinite(few.value[i])) few.value[i] *= 1.2, ++changed;
+    REQUIRE_FALSE(screenUnexplained(s.scene, camera, few, truth, checker.neighbours()));
+    REQUIRE(checker.verify(camera, few).comparison.report.unexplained() == 50);
+}

@@ -209,14 +209,21 @@ PixelClass PixelJudge::bothHit(double rayDepth, std::uint32_t rayPrimitive, doub
     return PixelClass::DepthError;
 }
 
-namespace {
+PixelClass PixelJudge::oneHit(bool rayHit, double depth, std::uint32_t primitive, double q,
+                              const glm::dvec2& pWindow) const
+{
+    // Explained at an edge of its triangle, (ray route only) at the clear value, or on the
+    // near/far plane.
+    if (nearEdge(primitive, pWindow)) return rayHit ? PixelClass::RayOnlyEdge : PixelClass::RasterOnlyEdge;
+    if (rayHit && std::abs(depth - camera_.clearDepth()) <= surfaceTolerance(primitive, q)) return PixelClass::RayOnlyAtClear;
+    if (atClipPlane(primitive, pWindow)) return PixelClass::AtClipPlane;
+    return rayHit ? PixelClass::RayOnly : PixelClass::RasterOnly;
+}
 
 bool isUnexplained(PixelClass c)
 {
     return c == PixelClass::DepthError || c == PixelClass::RayOnly || c == PixelClass::RasterOnly;
 }
-
-}  // namespace
 
 namespace {
 
@@ -406,24 +413,12 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
                     }
                     if (f.pixelClass == PixelClass::DepthError) withTolerance(f);
                 } else {
-                    // Coverage mismatch: only one route sees a surface. Explained at an edge of its
-                    // triangle, (ray route only) at the clear value, or on the near/far plane.
+                    // Coverage mismatch: only one route sees a surface (PixelJudge::oneHit).
                     rayHit ? ++r.rayOnly : ++r.rasterOnly;
-                    const std::uint32_t primitive = rayHit ? f.rayPrimitive : f.rasterPrimitive;
-                    const double q = quantumAt(i);
-                    const bool atClear =
-                        rayHit && std::abs(f.rayWindowDepth - camera.clearDepth()) <= judge.surfaceTolerance(primitive, q);
-                    if (judge.nearEdge(primitive, pWindow)) {
-                        f.pixelClass = rayHit ? PixelClass::RayOnlyEdge : PixelClass::RasterOnlyEdge;
-                    } else if (atClear) {
-                        f.pixelClass = PixelClass::RayOnlyAtClear;
-                        ++r.lostAtClearValue;
-                    } else if (judge.atClipPlane(primitive, pWindow)) {
-                        f.pixelClass = PixelClass::AtClipPlane;
-                        ++r.atClipPlane;
-                    } else {
-                        f.pixelClass = rayHit ? PixelClass::RayOnly : PixelClass::RasterOnly;
-                    }
+                    f.pixelClass = judge.oneHit(rayHit, rayHit ? f.rayWindowDepth : f.rasterWindowDepth,
+                                                rayHit ? f.rayPrimitive : f.rasterPrimitive, quantumAt(i), pWindow);
+                    if (f.pixelClass == PixelClass::RayOnlyAtClear) ++r.lostAtClearValue;
+                    if (f.pixelClass == PixelClass::AtClipPlane) ++r.atClipPlane;
                     isUnexplained(f.pixelClass) ? ++r.coverageUnexplained : ++r.coverageExplained;
                 }
                 out.pixelClass[i] = f.pixelClass;

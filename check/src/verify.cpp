@@ -9,6 +9,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <unordered_map>
 #include <cmath>
@@ -51,6 +52,110 @@ VertexNeighbours::VertexNeighbours(const Scene& scene) : scene_(scene)
 
 std::string VertexNeighbours::key(const glm::vec3& p) { return std::string(reinterpret_cast<const char*>(&p), sizeof p); }
 
+MapReader::MapReader(const Scene& scene, const Camera& camera, const DepthMap& map, const RenderResult& truth,
+                     const VertexNeighbours& neighbours)
+    : scene_(scene), camera_(camera), map_(map), truth_(truth), neighbours_(neighbours), judge_(scene, camera)
+{
+}
+
+MapPixel MapReader::read(int col, int row, bool search) const
+{
+    // Per thread, reused from pixel to pixel: the candidates considered and the surfaces seen.
+    thread_local std::vector<std::uint32_t> considered, seen;
+    const int W = camera_.width(), H = camera_.height();
+    const std::size_t i = std::size_t(row) * W + col;
+    const glm::dvec2 pWindow = windowFromPixelCentre(camera_, col, row);
+    const double value = map_.value[i];
+    MapPixel out;
+    out.depth = windowDepthOfValue(camera_, pWindow, value, map_.quantity);
+    const double depth = out.depth;
+    // The storage step, carried into window units through the quantity's mapping.
+    const double reference = std::isfinite(depth) ? depth : truth_.windowDepth.value[i];
+    if (map_.quantity == DepthQuantity::Window && map_.valueQuantum == 0) {
+        out.quantum = storageQuantum(camera_.depth().format, reference);
+    } else if (std::isfinite(depth)) {
+        const double step = map_.valueQuantum > 0 ? map_.valueQuantum
+                                                  : double(std::nextafter(float(std::abs(value)), INFINITY)) - std::abs(double(float(value)));
+        const double other = windowDepthOfValue(camera_, pWindow, value + step, map_.quantity);
+        out.quantum = std::isfinite(other) ? std::max(std::abs(other - depth), storageQuantum(DepthFormat::Float32, depth))
+                                           : storageQuantum(camera_.depth().format, depth);
+    } else {
+        out.quantum = storageQuantum(camera_.depth().format, reference);
+    }
+    if (!std::isfinite(depth)) return out;
+    // Which surface did the map see? The comparison's own rule decides (PixelJudge): the
+    // truth's surface if the map's depth agrees with it; otherwise a surface drawn within S
+    // of the pixel centre whose tolerance interval, joined with the truth's, holds the
+    // map's depth, and under which the comparison explains the pixel. Every accepted set
+    // is then an interval around the true depth, so a map nearer to the truth never fails
+    // where a farther one passes (the regression "verify rejected a correct map at a
+    // sliver's edge" in tests/test_verify.cpp).
+    const std::uint32_t here = truth_.primitiveId[i];
+    const double q = out.quantum;
+    const double truthDepth = truth_.windowDepth.value[i];
+    double bound = 0;
+    if (here != kNoPrimitive && judge_.bothHit(truthDepth, here, depth, here, q, pWindow, bound) == PixelClass::Agree) {
+        out.primitive = here;
+        return out;
+    }
+    std::uint32_t primitive = here != kNoPrimitive ? here : kUnknownPrimitive;
+    if (!search) {
+        out.primitive = kUnknownPrimitive;
+        return out;
+    }
+    double closest = INFINITY;
+    const EyePlaneRay ray = worldEyePlaneRayThroughWindow(camera_, pWindow);
+    considered.clear();
+    auto consider = [&](std::uint32_t candidate) {
+        if (candidate == here || std::find(considered.begin(), considered.end(), candidate) != considered.end()) return;
+        considered.push_back(candidate);
+        const double plane = planeWindowDepth(scene_, camera_, candidate, ray);
+        if (!std::isfinite(plane)) return;
+        const double tolerance = judge_.surfaceTolerance(candidate, q);
+        double lo = plane - tolerance, hi = plane + tolerance;
+        if (here != kNoPrimitive) {
+            const double truthTolerance = judge_.surfaceTolerance(here, q);
+            lo = std::min(lo, truthDepth - truthTolerance), hi = std::max(hi, truthDepth + truthTolerance);
+        }
+        const double gap = std::abs(plane - depth);
+        if (!(depth >= lo && depth <= hi) || gap >= closest) return;
+        const glm::uvec3 t = scene_.triangles[candidate];
+        const glm::dvec3 a(scene_.positions[t[0]]), b(scene_.positions[t[1]]), c(scene_.positions[t[2]]);
+        if (!insideDrawnTriangle(camera_, a, b, c, pWindow) && !judge_.nearEdge(candidate, pWindow)) return;
+        const bool explained = here != kNoPrimitive
+                                   ? judge_.bothHit(truthDepth, here, depth, candidate, q, pWindow, bound) != PixelClass::DepthError
+                                   : judge_.nearEdge(candidate, pWindow) || judge_.atClipPlane(candidate, pWindow);
+        if (explained) closest = gap, primitive = candidate;
+    };
+    seen.clear();
+    for (int dy = -2; dy <= 2; ++dy)
+        for (int dx = -2; dx <= 2; ++dx) {
+            const int c = col + dx, r = row + dy;
+            if (c < 0 || c >= W || r < 0 || r >= H) continue;
+            const std::uint32_t nearby = truth_.primitiveId[std::size_t(r) * W + c];
+            if (nearby == kNoPrimitive || std::find(seen.begin(), seen.end(), nearby) != seen.end()) continue;
+            seen.push_back(nearby);
+            neighbours_.forEachNeighbour(nearby, consider);
+        }
+    out.primitive = primitive;
+    return out;
+}
+
+PixelClass MapReader::classify(int col, int row, const MapPixel& pixel) const
+{
+    const std::size_t i = std::size_t(row) * camera_.width() + col;
+    const bool truthHit = truth_.hit(i), mapHit = pixel.primitive != kNoPrimitive;
+    if (!truthHit && !mapHit) return PixelClass::BothMiss;
+    const glm::dvec2 pWindow = windowFromPixelCentre(camera_, col, row);
+    if (truthHit && mapHit) {
+        double bound = 0;
+        return judge_.bothHit(truth_.windowDepth.value[i], truth_.primitiveId[i], pixel.depth, pixel.primitive,
+                              pixel.quantum, pWindow, bound);
+    }
+    return truthHit ? judge_.oneHit(true, truth_.windowDepth.value[i], truth_.primitiveId[i], pixel.quantum, pWindow)
+                    : judge_.oneHit(false, pixel.depth, pixel.primitive, pixel.quantum, pWindow);
+}
+
 RenderResult renderResultFromMap(const Scene& scene, const Camera& camera, const DepthMap& map,
                                  const RenderResult& truth, const VertexNeighbours& neighbours,
                                  std::vector<double>& quantum)
@@ -60,97 +165,64 @@ RenderResult renderResultFromMap(const Scene& scene, const Camera& camera, const
     out.windowDepth = {W, H, DepthQuantity::Window, std::vector<double>(std::size_t(W) * H, camera.clearDepth())};
     out.primitiveId.assign(std::size_t(W) * H, kNoPrimitive);
     quantum.assign(std::size_t(W) * H, 0.0);
-    const PixelJudge judge(scene, camera);
+    const MapReader reader(scene, camera, map, truth, neighbours);
     // Rows in parallel: each pixel's choice reads only the truth and the map.
     tbb::parallel_for(0, H, [&](int row) {
-        std::vector<std::uint32_t> considered, seen;  // per pixel, reused along the row
         for (int col = 0; col < W; ++col) {
             const std::size_t i = std::size_t(row) * W + col;
-            const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
-            const double value = map.value[i];
-            const double depth = windowDepthOfValue(camera, pWindow, value, map.quantity);
-            // The storage step, carried into window units through the quantity's mapping.
-            const double reference = std::isfinite(depth) ? depth : truth.windowDepth.value[i];
-            if (map.quantity == DepthQuantity::Window && map.valueQuantum == 0) {
-                quantum[i] = storageQuantum(camera.depth().format, reference);
-            } else if (std::isfinite(depth)) {
-                const double step = map.valueQuantum > 0 ? map.valueQuantum
-                                                         : double(std::nextafter(float(std::abs(value)), INFINITY)) - std::abs(double(float(value)));
-                const double other = windowDepthOfValue(camera, pWindow, value + step, map.quantity);
-                quantum[i] = std::isfinite(other) ? std::max(std::abs(other - depth), storageQuantum(DepthFormat::Float32, depth))
-                                                  : storageQuantum(camera.depth().format, depth);
-            } else {
-                quantum[i] = storageQuantum(camera.depth().format, reference);
-            }
-            if (!std::isfinite(depth)) continue;
-            out.windowDepth.value[i] = depth;
-            // Which surface did the map see? The comparison's own rule decides (PixelJudge): the
-            // truth's surface if the map's depth agrees with it; otherwise a surface drawn within S
-            // of the pixel centre whose tolerance interval, joined with the truth's, holds the
-            // map's depth, and under which the comparison explains the pixel. Every accepted set
-            // is then an interval around the true depth, so a map nearer to the truth never fails
-            // where a farther one passes (the regression "verify rejected a correct map at a
-            // sliver's edge" in tests/test_verify.cpp).
-            const std::uint32_t here = truth.primitiveId[i];
-            const double q = quantum[i];
-            const double truthDepth = truth.windowDepth.value[i];
-            double bound = 0;
-            if (here != kNoPrimitive &&
-                judge.bothHit(truthDepth, here, depth, here, q, pWindow, bound) == PixelClass::Agree) {
-                out.primitiveId[i] = here;
-                continue;
-            }
-            std::uint32_t primitive = here != kNoPrimitive ? here : kUnknownPrimitive;
-            double closest = INFINITY;
-            const EyePlaneRay ray = worldEyePlaneRayThroughWindow(camera, pWindow);
-            considered.clear();
-            auto consider = [&](std::uint32_t candidate) {
-                if (candidate == here || std::find(considered.begin(), considered.end(), candidate) != considered.end())
-                    return;
-                considered.push_back(candidate);
-                const double plane = planeWindowDepth(scene, camera, candidate, ray);
-                if (!std::isfinite(plane)) return;
-                const double tolerance = judge.surfaceTolerance(candidate, q);
-                double lo = plane - tolerance, hi = plane + tolerance;
-                if (here != kNoPrimitive) {
-                    const double truthTolerance = judge.surfaceTolerance(here, q);
-                    lo = std::min(lo, truthDepth - truthTolerance), hi = std::max(hi, truthDepth + truthTolerance);
-                }
-                const double gap = std::abs(plane - depth);
-                if (!(depth >= lo && depth <= hi) || gap >= closest) return;
-                const glm::uvec3 t = scene.triangles[candidate];
-                const glm::dvec3 a(scene.positions[t[0]]), b(scene.positions[t[1]]), c(scene.positions[t[2]]);
-                if (!insideDrawnTriangle(camera, a, b, c, pWindow) && !judge.nearEdge(candidate, pWindow)) return;
-                const bool explained = here != kNoPrimitive
-                                           ? judge.bothHit(truthDepth, here, depth, candidate, q, pWindow, bound) !=
-                                                 PixelClass::DepthError
-                                           : judge.nearEdge(candidate, pWindow) || judge.atClipPlane(candidate, pWindow);
-                if (explained) closest = gap, primitive = candidate;
-            };
-            seen.clear();
-            for (int dy = -2; dy <= 2; ++dy)
-                for (int dx = -2; dx <= 2; ++dx) {
-                    const int c = col + dx, r = row + dy;
-                    if (c < 0 || c >= W || r < 0 || r >= H) continue;
-                    const std::uint32_t nearby = truth.primitiveId[std::size_t(r) * W + c];
-                    if (nearby == kNoPrimitive || std::find(seen.begin(), seen.end(), nearby) != seen.end()) continue;
-                    seen.push_back(nearby);
-                    neighbours.forEachNeighbour(nearby, consider);
-                }
-            out.primitiveId[i] = primitive;
+            const MapPixel pixel = reader.read(col, row);
+            quantum[i] = pixel.quantum;
+            if (pixel.primitive == kNoPrimitive) continue;
+            out.windowDepth.value[i] = pixel.depth;
+            out.primitiveId[i] = pixel.primitive;
         }
     });
     return out;
 }
 
-VerifyResult verifyAgainst(const Scene& scene, const Camera& camera, const DepthMap& map, RenderResult truth,
-                           const VertexNeighbours& neighbours)
+void requireMapFits(const Camera& camera, const DepthMap& map)
 {
     if (map.width != camera.width() || map.height != camera.height() ||
         map.value.size() != std::size_t(map.width) * std::size_t(map.height))
         throw Error("the depth map is " + std::to_string(map.width) + "x" + std::to_string(map.height) + " (" +
                     std::to_string(map.value.size()) + " values) but the camera's image is " +
                     std::to_string(camera.width()) + "x" + std::to_string(camera.height()));
+}
+
+std::optional<std::int64_t> screenUnexplained(const Scene& scene, const Camera& camera, const DepthMap& map,
+                                              const RenderResult& truth, const VertexNeighbours& neighbours)
+{
+    constexpr std::size_t kSample = 1024;
+    const int W = camera.width(), H = camera.height();
+    const MapReader reader(scene, camera, map, truth, neighbours);
+    // The suspects: pixels that do not simply agree with the truth's own surface.
+    std::vector<std::vector<std::uint32_t>> suspectsOfRow(static_cast<std::size_t>(H));
+    tbb::parallel_for(0, H, [&](int row) {
+        for (int col = 0; col < W; ++col) {
+            const std::size_t i = std::size_t(row) * W + col;
+            const MapPixel pixel = reader.read(col, row, false);
+            const bool suspect = pixel.primitive == kNoPrimitive ? truth.hit(i) : pixel.primitive == kUnknownPrimitive;
+            if (suspect) suspectsOfRow[std::size_t(row)].push_back(std::uint32_t(col));
+        }
+    });
+    std::vector<std::uint32_t> suspects;  // pixel indices, in scan order
+    for (int row = 0; row < H; ++row)
+        for (std::uint32_t col : suspectsOfRow[std::size_t(row)]) suspects.push_back(std::uint32_t(row) * W + col);
+    if (suspects.size() <= kSample) return std::nullopt;  // reading them all costs no more than the sample
+    std::atomic<std::int64_t> unexplained{0};
+    tbb::parallel_for(std::size_t(0), kSample, [&](std::size_t k) {
+        const std::uint32_t i = suspects[k * suspects.size() / kSample];
+        const int col = int(i % W), row = int(i / W);
+        if (isUnexplained(reader.classify(col, row, reader.read(col, row)))) ++unexplained;
+    });
+    if (unexplained == 0) return std::nullopt;
+    return std::int64_t(std::llround(double(unexplained) * double(suspects.size()) / double(kSample)));
+}
+
+VerifyResult verifyAgainst(const Scene& scene, const Camera& camera, const DepthMap& map, RenderResult truth,
+                           const VertexNeighbours& neighbours)
+{
+    requireMapFits(camera, map);
     VerifyResult run;
     run.truth = std::move(truth);
     std::vector<double> quantum;
@@ -173,6 +245,7 @@ VerifyResult Checker::verify(const Camera& camera, const DepthMap& map) const
 
 std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& map) const
 {
+    requireMapFits(camera, map);
     std::vector<Hypothesis> out;
     // A hypothesis that only re-reads the map compares it with the truth as it is: rendered once.
     std::optional<RenderResult> truth;
@@ -185,14 +258,22 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
                 const DepthMap& hypothesisMap = reading.map ? *reading.map : map;
                 const bool sameTruth = !reading.camera && reading.truthFaults.none();
                 if (sameTruth && !truth) truth = renderRay(camera);
-                const VerifyResult run =
-                    verifyAgainst(scene_, hypothesisCamera, hypothesisMap,
-                                  sameTruth ? *truth : renderRay(hypothesisCamera, reading.truthFaults), neighbours());
-                // Consistent only where something is compared: a view that sees nothing does not
-                // explain a map that holds nothing.
-                const ComparisonReport& r = run.comparison.report;
-                out.push_back({mistake.name, reading.variant, reading.explanation, r.consistent() && r.bothHit > 0,
-                               r.unexplained()});
+                const RenderResult hypothesisTruth =
+                    sameTruth ? RenderResult{} : renderRay(hypothesisCamera, reading.truthFaults);
+                const RenderResult& truthUsed = sameTruth ? *truth : hypothesisTruth;
+                Hypothesis h{mistake.name, reading.variant, reading.explanation, false, 0};
+                // Most hypotheses are plainly wrong: a sample of the pixels that need the surface
+                // search proves it without searching them all (screenUnexplained).
+                if (const auto estimate = screenUnexplained(scene_, hypothesisCamera, hypothesisMap, truthUsed, neighbours())) {
+                    h.unexplained = *estimate, h.estimated = true;
+                } else {
+                    const VerifyResult run = verifyAgainst(scene_, hypothesisCamera, hypothesisMap, truthUsed, neighbours());
+                    // Consistent only where something is compared: a view that sees nothing does
+                    // not explain a map that holds nothing.
+                    const ComparisonReport& r = run.comparison.report;
+                    h.consistent = r.consistent() && r.bothHit > 0, h.unexplained = r.unexplained();
+                }
+                out.push_back(std::move(h));
             } catch (const Error&) {
             }
         }

@@ -510,6 +510,7 @@ py::list diagnosisList(const std::vector<Hypothesis>& hypotheses)
         d["explanation"] = h.explanation;
         d["consistent"] = h.consistent;
         d["unexplained"] = h.unexplained;
+        d["unexplained_estimated"] = h.estimated;
         out.append(d);
     }
     return out;

@@ -194,7 +194,8 @@ std::string verifyReportJson(const CheckReport& report, const DepthMapSource& so
         nlohmann::json list = nlohmann::json::array();
         for (const auto& h : *diagnosis)
             list.push_back({{"hypothesis", h.name}, {"variant", h.variant}, {"explanation", h.explanation},
-                            {"consistent", h.consistent}, {"unexplained", h.unexplained}});
+                            {"consistent", h.consistent}, {"unexplained", h.unexplained},
+                            {"unexplained_estimated", h.estimated}});
         document["diagnosis"] = list;
     }
     return prettyJson(document);

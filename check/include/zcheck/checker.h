@@ -98,6 +98,8 @@ struct Hypothesis {
     std::string explanation;  // "consistent if read as ray distance instead of eye-z"
     bool consistent = false;
     std::int64_t unexplained = 0;
+    bool estimated = false;   // `unexplained` estimated from a sample that already ruled the
+                              // hypothesis out (verify.h, screenUnexplained)
 };
 
 class VertexNeighbours;

@@ -58,6 +58,8 @@ enum class PixelClass : std::uint8_t {
     RasterOnly,          // only the raster hits, unexplained
 };
 std::string toString(PixelClass pixelClass);
+// DepthError, RayOnly and RasterOnly: the classes no tolerance explains.
+bool isUnexplained(PixelClass pixelClass);
 
 struct ToleranceModel {
     int subpixelBits = 8;  // S = 2^−subpixelBits pixels
@@ -151,6 +153,9 @@ public:
     // pWindow. Returns Agree, EdgeSurface or DepthError; `bound` receives the tolerance used.
     PixelClass bothHit(double rayDepth, std::uint32_t rayPrimitive, double rasterDepth,
                        std::uint32_t rasterPrimitive, double q, const glm::dvec2& pWindow, double& bound) const;
+    // Only one route hits, on `primitive` (`rayHit`: the ray's hit, at window depth `depth`):
+    // RayOnlyEdge/RasterOnlyEdge, RayOnlyAtClear, AtClipPlane, or RayOnly/RasterOnly.
+    PixelClass oneHit(bool rayHit, double depth, std::uint32_t primitive, double q, const glm::dvec2& pWindow) const;
     // Whether pWindow lies within S pixels of the primitive's edge as drawn.
     bool nearEdge(std::uint32_t primitive, const glm::dvec2& pWindow) const;
     // Whether the primitive's plane meets the pixel's ray on the near or far plane.

@@ -12,6 +12,8 @@
 // true depth: a map nearer the truth never fails where a farther one passes.
 #include "zcheck/checker.h"
 
+#include <cmath>
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -37,12 +39,54 @@ private:
     std::unordered_map<std::string, std::vector<std::uint32_t>> around_;
 };
 
+// One pixel of a map as the raster side of a comparison sees it.
+struct MapPixel {
+    double depth = NAN;                        // window depth, NaN for a miss
+    double quantum = 0;                        // the storage step there, in window units
+    std::uint32_t primitive = kNoPrimitive;    // the surface chosen (above); kNoPrimitive for a miss
+};
+
+// Reads a map pixel by pixel against an already rendered truth: the per-pixel rule of
+// renderResultFromMap, and the comparison's class for one pixel, so that a diagnosis can
+// judge a sample of pixels without reading the whole map. Holds references; thread-safe.
+class MapReader {
+public:
+    MapReader(const Scene& scene, const Camera& camera, const DepthMap& map, const RenderResult& truth,
+              const VertexNeighbours& neighbours);
+    // `search` false: a hit that does not agree with the truth's own surface is left as
+    // kUnknownPrimitive unsearched (a cheap test of whether the pixel needs the search).
+    MapPixel read(int col, int row, bool search = true) const;
+    // The class compareRoutes gives the pixel (truth as the ray, the map as the raster).
+    PixelClass classify(int col, int row, const MapPixel& pixel) const;
+
+private:
+    const Scene& scene_;
+    const Camera& camera_;
+    const DepthMap& map_;
+    const RenderResult& truth_;
+    const VertexNeighbours& neighbours_;
+    PixelJudge judge_;
+};
+
 // The map as the raster side of a comparison (window depth per pixel, a hit where the value is
 // not a miss, the surface chosen as above). `quantum` receives each pixel's storage step in
 // window units.
 RenderResult renderResultFromMap(const Scene& scene, const Camera& camera, const DepthMap& map,
                                  const RenderResult& truth, const VertexNeighbours& neighbours,
                                  std::vector<double>& quantum);
+
+// Throws Error unless `map` is camera.width() × camera.height() with a value per pixel.
+void requireMapFits(const Camera& camera, const DepthMap& map);
+
+// Whether `map` certainly cannot be consistent with `truth`, judged on a sample: the pixels
+// that do not simply agree with the truth's own surface are found, and an evenly spaced
+// sample of at most 1024 of them is read and classified exactly as the full comparison
+// would. An unexplained pixel in the sample proves the map inconsistent (a consistent map
+// has none anywhere); the value returned then estimates how many pixels are unexplained,
+// from the sample's share. std::nullopt: every sampled pixel is explained, or there are too
+// few suspects to bother; only the full comparison can tell.
+std::optional<std::int64_t> screenUnexplained(const Scene& scene, const Camera& camera, const DepthMap& map,
+                                              const RenderResult& truth, const VertexNeighbours& neighbours);
 
 // The comparison of `map` against an already rendered ground truth `truth` (one BVH, one
 // truth render, many readings of the map).
