@@ -6,6 +6,7 @@
 #include "zcheck/atomic_file.h"
 #include "zcheck/error.h"
 #include "zcheck/export.h"
+#include "zcheck/fit.h"
 #include "zcheck/mesh_loader.h"
 #include "zcheck/png_file.h"
 #include "zcheck/version.h"
@@ -22,6 +23,7 @@ struct ExportOptions {
     SceneAndCamera input;
     std::string backend = "ray", quantities = "eye-z", output, preview;
     double scale = 0;
+    std::vector<double> sampleOffset;  // image pixels (x right, y down) from the pixel centre
     int threads = 0;
 };
 
@@ -49,7 +51,17 @@ int runExportCommand(const ExportOptions& o)
     const Camera camera(spec);
     const Checker checker(std::move(loaded));
     const Scene& scene = checker.scene();
-    const RenderResult route = checker.render(camera, routeFromName(o.backend));
+    Departure sampling;
+    if (!o.sampleOffset.empty()) {
+        if (o.backend != "ray") throw Error("--sample-offset needs --backend ray (the rasterizer samples pixel centres)");
+        for (double v : o.sampleOffset)
+            if (!(std::abs(v) <= 16)) throw Error("--sample-offset " + std::to_string(v) + " must lie within ±16 pixels");
+        sampling.sampleOffset = {o.sampleOffset[0], o.sampleOffset[1]};
+    }
+    // The ray route keeps its hits' eye points: eye-z and distance are then exact (Checker::render).
+    const RenderResult route = o.backend == "ray"
+                                   ? checker.renderRay(camera, departedSampling(camera, sampling), EyePoints::Keep)
+                                   : checker.renderRaster(camera);
     std::vector<QuantityImage> images;
     for (ExportQuantity q : quantities) images.push_back(quantityImage(scene, camera, route, q));
     std::string format;
@@ -77,7 +89,9 @@ int runExportCommand(const ExportOptions& o)
         {"width", camera.width()},
         {"height", camera.height()},
         {"orientation", orientation},
-        {"pixel_centres", "pixel (col,row) samples window point (col + 0.5, row + 0.5) from the top-left corner"},
+        {"pixel_centres", "pixel (col,row) samples image point (col + 0.5 + dx, row + 0.5 + dy) from the top-left "
+                          "corner, x right, y down"},
+        {"sample_offset", {sampling.sampleOffset.x, sampling.sampleOffset.y}},
         {"channels", channels},
         {"scale", format == "png" ? nlohmann::json(o.scale) : nlohmann::json(nullptr)},
         {"backend", o.backend},
@@ -124,6 +138,11 @@ Command addExportCommand(CLI::App& app)
         ->check(kPositiveFinite);
     command->add_option("--preview", o->preview, "also write an 8-bit colour-mapped PNG of the first quantity")
         ->check(kNonEmptyPath);
+    command->add_option("--sample-offset", o->sampleOffset,
+                        "DX,DY: take each pixel's depth at this offset from its centre, in pixels, x right, y down "
+                        "(ray backend): a renderer that keeps one sample of MSAA, e.g. 0.125,0.375 (4x, sample 3)")
+        ->delimiter(',')
+        ->expected(2);
     addThreadsOption(command, o->threads);
 
     return {command, [o] { return runExportCommand(*o); }};

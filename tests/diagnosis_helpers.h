@@ -2,6 +2,7 @@
 // For the tests of the diagnosis: a map as a renderer that made a mistake would deliver it,
 // and whether the diagnosis names that mistake.
 #include "zcheck/checker.h"
+#include "zcheck/export.h"
 #include "zcheck/mistakes.h"
 
 #include <algorithm>
@@ -17,6 +18,21 @@ inline const Mistake& mistakeNamed(const std::string& name)
     const auto found = std::find_if(all.begin(), all.end(), [&](const Mistake& m) { return m.name == name; });
     if (found == all.end()) throw std::logic_error("no mistake named " + name);
     return *found;
+}
+
+// One quantity of a render as a float32 file stores it.
+inline DepthMap mapOf(const Scene& scene, const Camera& camera, const RenderResult& route, ExportQuantity quantity)
+{
+    const QuantityImage image = quantityImage(scene, camera, route, quantity);
+    DepthMap map;
+    map.width = image.width, map.height = image.height;
+    map.quantity = quantity == ExportQuantity::Window ? DepthQuantity::Window
+                   : quantity == ExportQuantity::Ndc  ? DepthQuantity::Ndc
+                   : quantity == ExportQuantity::EyeZ ? DepthQuantity::EyeZ
+                                                       : DepthQuantity::Distance;
+    map.value = image.value;
+    for (double& v : map.value) v = double(float(v));
+    return map;
 }
 
 // The window depth of `render`, stored as a float32 file stores it.

@@ -79,7 +79,7 @@ QuantityImage Checker::render(const Camera& camera, ExportQuantity quantity, Rou
 
 const VertexNeighbours& Checker::neighbours() const
 {
-    std::call_once(neighboursOnce_, [&] { neighbours_ = std::make_unique<VertexNeighbours>(scene_); });
+    std::call_once(neighboursOnce_, [&] { neighbours_ = std::make_unique<VertexNeighbours>(scene_, &rays_); });
     return *neighbours_;
 }
 

@@ -44,13 +44,14 @@ double ToleranceModel::constantQuanta(const DepthSettings& depth)
     return 4.0;
 }
 
-DepthSlopeFrame::DepthSlopeFrame(const Camera& camera)
+DepthSlopeFrame::DepthSlopeFrame(const Camera& camera, SlopeCredit credit)
     // The plane n·p + d = 0 in world space maps to clip space through the transpose of
     // worldFromClip; there a·x + b·y + c·z + d·w = 0, so in NDC z = −(a·x + b·y + d)/c.
     : clipPlaneFromWorldPlane(glm::transpose(camera.worldFromClip)),
       zWindowPerZNdc(std::abs(camera.windowFromNdc[2][2])),
       ndcPerPixelX(std::abs(camera.ndcFromWindow[0][0])),
-      ndcPerPixelY(std::abs(camera.ndcFromWindow[1][1]))
+      ndcPerPixelY(std::abs(camera.ndcFromWindow[1][1])),
+      credit(credit)
 {
 }
 
@@ -63,7 +64,10 @@ double DepthSlopeFrame::slope(const glm::dvec3& a, const glm::dvec3& b, const gl
     auto row = [&](int k) { return m[0][k] * plane.x + m[1][k] * plane.y + m[2][k] * plane.z + m[3][k] * plane.w; };
     const double x = row(0), y = row(1), z = row(2);
     if (z == 0) return INFINITY;
-    return zWindowPerZNdc * std::max(std::abs(x) * ndcPerPixelX, std::abs(y) * ndcPerPixelY) / std::abs(z);
+    const double dx = std::abs(x) * ndcPerPixelX, dy = std::abs(y) * ndcPerPixelY;
+    // A sample up to S off in x and in y moves depth by up to S·(|∂d/∂x| + |∂d/∂y|); vertices
+    // snapped by up to S/2 per axis by no more than S·max (compare.h).
+    return zWindowPerZNdc * (credit == SlopeCredit::SampleOffset ? dx + dy : std::max(dx, dy)) / std::abs(z);
 }
 
 double windowDepthSlope(const Camera& camera, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c)
@@ -144,7 +148,7 @@ PixelJudge::PixelJudge(const Scene& scene, const Camera& camera, const Tolerance
       C_(ToleranceModel::constantQuanta(camera.depth())),
       S_(tolerance.snapPixels()),
       E_(16 * std::ldexp(1.0, -52) * std::max(std::abs(camera.depth().rangeMin), std::abs(camera.depth().rangeMax))),
-      slopeFrame_(camera),
+      slopeFrame_(camera, tolerance.slopeCredit),
       serial_(nextJudgeSerial.fetch_add(1, std::memory_order_relaxed))
 {
 }

@@ -1,5 +1,6 @@
 #include "zcheck/mistakes.h"
 
+#include "zcheck/fit.h"
 #include "zcheck/inverse_projection.h"
 
 #include <cmath>
@@ -157,7 +158,7 @@ std::vector<Mistake> buildCatalogue()
                            "consistent if flipped horizontally (a mirrored x axis)", false));
     Mistake half = wrongSampling("half-pixel", "pixel centres at integer coordinates: the +0.5 offset forgotten", "",
                                  halfPixel);
-    half.reread = [](const Camera&, const DepthMap&) {
+    half.reread = [](const Camera& camera, const DepthMap&) {
         Rereadings out;
         for (auto [dx, dy, what] : {std::tuple{-0.5, -0.5, "x and y"}, std::tuple{-0.5, 0.0, "x"},
                                     std::tuple{0.0, -0.5, "y"}, std::tuple{0.5, 0.5, "x and y, the other way"}}) {
@@ -165,7 +166,11 @@ std::vector<Mistake> buildCatalogue()
             r.variant = what;
             r.explanation = std::string("consistent if rendered with pixel centres half a pixel off in ") + what +
                             " (the +0.5 pixel-centre offset missing or doubled)";
-            r.truthFaults.shiftPixels = {dx, dy};
+            // The truth seen at the shifted points, through a camera whose image moved the other
+            // way (fit.h): the map is then read, and its edges judged, where it was sampled.
+            Departure shifted;
+            shifted.sampleOffset = {dx, dy * (camera.windowYFromImageY(1) - camera.windowYFromImageY(0))};
+            r.camera = departedCameraSpec(camera, shifted);
             out.push_back(r);
         }
         return out;
@@ -268,50 +273,8 @@ std::vector<Mistake> buildCatalogue()
                                       });
     swapped.reread = nullptr;
     all.push_back(swapped);
-    Mistake fovy{"fovy-error",
-                 "the field of view off by a small factor (0.98 to 1.02): fovy, a lens's focal length, a pinhole's fx "
-                 "and fy, or a frustum's bounds",
-                 Route::Raster, {}, {}};
-    fovy.reread = [](const Camera& camera, const DepthMap&) {
-        Rereadings out;
-        const Projection& p = camera.spec().projection;
-        for (double factor : {0.98, 0.99, 0.995, 1.005, 1.01, 1.02}) {
-            CameraSpec spec = camera.spec();
-            Projection& q = spec.projection;
-            char variant[96], text[200];
-            switch (p.type) {
-            case ProjectionType::Perspective:
-                q.fovyDeg *= factor;
-                std::snprintf(variant, sizeof variant, "fovy %.4g°", q.fovyDeg);
-                std::snprintf(text, sizeof text, "consistent with a vertical field of view of %.4g° instead of %.4g°",
-                              q.fovyDeg, p.fovyDeg);
-                break;
-            case ProjectionType::Lens:  // a wider view is a shorter focal length
-                q.focalMm /= factor;
-                std::snprintf(variant, sizeof variant, "focal %.4g mm", q.focalMm);
-                std::snprintf(text, sizeof text, "consistent with a focal length of %.4g mm instead of %.4g mm", q.focalMm,
-                              p.focalMm);
-                break;
-            case ProjectionType::Pinhole:
-                q.fx /= factor, q.fy /= factor;
-                std::snprintf(variant, sizeof variant, "fx %.6g, fy %.6g", q.fx, q.fy);
-                std::snprintf(text, sizeof text, "consistent with focal lengths fx %.6g, fy %.6g px instead of %.6g, %.6g",
-                              q.fx, q.fy, p.fx, p.fy);
-                break;
-            case ProjectionType::Frustum:
-                q.left *= factor, q.right *= factor, q.bottom *= factor, q.top *= factor;
-                std::snprintf(variant, sizeof variant, "frustum x %.4g", factor);
-                std::snprintf(text, sizeof text,
-                              "consistent with the frustum's left, right, bottom and top %.4g times what the camera says",
-                              factor);
-                break;
-            default: return out;  // parallel projections and raw matrices have no field of view
-            }
-            out.push_back({variant, text, spec, {}, {}});
-        }
-        return out;
-    };
-    all.push_back(fovy);
+    // A field of view off by a small factor is measured, not guessed: fit.h's field-of-view
+    // family, in Checker::diagnose.
 
     // What the numbers are.
     Mistake linear{"linear-depth", "linear eye depth (z − n)/(f − n) stored as the window depth", Route::Raster, {}, {}};

@@ -2,6 +2,7 @@
 
 #include "zcheck/error.h"
 #include "zcheck/drawn_polygon.h"
+#include "zcheck/fit.h"
 #include "zcheck/mistakes.h"
 
 #include "zcheck/inverse_projection.h"
@@ -20,16 +21,55 @@ namespace zcheck {
 
 namespace {
 
-// Window depth of a map value at a window point, or NaN for a miss.
-double windowDepthOfValue(const Camera& camera, const glm::dvec2& pWindow, double value, DepthQuantity quantity)
-{
-    if (quantity == DepthQuantity::Window) {
-        if (!std::isfinite(value) || value == camera.clearDepth() || value == camera.windowDepthFar()) return NAN;
-        return value;
+// Window depths of map values at one window point (NaN for a miss), with eyePointFromDepth's
+// arithmetic; the viewing ray is built once for the point, however many values are read there
+// (a value and its neighbour one storage step away).
+class WindowDepthAt {
+public:
+    WindowDepthAt(const Camera& camera, const glm::dvec2& pWindow, DepthQuantity quantity)
+        : camera_(camera), pWindow_(pWindow), quantity_(quantity)
+    {
     }
-    const auto pEye = eyePointFromDepth(camera, pWindow, value, quantity);
-    return pEye ? windowFromEye(camera, *pEye).z : NAN;
-}
+
+    double operator()(double value)
+    {
+        if (!std::isfinite(value)) return NAN;
+        switch (quantity_) {
+        case DepthQuantity::Window:
+            return value == camera_.clearDepth() || value == camera_.windowDepthFar() ? NAN : value;
+        case DepthQuantity::Ndc: {
+            const double window = camera_.windowDepthFromNdcZ(value);
+            if (window == camera_.clearDepth() || window == camera_.windowDepthFar()) return NAN;
+            return windowFromEye(camera_, eyeFromWindow(camera_, {pWindow_, window})).z;
+        }
+        case DepthQuantity::EyeZ: {
+            if (!(value > 0)) return NAN;
+            const Ray& r = ray();
+            const double t = (value - camera_.eyeZOf(r.origin)) / camera_.eyeZOf(r.direction);
+            return windowFromEye(camera_, r.origin + t * r.direction).z;
+        }
+        case DepthQuantity::Distance: {
+            if (!(value > 0)) return NAN;
+            if (!planeRay_) planeRay_ = eyePlaneRayFrom(ray());
+            return windowFromEye(camera_, planeRay_->origin + value * planeRay_->direction).z;
+        }
+        }
+        return NAN;
+    }
+
+private:
+    const Ray& ray()
+    {
+        if (!ray_) ray_ = eyeRayThroughWindow(camera_, pWindow_);
+        return *ray_;
+    }
+
+    const Camera& camera_;
+    glm::dvec2 pWindow_;
+    DepthQuantity quantity_;
+    std::optional<Ray> ray_;
+    std::optional<EyePlaneRay> planeRay_;
+};
 
 }  // namespace
 
@@ -44,7 +84,7 @@ double planeWindowDepth(const Scene& scene, const Camera& camera, std::uint32_t 
 }
 
 
-VertexNeighbours::VertexNeighbours(const Scene& scene) : scene_(scene)
+VertexNeighbours::VertexNeighbours(const Scene& scene, const RayRenderer* rays) : scene_(scene), rays_(rays)
 {
     for (std::uint32_t t = 0; t < scene.triangles.size(); ++t)
         for (int k = 0; k < 3; ++k) around_[key(scene.positions[scene.triangles[t][k]])].push_back(t);
@@ -54,7 +94,8 @@ std::string VertexNeighbours::key(const glm::vec3& p) { return std::string(reint
 
 MapReader::MapReader(const Scene& scene, const Camera& camera, const DepthMap& map, const RenderResult& truth,
                      const VertexNeighbours& neighbours)
-    : scene_(scene), camera_(camera), map_(map), truth_(truth), neighbours_(neighbours), judge_(scene, camera)
+    : scene_(scene), camera_(camera), map_(map), truth_(truth), neighbours_(neighbours),
+      judge_(scene, camera, mapTolerance())
 {
 }
 
@@ -67,7 +108,8 @@ MapPixel MapReader::read(int col, int row, bool search) const
     const glm::dvec2 pWindow = windowFromPixelCentre(camera_, col, row);
     const double value = map_.value[i];
     MapPixel out;
-    out.depth = windowDepthOfValue(camera_, pWindow, value, map_.quantity);
+    WindowDepthAt windowDepthOf(camera_, pWindow, map_.quantity);
+    out.depth = windowDepthOf(value);
     const double depth = out.depth;
     // The storage step, carried into window units through the quantity's mapping.
     const double reference = std::isfinite(depth) ? depth : truth_.windowDepth.value[i];
@@ -76,7 +118,7 @@ MapPixel MapReader::read(int col, int row, bool search) const
     } else if (std::isfinite(depth)) {
         const double step = map_.valueQuantum > 0 ? map_.valueQuantum
                                                   : double(std::nextafter(float(std::abs(value)), INFINITY)) - std::abs(double(float(value)));
-        const double other = windowDepthOfValue(camera_, pWindow, value + step, map_.quantity);
+        const double other = windowDepthOf(value + step);
         out.quantum = std::isfinite(other) ? std::max(std::abs(other - depth), storageQuantum(DepthFormat::Float32, depth))
                                            : storageQuantum(camera_.depth().format, depth);
     } else {
@@ -137,6 +179,13 @@ MapPixel MapReader::read(int col, int row, bool search) const
             seen.push_back(nearby);
             neighbours_.forEachNeighbour(nearby, consider);
         }
+    // None of them: a surface seen only within S of the centre (behind a ridge, say)?
+    if (closest == INFINITY)
+        neighbours_.forEachSeenNear(camera_, pWindow, judge_.snapPixels(), [&](std::uint32_t seenNear) {
+            if (std::find(seen.begin(), seen.end(), seenNear) != seen.end()) return;
+            seen.push_back(seenNear);
+            neighbours_.forEachNeighbour(seenNear, consider);
+        });
     out.primitive = primitive;
     return out;
 }
@@ -228,10 +277,10 @@ VerifyResult verifyAgainst(const Scene& scene, const Camera& camera, const Depth
     std::vector<double> quantum;
     run.map = renderResultFromMap(scene, camera, map, run.truth, neighbours, quantum);
     const auto start = std::chrono::steady_clock::now();
-    run.comparison = compareRoutes(scene, camera, run.truth, run.map, {}, &quantum);
+    run.comparison = compareRoutes(scene, camera, run.truth, run.map, mapTolerance(), &quantum);
     run.report.timings.compareMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     run.report.timings.traceMs = run.truth.renderMilliseconds;
-    run.report.describeInputs(scene, camera, {});  // compareRoutes ran with the default tolerance
+    run.report.describeInputs(scene, camera, mapTolerance());
     run.report.comparison = run.comparison.report;
     return run;
 }
@@ -246,38 +295,66 @@ VerifyResult Checker::verify(const Camera& camera, const DepthMap& map) const
 std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& map) const
 {
     requireMapFits(camera, map);
-    std::vector<Hypothesis> out;
-    // A hypothesis that only re-reads the map compares it with the truth as it is: rendered once.
-    std::optional<RenderResult> truth;
-    for (const Mistake& mistake : mistakeCatalogue()) {
-        if (!mistake.reread) continue;
-        for (const Rereading& reading : mistake.reread(camera, map)) {
-            // A variant that is not a valid camera (a near plane behind the eye) is no hypothesis.
-            try {
-                const Camera hypothesisCamera(reading.camera ? *reading.camera : camera.spec());
-                const DepthMap& hypothesisMap = reading.map ? *reading.map : map;
-                const bool sameTruth = !reading.camera && reading.truthFaults.none();
-                if (sameTruth && !truth) truth = renderRay(camera);
-                const RenderResult hypothesisTruth =
-                    sameTruth ? RenderResult{} : renderRay(hypothesisCamera, reading.truthFaults);
-                const RenderResult& truthUsed = sameTruth ? *truth : hypothesisTruth;
-                Hypothesis h{mistake.name, reading.variant, reading.explanation, false, 0};
-                // Most hypotheses are plainly wrong: a sample of the pixels that need the surface
-                // search proves it without searching them all (screenUnexplained).
-                if (const auto estimate = screenUnexplained(scene_, hypothesisCamera, hypothesisMap, truthUsed, neighbours())) {
-                    h.unexplained = *estimate, h.estimated = true;
-                } else {
-                    const VerifyResult run = verifyAgainst(scene_, hypothesisCamera, hypothesisMap, truthUsed, neighbours());
-                    // Consistent only where something is compared: a view that sees nothing does
-                    // not explain a map that holds nothing.
-                    const ComparisonReport& r = run.comparison.report;
-                    h.consistent = r.consistent() && r.bothHit > 0, h.unexplained = r.unexplained();
-                }
-                out.push_back(std::move(h));
-            } catch (const Error&) {
-            }
+    const RenderResult truth = renderRay(camera);
+    // One hypothesis judged: the truth through `hypothesisCamera` (rendered unless the same as
+    // the declared one), the map as re-read.
+    auto judge = [&](Hypothesis h, const Camera& hypothesisCamera, const DepthMap& hypothesisMap, bool sameTruth,
+                     const RayFaults& faults) {
+        const RenderResult hypothesisTruth = sameTruth ? RenderResult{} : renderRay(hypothesisCamera, faults);
+        const RenderResult& truthUsed = sameTruth ? truth : hypothesisTruth;
+        // Most hypotheses are plainly wrong: a sample of the pixels that need the surface
+        // search proves it without searching them all (screenUnexplained).
+        if (const auto estimate = screenUnexplained(scene_, hypothesisCamera, hypothesisMap, truthUsed, neighbours())) {
+            h.unexplained = *estimate, h.estimated = true;
+        } else {
+            const VerifyResult run = verifyAgainst(scene_, hypothesisCamera, hypothesisMap, truthUsed, neighbours());
+            // Consistent only where something is compared: a view that sees nothing does not
+            // explain a map that holds nothing.
+            const ComparisonReport& r = run.comparison.report;
+            h.consistent = r.consistent() && r.bothHit > 0, h.unexplained = r.unexplained();
         }
-    }
+        return h;
+    };
+    // The catalogue's readings, judged side by side (each judgement is parallel inside too;
+    // side by side they also overlap each other's serial parts).
+    std::vector<std::pair<const Mistake*, Rereading>> readings;
+    for (const Mistake& mistake : mistakeCatalogue())
+        if (mistake.reread)
+            for (Rereading& reading : mistake.reread(camera, map)) readings.emplace_back(&mistake, std::move(reading));
+    std::vector<std::optional<Hypothesis>> judged(readings.size());
+    tbb::parallel_for(std::size_t(0), readings.size(), [&](std::size_t k) {
+        const auto& [mistake, reading] = readings[k];
+        // A variant that is not a valid camera (a near plane behind the eye) is no hypothesis.
+        try {
+            const Camera hypothesisCamera(reading.camera ? *reading.camera : camera.spec());
+            const bool sameTruth = !reading.camera && reading.truthFaults.none();
+            judged[k] = judge({mistake->name, reading.variant, reading.explanation, false, 0, false, {}}, hypothesisCamera,
+                              reading.map ? *reading.map : map, sameTruth, reading.truthFaults);
+        } catch (const Error&) {
+        }
+    });
+    std::vector<Hypothesis> out;
+    for (auto& h : judged)
+        if (h) out.push_back(std::move(*h));
+    // The continuous families, fitted side by side, each confirmed by a full comparison.
+    const std::vector<FitFamily> families = fitFamilies(camera, map);
+    std::vector<std::optional<Hypothesis>> fitted(families.size());
+    const TruthRender render = [&](const Camera& c, const RayFaults& faults) { return renderRay(c, faults); };
+    tbb::parallel_for(std::size_t(0), families.size(), [&](std::size_t k) {
+        try {
+            const FitResult fit = fitDeparture(scene_, camera, map, truth, families[k], render);
+            const Camera fittedCamera(departedCameraSpec(camera, fit.departure));
+            Hypothesis h{toString(families[k]), "", "consistent with " + describeFit(camera, map, fit), false, 0, false, {}};
+            h.fitted = fittedValues(camera, map, fit);
+            fitted[k] = judge(std::move(h), fittedCamera, departedReading(camera, map, fit.departure), false, {});
+        } catch (const Error&) {
+        }
+    });
+    for (auto& h : fitted)
+        if (h) out.push_back(std::move(*h));
+    std::stable_sort(out.begin(), out.end(), [](const Hypothesis& a, const Hypothesis& b) {
+        return a.consistent != b.consistent ? a.consistent : a.unexplained < b.unexplained;
+    });
     return out;
 }
 

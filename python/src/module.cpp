@@ -511,6 +511,13 @@ py::list diagnosisList(const std::vector<Hypothesis>& hypotheses)
         d["consistent"] = h.consistent;
         d["unexplained"] = h.unexplained;
         d["unexplained_estimated"] = h.estimated;
+        py::list fitted;
+        for (const FittedValue& v : h.fitted) {
+            py::dict f;
+            f["name"] = v.name, f["value"] = v.value, f["declared"] = v.declared;
+            fitted.append(f);
+        }
+        d["fitted"] = fitted;
         out.append(d);
     }
     return out;
@@ -971,9 +978,14 @@ Returns a Report whose to_dict() is `zcheck verify --json`'s document (depth_map
             },
             py::arg("camera"), py::arg("depth"), py::arg("quantity"), py::kw_only(), py::arg("miss") = py::none(),
             py::arg("scale") = py::none(), py::arg("offset") = py::none(), py::arg("threads") = py::none(),
-            R"doc(Every hypothesis of the mistake catalogue that applies to this camera and map, in catalogue
-order, as dicts {hypothesis, variant, explanation, consistent, unexplained}: the consistent ones
-name what explains the map (e.g. "y-flip", "distance-as-eye-z"). Arguments as for verify().)doc")
+            R"doc(Every hypothesis of the mistake catalogue that applies to this camera and map, then every
+fitted family (sample-offset, field-of-view, near-far, depth-scale, intrinsics, pose), ranked:
+consistent ones first, then by unexplained pixels. Dicts {hypothesis, variant, explanation,
+consistent, unexplained, unexplained_estimated, fitted}; `fitted` lists a fit's measured
+parameters as {name, value, declared} (e.g. fovy_deg, sample_dx_px, near, value_scale) and
+its median relative depth residual ("residual": fitted vs declared camera). The consistent
+ones name what explains the map (e.g. "y-flip", "distance-as-eye-z", "sample-offset").
+Arguments as for verify().)doc")
         .def("__repr__", [](const Checker& c) {
             return "<zcheck.Checker scene '" + c.scene().name + "', " + std::to_string(c.scene().triangleCount()) +
                    " triangles>";

@@ -2,6 +2,7 @@
 
 #include "zcheck/error.h"
 #include "zcheck/camera_rays.h"
+#include "zcheck/inverse_projection.h"
 
 #include <embree3/rtcore.h>
 #include <tbb/blocked_range.h>
@@ -120,6 +121,25 @@ RayRenderer::RayRenderer(const Scene& scene) : embree_(std::make_unique<Embree>(
 }
 
 RayRenderer::~RayRenderer() = default;
+
+std::uint32_t RayRenderer::primitiveAt(const Camera& camera, const glm::dvec2& pWindow) const
+{
+    const EyePlaneRay r = worldEyePlaneRayThroughWindow(camera, pWindow);
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    alignas(16) RTCRayHit hit{};
+    hit.ray.org_x = float(r.origin.x - embree_->frameOrigin.x);
+    hit.ray.org_y = float(r.origin.y - embree_->frameOrigin.y);
+    hit.ray.org_z = float(r.origin.z - embree_->frameOrigin.z);
+    hit.ray.dir_x = float(r.direction.x), hit.ray.dir_y = float(r.direction.y), hit.ray.dir_z = float(r.direction.z);
+    hit.ray.tnear = float(r.tNear);
+    hit.ray.tfar = std::isinf(r.tFar) ? INFINITY : float(r.tFar);
+    hit.ray.mask = 0xFFFFFFFFu;
+    hit.hit.geomID = hit.hit.primID = RTC_INVALID_GEOMETRY_ID;
+    hit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(embree_->scene.get(), &context, &hit);
+    return hit.hit.geomID == RTC_INVALID_GEOMETRY_ID ? kNoPrimitive : hit.hit.primID;
+}
 
 RenderResult RayRenderer::render(const Camera& camera, const RayFaults& fault, EyePoints eyePoints) const
 {

@@ -61,7 +61,10 @@ nlohmann::json toJson(const CheckReport& report)
         {"tolerance",
          {{"subpixel_bits", report.tolerance.subpixelBits},
           {"constant_quanta", ToleranceModel::constantQuanta(report.camera.depth)},
-          {"rule", "|d_raster - d_ray| <= C*q + S*m (sum over both surfaces when they differ)"}}},
+          {"slope_credit", report.tolerance.slopeCredit == SlopeCredit::SampleOffset ? "sample-offset" : "vertex-snapping"},
+          {"rule", report.tolerance.slopeCredit == SlopeCredit::SampleOffset
+                       ? "|d_map - d_ray| <= C*q + S*m, m = |dd/dx| + |dd/dy| (sum over both surfaces when they differ)"
+                       : "|d_raster - d_ray| <= C*q + S*m, m = max(|dd/dx|, |dd/dy|) (sum over both surfaces when they differ)"}}},
         {"pixels",
          {{"total", std::int64_t(c.width) * c.height},
           {"both_hit", c.bothHit},
@@ -192,10 +195,14 @@ std::string verifyReportJson(const CheckReport& report, const DepthMapSource& so
                              {"miss", r.miss.given() ? nlohmann::json(r.miss.text()) : nlohmann::json(nullptr)}};
     if (diagnosis) {
         nlohmann::json list = nlohmann::json::array();
-        for (const auto& h : *diagnosis)
+        for (const auto& h : *diagnosis) {
+            nlohmann::json fitted = nlohmann::json::array();
+            for (const FittedValue& v : h.fitted)
+                fitted.push_back({{"name", v.name}, {"value", v.value}, {"declared", v.declared}});
             list.push_back({{"hypothesis", h.name}, {"variant", h.variant}, {"explanation", h.explanation},
                             {"consistent", h.consistent}, {"unexplained", h.unexplained},
-                            {"unexplained_estimated", h.estimated}});
+                            {"unexplained_estimated", h.estimated}, {"fitted", fitted}});
+        }
         document["diagnosis"] = list;
     }
     return prettyJson(document);

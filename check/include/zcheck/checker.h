@@ -90,6 +90,13 @@ struct VerifyResult {
     CheckReport report;
 };
 
+// A parameter a diagnosis measured: "fovy_deg", "sample_dx_px", "near", "value_scale", ...
+struct FittedValue {
+    std::string name;
+    double value = 0;      // fitted
+    double declared = 0;   // what the camera file or the reading says
+};
+
 // One hypothesis of the diagnosis: a mistake of the catalogue (mistakes.h), perhaps one of
 // several variants of it, under which the map was re-read or the truth re-rendered.
 struct Hypothesis {
@@ -100,6 +107,7 @@ struct Hypothesis {
     std::int64_t unexplained = 0;
     bool estimated = false;   // `unexplained` estimated from a sample that already ruled the
                               // hypothesis out (verify.h, screenUnexplained)
+    std::vector<FittedValue> fitted;  // a fitted hypothesis's values (fit.h); empty for the catalogue's
 };
 
 class VertexNeighbours;
@@ -136,7 +144,8 @@ public:
     // tolerance model; `map` must be camera.width() × camera.height() (throws Error otherwise).
     VerifyResult verify(const Camera& camera, const DepthMap& map) const;
     // Every hypothesis of the mistake catalogue that has a meaning for this camera and map,
-    // in catalogue order; the consistent ones name what explains the map.
+    // then every fitted family (fit.h), each confirmed by a full comparison; ranked: the
+    // consistent ones first, then by unexplained pixels, ties in that order.
     std::vector<Hypothesis> diagnose(const Camera& camera, const DepthMap& map) const;
 
     // Triangles around each vertex position, built on first use (verify's surface search).

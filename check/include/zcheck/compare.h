@@ -5,7 +5,9 @@
 //
 // Both hit, on the same primitive: consistent iff |d_raster − d_ray| ≤ C·q + S·m, where
 //   q = storage quantum at d_ray (1 LSB for unorm-N, 1 ulp of binary32 for float32),
-//   m = max(|∂d/∂x|, |∂d/∂y|), the window-depth slope of the hit plane per pixel,
+//   m = the window-depth slope of the hit plane per pixel: max(|∂d/∂x|, |∂d/∂y|) for the raster
+//       route (its vertices snap by at most S/2 in x and in y), |∂d/∂x| + |∂d/∂y| for a map
+//       rendered elsewhere (`verify`: its depth may be sampled up to S off the centre in both),
 //   S = 2^−subpixelBits (the rasterizer's vertex snapping, 2^−8 for 16.8 fixed point),
 //   C = 1 (unorm16), 4 (unorm24, float32), 8 (float32 with reversed-Z).
 // Both hit, on different primitives (adjacent triangles, or surfaces closer together than
@@ -61,8 +63,15 @@ std::string toString(PixelClass pixelClass);
 // DepthError, RayOnly and RasterOnly: the classes no tolerance explains.
 bool isUnexplained(PixelClass pixelClass);
 
+// What the slope credit S·m stands for (compare.h's m).
+enum class SlopeCredit {
+    VertexSnapping,  // the raster route: vertices snapped by at most S/2 per axis; m = max of the partials
+    SampleOffset,    // a map from elsewhere: depth sampled up to S off the centre per axis; m = their sum
+};
+
 struct ToleranceModel {
     int subpixelBits = 8;  // S = 2^−subpixelBits pixels
+    SlopeCredit slopeCredit = SlopeCredit::VertexSnapping;
 
     double snapPixels() const { return 1.0 / double(1 << subpixelBits); }
     // C, in storage quanta.
@@ -127,11 +136,12 @@ struct Comparison {
 // Window-depth slope m of a world-space triangle's plane, per pixel (may be +inf for a plane
 // seen edge-on), with what it needs of the camera computed once.
 struct DepthSlopeFrame {
-    explicit DepthSlopeFrame(const Camera& camera);
+    explicit DepthSlopeFrame(const Camera& camera, SlopeCredit credit = SlopeCredit::VertexSnapping);
     double slope(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) const;
 
     glm::dmat4 clipPlaneFromWorldPlane;  // transpose(worldFromClip)
     double zWindowPerZNdc, ndcPerPixelX, ndcPerPixelY;
+    SlopeCredit credit;
 };
 
 // The per-pixel rule above, in one place: the comparison applies it to the raster's surface,

@@ -21,10 +21,22 @@
 namespace zcheck {
 
 // Triangles around each vertex position (positions, not indices: loaders duplicate vertices),
-// for guessing which surface a map saw. Holds a reference to the scene. Immutable once built.
+// for guessing which surface a map saw, and, given the ray route, the triangles seen at points
+// near a pixel centre. Holds references to the scene and the renderer. Immutable once built.
 class VertexNeighbours {
 public:
-    explicit VertexNeighbours(const Scene& scene);
+    explicit VertexNeighbours(const Scene& scene, const RayRenderer* rays = nullptr);
+    // The triangles the ray route sees at the four corners of the box of half-side `reach`
+    // pixels around pWindow (none without a ray renderer): surfaces a sample that close to the
+    // centre may show that no neighbouring pixel shows (the far side of a ridge).
+    template <class Visit>
+    void forEachSeenNear(const Camera& camera, const glm::dvec2& pWindow, double reach, Visit&& visit) const
+    {
+        if (!rays_) return;
+        for (const glm::dvec2 corner : {glm::dvec2(-reach, -reach), glm::dvec2(reach, -reach), glm::dvec2(-reach, reach),
+                                        glm::dvec2(reach, reach)})
+            if (const std::uint32_t seen = rays_->primitiveAt(camera, pWindow + corner); seen != kNoPrimitive) visit(seen);
+    }
     // `primitive` and every triangle that shares a vertex position with it.
     template <class Visit>
     void forEachNeighbour(std::uint32_t primitive, Visit&& visit) const
@@ -36,8 +48,18 @@ public:
 private:
     static std::string key(const glm::vec3& p);
     const Scene& scene_;
+    const RayRenderer* rays_;
     std::unordered_map<std::string, std::vector<std::uint32_t>> around_;
 };
+
+// The tolerance a map rendered elsewhere is judged with: the default, its slope credit for a
+// depth sampled up to S off the pixel centre in each axis (compare.h).
+inline ToleranceModel mapTolerance()
+{
+    ToleranceModel model;
+    model.slopeCredit = SlopeCredit::SampleOffset;
+    return model;
+}
 
 // One pixel of a map as the raster side of a comparison sees it.
 struct MapPixel {

@@ -51,6 +51,10 @@ public:
     // EyePoints::Keep also fills RenderResult::pEye (24 bytes per pixel more).
     RenderResult render(const Camera& camera, const RayFaults& faults = {}, EyePoints eyePoints = EyePoints::Omit) const;
 
+    // The triangle the viewing ray through one window point hits first (kNoPrimitive on a
+    // miss), traced alone: for questions about single points, not for images.
+    std::uint32_t primitiveAt(const Camera& camera, const glm::dvec2& pWindow) const;
+
     double buildMilliseconds() const { return buildMilliseconds_; }
 
 private:

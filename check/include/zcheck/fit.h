@@ -1,0 +1,88 @@
+#pragma once
+// The continuous half of the diagnosis: which camera and reading, departing a little from the
+// declared ones, best explain a depth map — measured, not guessed from a list.
+//
+// A Departure describes a renderer's camera and reading relative to the declared camera:
+// where in the pixel the depth was sampled, the projection's focal scale and principal point,
+// near and far, a scale and offset on the values, and a small pose error. fitDeparture fits
+// one family of these parameters (FitFamily) by robust least squares:
+//
+//   model     At each sample pixel the ground truth shows a surface; its plane is kept. The
+//             departed camera's ray through the pixel's (offset) sample point meets that plane,
+//             and the declared quantity of that point under the departed camera, scaled and
+//             offset, is what the map should hold there. Exact for every pixel whose surface
+//             stays the same plane; pixels near edges and occlusion changes break it, so
+//   weights   are Cauchy's, 1/(1 + (r/c)²) with c = 2.4 × the residuals' robust spread (MAD),
+//             refreshed every step, and only pixels whose 3×3 neighbourhood lies on one plane
+//             are sampled (at most 4096, evenly spaced).
+//   residual  (predicted − map) / (the value's change for a relative eye-z change of 1): a
+//             relative eye depth, the same unit for every quantity.
+//   solver    Levenberg–Marquardt on the weighted normal equations, forward-difference
+//             Jacobian; then the truth is re-rendered through the fitted camera (new planes
+//             where surfaces moved) and the fit repeated, three rounds at most.
+//
+// Checker::diagnose then confirms each fitted camera with the full comparison.
+#include "zcheck/checker.h"
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace zcheck {
+
+struct Departure {
+    glm::dvec2 sampleOffset{0.0};      // image pixels (x right, y down) from the pixel centre to the sample
+    glm::dvec2 focalScale{1.0, 1.0};   // eye x and y scaled before the projection (focal lengths): > 1 is narrower
+    glm::dvec2 principalShift{0.0};    // image pixels (x right, y down) the principal point moved
+    double nearDistance = 0, farDistance = 0;  // 0: as declared (only window and NDC maps see them)
+    double valueScale = 1, valueOffset = 0;    // map value = valueScale · value + valueOffset
+    glm::dvec3 eyeShift{0.0};          // eye-space translation composed after the view (scene units)
+    glm::dvec3 eyeTurn{0.0};           // eye-space rotation vector composed after the view (radians)
+};
+
+// The camera a departure describes: a raw-matrix projection when the intrinsics, the sample
+// offset (as the image moved the other way: what the camera sees at its pixel centres is then
+// what the declared one saw at the samples) or near and far move, a raw view when the pose
+// moves, otherwise the declared spec. Throws Error where it is no valid camera.
+CameraSpec departedCameraSpec(const Camera& declared, const Departure& departure);
+// The sample offset alone as the ray route's fault (window coordinates): a renderer sampling
+// off the pixel centres through the declared camera (zcheck export --sample-offset).
+RayFaults departedSampling(const Camera& declared, const Departure& departure);
+// The map as it reads once that departure's value scale and offset are undone: (v − offset) /
+// scale, its misses (as the declared camera reads them) kept as misses.
+DepthMap departedReading(const Camera& declared, const DepthMap& map, const Departure& departure);
+
+enum class FitFamily {
+    SampleOffset,  // (dx, dy): where in the pixel depth was sampled, whole-pixel shifts included
+    FieldOfView,   // one focal scale: fovy, focal length, fx = fy, a frustum's or box's extent
+    Intrinsics,    // focal scales in x and y (aspect) and the principal point
+    NearFar,       // near and far (window and NDC maps, cameras with a model)
+    DepthScale,    // a scale and offset on the values (units, a PNG's scale, an origin)
+    Pose,          // a small error of eye position and orientation
+};
+std::string toString(FitFamily family);
+// The families that have a meaning for this camera and map.
+std::vector<FitFamily> fitFamilies(const Camera& camera, const DepthMap& map);
+
+struct FitResult {
+    FitFamily family = FitFamily::SampleOffset;
+    Departure departure;
+    double initialResidual = 0;  // robust RMS relative depth residual under the declared camera
+    double residual = 0;         // the same after the fit
+    std::size_t samples = 0;     // sample pixels in the last round
+};
+
+// Renders the ground truth through a camera with a sampling fault (Checker::renderRay).
+using TruthRender = std::function<RenderResult(const Camera&, const RayFaults&)>;
+
+// Fits one family. `truth` is the declared camera's ground truth (the first round's planes).
+FitResult fitDeparture(const Scene& scene, const Camera& camera, const DepthMap& map, const RenderResult& truth,
+                       FitFamily family, const TruthRender& render);
+
+// What a fit found, in the camera's own terms, for people ("a vertical field of view of
+// 61.5° instead of 60°") and as named values (FittedValue, checker.h) for --json; the last
+// value is the residual, fitted against declared.
+std::string describeFit(const Camera& camera, const DepthMap& map, const FitResult& fit);
+std::vector<FittedValue> fittedValues(const Camera& camera, const DepthMap& map, const FitResult& fit);
+
+}  // namespace zcheck

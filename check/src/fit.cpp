@@ -1,0 +1,605 @@
+#include "zcheck/fit.h"
+
+#include "zcheck/error.h"
+#include "zcheck/inverse_projection.h"
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <optional>
+
+namespace zcheck {
+
+namespace {
+
+// Image y (down) → window y: +1 where the window's origin is at the top, −1 at the bottom.
+double windowYPerImageY(const Camera& camera) { return camera.windowYFromImageY(1) - camera.windowYFromImageY(0); }
+
+glm::dvec2 windowFromImageOffset(const Camera& camera, const glm::dvec2& image)
+{
+    return {image.x, windowYPerImageY(camera) * image.y};
+}
+
+// The map's value of the eye-space point under `camera`, as `quantity`.
+double valueOfEyePoint(const Camera& camera, const glm::dvec3& pEye, DepthQuantity quantity)
+{
+    switch (quantity) {
+    case DepthQuantity::Window: return windowFromEye(camera, pEye).z;
+    case DepthQuantity::Ndc: return camera.ndcZFromWindowDepth(windowFromEye(camera, pEye).z);
+    case DepthQuantity::EyeZ: return camera.eyeZOf(pEye);
+    case DepthQuantity::Distance: return distanceOfEyePoint(camera, pEye);
+    }
+    return NAN;
+}
+
+double valueOfEyeZ(const Camera& camera, const glm::dvec2& pWindow, double eyeZ, DepthQuantity quantity)
+{
+    switch (quantity) {
+    case DepthQuantity::Window: return windowDepthFromEyeZ(camera, pWindow, eyeZ);
+    case DepthQuantity::Ndc: return camera.ndcZFromWindowDepth(windowDepthFromEyeZ(camera, pWindow, eyeZ));
+    case DepthQuantity::EyeZ: return eyeZ;
+    case DepthQuantity::Distance: return distanceFromEyeZ(camera, pWindow, eyeZ);
+    }
+    return NAN;
+}
+
+bool isMissValue(const Camera& camera, const glm::dvec2& pWindow, double value, DepthQuantity quantity)
+{
+    return !eyePointFromDepth(camera, pWindow, value, quantity);
+}
+
+// One sample pixel: the plane the truth shows there, the map's value and the value's scale.
+struct Sample {
+    int col, row;
+    glm::dvec3 normal;  // world plane normal·x = offset
+    double offset;
+    double mapValue;
+    double sigma;  // value change per relative eye-z change
+};
+
+struct Problem {
+    const Camera& camera;
+    const DepthMap& map;
+    FitFamily family;
+    Departure base;       // the round's starting point; parameters are departures from it
+    double sceneDepth;    // median eye-z of the samples (pose translations are in its units)
+    double valueSpan;     // median |map value| (value offsets are in its units)
+    std::vector<Sample> samples;
+
+    int parameterCount() const
+    {
+        switch (family) {
+        case FitFamily::SampleOffset: return 2;
+        case FitFamily::FieldOfView: return 1;
+        case FitFamily::Intrinsics: return 4;
+        case FitFamily::NearFar: return 2;
+        case FitFamily::DepthScale: return 2;
+        case FitFamily::Pose: return 6;
+        }
+        return 0;
+    }
+
+    // The departure at parameters p (dimensionless: pixels, relative scales, radians,
+    // fractions of the scene's depth or of the values' size).
+    Departure at(const std::vector<double>& p) const
+    {
+        Departure d = base;
+        switch (family) {
+        case FitFamily::SampleOffset: d.sampleOffset += glm::dvec2(p[0], p[1]); break;
+        case FitFamily::FieldOfView: d.focalScale *= 1 + p[0]; break;
+        case FitFamily::Intrinsics:
+            d.focalScale *= glm::dvec2(1 + p[0], 1 + p[1]);
+            d.principalShift += glm::dvec2(p[2], p[3]);
+            break;
+        case FitFamily::NearFar:
+            d.nearDistance = (d.nearDistance > 0 ? d.nearDistance : camera.nearDistance()) * std::exp(p[0]);
+            d.farDistance = (d.farDistance > 0 ? d.farDistance : camera.farDistance()) * std::exp(p[1]);
+            break;
+        case FitFamily::DepthScale:
+            d.valueScale *= 1 + p[0];
+            d.valueOffset += p[1] * valueSpan;
+            break;
+        case FitFamily::Pose:
+            d.eyeShift += glm::dvec3(p[0], p[1], p[2]) * sceneDepth;
+            d.eyeTurn += glm::dvec3(p[3], p[4], p[5]);
+            break;
+        }
+        return d;
+    }
+
+    // Residuals (predicted − map) / sigma at the departure; empty where it is no camera.
+    std::vector<double> residuals(const Departure& d) const
+    {
+        std::optional<Camera> departed;
+        try {
+            departed.emplace(departedCameraSpec(camera, d));
+        } catch (const Error&) {
+            return {};
+        }
+        const Camera& c = *departed;  // its image moved by the sample offset (departedCameraSpec)
+        std::vector<double> r(samples.size());
+        tbb::parallel_for(std::size_t(0), samples.size(), [&](std::size_t k) {
+            const Sample& s = samples[k];
+            const EyePlaneRay ray = worldEyePlaneRayThroughWindow(c, windowFromPixelCentre(c, s.col, s.row));
+            const double t = (s.offset - glm::dot(s.normal, ray.origin)) / glm::dot(s.normal, ray.direction);
+            const glm::dvec3 pEye(c.eyeFromWorld * glm::dvec4(ray.origin + t * ray.direction, 1.0));
+            const double predicted = d.valueScale * valueOfEyePoint(c, pEye, map.quantity) + d.valueOffset;
+            r[k] = (predicted - s.mapValue) / s.sigma;
+            if (!std::isfinite(r[k])) r[k] = 1e30;
+        });
+        return r;
+    }
+};
+
+double medianOf(std::vector<double> v)
+{
+    if (v.empty()) return 0;
+    const auto middle = v.begin() + std::ptrdiff_t(v.size() / 2);
+    std::nth_element(v.begin(), middle, v.end());
+    return *middle;
+}
+
+double medianAbsolute(const std::vector<double>& r)
+{
+    std::vector<double> a(r.size());
+    std::transform(r.begin(), r.end(), a.begin(), [](double x) { return std::abs(x); });
+    return medianOf(std::move(a));
+}
+
+// Cauchy's robust cost at scale c.
+double robustCost(const std::vector<double>& r, double c)
+{
+    if (r.empty()) return INFINITY;
+    double sum = 0;
+    for (double x : r) sum += std::log1p((x / c) * (x / c));
+    return sum;
+}
+
+// Solves A·x = b (n ≤ 6) by Gaussian elimination with partial pivoting; false if singular.
+bool solve(std::vector<double> A, std::vector<double> b, int n, std::vector<double>& x)
+{
+    for (int col = 0; col < n; ++col) {
+        int pivot = col;
+        for (int row = col + 1; row < n; ++row)
+            if (std::abs(A[row * n + col]) > std::abs(A[pivot * n + col])) pivot = row;
+        if (!(std::abs(A[pivot * n + col]) > 0)) return false;
+        for (int k = 0; k < n; ++k) std::swap(A[col * n + k], A[pivot * n + k]);
+        std::swap(b[col], b[pivot]);
+        for (int row = col + 1; row < n; ++row) {
+            const double f = A[row * n + col] / A[col * n + col];
+            for (int k = col; k < n; ++k) A[row * n + k] -= f * A[col * n + k];
+            b[row] -= f * b[col];
+        }
+    }
+    x.assign(n, 0);
+    for (int row = n - 1; row >= 0; --row) {
+        double sum = b[row];
+        for (int k = row + 1; k < n; ++k) sum -= A[row * n + k] * x[k];
+        x[row] = sum / A[row * n + row];
+    }
+    return std::all_of(x.begin(), x.end(), [](double v) { return std::isfinite(v); });
+}
+
+// The robust scale of the residuals: 2.4 × their MAD-estimated spread, floored at binary32's
+// resolution (a map that matches exactly would otherwise weigh its rounding).
+double cauchyScale(const std::vector<double>& r) { return std::max(2.4 * 1.4826 * medianAbsolute(r), 1e-7); }
+
+// Levenberg–Marquardt from the problem's base; returns the departure reached.
+Departure levenbergMarquardt(const Problem& problem)
+{
+    const int n = problem.parameterCount();
+    std::vector<double> p(static_cast<std::size_t>(n), 0.0);
+    std::vector<double> r = problem.residuals(problem.at(p));
+    if (r.empty()) return problem.base;
+    double lambda = 1e-3;
+    constexpr double h = 1e-6;
+    for (int iteration = 0; iteration < 30; ++iteration) {
+        const double c = cauchyScale(r);
+        const double cost = robustCost(r, c);
+        // Weighted normal equations with a forward-difference Jacobian.
+        std::vector<std::vector<double>> J(static_cast<std::size_t>(n));
+        for (int j = 0; j < n; ++j) {
+            std::vector<double> q = p;
+            q[std::size_t(j)] += h;
+            J[std::size_t(j)] = problem.residuals(problem.at(q));
+            if (J[std::size_t(j)].empty()) return problem.at(p);
+            for (std::size_t k = 0; k < r.size(); ++k) J[std::size_t(j)][k] = (J[std::size_t(j)][k] - r[k]) / h;
+        }
+        std::vector<double> A(std::size_t(n * n), 0.0), g(std::size_t(n), 0.0);
+        for (std::size_t k = 0; k < r.size(); ++k) {
+            const double w = 1 / (1 + (r[k] / c) * (r[k] / c));
+            for (int a = 0; a < n; ++a) {
+                g[std::size_t(a)] -= w * J[std::size_t(a)][k] * r[k];
+                for (int b = 0; b < n; ++b) A[std::size_t(a * n + b)] += w * J[std::size_t(a)][k] * J[std::size_t(b)][k];
+            }
+        }
+        bool improved = false;
+        std::vector<double> step;
+        while (lambda < 1e10) {
+            std::vector<double> damped = A;
+            for (int a = 0; a < n; ++a) damped[std::size_t(a * n + a)] *= 1 + lambda;
+            if (solve(damped, g, n, step)) {
+                std::vector<double> q = p;
+                for (int a = 0; a < n; ++a) q[std::size_t(a)] += step[std::size_t(a)];
+                std::vector<double> rq = problem.residuals(problem.at(q));
+                if (robustCost(rq, c) < cost) {
+                    p = std::move(q), r = std::move(rq), lambda = std::max(lambda / 4, 1e-9), improved = true;
+                    break;
+                }
+            }
+            lambda *= 8;
+        }
+        double size = 0;
+        for (double s : step) size = std::max(size, std::abs(s));
+        if (!improved) break;
+        if (size < 1e-6) break;  // a millionth of a pixel, of a scale, of the depth: converged
+    }
+    return problem.at(p);
+}
+
+// The sample pixels of a truth render: hit, with a map value, and a 3×3 neighbourhood on the
+// pixel's plane (relative eye depth within 1e-3), at most 4096 evenly spaced.
+std::vector<Sample> samplesOf(const Scene& scene, const Camera& declared, const Camera& departed,
+                              const DepthMap& map, const RenderResult& truth)
+{
+    const int W = declared.width(), H = declared.height();
+    const int stride = std::max(1, int(std::sqrt(double(W) * H / 16384.0)));
+    std::vector<std::vector<Sample>> ofRow(static_cast<std::size_t>(H));
+    tbb::parallel_for(1, H - 1, [&](int row) {
+        if (row % stride != 0) return;
+        for (int col = 1; col < W - 1; col += stride) {
+            const std::size_t i = std::size_t(row) * W + col;
+            if (!truth.hit(i)) continue;
+            const glm::dvec2 pWindow = windowFromPixelCentre(declared, col, row);
+            if (isMissValue(declared, pWindow, map.value[i], map.quantity)) continue;
+            const glm::uvec3 t = scene.triangles[truth.primitiveId[i]];
+            const glm::dvec3 a(scene.positions[t[0]]), b(scene.positions[t[1]]), c(scene.positions[t[2]]);
+            const glm::dvec3 normal = glm::cross(b - a, c - a);
+            // On a plane, window depth is affine in window x and y: its second differences
+            // across the pixel vanish (up to rounding) in x, y and both diagonals.
+            bool planar = true;
+            auto depthAt = [&](int dx, int dy) {
+                const std::size_t j = std::size_t(row + dy) * W + (col + dx);
+                if (!truth.hit(j)) planar = false;
+                return truth.windowDepth.value[j];
+            };
+            const double centre = truth.windowDepth.value[i];
+            for (const auto& [dx, dy] : {std::pair{1, 0}, std::pair{0, 1}, std::pair{1, 1}, std::pair{1, -1}}) {
+                const double before = depthAt(-dx, -dy), after = depthAt(dx, dy);
+                const double bend = std::abs(before - 2 * centre + after), rise = std::abs(after - before);
+                if (!(bend <= 1e-3 * rise + 1e-12)) planar = false;
+            }
+            if (!planar) continue;
+            const double z = eyeZFromWindowDepth(departed, windowFromPixelCentre(departed, col, row), truth.windowDepth.value[i]);
+            const double v0 = valueOfEyeZ(declared, pWindow, z, map.quantity);
+            const double v1 = valueOfEyeZ(declared, pWindow, z * (1 + 1e-6), map.quantity);
+            const double sigma = std::abs(v1 - v0) / 1e-6;
+            if (!(sigma > 0) || !std::isfinite(sigma)) continue;
+            ofRow[std::size_t(row)].push_back({col, row, normal, glm::dot(normal, a), map.value[i], sigma});
+        }
+    });
+    std::vector<Sample> all;
+    for (auto& row : ofRow) all.insert(all.end(), row.begin(), row.end());
+    constexpr std::size_t kMost = 4096;
+    if (all.size() <= kMost) return all;
+    std::vector<Sample> kept;
+    kept.reserve(kMost);
+    for (std::size_t k = 0; k < kMost; ++k) kept.push_back(all[k * all.size() / kMost]);
+    return kept;
+}
+
+bool isRawMatrix(const Camera& camera) { return camera.spec().projection.type == ProjectionType::Matrix; }
+
+}  // namespace
+
+CameraSpec departedCameraSpec(const Camera& declared, const Departure& d)
+{
+    CameraSpec spec = declared.spec();
+    const bool nearFarMove = d.nearDistance > 0 || d.farDistance > 0;
+    if (nearFarMove) {
+        if (isRawMatrix(declared)) throw Error("a raw projection matrix has no near and far to move");
+        if (d.nearDistance > 0) spec.projection.near = d.nearDistance;
+        if (d.farDistance > 0) spec.projection.far = d.farDistance;
+    }
+    // Sampling at pixel centre + offset sees what a camera whose image moved by −offset sees at
+    // the centre: eye-z, distance and window depth are the same, and the comparison then judges
+    // every pixel (its depth conversion, its edges) at the point that was sampled.
+    const glm::dvec2 imageShift = d.principalShift - d.sampleOffset;
+    if (d.focalScale != glm::dvec2(1.0) || imageShift != glm::dvec2(0.0)) {
+        // The focal lengths scale eye x and y (the principal point stays: an off-axis frustum's
+        // bounds scale about the axis), and the principal point moves the image by tx·w in clip
+        // space (ndcFromWindow's scale turns pixels into NDC).
+        const Camera withNearFar(spec);
+        glm::dmat4 m = withNearFar.clipFromEye;
+        m[0] *= d.focalScale.x, m[1] *= d.focalScale.y;
+        const glm::dvec2 shift = windowFromImageOffset(declared, imageShift);
+        const double tx = shift.x * declared.ndcFromWindow[0][0], ty = shift.y * declared.ndcFromWindow[1][1];
+        for (int c = 0; c < 4; ++c) m[c][0] += tx * m[c][3], m[c][1] += ty * m[c][3];
+        spec.projection.type = ProjectionType::Matrix;
+        spec.projection.clipFromEye = m;
+    }
+    if (d.eyeShift != glm::dvec3(0.0) || d.eyeTurn != glm::dvec3(0.0)) {
+        const double angle = glm::length(d.eyeTurn);
+        glm::dmat4 turn(1.0);
+        if (angle > 0) turn = glm::rotate(glm::dmat4(1.0), angle, d.eyeTurn / angle);
+        glm::dmat4 move(1.0);
+        move[3] = glm::dvec4(d.eyeShift, 1.0);
+        spec.view.hasMatrix = true;
+        spec.view.eyeFromWorld = move * turn * declared.eyeFromWorld;
+    }
+    return spec;
+}
+
+RayFaults departedSampling(const Camera& declared, const Departure& departure)
+{
+    RayFaults faults;
+    faults.shiftPixels = windowFromImageOffset(declared, departure.sampleOffset);
+    return faults;
+}
+
+DepthMap departedReading(const Camera& declared, const DepthMap& map, const Departure& d)
+{
+    DepthMap out = map;
+    if (d.valueScale == 1 && d.valueOffset == 0) return out;
+    for (int row = 0; row < map.height; ++row)
+        for (int col = 0; col < map.width; ++col) {
+            double& v = out.value[std::size_t(row) * map.width + col];
+            v = isMissValue(declared, windowFromPixelCentre(declared, col, row), v, map.quantity)
+                    ? NAN
+                    : (v - d.valueOffset) / d.valueScale;
+        }
+    if (out.valueQuantum > 0) out.valueQuantum /= std::abs(d.valueScale);
+    return out;
+}
+
+std::string toString(FitFamily family)
+{
+    switch (family) {
+    case FitFamily::SampleOffset: return "sample-offset";
+    case FitFamily::FieldOfView: return "field-of-view";
+    case FitFamily::Intrinsics: return "intrinsics";
+    case FitFamily::NearFar: return "near-far";
+    case FitFamily::DepthScale: return "depth-scale";
+    case FitFamily::Pose: return "pose";
+    }
+    return "?";
+}
+
+std::vector<FitFamily> fitFamilies(const Camera& camera, const DepthMap& map)
+{
+    // Fewest parameters first: the diagnosis ranks equally good fits in this order.
+    std::vector<FitFamily> out = {FitFamily::FieldOfView, FitFamily::SampleOffset};
+    const bool windowLike = map.quantity == DepthQuantity::Window || map.quantity == DepthQuantity::Ndc;
+    if (windowLike && !isRawMatrix(camera) && !camera.farIsInfinite()) out.push_back(FitFamily::NearFar);
+    out.push_back(FitFamily::DepthScale);
+    out.push_back(FitFamily::Intrinsics);
+    out.push_back(FitFamily::Pose);
+    return out;
+}
+
+FitResult fitDeparture(const Scene& scene, const Camera& camera, const DepthMap& map, const RenderResult& truth,
+                       FitFamily family, const TruthRender& render)
+{
+    FitResult out;
+    out.family = family;
+    Departure d;
+    std::optional<RenderResult> rendered;  // the truth through the departed camera, from round 2
+    double previous = 0;                   // the last round's residual
+    for (int round = 0; round < 3; ++round) {
+        const Camera departed(departedCameraSpec(camera, d));
+        Problem problem{camera, map, family, d, 1, 1, samplesOf(scene, camera, departed, map, rendered ? *rendered : truth)};
+        if (problem.samples.size() < 16) break;
+        std::vector<double> depths, values;
+        for (const Sample& s : problem.samples) {
+            values.push_back(std::abs(s.mapValue));
+            depths.push_back(std::abs(s.sigma));  // for eye-z maps sigma is the depth itself
+        }
+        problem.valueSpan = std::max(medianOf(values), 1e-12);
+        problem.sceneDepth = 1;
+        {
+            // The median eye depth of the samples, for the pose's translations.
+            std::vector<double> z;
+            for (const Sample& s : problem.samples) {
+                const glm::dvec2 pWindow = windowFromPixelCentre(departed, s.col, s.row);
+                const EyePlaneRay ray = worldEyePlaneRayThroughWindow(departed, pWindow);
+                const double t = (s.offset - glm::dot(s.normal, ray.origin)) / glm::dot(s.normal, ray.direction);
+                z.push_back(std::abs(departed.eyeZOf(glm::dvec3(departed.eyeFromWorld * glm::dvec4(ray.origin + t * ray.direction, 1.0)))));
+            }
+            problem.sceneDepth = std::max(medianOf(z), 1e-12);
+        }
+        if (round == 0) out.initialResidual = medianAbsolute(problem.residuals(d));
+        if (family == FitFamily::SampleOffset && round == 0) {
+            // Whole-pixel shifts first: the best of the offsets within two pixels.
+            double best = INFINITY;
+            Departure start = d;
+            for (int dy = -2; dy <= 2; ++dy)
+                for (int dx = -2; dx <= 2; ++dx) {
+                    Departure trial = d;
+                    trial.sampleOffset = glm::dvec2(dx, dy);
+                    const std::vector<double> r = problem.residuals(trial);
+                    const double cost = robustCost(r, 1e-3);
+                    if (cost < best) best = cost, start = trial;
+                }
+            problem.base = start;
+        }
+        const Departure next = levenbergMarquardt(problem);
+        out.samples = problem.samples.size();
+        out.residual = medianAbsolute(problem.residuals(next));
+        const bool moved = glm::length(next.sampleOffset - d.sampleOffset) > 1e-4 ||
+                           glm::length(next.focalScale - d.focalScale) > 1e-6 ||
+                           glm::length(next.principalShift - d.principalShift) > 1e-4 ||
+                           glm::length(next.eyeShift - d.eyeShift) > 1e-6 * problem.sceneDepth ||
+                           glm::length(next.eyeTurn - d.eyeTurn) > 1e-7 || next.nearDistance != d.nearDistance ||
+                           next.farDistance != d.farDistance;
+        const double before = round == 0 ? out.initialResidual : previous;
+        previous = out.residual;
+        d = next;
+        // Another round (new planes where surfaces moved) only for a fit that explains much of
+        // the map and still improves; a scale and offset move no surface.
+        if (!moved || family == FitFamily::DepthScale || out.residual > 0.5 * out.initialResidual ||
+            out.residual > 0.9 * before)
+            break;
+        try {
+            rendered = render(Camera(departedCameraSpec(camera, d)), RayFaults{});
+        } catch (const Error&) {
+            break;
+        }
+    }
+    out.departure = d;
+    return out;
+}
+
+namespace {
+
+std::string signedNumber(double v, int digits = 4)
+{
+    char text[32];
+    std::snprintf(text, sizeof text, "%+.*g", digits, std::abs(v) < 5e-13 ? 0.0 : v);
+    return text;
+}
+
+std::string number(double v, int digits = 4)
+{
+    char text[32];
+    std::snprintf(text, sizeof text, "%.*g", digits, v);
+    return text;
+}
+
+// The standard sample positions of 4× and 8× multisampling (Direct3D and Vulkan's, in 1/16
+// pixel, x right, y down) the offset matches within 1/64 px, as "sample k of N× MSAA".
+std::string msaaSampleOf(const glm::dvec2& offset)
+{
+    static const int four[4][2] = {{-2, -6}, {6, -2}, {-6, 2}, {2, 6}};
+    static const int eight[8][2] = {{1, -3}, {-1, 3}, {5, 1}, {-3, -5}, {-5, 5}, {-7, -1}, {3, 7}, {7, -7}};
+    auto near = [&](const int p[2]) { return std::abs(offset.x - p[0] / 16.0) < 1.0 / 64 && std::abs(offset.y - p[1] / 16.0) < 1.0 / 64; };
+    if (std::abs(offset.x) < 1.0 / 64 && std::abs(offset.y) < 1.0 / 64) return "";
+    for (int k = 0; k < 4; ++k)
+        if (near(four[k])) return "sample " + std::to_string(k) + " of 4× MSAA's standard pattern";
+    for (int k = 0; k < 8; ++k)
+        if (near(eight[k])) return "sample " + std::to_string(k) + " of 8× MSAA's standard pattern";
+    return "";
+}
+
+glm::dvec3 eyePositionOf(const glm::dmat4& eyeFromWorld) { return glm::dvec3(glm::inverse(eyeFromWorld)[3]); }
+
+}  // namespace
+
+std::vector<FittedValue> fittedValues(const Camera& camera, const DepthMap&, const FitResult& fit)
+{
+    const Departure& d = fit.departure;
+    const Projection& p = camera.spec().projection;
+    std::vector<FittedValue> out;
+    switch (fit.family) {
+    case FitFamily::SampleOffset:
+        out = {{"sample_dx_px", d.sampleOffset.x, 0}, {"sample_dy_px", d.sampleOffset.y, 0}};
+        break;
+    case FitFamily::FieldOfView: {
+        const double k = d.focalScale.x;
+        out.push_back({"focal_scale", k, 1});
+        if (p.type == ProjectionType::Perspective)
+            out.push_back({"fovy_deg", glm::degrees(2 * std::atan(std::tan(glm::radians(p.fovyDeg) / 2) / k)), p.fovyDeg});
+        if (p.type == ProjectionType::Lens) out.push_back({"focal_mm", p.focalMm * k, p.focalMm});
+        if (p.type == ProjectionType::Pinhole) out.push_back({"fx", p.fx * k, p.fx}), out.push_back({"fy", p.fy * k, p.fy});
+        break;
+    }
+    case FitFamily::Intrinsics:
+        out = {{"focal_scale_x", d.focalScale.x, 1},
+               {"focal_scale_y", d.focalScale.y, 1},
+               {"principal_dx_px", d.principalShift.x, 0},
+               {"principal_dy_px", d.principalShift.y, 0}};
+        if (p.type == ProjectionType::Pinhole) {
+            out.push_back({"fx", p.fx * d.focalScale.x, p.fx});
+            out.push_back({"fy", p.fy * d.focalScale.y, p.fy});
+            out.push_back({"cx", p.cx + d.principalShift.x, p.cx});
+            out.push_back({"cy", p.cy + d.principalShift.y, p.cy});
+        }
+        break;
+    case FitFamily::NearFar:
+        out = {{"near", d.nearDistance > 0 ? d.nearDistance : camera.nearDistance(), camera.nearDistance()},
+               {"far", d.farDistance > 0 ? d.farDistance : camera.farDistance(), camera.farDistance()}};
+        break;
+    case FitFamily::DepthScale: out = {{"value_scale", d.valueScale, 1}, {"value_offset", d.valueOffset, 0}}; break;
+    case FitFamily::Pose: {
+        const glm::dvec3 eye = eyePositionOf(camera.eyeFromWorld);
+        const glm::dvec3 moved = eyePositionOf(departedCameraSpec(camera, d).view.eyeFromWorld);
+        out = {{"eye_x", moved.x, eye.x},
+               {"eye_y", moved.y, eye.y},
+               {"eye_z", moved.z, eye.z},
+               {"turn_deg", glm::degrees(glm::length(d.eyeTurn)), 0}};
+        break;
+    }
+    }
+    out.push_back({"residual", fit.residual, fit.initialResidual});
+    return out;
+}
+
+std::string describeFit(const Camera& camera, const DepthMap& map, const FitResult& fit)
+{
+    const Departure& d = fit.departure;
+    const Projection& p = camera.spec().projection;
+    switch (fit.family) {
+    case FitFamily::SampleOffset: {
+        const glm::dvec2 whole = glm::round(d.sampleOffset);
+        const glm::dvec2 within = d.sampleOffset - whole;
+        std::string text = "depth sampled at (" + signedNumber(within.x, 3) + ", " + signedNumber(within.y, 3) +
+                           ") px from the pixel centre (x right, y down)";
+        if (const std::string msaa = msaaSampleOf(within); !msaa.empty()) text += " — " + msaa;
+        if (whole != glm::dvec2(0.0))
+            text += (within == glm::dvec2(0.0) ? "" : ",") + std::string(" the image shifted by (") +
+                    signedNumber(whole.x) + ", " + signedNumber(whole.y) + ") px";
+        return text;
+    }
+    case FitFamily::FieldOfView: {
+        const double k = d.focalScale.x;
+        switch (p.type) {
+        case ProjectionType::Perspective:
+            return "a vertical field of view of " + number(glm::degrees(2 * std::atan(std::tan(glm::radians(p.fovyDeg) / 2) / k))) +
+                   "° (the camera says " + number(p.fovyDeg) + "°)";
+        case ProjectionType::Lens:
+            return "a focal length of " + number(p.focalMm * k) + " mm (the camera says " + number(p.focalMm) + " mm)";
+        case ProjectionType::Pinhole:
+            return "focal lengths fx " + number(p.fx * k, 6) + ", fy " + number(p.fy * k, 6) + " px (the camera says " +
+                   number(p.fx, 6) + ", " + number(p.fy, 6) + ")";
+        default:
+            return "a view " + number(1 / k) + " times as wide and high as the camera says";
+        }
+    }
+    case FitFamily::Intrinsics: {
+        std::string text = "focal lengths × (" + number(d.focalScale.x, 5) + ", " + number(d.focalScale.y, 5) +
+                           ") and the principal point moved by (" + signedNumber(d.principalShift.x, 3) + ", " +
+                           signedNumber(d.principalShift.y, 3) + ") px (x right, y down)";
+        if (p.type == ProjectionType::Pinhole)
+            text += ": fx " + number(p.fx * d.focalScale.x, 6) + ", fy " + number(p.fy * d.focalScale.y, 6) + ", cx " +
+                    number(p.cx + d.principalShift.x, 6) + ", cy " + number(p.cy + d.principalShift.y, 6);
+        return text;
+    }
+    case FitFamily::NearFar:
+        return "near " + number(d.nearDistance > 0 ? d.nearDistance : camera.nearDistance(), 5) + ", far " +
+               number(d.farDistance > 0 ? d.farDistance : camera.farDistance(), 5) + " (the camera says " +
+               number(camera.nearDistance(), 5) + ", " + number(camera.farDistance(), 5) + ")";
+    case FitFamily::DepthScale:
+        return "the map's values " + number(d.valueScale, 5) + " × the " + toString(map.quantity) +
+               (std::abs(d.valueOffset) > 0 ? " " + signedNumber(d.valueOffset, 5) : std::string()) +
+               " (a unit or scale mistake: divide by " + number(d.valueScale, 5) + ")";
+    case FitFamily::Pose: {
+        const glm::dvec3 eye = eyePositionOf(camera.eyeFromWorld);
+        const glm::dvec3 moved = eyePositionOf(departedCameraSpec(camera, d).view.eyeFromWorld);
+        std::string text = "the eye at (" + number(moved.x, 5) + ", " + number(moved.y, 5) + ", " + number(moved.z, 5) +
+                           ") instead of (" + number(eye.x, 5) + ", " + number(eye.y, 5) + ", " + number(eye.z, 5) + ")";
+        const View& v = camera.spec().view;
+        if (!v.hasMatrix) {
+            const double before = glm::length(v.target - eye), after = glm::length(v.target - moved);
+            if (before > 0) text += ", " + number(100 * std::abs(after - before) / before, 3) + " % " +
+                                    (after > before ? "farther from" : "nearer to") + " the target";
+        }
+        text += ", turned " + number(glm::degrees(glm::length(d.eyeTurn)), 3) + "°";
+        return text;
+    }
+    }
+    return "";
+}
+
+}  // namespace zcheck
