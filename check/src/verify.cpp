@@ -292,6 +292,45 @@ VerifyResult Checker::verify(const Camera& camera, const DepthMap& map) const
     return run;
 }
 
+bool Hypothesis::consistentExceptEdges() const
+{
+    return !consistent && !estimated && unexplained > 0 && unexplainedAtEdges == unexplained && compared > 0 &&
+           unexplained <= compared / 10;
+}
+
+EdgeTally tallyEdges(const Camera& camera, const RenderResult& truth, const RenderResult& map, const Comparison& comparison)
+{
+    const int W = camera.width(), H = camera.height();
+    EdgeTally tally;
+    for (int row = 0; row < H; ++row)
+        for (int col = 0; col < W; ++col) {
+            const std::size_t i = std::size_t(row) * W + col;
+            if (!isUnexplained(comparison.pixelClass[i])) continue;
+            // The truth around the pixel: one plane (window depth affine: second differences
+            // vanish), or an edge; and the range of its depths, the clear value for a miss.
+            bool edge = false;
+            double lo = INFINITY, hi = -INFINITY;
+            auto depthAt = [&](int dx, int dy) {
+                const int c = std::clamp(col + dx, 0, W - 1), r = std::clamp(row + dy, 0, H - 1);
+                const std::size_t j = std::size_t(r) * W + c;
+                if (truth.hit(j) != truth.hit(i)) edge = true;
+                const double d = truth.hit(j) ? truth.windowDepth.value[j] : camera.clearDepth();
+                lo = std::min(lo, d), hi = std::max(hi, d);
+                return d;
+            };
+            const double centre = depthAt(0, 0);
+            for (const auto& [dx, dy] : {std::pair{1, 0}, std::pair{0, 1}, std::pair{1, 1}, std::pair{1, -1}}) {
+                const double before = depthAt(-dx, -dy), after = depthAt(dx, dy);
+                if (!(std::abs(before - 2 * centre + after) <= 1e-3 * std::abs(after - before) + 1e-12)) edge = true;
+            }
+            if (!edge) continue;
+            ++tally.atEdges;
+            const double d = map.hit(i) ? map.windowDepth.value[i] : camera.clearDepth();
+            if (d >= lo && d <= hi) ++tally.blends;
+        }
+    return tally;
+}
+
 std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& map) const
 {
     requireMapFits(camera, map);
@@ -299,12 +338,13 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
     // One hypothesis judged: the truth through `hypothesisCamera` (rendered unless the same as
     // the declared one), the map as re-read.
     auto judge = [&](Hypothesis h, const Camera& hypothesisCamera, const DepthMap& hypothesisMap, bool sameTruth,
-                     const RayFaults& faults) {
+                     const RayFaults& faults, bool screen = true) {
         const RenderResult hypothesisTruth = sameTruth ? RenderResult{} : renderRay(hypothesisCamera, faults);
         const RenderResult& truthUsed = sameTruth ? truth : hypothesisTruth;
         // Most hypotheses are plainly wrong: a sample of the pixels that need the surface
         // search proves it without searching them all (screenUnexplained).
-        if (const auto estimate = screenUnexplained(scene_, hypothesisCamera, hypothesisMap, truthUsed, neighbours())) {
+        if (const auto estimate = screen ? screenUnexplained(scene_, hypothesisCamera, hypothesisMap, truthUsed, neighbours())
+                                         : std::nullopt) {
             h.unexplained = *estimate, h.estimated = true;
         } else {
             const VerifyResult run = verifyAgainst(scene_, hypothesisCamera, hypothesisMap, truthUsed, neighbours());
@@ -312,6 +352,11 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
             // explain a map that holds nothing.
             const ComparisonReport& r = run.comparison.report;
             h.consistent = r.consistent() && r.bothHit > 0, h.unexplained = r.unexplained();
+            h.compared = r.bothHit + r.rayOnly + r.rasterOnly;
+            if (!h.consistent && !r.depthBias) {
+                const EdgeTally edges = tallyEdges(hypothesisCamera, run.truth, run.map, run.comparison);
+                h.unexplainedAtEdges = edges.atEdges, h.blendsAtEdges = edges.blends;
+            }
         }
         return h;
     };
@@ -336,6 +381,19 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
     std::vector<Hypothesis> out;
     for (auto& h : judged)
         if (h) out.push_back(std::move(*h));
+    // The map as declared, when only edge pixels fail: anti-aliased depth if each of them holds
+    // a blend of the surfaces either side.
+    if (Hypothesis asDeclared = judge({"", "", "", false, 0, false, {}}, camera, map, true, {}, false);
+        asDeclared.consistentExceptEdges()) {
+        const bool blends = asDeclared.blendsAtEdges == asDeclared.unexplainedAtEdges;
+        asDeclared.name = blends ? "anti-aliased" : "edge-pixels";
+        asDeclared.explanation =
+            blends ? "consistent except at edges, whose depths lie between the surfaces either side: anti-aliased or "
+                     "resolved multisample depth (keep one sample's depth, or resolve depth with min or max, not an "
+                     "average)"
+                   : "consistent except at edges";
+        out.push_back(std::move(asDeclared));
+    }
     // The continuous families, fitted side by side, each confirmed by a full comparison.
     const std::vector<FitFamily> families = fitFamilies(camera, map);
     std::vector<std::optional<Hypothesis>> fitted(families.size());
@@ -353,7 +411,9 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
     for (auto& h : fitted)
         if (h) out.push_back(std::move(*h));
     std::stable_sort(out.begin(), out.end(), [](const Hypothesis& a, const Hypothesis& b) {
-        return a.consistent != b.consistent ? a.consistent : a.unexplained < b.unexplained;
+        if (a.consistent != b.consistent) return a.consistent;
+        if (a.consistentExceptEdges() != b.consistentExceptEdges()) return a.consistentExceptEdges();
+        return a.unexplained < b.unexplained;
     });
     return out;
 }

@@ -511,6 +511,8 @@ py::list diagnosisList(const std::vector<Hypothesis>& hypotheses)
         d["consistent"] = h.consistent;
         d["unexplained"] = h.unexplained;
         d["unexplained_estimated"] = h.estimated;
+        d["consistent_except_edges"] = h.consistentExceptEdges();
+        d["unexplained_at_edges"] = h.unexplainedAtEdges;
         py::list fitted;
         for (const FittedValue& v : h.fitted) {
             py::dict f;

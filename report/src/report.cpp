@@ -200,8 +200,9 @@ std::string verifyReportJson(const CheckReport& report, const DepthMapSource& so
             for (const FittedValue& v : h.fitted)
                 fitted.push_back({{"name", v.name}, {"value", v.value}, {"declared", v.declared}});
             list.push_back({{"hypothesis", h.name}, {"variant", h.variant}, {"explanation", h.explanation},
-                            {"consistent", h.consistent}, {"unexplained", h.unexplained},
-                            {"unexplained_estimated", h.estimated}, {"fitted", fitted}});
+                            {"consistent", h.consistent}, {"consistent_except_edges", h.consistentExceptEdges()},
+                            {"unexplained", h.unexplained}, {"unexplained_estimated", h.estimated},
+                            {"unexplained_at_edges", h.unexplainedAtEdges}, {"fitted", fitted}});
         }
         document["diagnosis"] = list;
     }
@@ -225,16 +226,26 @@ VerifyOutcome verifyAndReport(const Checker& checker, const Camera& camera, cons
 
 std::string formatDiagnosis(const std::vector<Hypothesis>& hypotheses)
 {
-    for (const auto& h : hypotheses)
-        if (h.consistent) return "diagnosis  " + h.explanation + "\n";
+    // Ranked (Checker::diagnose): the consistent ones first, then those failing only at edges.
     if (hypotheses.empty()) return "diagnosis  no hypothesis applies to this camera and map\n";
-    const Hypothesis* closest = &hypotheses.front();
-    for (const auto& h : hypotheses)
-        if (h.unexplained < closest->unexplained) closest = &h;
+    auto named = [](const Hypothesis& h) {
+        std::string text = h.explanation;
+        if (h.consistentExceptEdges())
+            text += " (consistent except " + std::to_string(h.unexplained) + " edge pixel" + (h.unexplained == 1 ? "" : "s") + ")";
+        return text;
+    };
+    const Hypothesis& best = hypotheses.front();
+    if (best.consistent || best.consistentExceptEdges()) {
+        std::string out = "diagnosis  " + named(best) + "\n";
+        for (std::size_t k = 1; k < hypotheses.size() && k < 4; ++k)
+            if (hypotheses[k].consistent || hypotheses[k].consistentExceptEdges())
+                out += "  also     " + hypotheses[k].name + ": " + named(hypotheses[k]) + "\n";
+        return out;
+    }
     return "diagnosis  none of the " + std::to_string(hypotheses.size()) +
-           " hypotheses makes the map consistent (closest: " + closest->name +
-           (closest->variant.empty() ? "" : " " + closest->variant) + ", " + std::to_string(closest->unexplained) +
-           " unexplained pixels)\n";
+           " hypotheses makes the map consistent (closest: " + best.name +
+           (best.variant.empty() ? "" : " " + best.variant) + ", " + (best.estimated ? "about " : "") +
+           std::to_string(best.unexplained) + " unexplained pixels)\n";
 }
 
 namespace {

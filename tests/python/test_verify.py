@@ -27,7 +27,8 @@ def test_ray_render_verifies_and_its_flip_does_not(default_checker, small_camera
     hypotheses = default_checker.diagnose(small_camera, flipped, "eye-z")
     assert consistent_names(hypotheses)[0] == "y-flip"
     assert set(hypotheses[0]) == {"hypothesis", "variant", "explanation", "consistent", "unexplained",
-                                  "unexplained_estimated", "fitted"}
+                                  "unexplained_estimated", "fitted", "consistent_except_edges",
+                                  "unexplained_at_edges"}
     diagnosed = default_checker.verify(small_camera, flipped, "eye-z", diagnose=True)
     assert diagnosed.diagnosis == hypotheses
     # (the JSON's explanations can differ in spacing: prettyJson folds "[-1,1]" inside strings too)

@@ -110,6 +110,15 @@ void requireMapFits(const Camera& camera, const DepthMap& map);
 std::optional<std::int64_t> screenUnexplained(const Scene& scene, const Camera& camera, const DepthMap& map,
                                               const RenderResult& truth, const VertexNeighbours& neighbours);
 
+// Of a comparison's unexplained pixels, those at edges of the truth (a 3×3 neighbourhood that
+// is not one plane, or a coverage change), and of those the ones whose map depth lies between
+// the truth's depths around them (the clear value standing for a miss): a blend of the
+// surfaces either side, as anti-aliased or resolved multisample depth holds.
+struct EdgeTally {
+    std::int64_t atEdges = 0, blends = 0;
+};
+EdgeTally tallyEdges(const Camera& camera, const RenderResult& truth, const RenderResult& map, const Comparison& comparison);
+
 // The comparison of `map` against an already rendered ground truth `truth` (one BVH, one
 // truth render, many readings of the map).
 VerifyResult verifyAgainst(const Scene& scene, const Camera& camera, const DepthMap& map, RenderResult truth,

@@ -41,7 +41,8 @@ struct VerifyOutcome {
 VerifyOutcome verifyAndReport(const Checker& checker, const Camera& camera, const DepthMap& map,
                               const DepthMapSource& source, bool diagnose);
 
-// The diagnosis line for people: the first consistent hypothesis, or the closest one.
+// The diagnosis lines for people: the best hypothesis (and up to three more that also explain
+// the map, or all of it but a handful of edge pixels), or the closest one.
 std::string formatDiagnosis(const std::vector<Hypothesis>& hypotheses);
 
 // The suite: the detection table, and the whole run as JSON and as self-contained HTML (with
