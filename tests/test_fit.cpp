@@ -61,12 +61,16 @@ struct Bench {
         return mapOf(scene, c, faults.none() ? checker.renderRaster(c) : checker.renderRay(c, faults, EyePoints::Keep),
                      quantity);
     }
-    // The diagnosis's hypothesis `name`, which must be consistent.
-    Hypothesis diagnosed(const DepthMap& map, const std::string& name) const
+    // The diagnosis's hypothesis `name`. Fits are not run where a mistake of the catalogue
+    // explains the map whole: a departure that is one (`catalogued`) is named by it.
+    Hypothesis diagnosed(const DepthMap& map, const std::string& name, const std::string& catalogued = "") const
     {
         REQUIRE_FALSE(checker.verify(camera, map).comparison.report.consistent());
-        for (const Hypothesis& h : checker.diagnose(camera, map))
+        const std::vector<Hypothesis> diagnosis = checker.diagnose(camera, map);
+        for (const Hypothesis& h : diagnosis)
             if (h.name == name) return h;
+        if (!catalogued.empty() && !diagnosis.empty() && diagnosis.front().name == catalogued && diagnosis.front().consistent)
+            return diagnosis.front();
         FAIL("no hypothesis " << name);
         return {};
     }
@@ -100,7 +104,12 @@ TEST_CASE("a map sampled off the pixel centre is diagnosed with the offset, MSAA
             INFO("offset " << offset.x << ", " << offset.y);
             Departure d;
             d.sampleOffset = offset;
-            const Hypothesis h = b.diagnosed(b.mapDrawnWith(b.camera.spec(), departedSampling(b.camera, d)), "sample-offset");
+            const Hypothesis h =
+                b.diagnosed(b.mapDrawnWith(b.camera.spec(), departedSampling(b.camera, d)), "sample-offset", "half-pixel");
+            if (h.name == "half-pixel") {
+                REQUIRE(offset == glm::dvec2(0.5, 0.5));
+                continue;
+            }
             INFO(h.explanation << ": unexplained " << h.unexplained << (h.estimated ? " (estimated)" : "") << ", fitted "
                                << fittedValue(h, "sample_dx_px") << ", " << fittedValue(h, "sample_dy_px"));
             REQUIRE(h.consistent);
@@ -134,7 +143,11 @@ TEST_CASE("a map drawn with a moved principal point or another aspect is diagnos
             INFO("principal point moved by " << shift.x << ", " << shift.y << " px");
             Departure d;
             d.principalShift = shift;
-            const Hypothesis h = b.diagnosed(b.mapDrawnWith(departedCameraSpec(b.camera, d)), "intrinsics");
+            const Hypothesis h = b.diagnosed(b.mapDrawnWith(departedCameraSpec(b.camera, d)), "intrinsics", "half-pixel");
+            if (h.name == "half-pixel") {
+                REQUIRE(shift == glm::dvec2(0.5, 0.0));
+                continue;
+            }
             INFO(h.explanation << ": unexplained " << h.unexplained << (h.estimated ? " (estimated)" : "") << " at edges " << h.unexplainedAtEdges);
             REQUIRE(h.consistent);
             REQUIRE(std::abs(fittedValue(h, "principal_dx_px") - shift.x) <= 0.01);
@@ -177,7 +190,11 @@ TEST_CASE("a map in other units or from another origin is diagnosed with its sca
             DepthMap map = b.mapDrawnWith(b.camera.spec());
             for (double& v : map.value)
                 if (std::isfinite(v)) v = double(float(scale * v + offset));
-            const Hypothesis h = b.diagnosed(map, "depth-scale");
+            const Hypothesis h = b.diagnosed(map, "depth-scale", "affine-depth-offset");
+            if (h.name == "affine-depth-offset") {
+                REQUIRE((scale == 1.0 && offset == -n));
+                continue;
+            }
             INFO(h.explanation << ": unexplained " << h.unexplained << (h.estimated ? " (estimated)" : "") << " at edges " << h.unexplainedAtEdges);
             REQUIRE(h.consistent);
             REQUIRE(std::abs(fittedValue(h, "value_scale") - scale) <= 1e-4 * scale);

@@ -367,3 +367,53 @@ TEST_CASE("the diagnosis's sampled screen never rules out a consistent reading, 
     REQUIRE_FALSE(screenUnexplained(s.scene, camera, few, truth, checker.neighbours()));
     REQUIRE(checker.verify(camera, few).comparison.report.unexplained() == 50);
 }
+
+TEST_CASE("two mistakes at once are diagnosed by both names: flipped and reversed, flipped and a quantity swap", "[verify][diagnose]")
+{
+    Setup s;
+    const Checker checker(s.scene);
+    CameraSpec reversedSpec = s.spec;
+    reversedSpec.depth.reversed = true;
+    const Camera camera(s.spec), reversedCamera(reversedSpec);
+    auto flipped = [](DepthMap map) {
+        for (int row = 0; row < map.height / 2; ++row)
+            for (int col = 0; col < map.width; ++col)
+                std::swap(map.value[std::size_t(row) * map.width + col], map.value[std::size_t(map.height - 1 - row) * map.width + col]);
+        return map;
+    };
+    // A reversed-Z renderer's buffer, flipped vertically, declared as standard depth.
+    const DepthMap flippedReversed = flipped(mapOf(s.scene, reversedCamera, checker.renderRaster(reversedCamera), ExportQuantity::Window));
+    REQUIRE(testing::diagnosedAs(checker, camera, flippedReversed, "y-flip + reversed-as-standard"));
+    // Ray distance, flipped vertically, declared as eye-z.
+    DepthMap flippedDistance = flipped(mapOf(s.scene, camera, checker.renderRaster(camera), ExportQuantity::Distance));
+    flippedDistance.quantity = DepthQuantity::EyeZ;
+    REQUIRE(testing::diagnosedAs(checker, camera, flippedDistance, "y-flip + distance-as-eye-z"));
+}
+
+TEST_CASE("a mirrored principal point, depth without near added, and a map quantized finer than declared are named", "[verify][diagnose]")
+{
+    Setup s;
+    const Checker checker(s.scene);
+    // The off-axis frustum example drawn with its principal point mirrored about the centre.
+    CameraSpec offAxis = readCameraFile(std::string(ZCHECK_TESTS_DIR) + "/../examples/frustum.json");
+    offAxis.view = s.spec.view;
+    offAxis.width /= 4, offAxis.height /= 4;
+    CameraSpec mirroredSpec = offAxis;
+    mirroredSpec.projection.left = -offAxis.projection.right, mirroredSpec.projection.right = -offAxis.projection.left;
+    mirroredSpec.projection.bottom = -offAxis.projection.top, mirroredSpec.projection.top = -offAxis.projection.bottom;
+    const Camera declared(offAxis), mirrored(mirroredSpec);
+    REQUIRE(testing::diagnosedAs(checker, declared, testing::windowMapOf(mirrored, checker.renderRaster(mirrored)),
+                                 "principal-point-mirrored"));
+    // Eye-z minus near (linear depth scaled by far - near, near not added).
+    const Camera camera(s.spec);
+    DepthMap withoutNear = mapOf(s.scene, camera, checker.renderRaster(camera), ExportQuantity::EyeZ);
+    for (double& v : withoutNear.value)
+        if (std::isfinite(v)) v = double(float(v - camera.nearDistance()));
+    REQUIRE(testing::diagnosedAs(checker, camera, withoutNear, "affine-depth-offset"));
+    // A unorm16 depth buffer declared as float32.
+    CameraSpec unorm16Spec = s.spec;
+    unorm16Spec.depth.format = DepthFormat::Unorm16;
+    const Camera unorm16(unorm16Spec);
+    REQUIRE(s.spec.depth.format == DepthFormat::Float32);
+    REQUIRE(testing::diagnosedAs(checker, camera, testing::windowMapOf(unorm16, checker.renderRaster(unorm16)), "quantized-depth"));
+}

@@ -161,11 +161,13 @@ std::vector<Mistake> buildCatalogue()
     half.reread = [](const Camera& camera, const DepthMap&) {
         Rereadings out;
         for (auto [dx, dy, what] : {std::tuple{-0.5, -0.5, "x and y"}, std::tuple{-0.5, 0.0, "x"},
-                                    std::tuple{0.0, -0.5, "y"}, std::tuple{0.5, 0.5, "x and y, the other way"}}) {
+                                    std::tuple{0.0, -0.5, "y"}, std::tuple{0.5, 0.5, "x and y, the other way"},
+                                    std::tuple{0.5, 0.0, "x, the other way"}, std::tuple{0.0, 0.5, "y, the other way"}}) {
             Rereading r;
             r.variant = what;
             r.explanation = std::string("consistent if rendered with pixel centres half a pixel off in ") + what +
-                            " (the +0.5 pixel-centre offset missing or doubled)";
+                            " (the +0.5 pixel-centre offset missing or doubled, or a principal point off by half a "
+                            "pixel: cx = W/2 where (W - 1)/2 belongs)";
             // The truth seen at the shifted points, through a camera whose image moved the other
             // way (fit.h): the map is then read, and its edges judged, where it was sampled.
             Departure shifted;
@@ -232,6 +234,18 @@ std::vector<Mistake> buildCatalogue()
                                       m = camera.clipFromEye * mirror;
                                       return true;
                                   }));
+    all.push_back(wrongProjection("principal-point-mirrored",
+                                  "an off-centre principal point mirrored about the image centre (cx for W - 1 - cx, a "
+                                  "frustum's left for -right), as a y-up vs y-down or sign slip does",
+                                  "consistent if the principal point is mirrored about the image centre",
+                                  [](const Camera& camera, glm::dmat4& m) {
+                                      // The image offset lives in the z column (perspective) or the
+                                      // w column (parallel) of the x and y rows: negate it.
+                                      m = camera.clipFromEye;
+                                      for (int c : {2, 3})
+                                          for (int r : {0, 1}) m[c][r] = -m[c][r];
+                                      return differ(m, camera.clipFromEye);
+                                  }));
     all.push_back(wrongProjection("transposed", "the projection matrix transposed (row- vs column-major confusion)",
                                   "consistent if the projection matrix is transposed (row- vs column-major)",
                                   [](const Camera& camera, glm::dmat4& m) {
@@ -290,6 +304,45 @@ std::vector<Mistake> buildCatalogue()
                                  [=](double v) { return std::isfinite(v) && v != clear ? n + (v - lo) / span * (f - n) : INFINITY; })};
     };
     all.push_back(linear);
+    Mistake affineOffset{"affine-depth-offset",
+                         "linear depth scaled by far - near without adding near: eye-z - near delivered as eye-z",
+                         Route::Raster, {}, {}};
+    affineOffset.reread = [](const Camera& camera, const DepthMap& map) {
+        if (map.quantity != DepthQuantity::EyeZ && map.quantity != DepthQuantity::Distance) return Rereadings{};
+        const double n = camera.nearDistance();
+        return Rereadings{readAs(map, map.quantity,
+                                 "consistent if near is added to the values (linear depth scaled by far - near without "
+                                 "adding near)",
+                                 [n](double v) { return std::isfinite(v) ? v + n : v; })};
+    };
+    all.push_back(affineOffset);
+    // A map stored in fewer bits than declared: its values lie on an integer grid.
+    // (unorm24 cannot be told apart: binary32 has no finer resolution than its grid near 1.)
+    Mistake quantized{"quantized-depth", "window depth stored as unorm16 where float32 was declared", Route::Raster, {}, {}};
+    quantized.reread = [](const Camera& camera, const DepthMap& map) {
+        if (map.quantity != DepthQuantity::Window || camera.depth().format != DepthFormat::Float32 || map.valueQuantum > 0)
+            return Rereadings{};
+        Rereadings out;
+        for (auto [format, bits] : {std::pair{DepthFormat::Unorm16, 16}}) {
+            const double steps = std::ldexp(1.0, bits) - 1;
+            std::size_t values = 0, onGrid = 0;
+            for (double v : map.value)
+                if (std::isfinite(v) && v > 0 && v < 1) {
+                    ++values;
+                    // Within a hundredth of a step (a binary32 value near 1 holds k/65535 to 0.004 steps).
+                    onGrid += std::abs(v * steps - std::round(v * steps)) <= 0.01 ? 1 : 0;
+                }
+            if (values == 0 || onGrid < values - values / 100) continue;  // 99 % on the grid
+            CameraSpec spec = camera.spec();
+            spec.depth.format = format;
+            out.push_back({toString(format), "consistent if read as " + toString(format) + " depth (the map's values lie on its grid of " +
+                                                 std::to_string(std::int64_t(steps)) + " steps), not float32",
+                           spec, {}, {}});
+            break;
+        }
+        return out;
+    };
+    all.push_back(quantized);
     Mistake distanceAsEyeZ{"distance-as-eye-z", "ray distance taken as planar depth (eye-z)", Route::Ray, {}, {}};
     distanceAsEyeZ.inject = [](const Camera&, RouteFaults& faults) { return faults.ray.distanceAsEyeZ = true; };
     distanceAsEyeZ.reread = [](const Camera&, const DepthMap& map) {

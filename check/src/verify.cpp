@@ -241,13 +241,18 @@ void requireMapFits(const Camera& camera, const DepthMap& map)
 std::optional<std::int64_t> screenUnexplained(const Scene& scene, const Camera& camera, const DepthMap& map,
                                               const RenderResult& truth, const VertexNeighbours& neighbours)
 {
-    constexpr std::size_t kSample = 1024;
+    // Any pixel found unexplained proves the map inconsistent, however it was found: the
+    // suspects are looked for on every other row and column (a quarter of the pixels), and the
+    // sample is read in blocks until enough unexplained pixels make the estimate.
+    constexpr std::size_t kSample = 1024, kBlock = 128;
+    constexpr std::int64_t kEnough = 64;
+    constexpr int kStride = 2;
     const int W = camera.width(), H = camera.height();
     const MapReader reader(scene, camera, map, truth, neighbours);
-    // The suspects: pixels that do not simply agree with the truth's own surface.
     std::vector<std::vector<std::uint32_t>> suspectsOfRow(static_cast<std::size_t>(H));
     tbb::parallel_for(0, H, [&](int row) {
-        for (int col = 0; col < W; ++col) {
+        if (row % kStride != 0) return;
+        for (int col = 0; col < W; col += kStride) {
             const std::size_t i = std::size_t(row) * W + col;
             const MapPixel pixel = reader.read(col, row, false);
             const bool suspect = pixel.primitive == kNoPrimitive ? truth.hit(i) : pixel.primitive == kUnknownPrimitive;
@@ -257,15 +262,27 @@ std::optional<std::int64_t> screenUnexplained(const Scene& scene, const Camera& 
     std::vector<std::uint32_t> suspects;  // pixel indices, in scan order
     for (int row = 0; row < H; ++row)
         for (std::uint32_t col : suspectsOfRow[std::size_t(row)]) suspects.push_back(std::uint32_t(row) * W + col);
-    if (suspects.size() <= kSample) return std::nullopt;  // reading them all costs no more than the sample
-    std::atomic<std::int64_t> unexplained{0};
-    tbb::parallel_for(std::size_t(0), kSample, [&](std::size_t k) {
-        const std::uint32_t i = suspects[k * suspects.size() / kSample];
-        const int col = int(i % W), row = int(i / W);
-        if (isUnexplained(reader.classify(col, row, reader.read(col, row)))) ++unexplained;
-    });
+    if (suspects.size() * kStride * kStride <= kSample) return std::nullopt;  // few: the full comparison is as cheap
+    const std::size_t sample = std::min(kSample, suspects.size());
+    // Spread over the suspects block by block: block b reads every blocks-th one from offset b.
+    const std::size_t blocks = (sample + kBlock - 1) / kBlock;
+    std::int64_t unexplained = 0;
+    std::size_t read = 0;
+    for (std::size_t block = 0; block < blocks && unexplained < kEnough; ++block) {
+        std::atomic<std::int64_t> found{0};
+        const std::size_t first = block, count = (sample - first + blocks - 1) / blocks;
+        tbb::parallel_for(std::size_t(0), count, [&](std::size_t k) {
+            const std::uint32_t i = suspects[(first + k * blocks) * suspects.size() / sample];
+            const int col = int(i % W), row = int(i / W);
+            if (isUnexplained(reader.classify(col, row, reader.read(col, row)))) ++found;
+        });
+        unexplained += found, read += count;
+    }
     if (unexplained == 0) return std::nullopt;
-    return std::int64_t(std::llround(double(unexplained) * double(suspects.size()) / double(kSample)));
+    // The strided pixels stand for all of them.
+    const double suspectsInAll = double(suspects.size()) * double(W) * double(H) /
+                                 (double((W + kStride - 1) / kStride) * double((H + kStride - 1) / kStride));
+    return std::int64_t(std::llround(double(unexplained) / double(read) * suspectsInAll));
 }
 
 VerifyResult verifyAgainst(const Scene& scene, const Camera& camera, const DepthMap& map, RenderResult truth,
@@ -335,16 +352,17 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
 {
     requireMapFits(camera, map);
     const RenderResult truth = renderRay(camera);
-    // One hypothesis judged: the truth through `hypothesisCamera` (rendered unless the same as
-    // the declared one), the map as re-read.
-    auto judge = [&](Hypothesis h, const Camera& hypothesisCamera, const DepthMap& hypothesisMap, bool sameTruth,
-                     const RayFaults& faults, bool screen = true) {
-        const RenderResult hypothesisTruth = sameTruth ? RenderResult{} : renderRay(hypothesisCamera, faults);
-        const RenderResult& truthUsed = sameTruth ? truth : hypothesisTruth;
+    // One hypothesis judged against `truthUsed` (the truth through `hypothesisCamera`), the map
+    // as re-read.
+    auto judgeAgainst = [&](Hypothesis h, const Camera& hypothesisCamera, const DepthMap& hypothesisMap,
+                            const RenderResult& truthUsed) {
         // Most hypotheses are plainly wrong: a sample of the pixels that need the surface
         // search proves it without searching them all (screenUnexplained).
-        if (const auto estimate = screen ? screenUnexplained(scene_, hypothesisCamera, hypothesisMap, truthUsed, neighbours())
-                                         : std::nullopt) {
+        // A hypothesis failing at a few pixels only (at most a tenth of the truth's surface,
+        // by the estimate) is compared in full all the same: it may fail only at edges.
+        const std::optional<std::int64_t> estimate = screenUnexplained(scene_, hypothesisCamera, hypothesisMap, truthUsed, neighbours());
+        if (estimate && *estimate * 10 > std::count_if(truthUsed.primitiveId.begin(), truthUsed.primitiveId.end(),
+                                                       [](std::uint32_t p) { return p != kNoPrimitive; })) {
             h.unexplained = *estimate, h.estimated = true;
         } else {
             const VerifyResult run = verifyAgainst(scene_, hypothesisCamera, hypothesisMap, truthUsed, neighbours());
@@ -361,29 +379,39 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
         return h;
     };
     // The catalogue's readings, judged side by side (each judgement is parallel inside too;
-    // side by side they also overlap each other's serial parts).
-    std::vector<std::pair<const Mistake*, Rereading>> readings;
+    // side by side they also overlap each other's serial parts). A reading that changes the
+    // camera or the sampling keeps its truth, for the pairs below.
+    struct Candidate {
+        const Mistake* mistake;
+        Rereading reading;
+        std::optional<Camera> camera;       // the reading's camera, once built
+        std::optional<RenderResult> truth;  // when not the declared camera's
+        std::optional<Hypothesis> judged;
+        bool readsMapOnly() const { return !reading.camera && reading.truthFaults.none(); }
+        const DepthMap& mapOr(const DepthMap& given) const { return reading.map ? *reading.map : given; }
+    };
+    std::vector<Candidate> candidates;
     for (const Mistake& mistake : mistakeCatalogue())
         if (mistake.reread)
-            for (Rereading& reading : mistake.reread(camera, map)) readings.emplace_back(&mistake, std::move(reading));
-    std::vector<std::optional<Hypothesis>> judged(readings.size());
-    tbb::parallel_for(std::size_t(0), readings.size(), [&](std::size_t k) {
-        const auto& [mistake, reading] = readings[k];
+            for (Rereading& reading : mistake.reread(camera, map)) candidates.push_back({&mistake, std::move(reading), {}, {}, {}});
+    tbb::parallel_for(std::size_t(0), candidates.size(), [&](std::size_t k) {
+        Candidate& c = candidates[k];
         // A variant that is not a valid camera (a near plane behind the eye) is no hypothesis.
         try {
-            const Camera hypothesisCamera(reading.camera ? *reading.camera : camera.spec());
-            const bool sameTruth = !reading.camera && reading.truthFaults.none();
-            judged[k] = judge({mistake->name, reading.variant, reading.explanation, false, 0, false, {}}, hypothesisCamera,
-                              reading.map ? *reading.map : map, sameTruth, reading.truthFaults);
+            c.camera.emplace(c.reading.camera ? *c.reading.camera : camera.spec());
+            if (!c.readsMapOnly()) c.truth = renderRay(*c.camera, c.reading.truthFaults);
+            c.judged = judgeAgainst({c.mistake->name, c.reading.variant, c.reading.explanation, false, 0, false, {}}, *c.camera,
+                                    c.mapOr(map), c.truth ? *c.truth : truth);
         } catch (const Error&) {
+            c.camera.reset(), c.truth.reset();
         }
     });
     std::vector<Hypothesis> out;
-    for (auto& h : judged)
-        if (h) out.push_back(std::move(*h));
+    for (const Candidate& c : candidates)
+        if (c.judged) out.push_back(*c.judged);
     // The map as declared, when only edge pixels fail: anti-aliased depth if each of them holds
     // a blend of the surfaces either side.
-    if (Hypothesis asDeclared = judge({"", "", "", false, 0, false, {}}, camera, map, true, {}, false);
+    if (Hypothesis asDeclared = judgeAgainst({"", "", "", false, 0, false, {}}, camera, map, truth);
         asDeclared.consistentExceptEdges()) {
         const bool blends = asDeclared.blendsAtEdges == asDeclared.unexplainedAtEdges;
         asDeclared.name = blends ? "anti-aliased" : "edge-pixels";
@@ -392,10 +420,12 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
                      "resolved multisample depth (keep one sample's depth, or resolve depth with min or max, not an "
                      "average)"
                    : "consistent except at edges";
-        out.push_back(std::move(asDeclared));
+        out.insert(out.begin(), std::move(asDeclared));  // before readings that only rename the same values
     }
-    // The continuous families, fitted side by side, each confirmed by a full comparison.
-    const std::vector<FitFamily> families = fitFamilies(camera, map);
+    // The continuous families, fitted side by side, each confirmed by a full comparison; not
+    // needed where a mistake of the catalogue explains the map whole.
+    const bool named = std::any_of(out.begin(), out.end(), [](const Hypothesis& h) { return h.consistent; });
+    const std::vector<FitFamily> families = named ? std::vector<FitFamily>{} : fitFamilies(camera, map);
     std::vector<std::optional<Hypothesis>> fitted(families.size());
     const TruthRender render = [&](const Camera& c, const RayFaults& faults) { return renderRay(c, faults); };
     tbb::parallel_for(std::size_t(0), families.size(), [&](std::size_t k) {
@@ -404,12 +434,52 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
             const Camera fittedCamera(departedCameraSpec(camera, fit.departure));
             Hypothesis h{toString(families[k]), "", "consistent with " + describeFit(camera, map, fit), false, 0, false, {}};
             h.fitted = fittedValues(camera, map, fit);
-            fitted[k] = judge(std::move(h), fittedCamera, departedReading(camera, map, fit.departure), false, {});
+            fitted[k] = judgeAgainst(std::move(h), fittedCamera, departedReading(camera, map, fit.departure),
+                                     renderRay(fittedCamera));
         } catch (const Error&) {
         }
     });
     for (auto& h : fitted)
         if (h) out.push_back(std::move(*h));
+    const bool explained = std::any_of(out.begin(), out.end(), [](const Hypothesis& h) {
+        return h.consistent || h.consistentExceptEdges();
+    });
+    // Two mistakes at once (flipped and reversed, say), when no single one, no fit and no
+    // edge-only reading explains the map: a
+    // reading of the map composed with a reading of the map or of the camera, judged against
+    // the truth already rendered for the latter. Two camera mistakes at once are not tried.
+    if (!explained) {
+        std::vector<std::pair<std::size_t, std::size_t>> pairs;
+        auto changesQuantity = [&](const Candidate& c) { return c.reading.map && c.reading.map->quantity != map.quantity; };
+        for (std::size_t a = 0; a < candidates.size(); ++a)
+            for (std::size_t b = 0; b < candidates.size(); ++b) {
+                const Candidate &first = candidates[a], &second = candidates[b];
+                if (!first.camera || !second.camera || first.mistake == second.mistake || !first.readsMapOnly()) continue;
+                if (second.readsMapOnly() && (b <= a || (changesQuantity(first) && changesQuantity(second)))) continue;
+                pairs.emplace_back(a, b);
+            }
+        std::vector<std::optional<Hypothesis>> paired(pairs.size());
+        tbb::parallel_for(std::size_t(0), pairs.size(), [&](std::size_t k) {
+            const Candidate &first = candidates[pairs[k].first], &second = candidates[pairs[k].second];
+            try {
+                // The first re-reads the map; the second then re-reads that, or changes the camera.
+                const DepthMap firstMap = first.mapOr(map);
+                std::vector<Rereading> again = second.mistake->reread(camera, firstMap);
+                const auto same = std::find_if(again.begin(), again.end(), [&](const Rereading& r) { return r.variant == second.reading.variant; });
+                if (same == again.end()) return;
+                const DepthMap& both = same->map ? *same->map : firstMap;
+                const std::string name = first.mistake->name + " + " + second.mistake->name;
+                const std::string variant = second.reading.variant;
+                std::string also = second.reading.explanation;
+                if (also.rfind("consistent if ", 0) == 0) also = also.substr(14);
+                paired[k] = judgeAgainst({name, variant, first.reading.explanation + ", and " + also, false, 0, false, {}},
+                                         *second.camera, both, second.truth ? *second.truth : truth);
+            } catch (const Error&) {
+            }
+        });
+        for (auto& h : paired)
+            if (h) out.push_back(std::move(*h));
+    }
     std::stable_sort(out.begin(), out.end(), [](const Hypothesis& a, const Hypothesis& b) {
         if (a.consistent != b.consistent) return a.consistent;
         if (a.consistentExceptEdges() != b.consistentExceptEdges()) return a.consistentExceptEdges();

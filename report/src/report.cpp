@@ -269,12 +269,12 @@ std::string suiteTable(const SuiteResult& result)
     std::snprintf(line, sizeof line, "clean configurations: %d consistent of %d (false positives: %d)\n\n",
                   clean - result.falsePositives, clean, result.falsePositives);
     out << line;
-    std::snprintf(line, sizeof line, "%-22s %-7s %10s %14s %9s  %s\n", "fault", "route", "detected", "not applicable",
+    std::snprintf(line, sizeof line, "%-24s %-7s %10s %14s %9s  %s\n", "fault", "route", "detected", "not applicable",
                   "n/a", "");
     out << line;
     for (std::size_t k = 0; k < tally.size(); ++k) {
         const int applicable = tally[k].detected + tally[k].missed;
-        std::snprintf(line, sizeof line, "%-22s %-7s %4d / %-4d %14d %9d  %s\n", mistakes[k]->name.c_str(),
+        std::snprintf(line, sizeof line, "%-24s %-7s %4d / %-4d %14d %9d  %s\n", mistakes[k]->name.c_str(),
                       toString(mistakes[k]->route).c_str(), tally[k].detected, applicable, tally[k].notApplicable,
                       tally[k].meaningless, tally[k].missed ? "<- MISSED" : "");
         out << line;
