@@ -70,9 +70,11 @@ void addImageSizeOptions(CLI::App* command, ImageSize& size);
 
 // --channel, --scale, --offset and --miss, as verify and unproject read a depth map.
 struct DepthMapOptions {
-    std::string channel, miss;
+    std::string channel, miss, sidecar;
     double scale = 0, offset = 0;
-    // The reading for a map of quantity `quantityName`; throws Error naming a bad --miss.
+    // The reading for a map of quantity `quantityName`: the options, and for those not given,
+    // the sidecar's keys ("channel", "miss", "scale", "offset"; others ignored); throws Error
+    // naming a bad --miss or sidecar key.
     DepthMapReading reading(const std::string& quantityName) const;
 };
 void addDepthMapOptions(CLI::App* command, DepthMapOptions& options);

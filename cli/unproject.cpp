@@ -84,6 +84,7 @@ int runUnprojectCommand(const UnprojectOptions& o)
     OutputFiles outputs;
     outputs.addInput(o.cameraFile);
     outputs.addInput(o.depthMap);
+    outputs.addInput(o.reading.sidecar);
     outputs.add(o.output, "-o");
     const DepthMapFile map = images().readDepthMap(o.depthMap, o.reading.reading(o.quantity), camera.width(), camera.height());
     const UnprojectedMap cloud =

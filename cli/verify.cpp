@@ -28,6 +28,7 @@ int runVerifyCommand(const VerifyOptions& o)
     outputs.addInput(o.input.scene);
     outputs.addInput(o.input.cameraFile);
     outputs.addInput(o.depthMap);
+    outputs.addInput(o.reading.sidecar);
     const RunFolder folder{o.outDir, "map_depth.exr"};
     if (!o.outDir.empty()) folder.plan(outputs);
     Scene scene = loadScene(o.input.scene);

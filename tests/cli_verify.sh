@@ -61,6 +61,22 @@ set -e
 [[ $status -eq 1 ]]
 "$zcheck" verify --depth-map far_misses.exr --quantity eye-z --miss '>=1e9' | grep -q "verdict    CONSISTENT"
 expect_error 2 "miss value 'abc' is neither a number" verify --depth-map render.exr --quantity eye-z --miss abc
+# The same rule from a sidecar (other keys ignored); an option wins over the sidecar's key.
+echo '{"miss": ">=1e9", "renderer": "another one"}' > far_misses.json
+"$zcheck" verify --depth-map far_misses.exr --quantity eye-z --sidecar far_misses.json | grep -q "verdict    CONSISTENT"
+echo '{"miss": 1e10}' > exact_miss.json
+"$zcheck" verify --depth-map far_misses.exr --quantity eye-z --sidecar exact_miss.json | grep -q "verdict    CONSISTENT"
+set +e
+"$zcheck" verify --depth-map far_misses.exr --quantity eye-z --sidecar far_misses.json --miss 0 > /dev/null
+status=$?
+set -e
+[[ $status -eq 1 ]]
+echo '{"miss": true}' > bad_miss.json
+expect_error 2 "sidecar 'bad_miss.json': \"miss\" must be a number or a string" verify --depth-map far_misses.exr --quantity eye-z --sidecar bad_miss.json
+echo '{"scale": -3}' > bad_scale.json
+expect_error 2 "\"scale\" must be a positive finite number" verify --depth-map far_misses.exr --quantity eye-z --sidecar bad_scale.json
+echo '{"miss": 1, "miss": 2}' > twice.json
+expect_error 2 "twice.json" verify --depth-map far_misses.exr --quantity eye-z --sidecar twice.json
 
 # Bad input exits 2.
 expect_error 2 "cannot read depth map" verify --depth-map missing.exr
