@@ -2,6 +2,7 @@
 
 #include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
+#include "zcheck/verify.h"
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <tbb/parallel_for.h>
@@ -240,8 +241,8 @@ Departure levenbergMarquardt(const Problem& problem)
     return problem.at(p);
 }
 
-// The sample pixels of a truth render: hit, with a map value, and a 3×3 neighbourhood on the
-// pixel's plane (relative eye depth within 1e-3), at most 4096 evenly spaced.
+// The sample pixels of a truth render: hit, with a map value, and a 3×3 neighbourhood on one
+// plane (onePlaneAround), at most 4096 evenly spaced.
 std::vector<Sample> samplesOf(const Scene& scene, const Camera& declared, const Camera& departed,
                               const DepthMap& map, const RenderResult& truth)
 {
@@ -258,21 +259,7 @@ std::vector<Sample> samplesOf(const Scene& scene, const Camera& declared, const 
             const glm::uvec3 t = scene.triangles[truth.primitiveId[i]];
             const glm::dvec3 a(scene.positions[t[0]]), b(scene.positions[t[1]]), c(scene.positions[t[2]]);
             const glm::dvec3 normal = glm::cross(b - a, c - a);
-            // On a plane, window depth is affine in window x and y: its second differences
-            // across the pixel vanish (up to rounding) in x, y and both diagonals.
-            bool planar = true;
-            auto depthAt = [&](int dx, int dy) {
-                const std::size_t j = std::size_t(row + dy) * W + (col + dx);
-                if (!truth.hit(j)) planar = false;
-                return truth.windowDepth.value[j];
-            };
-            const double centre = truth.windowDepth.value[i];
-            for (const auto& [dx, dy] : {std::pair{1, 0}, std::pair{0, 1}, std::pair{1, 1}, std::pair{1, -1}}) {
-                const double before = depthAt(-dx, -dy), after = depthAt(dx, dy);
-                const double bend = std::abs(before - 2 * centre + after), rise = std::abs(after - before);
-                if (!(bend <= 1e-3 * rise + 1e-12)) planar = false;
-            }
-            if (!planar) continue;
+            if (!onePlaneAround(truth, W, H, col, row)) continue;
             const double z = eyeZFromWindowDepth(departed, windowFromPixelCentre(departed, col, row), truth.windowDepth.value[i]);
             const double v0 = valueOfEyeZ(declared, pWindow, z, map.quantity);
             const double v1 = valueOfEyeZ(declared, pWindow, z * (1 + 1e-6), map.quantity);
@@ -392,11 +379,8 @@ FitResult fitDeparture(const Scene& scene, const Camera& camera, const DepthMap&
         const Camera departed(departedCameraSpec(camera, d));
         Problem problem{camera, map, family, d, 1, 1, samplesOf(scene, camera, departed, map, rendered ? *rendered : truth)};
         if (problem.samples.size() < 16) break;
-        std::vector<double> depths, values;
-        for (const Sample& s : problem.samples) {
-            values.push_back(std::abs(s.mapValue));
-            depths.push_back(std::abs(s.sigma));  // for eye-z maps sigma is the depth itself
-        }
+        std::vector<double> values;
+        for (const Sample& s : problem.samples) values.push_back(std::abs(s.mapValue));
         problem.valueSpan = std::max(medianOf(values), 1e-12);
         problem.sceneDepth = 1;
         {

@@ -309,10 +309,39 @@ VerifyResult Checker::verify(const Camera& camera, const DepthMap& map) const
     return run;
 }
 
+namespace {
+
+// A hypothesis not judged yet.
+Hypothesis hypothesis(std::string name, std::string variant, std::string explanation)
+{
+    Hypothesis h;
+    h.name = std::move(name), h.variant = std::move(variant), h.explanation = std::move(explanation);
+    return h;
+}
+
+}  // namespace
+
 bool Hypothesis::consistentExceptEdges() const
 {
     return !consistent && !estimated && unexplained > 0 && unexplainedAtEdges == unexplained && compared > 0 &&
            unexplained <= compared / 10;
+}
+
+bool onePlaneAround(const RenderResult& truth, int width, int height, int col, int row)
+{
+    const std::size_t i = std::size_t(row) * width + col;
+    bool one = true;
+    auto depthAt = [&](int dx, int dy) {
+        const std::size_t j = std::size_t(std::clamp(row + dy, 0, height - 1)) * width + std::clamp(col + dx, 0, width - 1);
+        if (truth.hit(j) != truth.hit(i)) one = false;
+        return truth.windowDepth.value[j];
+    };
+    const double centre = truth.windowDepth.value[i];
+    for (const auto& [dx, dy] : {std::pair{1, 0}, std::pair{0, 1}, std::pair{1, 1}, std::pair{1, -1}}) {
+        const double before = depthAt(-dx, -dy), after = depthAt(dx, dy);
+        if (!(std::abs(before - 2 * centre + after) <= 1e-3 * std::abs(after - before) + 1e-12)) one = false;
+    }
+    return one;
 }
 
 EdgeTally tallyEdges(const Camera& camera, const RenderResult& truth, const RenderResult& map, const Comparison& comparison)
@@ -323,24 +352,15 @@ EdgeTally tallyEdges(const Camera& camera, const RenderResult& truth, const Rend
         for (int col = 0; col < W; ++col) {
             const std::size_t i = std::size_t(row) * W + col;
             if (!isUnexplained(comparison.pixelClass[i])) continue;
-            // The truth around the pixel: one plane (window depth affine: second differences
-            // vanish), or an edge; and the range of its depths, the clear value for a miss.
-            bool edge = false;
+            if (onePlaneAround(truth, W, H, col, row)) continue;
+            // The range of the truth's depths around it, the clear value for a miss.
             double lo = INFINITY, hi = -INFINITY;
-            auto depthAt = [&](int dx, int dy) {
-                const int c = std::clamp(col + dx, 0, W - 1), r = std::clamp(row + dy, 0, H - 1);
-                const std::size_t j = std::size_t(r) * W + c;
-                if (truth.hit(j) != truth.hit(i)) edge = true;
-                const double d = truth.hit(j) ? truth.windowDepth.value[j] : camera.clearDepth();
-                lo = std::min(lo, d), hi = std::max(hi, d);
-                return d;
-            };
-            const double centre = depthAt(0, 0);
-            for (const auto& [dx, dy] : {std::pair{1, 0}, std::pair{0, 1}, std::pair{1, 1}, std::pair{1, -1}}) {
-                const double before = depthAt(-dx, -dy), after = depthAt(dx, dy);
-                if (!(std::abs(before - 2 * centre + after) <= 1e-3 * std::abs(after - before) + 1e-12)) edge = true;
-            }
-            if (!edge) continue;
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx) {
+                    const std::size_t j = std::size_t(std::clamp(row + dy, 0, H - 1)) * W + std::clamp(col + dx, 0, W - 1);
+                    const double d = truth.hit(j) ? truth.windowDepth.value[j] : camera.clearDepth();
+                    lo = std::min(lo, d), hi = std::max(hi, d);
+                }
             ++tally.atEdges;
             const double d = map.hit(i) ? map.windowDepth.value[i] : camera.clearDepth();
             if (d >= lo && d <= hi) ++tally.blends;
@@ -400,7 +420,7 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
         try {
             c.camera.emplace(c.reading.camera ? *c.reading.camera : camera.spec());
             if (!c.readsMapOnly()) c.truth = renderRay(*c.camera, c.reading.truthFaults);
-            c.judged = judgeAgainst({c.mistake->name, c.reading.variant, c.reading.explanation, false, 0, false, {}}, *c.camera,
+            c.judged = judgeAgainst(hypothesis(c.mistake->name, c.reading.variant, c.reading.explanation), *c.camera,
                                     c.mapOr(map), c.truth ? *c.truth : truth);
         } catch (const Error&) {
             c.camera.reset(), c.truth.reset();
@@ -411,7 +431,7 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
         if (c.judged) out.push_back(*c.judged);
     // The map as declared, when only edge pixels fail: anti-aliased depth if each of them holds
     // a blend of the surfaces either side.
-    if (Hypothesis asDeclared = judgeAgainst({"", "", "", false, 0, false, {}}, camera, map, truth);
+    if (Hypothesis asDeclared = judgeAgainst(hypothesis("", "", ""), camera, map, truth);
         asDeclared.consistentExceptEdges()) {
         const bool blends = asDeclared.blendsAtEdges == asDeclared.unexplainedAtEdges;
         asDeclared.name = blends ? "anti-aliased" : "edge-pixels";
@@ -432,7 +452,7 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
         try {
             const FitResult fit = fitDeparture(scene_, camera, map, truth, families[k], render);
             const Camera fittedCamera(departedCameraSpec(camera, fit.departure));
-            Hypothesis h{toString(families[k]), "", "consistent with " + describeFit(camera, map, fit), false, 0, false, {}};
+            Hypothesis h = hypothesis(toString(families[k]), "", "consistent with " + describeFit(camera, map, fit));
             h.fitted = fittedValues(camera, map, fit);
             fitted[k] = judgeAgainst(std::move(h), fittedCamera, departedReading(camera, map, fit.departure),
                                      renderRay(fittedCamera));
@@ -463,7 +483,7 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
             const Candidate &first = candidates[pairs[k].first], &second = candidates[pairs[k].second];
             try {
                 // The first re-reads the map; the second then re-reads that, or changes the camera.
-                const DepthMap firstMap = first.mapOr(map);
+                const DepthMap& firstMap = first.mapOr(map);
                 std::vector<Rereading> again = second.mistake->reread(camera, firstMap);
                 const auto same = std::find_if(again.begin(), again.end(), [&](const Rereading& r) { return r.variant == second.reading.variant; });
                 if (same == again.end()) return;
@@ -472,7 +492,7 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
                 const std::string variant = second.reading.variant;
                 std::string also = second.reading.explanation;
                 if (also.rfind("consistent if ", 0) == 0) also = also.substr(14);
-                paired[k] = judgeAgainst({name, variant, first.reading.explanation + ", and " + also, false, 0, false, {}},
+                paired[k] = judgeAgainst(hypothesis(name, variant, first.reading.explanation + ", and " + also),
                                          *second.camera, both, second.truth ? *second.truth : truth);
             } catch (const Error&) {
             }

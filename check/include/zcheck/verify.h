@@ -110,6 +110,12 @@ void requireMapFits(const Camera& camera, const DepthMap& map);
 std::optional<std::int64_t> screenUnexplained(const Scene& scene, const Camera& camera, const DepthMap& map,
                                               const RenderResult& truth, const VertexNeighbours& neighbours);
 
+// Whether the truth around pixel (col, row) is one surface: its 3×3 neighbourhood (clamped at
+// the image's border) all hit or all miss, and, where hit, window depth affine in x and y (a
+// plane's is): second differences across the pixel in x, y and both diagonals within 1e-3 of
+// the rise plus 1e-12. False at silhouettes, occlusion edges and creases.
+bool onePlaneAround(const RenderResult& truth, int width, int height, int col, int row);
+
 // Of a comparison's unexplained pixels, those at edges of the truth (a 3×3 neighbourhood that
 // is not one plane, or a coverage change), and of those the ones whose map depth lies between
 // the truth's depths around them (the clear value standing for a miss): a blend of the
