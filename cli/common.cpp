@@ -1,8 +1,6 @@
 #include "common.h"
 
-#include "camera_json.h"
 #include "zcheck/camera_file.h"
-#include "zcheck/input_file.h"
 #include "zcheck/error.h"
 
 #include <cmath>
@@ -122,41 +120,7 @@ DepthMapReading DepthMapOptions::reading(const std::string& quantityName) const
     r.quantityChannel = channelNameOf(exportQuantitiesFromList(quantityName).front());
     r.scale = scale, r.offset = offset;
     if (!miss.empty()) r.miss = MissRule::parse(miss);
-    if (sidecar.empty()) return r;
-    const nlohmann::json doc = parseJsonStrictly(readInputFile(sidecar, kSidecarInput), sidecar);
-    if (!doc.is_object()) throw Error("sidecar '" + sidecar + "' must hold a JSON object");
-    auto bad = [&](const char* key, const char* rule) { return Error("sidecar '" + sidecar + "': \"" + key + "\" " + rule); };
-    auto given = [&](const char* key) { return doc.contains(key) && !doc[key].is_null(); };
-    if (given("channel") && r.channel.empty()) {
-        if (!doc["channel"].is_string()) throw bad("channel", "must be a channel name (a string)");
-        r.channel = doc["channel"].get<std::string>();
-    }
-    if (given("scale") && r.scale == 0) {
-        if (!doc["scale"].is_number() || !(doc["scale"].get<double>() > 0) || !std::isfinite(doc["scale"].get<double>()))
-            throw bad("scale", "must be a positive finite number");
-        r.scale = doc["scale"].get<double>();
-    }
-    if (given("offset") && r.offset == 0) {
-        if (!doc["offset"].is_number() || !std::isfinite(doc["offset"].get<double>())) throw bad("offset", "must be a finite number");
-        r.offset = doc["offset"].get<double>();
-    }
-    if (given("miss") && miss.empty()) {
-        const nlohmann::json& m = doc["miss"];
-        if (m.is_number()) {
-            char text[40];
-            std::snprintf(text, sizeof text, "%.17g", m.get<double>());
-            r.miss = MissRule::parse(text);
-        } else if (m.is_string()) {
-            try {
-                r.miss = MissRule::parse(m.get<std::string>());
-            } catch (const Error& e) {
-                throw bad("miss", (std::string("is not a miss rule: ") + e.what()).c_str());
-            }
-        } else {
-            throw bad("miss", "must be a number or a string such as \">=1e9\", \"nan\" or \"inf\"");
-        }
-    }
-    return r;
+    return sidecar.empty() ? r : withSidecar(r, sidecar);
 }
 
 }  // namespace zcheck::cli

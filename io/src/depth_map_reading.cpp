@@ -1,11 +1,15 @@
 #include "zcheck/depth_map_reading.h"
 
+#include "camera_json.h"
+#include "zcheck/input_file.h"
+
 #include "zcheck/error.h"
 
 #include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <iterator>
 
 namespace zcheck {
@@ -94,6 +98,44 @@ std::string chooseDepthChannel(const std::string& path, const std::vector<std::s
         refuseDepthMap(path, "none of its " + std::to_string(names.size()) + " channels (" + listed(names) +
                             ") is named as depth (Z, depth, *.Z, *.depth); name the one to read with --channel");
     refuseDepthMap(path, "several of its channels are named as depth (" + listed(depth) + "); name the one to read with --channel");
+}
+
+DepthMapReading withSidecar(DepthMapReading r, const std::string& sidecar)
+{
+    const nlohmann::json doc = parseJsonStrictly(readInputFile(sidecar, kSidecarInput), sidecar);
+    if (!doc.is_object()) throw Error("sidecar '" + sidecar + "' must hold a JSON object");
+    auto bad = [&](const char* key, const char* rule) { return Error("sidecar '" + sidecar + "': \"" + key + "\" " + rule); };
+    auto given = [&](const char* key) { return doc.contains(key) && !doc[key].is_null(); };
+    if (given("channel") && r.channel.empty()) {
+        if (!doc["channel"].is_string()) throw bad("channel", "must be a channel name (a string)");
+        r.channel = doc["channel"].get<std::string>();
+    }
+    if (given("scale") && r.scale == 0) {
+        if (!doc["scale"].is_number() || !(doc["scale"].get<double>() > 0) || !std::isfinite(doc["scale"].get<double>()))
+            throw bad("scale", "must be a positive finite number");
+        r.scale = doc["scale"].get<double>();
+    }
+    if (given("offset") && r.offset == 0) {
+        if (!doc["offset"].is_number() || !std::isfinite(doc["offset"].get<double>())) throw bad("offset", "must be a finite number");
+        r.offset = doc["offset"].get<double>();
+    }
+    if (given("miss") && !r.miss.given()) {
+        const nlohmann::json& m = doc["miss"];
+        if (m.is_number()) {
+            char text[40];
+            std::snprintf(text, sizeof text, "%.17g", m.get<double>());
+            r.miss = MissRule::parse(text);
+        } else if (m.is_string()) {
+            try {
+                r.miss = MissRule::parse(m.get<std::string>());
+            } catch (const Error& e) {
+                throw bad("miss", (std::string("is not a miss rule: ") + e.what()).c_str());
+            }
+        } else {
+            throw bad("miss", "must be a number or a string such as \">=1e9\", \"nan\" or \"inf\"");
+        }
+    }
+    return r;
 }
 
 }  // namespace zcheck

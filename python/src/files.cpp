@@ -21,13 +21,14 @@ PYBIND11_MODULE(_zcheck_files, m)
         "verify_file",
         [](const Checker& checker, const Camera& camera, const std::string& path, const std::string& quantityName,
            std::optional<std::string> channel, const py::object& miss, std::optional<double> scale,
-           std::optional<double> offset, bool diagnose, std::optional<int> threads) {
+           std::optional<double> offset, std::optional<std::string> sidecar, bool diagnose, std::optional<int> threads) {
             // Exactly `zcheck verify --depth-map PATH --quantity Q [--channel C] [--scale S]
             // [--offset O] [--miss M] [--diagnose]` (cli/verify.cpp).
             const DepthQuantity quantity = depthQuantityFromName(quantityName);
             DepthMapReading reading = readingOf(miss, scale, offset);
             reading.channel = channel ? *channel : "";
             reading.quantityChannel = channelNameOf(exportOf(quantity));
+            if (sidecar) reading = withSidecar(reading, *sidecar);
             auto r = std::make_unique<PyReport>();
             r->verify = true;
             {
@@ -41,18 +42,19 @@ PYBIND11_MODULE(_zcheck_files, m)
         },
         py::arg("checker"), py::arg("camera"), py::arg("path"), py::arg("quantity"), py::kw_only(),
         py::arg("channel") = py::none(), py::arg("miss") = py::none(), py::arg("scale") = py::none(),
-        py::arg("offset") = py::none(), py::arg("diagnose") = false, py::arg("threads") = py::none(),
-        R"doc(See zcheck.Checker.verify_file.)doc");
+        py::arg("offset") = py::none(), py::arg("sidecar") = py::none(), py::arg("diagnose") = false,
+        py::arg("threads") = py::none(), R"doc(See zcheck.Checker.verify_file.)doc");
 
     m.def(
         "read_depth_map",
         [](const std::string& path, const Camera& camera, std::optional<std::string> quantity,
            std::optional<std::string> channel, const py::object& miss, std::optional<double> scale,
-           std::optional<double> offset) {
+           std::optional<double> offset, std::optional<std::string> sidecar) {
             if (quantity && channel) fail("read_depth_map: give quantity or channel, not both");
             DepthMapReading reading = readingOf(miss, scale, offset);
             reading.channel = channel ? *channel : "";
             if (quantity) reading.quantityChannel = channelNameOf(exportOf(depthQuantityFromName(*quantity)));
+            if (sidecar) reading = withSidecar(reading, *sidecar);
             DepthMapFile file;
             {
                 py::gil_scoped_release release;
@@ -62,5 +64,5 @@ PYBIND11_MODULE(_zcheck_files, m)
         },
         py::arg("path"), py::arg("camera"), py::kw_only(), py::arg("quantity") = py::none(),
         py::arg("channel") = py::none(), py::arg("miss") = py::none(), py::arg("scale") = py::none(),
-        py::arg("offset") = py::none(), R"doc(See zcheck.read_depth_map.)doc");
+        py::arg("offset") = py::none(), py::arg("sidecar") = py::none(), R"doc(See zcheck.read_depth_map.)doc");
 }

@@ -126,7 +126,7 @@ def _files():
     return _zcheck_files
 
 
-def read_depth_map(path, camera, *, quantity=None, channel=None, scale=None, offset=None, miss=None):
+def read_depth_map(path, camera, *, quantity=None, channel=None, scale=None, offset=None, miss=None, sidecar=None):
     """Read a depth map file as `zcheck verify` and `zcheck unproject` do: EXR (multi-layer too), PFM,
 TIFF, or a 16-bit PNG with scale, told apart by their first bytes. Returns an (H, W) float64 array,
 row 0 at the top (PFM's bottom-to-top rows are flipped), NaN where the file marks a miss.
@@ -142,21 +142,24 @@ offset:   added to every depth after scale (default 0).
 miss:     the stored value that marks "no surface" (0, 65535, 1e10, float("inf"), "nan") or a
           comparison as a string (">=1e9"), compared before scale and offset. Without it, 0 is a
           miss in integer files; NaN always is. 8-bit files are refused (8 bits cannot hold depth).
+sidecar:  a JSON file whose "channel", "miss", "scale" and "offset" keys apply where the arguments
+          above are not given (other keys ignored), as `--sidecar` does.
     """
     return _files().read_depth_map(str(path), camera, quantity=quantity, channel=channel, scale=scale, offset=offset,
-                                   miss=miss)
+                                   miss=miss, sidecar=None if sidecar is None else str(sidecar))
 
 
-def _verify_file(self, camera, path, quantity, *, channel=None, scale=None, offset=None, miss=None, diagnose=False,
-                 threads=None):
+def _verify_file(self, camera, path, quantity, *, channel=None, scale=None, offset=None, miss=None, sidecar=None,
+                 diagnose=False, threads=None):
     """A depth map file against the ground truth, exactly as `zcheck verify --depth-map PATH --quantity Q
-[--channel C] [--scale S] [--offset O] [--miss M] [--diagnose]` does it: the file read as
-read_depth_map reads it (channel, scale, offset, miss), with the file's storage quantum (1/scale
+[--channel C] [--scale S] [--offset O] [--miss M] [--sidecar F] [--diagnose]` does it: the file read
+as read_depth_map reads it (channel, scale, offset, miss, sidecar), with the file's storage quantum (1/scale
 for integer files, binary32's own step for float files). to_dict() equals `zcheck verify --json`'s
 document but for timings; its depth_map entry names the channel read.
     """
     return _files().verify_file(self, camera, str(path), quantity, channel=channel, miss=miss, scale=scale,
-                                offset=offset, diagnose=diagnose, threads=threads)
+                                offset=offset, sidecar=None if sidecar is None else str(sidecar), diagnose=diagnose,
+                                threads=threads)
 
 
 _verify_file.__name__ = _verify_file.__qualname__ = "verify_file"

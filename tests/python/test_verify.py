@@ -180,3 +180,19 @@ def test_miss_rules_offset_and_channels(tmp_path, default_checker, small_camera,
     assert default_checker.verify_file(small_camera, str(path), "eye-z").to_dict()["depth_map"]["channel"] == "Z"
     wrong = default_checker.verify_file(small_camera, str(path), "eye-z", channel="distance")
     assert not wrong.consistent and wrong.to_dict()["depth_map"]["channel"] == "distance"
+
+
+def test_sidecar_describes_the_file(tmp_path, default_checker, small_camera, small_camera_file):
+    # A two-channel EXR whose sidecar names the channel; the keys the options leave open come from it.
+    path = tmp_path / "both.exr"
+    run_cli("export", "--camera", small_camera_file, "--quantity", "eye-z,distance", "-o", path, check_rc=0)
+    sidecar = tmp_path / "both.json"
+    sidecar.write_text('{"channel": "distance", "renderer": "ignored"}')
+    depth = zcheck.read_depth_map(path, small_camera, sidecar=sidecar)
+    assert np.array_equal(np.isfinite(depth), np.isfinite(zcheck.read_depth_map(path, small_camera, channel="distance")))
+    assert default_checker.verify_file(small_camera, path, "distance", sidecar=sidecar).consistent
+    # the channel argument wins over the sidecar's
+    assert default_checker.verify_file(small_camera, path, "eye-z", channel="Z", sidecar=sidecar).consistent
+    sidecar.write_text('{"scale": "a thousand"}')
+    with pytest.raises(zcheck.Error, match=r"\"scale\" must be a positive finite number"):
+        zcheck.read_depth_map(path, small_camera, quantity="eye-z", sidecar=sidecar)

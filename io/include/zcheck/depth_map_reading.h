@@ -57,4 +57,10 @@ std::string chooseDepthChannel(const std::string& path, const std::vector<std::s
 // Throws Error "cannot read depth map '<path>': <why>".
 [[noreturn]] void refuseDepthMap(const std::string& path, const std::string& why);
 
+// The reading with the fields not given (an empty channel, scale 0, offset 0, no miss rule)
+// taken from a sidecar: a JSON object whose "channel", "miss" (a number, or a rule such as
+// ">=1e9", "nan", "inf"), "scale" and "offset" keys describe the map; other keys are ignored
+// and null is absent. Throws Error naming the sidecar and the key that breaks its rule.
+DepthMapReading withSidecar(DepthMapReading reading, const std::string& sidecar);
+
 }  // namespace zcheck
