@@ -242,11 +242,11 @@ std::optional<std::int64_t> screenUnexplained(const Scene& scene, const Camera& 
                                               const RenderResult& truth, const VertexNeighbours& neighbours)
 {
     // Any pixel found unexplained proves the map inconsistent, however it was found: the
-    // suspects are looked for on every other row and column (a quarter of the pixels), and the
+    // suspects are looked for on every fourth row and column (a sixteenth of the pixels), and the
     // sample is read in blocks until enough unexplained pixels make the estimate.
     constexpr std::size_t kSample = 1024, kBlock = 128;
     constexpr std::int64_t kEnough = 64;
-    constexpr int kStride = 2;
+    constexpr int kStride = 4;
     const int W = camera.width(), H = camera.height();
     const MapReader reader(scene, camera, map, truth, neighbours);
     std::vector<std::vector<std::uint32_t>> suspectsOfRow(static_cast<std::size_t>(H));
