@@ -3,6 +3,7 @@
 #include "zcheck/checker.h"
 #include "zcheck/error.h"
 #include "zcheck/mistakes.h"
+#include "zcheck/report.h"
 
 #include "diagnosis_helpers.h"
 
@@ -229,8 +230,12 @@ TEST_CASE("a map with no surface is explained by no hypothesis (a view that sees
     const Camera camera(smallCamera(checker.scene()));
     const DepthMap empty{camera.width(), camera.height(), DepthQuantity::Window,
                          std::vector<double>(std::size_t(camera.width()) * camera.height(), camera.clearDepth()), 0};
-    for (const Hypothesis& h : checker.diagnose(camera, empty)) {
+    const std::vector<Hypothesis> diagnosis = checker.diagnose(camera, empty);
+    for (const Hypothesis& h : diagnosis) {
         INFO(h.name << " " << h.variant);
         REQUIRE_FALSE(h.consistent);
     }
+    // ... and the diagnosis says that it is empty, first, not which hypothesis came closest.
+    REQUIRE(diagnosis.front().name == "empty-map");
+    REQUIRE(formatDiagnosis(diagnosis).find("holds no surface") != std::string::npos);
 }

@@ -500,6 +500,19 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
         for (auto& h : paired)
             if (h) out.push_back(std::move(*h));
     }
+    // A map with no surface at all, as read, is evidence for nothing: say so first.
+    const bool anySurface = !explained && [&] {
+        for (int row = 0; row < map.height; ++row)
+            for (int col = 0; col < map.width; ++col)
+                if (eyePointFromDepth(camera, windowFromPixelCentre(camera, col, row), map.value[std::size_t(row) * map.width + col],
+                                      map.quantity))
+                    return true;
+        return false;
+    }();
+    if (!explained && !anySurface)
+        out.insert(out.begin(), hypothesis("empty-map", "",
+                                           "the map holds no surface as read: every value is a miss (check --quantity, "
+                                           "--channel, --miss and --scale)"));
     std::stable_sort(out.begin(), out.end(), [](const Hypothesis& a, const Hypothesis& b) {
         if (a.consistent != b.consistent) return a.consistent;
         if (a.consistentExceptEdges() != b.consistentExceptEdges()) return a.consistentExceptEdges();

@@ -235,6 +235,7 @@ std::string formatDiagnosis(const std::vector<Hypothesis>& hypotheses)
         return text;
     };
     const Hypothesis& best = hypotheses.front();
+    if (best.name == "empty-map") return "diagnosis  " + best.explanation + "\n";
     if (best.consistent || best.consistentExceptEdges()) {
         std::string out = "diagnosis  " + named(best) + "\n";
         for (std::size_t k = 1; k < hypotheses.size() && k < 4; ++k)
