@@ -16,13 +16,6 @@ namespace zcheck {
 
 namespace {
 
-// Image y (down) → window y: +1 where the window's origin is at the top, −1 at the bottom.
-double windowYPerImageY(const Camera& camera) { return camera.windowYFromImageY(1) - camera.windowYFromImageY(0); }
-
-glm::dvec2 windowFromImageOffset(const Camera& camera, const glm::dvec2& image)
-{
-    return {image.x, windowYPerImageY(camera) * image.y};
-}
 
 // The map's value of the eye-space point under `camera`, as `quantity`.
 double valueOfEyePoint(const Camera& camera, const glm::dvec3& pEye, DepthQuantity quantity)
@@ -60,6 +53,15 @@ struct Sample {
     double mapValue;
     double sigma;  // value change per relative eye-z change
 };
+
+// The model: where camera c's ray through the sample's pixel centre meets the sample's plane,
+// in c's eye space.
+glm::dvec3 eyePointOnPlane(const Camera& c, const Sample& s)
+{
+    const EyePlaneRay ray = worldEyePlaneRayThroughWindow(c, windowFromPixelCentre(c, s.col, s.row));
+    const double t = (s.offset - glm::dot(s.normal, ray.origin)) / glm::dot(s.normal, ray.direction);
+    return glm::dvec3(c.eyeFromWorld * glm::dvec4(ray.origin + t * ray.direction, 1.0));
+}
 
 struct Problem {
     const Camera& camera;
@@ -124,10 +126,7 @@ struct Problem {
         std::vector<double> r(samples.size());
         tbb::parallel_for(std::size_t(0), samples.size(), [&](std::size_t k) {
             const Sample& s = samples[k];
-            const EyePlaneRay ray = worldEyePlaneRayThroughWindow(c, windowFromPixelCentre(c, s.col, s.row));
-            const double t = (s.offset - glm::dot(s.normal, ray.origin)) / glm::dot(s.normal, ray.direction);
-            const glm::dvec3 pEye(c.eyeFromWorld * glm::dvec4(ray.origin + t * ray.direction, 1.0));
-            const double predicted = d.valueScale * valueOfEyePoint(c, pEye, map.quantity) + d.valueOffset;
+            const double predicted = d.valueScale * valueOfEyePoint(c, eyePointOnPlane(c, s), map.quantity) + d.valueOffset;
             r[k] = (predicted - s.mapValue) / s.sigma;
             if (!std::isfinite(r[k])) r[k] = 1e30;
         });
@@ -282,6 +281,12 @@ bool isRawMatrix(const Camera& camera) { return camera.spec().projection.type ==
 
 }  // namespace
 
+glm::dvec2 windowFromImageOffset(const Camera& camera, const glm::dvec2& offset)
+{
+    // Image y grows downward; window y too where the window's origin is at the top.
+    return {offset.x, (camera.windowYFromImageY(1) - camera.windowYFromImageY(0)) * offset.y};
+}
+
 CameraSpec departedCameraSpec(const Camera& declared, const Departure& d)
 {
     CameraSpec spec = declared.spec();
@@ -382,18 +387,10 @@ FitResult fitDeparture(const Scene& scene, const Camera& camera, const DepthMap&
         std::vector<double> values;
         for (const Sample& s : problem.samples) values.push_back(std::abs(s.mapValue));
         problem.valueSpan = std::max(medianOf(values), 1e-12);
-        problem.sceneDepth = 1;
-        {
-            // The median eye depth of the samples, for the pose's translations.
-            std::vector<double> z;
-            for (const Sample& s : problem.samples) {
-                const glm::dvec2 pWindow = windowFromPixelCentre(departed, s.col, s.row);
-                const EyePlaneRay ray = worldEyePlaneRayThroughWindow(departed, pWindow);
-                const double t = (s.offset - glm::dot(s.normal, ray.origin)) / glm::dot(s.normal, ray.direction);
-                z.push_back(std::abs(departed.eyeZOf(glm::dvec3(departed.eyeFromWorld * glm::dvec4(ray.origin + t * ray.direction, 1.0)))));
-            }
-            problem.sceneDepth = std::max(medianOf(z), 1e-12);
-        }
+        // The median eye depth of the samples, for the pose's translations.
+        std::vector<double> z;
+        for (const Sample& s : problem.samples) z.push_back(std::abs(departed.eyeZOf(eyePointOnPlane(departed, s))));
+        problem.sceneDepth = std::max(medianOf(z), 1e-12);
         if (round == 0) out.initialResidual = medianAbsolute(problem.residuals(d));
         if (family == FitFamily::SampleOffset && round == 0) {
             // Whole-pixel shifts first: the best of the offsets within two pixels.

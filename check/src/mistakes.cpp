@@ -171,7 +171,7 @@ std::vector<Mistake> buildCatalogue()
             // The truth seen at the shifted points, through a camera whose image moved the other
             // way (fit.h): the map is then read, and its edges judged, where it was sampled.
             Departure shifted;
-            shifted.sampleOffset = {dx, dy * (camera.windowYFromImageY(1) - camera.windowYFromImageY(0))};
+            shifted.sampleOffset = windowFromImageOffset(camera, {dx, dy});  // the variants are window offsets
             r.camera = departedCameraSpec(camera, shifted);
             out.push_back(r);
         }

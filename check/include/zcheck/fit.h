@@ -40,6 +40,10 @@ struct Departure {
     glm::dvec3 eyeTurn{0.0};           // eye-space rotation vector composed after the view (radians)
 };
 
+// An offset in image pixels (x right, y down) as window pixels, and back: the same map both
+// ways (only y's sign can differ).
+glm::dvec2 windowFromImageOffset(const Camera& camera, const glm::dvec2& offset);
+
 // The camera a departure describes: a raw-matrix projection when the intrinsics, the sample
 // offset (as the image moved the other way: what the camera sees at its pixel centres is then
 // what the declared one saw at the samples) or near and far move, a raw view when the pose
