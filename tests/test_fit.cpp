@@ -270,3 +270,18 @@ TEST_CASE("a resolved multisample depth map is named anti-aliased, consistent ex
         REQUIRE(best.unexplained > 0);
     });
 }
+
+TEST_CASE("regression: a finely tessellated mesh gave the fits no sample pixels, so an MSAA map of it went unnamed", "[fit][regression]")
+{
+    // The one-plane test of a pixel's neighbourhood allowed second differences of a thousandth
+    // of the rise: on triangles about a pixel wide every neighbourhood spans gentle creases and
+    // failed it (the Stanford bunny at 640×480 had none), so every fit had nothing to fit.
+    const Bench b({"regression", "builtin:terrain?n=300", "opengl", ExportQuantity::EyeZ});
+    Departure d;
+    d.sampleOffset = {-5.0 / 16, 5.0 / 16};
+    const Hypothesis h = b.diagnosed(b.mapDrawnWith(b.camera.spec(), departedSampling(b.camera, d)), "sample-offset");
+    INFO(h.explanation << ": unexplained " << h.unexplained);
+    REQUIRE(h.consistent);
+    REQUIRE(std::abs(fittedValue(h, "sample_dx_px") - d.sampleOffset.x) <= 1.0 / 256);
+    REQUIRE(std::abs(fittedValue(h, "sample_dy_px") - d.sampleOffset.y) <= 1.0 / 256);
+}

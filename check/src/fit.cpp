@@ -241,7 +241,7 @@ Departure levenbergMarquardt(const Problem& problem)
 }
 
 // The sample pixels of a truth render: hit, with a map value, and a 3×3 neighbourhood on one
-// plane (onePlaneAround), at most 4096 evenly spaced.
+// smooth surface (onePlaneAround), at most 4096 evenly spaced.
 std::vector<Sample> samplesOf(const Scene& scene, const Camera& declared, const Camera& departed,
                               const DepthMap& map, const RenderResult& truth)
 {
@@ -505,7 +505,7 @@ std::vector<FittedValue> fittedValues(const Camera& camera, const DepthMap&, con
     case FitFamily::DepthScale: out = {{"value_scale", d.valueScale, 1}, {"value_offset", d.valueOffset, 0}}; break;
     case FitFamily::Pose: {
         const glm::dvec3 eye = eyePositionOf(camera.eyeFromWorld);
-        const glm::dvec3 moved = eyePositionOf(departedCameraSpec(camera, d).view.eyeFromWorld);
+        const glm::dvec3 moved = eyePositionOf(Camera(departedCameraSpec(camera, d)).eyeFromWorld);
         out = {{"eye_x", moved.x, eye.x},
                {"eye_y", moved.y, eye.y},
                {"eye_z", moved.z, eye.z},
@@ -567,7 +567,7 @@ std::string describeFit(const Camera& camera, const DepthMap& map, const FitResu
                " (a unit or scale mistake: divide by " + number(d.valueScale, 5) + ")";
     case FitFamily::Pose: {
         const glm::dvec3 eye = eyePositionOf(camera.eyeFromWorld);
-        const glm::dvec3 moved = eyePositionOf(departedCameraSpec(camera, d).view.eyeFromWorld);
+        const glm::dvec3 moved = eyePositionOf(Camera(departedCameraSpec(camera, d)).eyeFromWorld);
         std::string text = "the eye at (" + number(moved.x, 5) + ", " + number(moved.y, 5) + ", " + number(moved.z, 5) +
                            ") instead of (" + number(eye.x, 5) + ", " + number(eye.y, 5) + ", " + number(eye.z, 5) + ")";
         const View& v = camera.spec().view;

@@ -73,7 +73,7 @@ struct FitResult {
     Departure departure;
     double initialResidual = 0;  // robust RMS relative depth residual under the declared camera
     double residual = 0;         // the same after the fit
-    std::size_t samples = 0;     // sample pixels in the last round
+    std::size_t samples = 0;     // sample pixels in the last round; 0: too few to fit (not reported)
 };
 
 // Renders the ground truth through a camera with a sampling fault (Checker::renderRay).

@@ -111,10 +111,12 @@ void requireMapFits(const Camera& camera, const DepthMap& map);
 std::optional<std::int64_t> screenUnexplained(const Scene& scene, const Camera& camera, const DepthMap& map,
                                               const RenderResult& truth, const VertexNeighbours& neighbours);
 
-// Whether the truth around pixel (col, row) is one surface: its 3×3 neighbourhood (clamped at
-// the image's border) all hit or all miss, and, where hit, window depth affine in x and y (a
-// plane's is): second differences across the pixel in x, y and both diagonals within 1e-3 of
-// the rise plus 1e-12. False at silhouettes, occlusion edges and creases.
+// Whether the truth around pixel (col, row) is one smooth surface: its 3×3 neighbourhood
+// (clamped at the image's border) all hit or all miss, and, where hit, window depth nearly
+// affine in x and y (a plane's is): second differences across the pixel in x, y and both
+// diagonals within a tenth of the rise plus 1e-12. False at silhouettes and occlusion edges
+// (there the second difference is as large as the rise) and at sharp creases; true on a
+// finely tessellated curved surface, whose gentle creases bend depth far less.
 bool onePlaneAround(const RenderResult& truth, int width, int height, int col, int row);
 
 // Of a comparison's unexplained pixels, those at edges of the truth (a 3×3 neighbourhood that
