@@ -35,6 +35,9 @@ const Setup kSetups[] = {
     {"tuning", "builtin:default", "direct3d", ExportQuantity::Window},
     {"held-out", "builtin:default", "vulkan", ExportQuantity::Window},
     {"held-out", "builtin:terrain?n=48", "direct3d", ExportQuantity::Distance},
+    {"held-out", "builtin:default", "opencv", ExportQuantity::Ndc},
+    {"tuning (fifth session)", "builtin:near-crossing", "opengl", ExportQuantity::Window},
+    {"tuning (fifth session)", "builtin:near-crossing", "metal", ExportQuantity::EyeZ},
 };
 
 struct Bench {
@@ -166,7 +169,7 @@ TEST_CASE("a map drawn with a moved principal point or another aspect is diagnos
 TEST_CASE("a map drawn with other near and far planes is diagnosed with them", "[fit]")
 {
     forEachSetup([](const Bench& b) {
-        if (b.quantity != ExportQuantity::Window) return;  // only window and NDC depth see near and far
+        if (b.quantity != ExportQuantity::Window && b.quantity != ExportQuantity::Ndc) return;  // only they see near and far
         for (const auto& [nearFactor, farFactor] : {std::pair{1.05, 1.0}, std::pair{1.5, 0.5}, std::pair{0.5, 3.0}}) {
             INFO("near x " << nearFactor << ", far x " << farFactor);
             CameraSpec drawn = b.camera.spec();
@@ -183,7 +186,8 @@ TEST_CASE("a map drawn with other near and far planes is diagnosed with them", "
 TEST_CASE("a map in other units or from another origin is diagnosed with its scale and offset", "[fit]")
 {
     forEachSetup([](const Bench& b) {
-        if (b.quantity == ExportQuantity::Window) return;  // a window map's scale is its near and far
+        // A window or NDC map's scale and offset are its near and far (and it has no units).
+        if (b.quantity == ExportQuantity::Window || b.quantity == ExportQuantity::Ndc) return;
         const double n = b.camera.nearDistance();
         for (const auto& [scale, offset] : {std::pair{1.002, 0.0}, std::pair{1000.0, 0.0}, std::pair{1.0, -n}}) {
             INFO("value x " << scale << " + " << offset);
@@ -284,4 +288,69 @@ TEST_CASE("regression: a finely tessellated mesh gave the fits no sample pixels,
     REQUIRE(h.consistent);
     REQUIRE(std::abs(fittedValue(h, "sample_dx_px") - d.sampleOffset.x) <= 1.0 / 256);
     REQUIRE(std::abs(fittedValue(h, "sample_dy_px") - d.sampleOffset.y) <= 1.0 / 256);
+}
+
+TEST_CASE("regression: a rescaled NDC map's far-plane misses read as surfaces once its scale was undone", "[fit][regression]")
+{
+    // The far plane's NDC 1, scaled by 1.002 and back, is 1 − 2^−25 in double: no longer the
+    // far plane, so 11232 background pixels of the map read as surfaces (departedReading).
+    const Bench b({"regression", "builtin:default", "opencv", ExportQuantity::Ndc});
+    DepthMap map = b.mapDrawnWith(b.camera.spec());
+    for (double& v : map.value)
+        if (std::isfinite(v)) v = double(float(1.002 * v));
+    Departure d;
+    d.valueScale = 1.002;
+    const ComparisonReport r = b.checker.verify(b.camera, departedReading(b.camera, map, d)).comparison.report;
+    INFO("unexplained " << r.unexplained());
+    REQUIRE(r.bothMiss > 1000);
+    REQUIRE(r.consistent());
+}
+
+TEST_CASE("regression: the near and far fit stopped short where the map's near plane clipped geometry", "[fit][regression]")
+{
+    // Drawn with near × 1.5 and far × 0.5, the map shows, where geometry lies between the two
+    // near planes, a surface behind: those residuals grew as the local fit walked toward the
+    // answer, and it stopped at near 0.55, far ∞ (near and far now start from a line through
+    // the samples by least median of squares).
+    const Bench b({"regression", "builtin:near-crossing", "opengl", ExportQuantity::Window});
+    CameraSpec drawn = b.camera.spec();
+    drawn.projection.near *= 1.5, drawn.projection.far *= 0.5;
+    const Hypothesis h = b.diagnosed(b.mapDrawnWith(drawn), "near-far");
+    INFO(h.explanation << ": unexplained " << h.unexplained);
+    REQUIRE(h.consistent);
+    REQUIRE(std::abs(fittedValue(h, "near") - drawn.projection.near) <= 1e-3 * drawn.projection.near);
+    REQUIRE(std::abs(fittedValue(h, "far") - drawn.projection.far) <= 2e-2 * drawn.projection.far);
+}
+
+TEST_CASE("regression: a fit pulled by steep surfaces' snapping left face-on pixels beyond their tolerance", "[fit][regression]")
+{
+    // The raster's snapped vertices move a steep triangle's values by up to its slope credit,
+    // all the same way; weighing every pixel alike, the scale fit came out 1e-5 off and 133
+    // face-on pixels failed the confirmation. Residuals are now weighed in each pixel's
+    // tolerance, and the largest minimised where one is still near its tolerance.
+    const Bench b({"regression", "builtin:near-crossing", "metal", ExportQuantity::EyeZ});
+    DepthMap map = b.mapDrawnWith(b.camera.spec());
+    for (double& v : map.value)
+        if (std::isfinite(v)) v = double(float(1.002 * v));
+    const Hypothesis h = b.diagnosed(map, "depth-scale");
+    INFO(h.explanation << ": unexplained " << h.unexplained);
+    REQUIRE(h.consistent);
+    REQUIRE(std::abs(fittedValue(h, "value_scale") - 1.002) <= 1e-4 * 1.002);
+}
+
+TEST_CASE("regression: a scaled reading's residuals were measured in the unscaled values' units", "[fit][regression]")
+{
+    // A residual is a relative eye depth: (predicted − map) over the value's change for a
+    // relative eye-z change, which a reading scaled by s multiplies by s. Without it a map in
+    // millimetres had residuals 1000× too large, so the fit seemed not to explain it and was
+    // never polished: 71 face-on pixels stayed beyond their tolerance.
+    const Bench b({"regression", "builtin:near-crossing", "metal", ExportQuantity::EyeZ});
+    DepthMap map = b.mapDrawnWith(b.camera.spec());
+    for (double& v : map.value)
+        if (std::isfinite(v)) v = double(float(1000 * v));
+    const Hypothesis h = b.diagnosed(map, "depth-scale");
+    INFO(h.explanation << ": unexplained " << h.unexplained);
+    REQUIRE(h.consistent);
+    REQUIRE(std::abs(fittedValue(h, "value_scale") - 1000) <= 1e-4 * 1000);
+    REQUIRE(std::abs(fittedValue(h, "residual")) <= 1e-4);
 }

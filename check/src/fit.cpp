@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <optional>
 
 namespace zcheck {
@@ -51,7 +52,9 @@ struct Sample {
     glm::dvec3 normal;  // world plane normal·x = offset
     double offset;
     double mapValue;
-    double sigma;  // value change per relative eye-z change
+    double sigma;                // value change per relative eye-z change
+    std::uint32_t primitive;     // the truth's surface there
+    double tolerance = 0;        // the comparison's tolerance there (withTolerances), as a relative eye-z change
 };
 
 // The model: where camera c's ray through the sample's pixel centre meets the sample's plane,
@@ -63,6 +66,26 @@ glm::dvec3 eyePointOnPlane(const Camera& c, const Sample& s)
     return glm::dvec3(c.eyeFromWorld * glm::dvec4(ray.origin + t * ray.direction, 1.0));
 }
 
+// A window depth as a line in u(z) (Problem::at, NearFar).
+struct WindowLine {
+    double a, b;
+    static double u(const Camera& camera, double z) { return camera.spec().projection.isPerspective() ? 1 / z : z; }
+    // The line through the window depths at the departure's near and far.
+    static WindowLine of(const Camera& camera, const Departure& d)
+    {
+        const double n = d.nearDistance > 0 ? d.nearDistance : camera.nearDistance();
+        const double f = d.farDistance > 0 ? d.farDistance : camera.farDistance();
+        const double b = (camera.windowDepthNear() - camera.windowDepthFar()) / (u(camera, n) - u(camera, f));
+        return {camera.windowDepthNear() - b * u(camera, n), b};
+    }
+    // The eye depth where the line reaches window depth w.
+    double depthAt(const Camera& camera, double w) const
+    {
+        const double uz = (w - a) / b;
+        return camera.spec().projection.isPerspective() ? 1 / uz : uz;
+    }
+};
+
 struct Problem {
     const Camera& camera;
     const DepthMap& map;
@@ -71,6 +94,7 @@ struct Problem {
     double sceneDepth;    // median eye-z of the samples (pose translations are in its units)
     double valueSpan;     // median |map value| (value offsets are in its units)
     std::vector<Sample> samples;
+    bool inTolerances = false;  // what residuals() gives by default (below)
 
     int parameterCount() const
     {
@@ -97,10 +121,20 @@ struct Problem {
             d.focalScale *= glm::dvec2(1 + p[0], 1 + p[1]);
             d.principalShift += glm::dvec2(p[2], p[3]);
             break;
-        case FitFamily::NearFar:
-            d.nearDistance = (d.nearDistance > 0 ? d.nearDistance : camera.nearDistance()) * std::exp(p[0]);
-            d.farDistance = (d.farDistance > 0 ? d.farDistance : camera.farDistance()) * std::exp(p[1]);
+        case FitFamily::NearFar: {
+            // Window depth is a + b·u(z) in the eye depth z, u(z) = 1/z for a perspective
+            // projection and z otherwise, and the map's values are linear in a and b: fitted
+            // there, the problem is linear (near and far themselves are badly conditioned:
+            // far moves a perspective map's values by n/f of their size). Near and far are
+            // where a + b·u(z) reaches the window's near and far depths.
+            const WindowLine base = WindowLine::of(camera, d);
+            const WindowLine line{base.a + p[0] * (camera.windowDepthFar() - camera.windowDepthNear()), base.b * (1 + p[1])};
+            d.nearDistance = line.depthAt(camera, camera.windowDepthNear());
+            d.farDistance = line.depthAt(camera, camera.windowDepthFar());
+            if (!(d.nearDistance > 0 && d.farDistance > d.nearDistance && std::isfinite(d.farDistance)))
+                d.nearDistance = d.farDistance = -1;  // no camera
             break;
+        }
         case FitFamily::DepthScale:
             d.valueScale *= 1 + p[0];
             d.valueOffset += p[1] * valueSpan;
@@ -113,9 +147,15 @@ struct Problem {
         return d;
     }
 
-    // Residuals (predicted − map) / sigma at the departure; empty where it is no camera.
-    std::vector<double> residuals(const Departure& d) const
+    // Residuals (predicted − map) / sigma at the departure, relative eye depths; empty where
+    // it is no camera. `inTolerances`: each divided by its pixel's tolerance, which is what the
+    // fit weighs: a steep surface's value may sit up to its slope credit off (a raster's snapped
+    // vertices, a sample off the centre), a face-on one only a few ulps, and a fit that let the
+    // steep pixels pull it would leave the face-on ones beyond their tolerance.
+    std::vector<double> residuals(const Departure& d) const { return residuals(d, inTolerances); }
+    std::vector<double> residuals(const Departure& d, bool inTolerances) const
     {
+        if (d.nearDistance < 0) return {};  // Problem::at: no camera
         std::optional<Camera> departed;
         try {
             departed.emplace(departedCameraSpec(camera, d));
@@ -127,7 +167,7 @@ struct Problem {
         tbb::parallel_for(std::size_t(0), samples.size(), [&](std::size_t k) {
             const Sample& s = samples[k];
             const double predicted = d.valueScale * valueOfEyePoint(c, eyePointOnPlane(c, s), map.quantity) + d.valueOffset;
-            r[k] = (predicted - s.mapValue) / s.sigma;
+            r[k] = (predicted - s.mapValue) / (s.sigma * std::abs(d.valueScale)) / (inTolerances ? s.tolerance : 1.0);
             if (!std::isfinite(r[k])) r[k] = 1e30;
         });
         return r;
@@ -184,11 +224,17 @@ bool solve(std::vector<double> A, std::vector<double> b, int n, std::vector<doub
 }
 
 // The robust scale of the residuals: 2.4 × their MAD-estimated spread, floored at binary32's
-// resolution (a map that matches exactly would otherwise weigh its rounding).
-double cauchyScale(const std::vector<double>& r) { return std::max(2.4 * 1.4826 * medianAbsolute(r), 1e-7); }
+// resolution or at a hundredth of a tolerance (a map that matches exactly would otherwise
+// weigh its rounding).
+double cauchyScale(const std::vector<double>& r, bool inTolerances)
+{
+    return std::max(2.4 * 1.4826 * medianAbsolute(r), inTolerances ? 1e-2 : 1e-7);
+}
 
-// Levenberg–Marquardt from the problem's base; returns the departure reached.
-Departure levenbergMarquardt(const Problem& problem)
+// Levenberg–Marquardt from the problem's base, at most `iterations` steps; returns the
+// departure reached. The cost is Cauchy's, refreshed every step, or with `weights` the weighted
+// sum of squares.
+Departure levenbergMarquardt(const Problem& problem, const std::vector<double>* weights = nullptr, int iterations = 30)
 {
     const int n = problem.parameterCount();
     std::vector<double> p(static_cast<std::size_t>(n), 0.0);
@@ -196,9 +242,16 @@ Departure levenbergMarquardt(const Problem& problem)
     if (r.empty()) return problem.base;
     double lambda = 1e-3;
     constexpr double h = 1e-6;
-    for (int iteration = 0; iteration < 30; ++iteration) {
-        const double c = cauchyScale(r);
-        const double cost = robustCost(r, c);
+    auto costOf = [&](const std::vector<double>& res, double c) {
+        if (!weights) return robustCost(res, c);
+        if (res.empty()) return double(INFINITY);
+        double sum = 0;
+        for (std::size_t k = 0; k < res.size(); ++k) sum += (*weights)[k] * res[k] * res[k];
+        return sum;
+    };
+    for (int iteration = 0; iteration < iterations; ++iteration) {
+        const double c = cauchyScale(r, problem.inTolerances);
+        const double cost = costOf(r, c);
         // Weighted normal equations with a forward-difference Jacobian.
         std::vector<std::vector<double>> J(static_cast<std::size_t>(n));
         for (int j = 0; j < n; ++j) {
@@ -210,7 +263,8 @@ Departure levenbergMarquardt(const Problem& problem)
         }
         std::vector<double> A(std::size_t(n * n), 0.0), g(std::size_t(n), 0.0);
         for (std::size_t k = 0; k < r.size(); ++k) {
-            const double w = 1 / (1 + (r[k] / c) * (r[k] / c));
+            const double w = weights ? (*weights)[k] : 1 / (1 + (r[k] / c) * (r[k] / c));
+            if (w == 0) continue;
             for (int a = 0; a < n; ++a) {
                 g[std::size_t(a)] -= w * J[std::size_t(a)][k] * r[k];
                 for (int b = 0; b < n; ++b) A[std::size_t(a * n + b)] += w * J[std::size_t(a)][k] * J[std::size_t(b)][k];
@@ -218,6 +272,7 @@ Departure levenbergMarquardt(const Problem& problem)
         }
         bool improved = false;
         std::vector<double> step;
+        double change = 0;  // the step's largest change of a residual
         while (lambda < 1e10) {
             std::vector<double> damped = A;
             for (int a = 0; a < n; ++a) damped[std::size_t(a * n + a)] *= 1 + lambda;
@@ -225,7 +280,8 @@ Departure levenbergMarquardt(const Problem& problem)
                 std::vector<double> q = p;
                 for (int a = 0; a < n; ++a) q[std::size_t(a)] += step[std::size_t(a)];
                 std::vector<double> rq = problem.residuals(problem.at(q));
-                if (robustCost(rq, c) < cost) {
+                if (costOf(rq, c) < cost) {
+                    for (std::size_t k = 0; k < r.size(); ++k) change = std::max(change, std::abs(rq[k] - r[k]));
                     p = std::move(q), r = std::move(rq), lambda = std::max(lambda / 4, 1e-9), improved = true;
                     break;
                 }
@@ -235,9 +291,159 @@ Departure levenbergMarquardt(const Problem& problem)
         double size = 0;
         for (double s : step) size = std::max(size, std::abs(s));
         if (!improved) break;
-        if (size < 1e-6) break;  // a millionth of a pixel, of a scale, of the depth: converged
+        // Converged: in tolerances, when no residual moved by a hundredth of one (a step size
+        // says nothing there: a face-on pixel's tolerance is 1e-7 of its depth); otherwise at a
+        // millionth of a pixel, of a scale, of the depth.
+        if (problem.inTolerances ? change < 1e-2 : size < 1e-6) break;
     }
     return problem.at(p);
+}
+
+// A line y = a + b·x through points weighed by their scales (y's change for a relative eye-z
+// change), by least median of squares: of `line` and the lines through 256 pairs of points,
+// the one whose residuals' median is smallest. Global, and indifferent to up to half the points
+// lying off it.
+struct LinePoint {
+    double x, y, sigma;
+};
+struct Line {
+    double a, b;
+};
+Line leastMedianLine(const std::vector<LinePoint>& points, Line line)
+{
+    const std::size_t n = points.size();
+    auto medianResidual = [&](const Line& l) {
+        std::vector<double> r(n);
+        for (std::size_t k = 0; k < n; ++k) r[k] = (l.a + l.b * points[k].x - points[k].y) / points[k].sigma;
+        return medianAbsolute(r);
+    };
+    double bestMedian = medianResidual(line);
+    constexpr std::size_t kPairs = 256;
+    for (std::size_t k = 0; n >= 16 && k < kPairs; ++k) {
+        const LinePoint& p = points[k * n / kPairs];
+        const LinePoint& q = points[(k * n / kPairs + n / 2 + 37 * k) % n];
+        if (!(std::abs(p.x - q.x) > 1e-9 * std::max(std::abs(p.x), std::abs(q.x)))) continue;
+        Line trial;
+        trial.b = (p.y - q.y) / (p.x - q.x);
+        trial.a = p.y - trial.b * p.x;
+        const double median = medianResidual(trial);
+        if (median < bestMedian) line = trial, bestMedian = median;
+    }
+    return line;
+}
+
+// The start of the two families whose values are linear in their parameters, found globally
+// (leastMedianLine) before the local fit. Near and far: a window or NDC map's values lie on a
+// line in u(z) (WindowLine), z the eye depth of each sample's plane, which near and far do not
+// move; a local fit from the declared near and far stops short where the map's nearer near
+// plane clipped geometry (those pixels show a surface behind, and their residuals grow as the
+// fit walks toward the answer). A scale and offset: the map's values on a line in the values
+// the declared reading expects, where a unit mistake of 1000 leaves a local fit's start far
+// off. Other families, and a line that gives no camera, keep the base.
+Departure linearStart(const Problem& problem)
+{
+    if (problem.family != FitFamily::NearFar && problem.family != FitFamily::DepthScale) return problem.base;
+    const Camera& camera = problem.camera;
+    const Camera departed(departedCameraSpec(camera, problem.base));
+    const bool ndc = problem.map.quantity == DepthQuantity::Ndc;
+    const double windowPerValue = ndc ? std::abs(camera.windowFromNdc[2][2]) : 1.0;
+    std::vector<LinePoint> points;
+    for (const Sample& s : problem.samples) {
+        const glm::dvec3 pEye = eyePointOnPlane(departed, s);
+        const double z = departed.eyeZOf(pEye);
+        if (!(z > 0)) continue;
+        if (problem.family == FitFamily::NearFar)
+            points.push_back({WindowLine::u(camera, z), ndc ? camera.windowDepthFromNdcZ(s.mapValue) : s.mapValue,
+                              s.sigma * windowPerValue});
+        else
+            points.push_back({valueOfEyePoint(departed, pEye, problem.map.quantity), s.mapValue, s.sigma});
+    }
+    Departure start = problem.base;
+    if (problem.family == FitFamily::DepthScale) {
+        const Line line = leastMedianLine(points, {problem.base.valueOffset, problem.base.valueScale});
+        if (!(line.b != 0) || !std::isfinite(line.a) || !std::isfinite(line.b)) return problem.base;
+        start.valueScale = line.b, start.valueOffset = line.a;
+        return start;
+    }
+    const WindowLine base = WindowLine::of(camera, problem.base);
+    const Line line = leastMedianLine(points, {base.a, base.b});
+    const WindowLine best{line.a, line.b};
+    start.nearDistance = best.depthAt(camera, camera.windowDepthNear());
+    start.farDistance = best.depthAt(camera, camera.windowDepthFar());
+    if (!(start.nearDistance > 0 && start.farDistance > start.nearDistance && std::isfinite(start.farDistance)))
+        return problem.base;
+    return start;
+}
+
+// The samples that, read through the departure, the comparison would judge as hits, with
+// their tolerance (PixelJudge's, on the truth's surface) as a relative eye-z change.
+std::vector<Sample> withTolerances(const Scene& scene, const Camera& declared, const DepthMap& map, const Departure& d,
+                                   std::vector<Sample> samples)
+{
+    const Camera departed(departedCameraSpec(declared, d));
+    const PixelJudge judge(scene, departed, mapTolerance());
+    const double valueQuantum = map.valueQuantum / std::abs(d.valueScale);
+    tbb::parallel_for(std::size_t(0), samples.size(), [&](std::size_t k) {
+        Sample& s = samples[k];
+        const MapPixel pixel = mapPixelDepth(departed, map.quantity, (s.mapValue - d.valueOffset) / d.valueScale,
+                                             valueQuantum, s.col, s.row, NAN);
+        const glm::dvec2 pWindow = windowFromPixelCentre(departed, s.col, s.row);
+        const double z = eyeZFromWindowDepth(departed, pWindow, pixel.depth);
+        const double windowSigma = std::abs(valueOfEyeZ(departed, pWindow, z * (1 + 1e-6), DepthQuantity::Window) - pixel.depth) / 1e-6;
+        s.tolerance = judge.surfaceTolerance(s.primitive, pixel.quantum) / windowSigma;
+    });
+    samples.erase(std::remove_if(samples.begin(), samples.end(),
+                                 [](const Sample& s) { return !(s.tolerance > 0) || !std::isfinite(s.tolerance); }),
+                  samples.end());
+    return samples;
+}
+
+// The largest of the residuals `inliers` marks.
+double largestOf(const std::vector<double>& r, const std::vector<double>& inliers)
+{
+    double most = 0;
+    for (std::size_t k = 0; k < r.size(); ++k)
+        if (inliers[k] > 0) most = std::max(most, std::abs(r[k]));
+    return most;
+}
+
+// The rounds' fit refined in the comparison's own terms: every residual in its pixel's
+// tolerance (Problem::residuals), which the confirmation asks each pixel to stay within, and
+// Cauchy's fit again in those units. Then, where most samples are within their tolerance but
+// an inlier (≤ 4 tolerances) is beyond 0.9 of its own (a raster's snapped vertices move a
+// whole triangle's values the same way, and the robust sum's optimum can leave a patch of
+// face-on pixels just beyond their tolerance), the inliers' largest residual is minimised by
+// Lawson's iteration: weighted least squares, each weight multiplied by its residual, which
+// converges to the minimax fit. Returns the departure with the smallest largest inlier
+// residual seen.
+Departure polished(const Scene& scene, Problem problem, const Departure& start)
+{
+    problem.samples = withTolerances(scene, problem.camera, problem.map, start, std::move(problem.samples));
+    if (problem.samples.size() < 16) return start;
+    problem.inTolerances = true;
+    problem.base = start;
+    Departure best = levenbergMarquardt(problem);
+    const std::vector<double> r1 = problem.residuals(best);
+    if (r1.empty()) return start;
+    std::vector<double> weights(r1.size());
+    for (std::size_t k = 0; k < r1.size(); ++k) weights[k] = std::abs(r1[k]) <= 4 ? 1.0 : 0.0;
+    double bestLargest = largestOf(r1, weights);
+    if (medianAbsolute(r1) > 1) return best;
+    problem.base = best;
+    for (int iteration = 0; iteration < 12 && bestLargest > 0.9; ++iteration) {
+        const Departure d = levenbergMarquardt(problem, &weights, 3);  // the weights change anyway
+        const std::vector<double> r = problem.residuals(d);
+        if (r.empty()) break;
+        const double most = largestOf(r, weights);
+        if (most < bestLargest) best = d, bestLargest = most;
+        double sum = 0;
+        for (std::size_t k = 0; k < r.size(); ++k)
+            if (weights[k] > 0) sum += weights[k] *= std::max(std::abs(r[k]), 1e-3 * most);
+        if (!(sum > 0)) break;
+        for (double& w : weights) w /= sum;
+        problem.base = d;
+    }
+    return best;
 }
 
 // The sample pixels of a truth render: hit, with a map value, and a 3×3 neighbourhood on one
@@ -264,16 +470,15 @@ std::vector<Sample> samplesOf(const Scene& scene, const Camera& declared, const 
             const double v1 = valueOfEyeZ(declared, pWindow, z * (1 + 1e-6), map.quantity);
             const double sigma = std::abs(v1 - v0) / 1e-6;
             if (!(sigma > 0) || !std::isfinite(sigma)) continue;
-            ofRow[std::size_t(row)].push_back({col, row, normal, glm::dot(normal, a), map.value[i], sigma});
+            ofRow[std::size_t(row)].push_back({col, row, normal, glm::dot(normal, a), map.value[i], sigma, truth.primitiveId[i]});
         }
     });
     std::vector<Sample> all;
     for (auto& row : ofRow) all.insert(all.end(), row.begin(), row.end());
     constexpr std::size_t kMost = 4096;
-    if (all.size() <= kMost) return all;
     std::vector<Sample> kept;
-    kept.reserve(kMost);
-    for (std::size_t k = 0; k < kMost; ++k) kept.push_back(all[k * all.size() / kMost]);
+    kept.reserve(std::min(kMost, all.size()));
+    for (std::size_t k = 0; k < std::min(kMost, all.size()); ++k) kept.push_back(all[k * all.size() / std::min(kMost, all.size())]);
     return kept;
 }
 
@@ -338,10 +543,14 @@ DepthMap departedReading(const Camera& declared, const DepthMap& map, const Depa
     if (d.valueScale == 1 && d.valueOffset == 0) return out;
     for (int row = 0; row < map.height; ++row)
         for (int col = 0; col < map.width; ++col) {
+            // A miss as read, or once undone as binary32 stores it: a far plane's 1 scaled by
+            // 1.002 and back is 1 − 2^−25, which only rounding returns to the far plane.
             double& v = out.value[std::size_t(row) * map.width + col];
-            v = isMissValue(declared, windowFromPixelCentre(declared, col, row), v, map.quantity)
+            const glm::dvec2 pWindow = windowFromPixelCentre(declared, col, row);
+            const double undone = (v - d.valueOffset) / d.valueScale;
+            v = isMissValue(declared, pWindow, v, map.quantity) || isMissValue(declared, pWindow, double(float(undone)), map.quantity)
                     ? NAN
-                    : (v - d.valueOffset) / d.valueScale;
+                    : undone;
         }
     if (out.valueQuantum > 0) out.valueQuantum /= std::abs(d.valueScale);
     return out;
@@ -380,6 +589,7 @@ FitResult fitDeparture(const Scene& scene, const Camera& camera, const DepthMap&
     Departure d;
     std::optional<RenderResult> rendered;  // the truth through the departed camera, from round 2
     double previous = 0;                   // the last round's residual
+    std::unique_ptr<Problem> last;         // the last round's
     for (int round = 0; round < 3; ++round) {
         const Camera departed(departedCameraSpec(camera, d));
         Problem problem{camera, map, family, d, 1, 1, samplesOf(scene, camera, departed, map, rendered ? *rendered : truth)};
@@ -391,7 +601,7 @@ FitResult fitDeparture(const Scene& scene, const Camera& camera, const DepthMap&
         std::vector<double> z;
         for (const Sample& s : problem.samples) z.push_back(std::abs(departed.eyeZOf(eyePointOnPlane(departed, s))));
         problem.sceneDepth = std::max(medianOf(z), 1e-12);
-        if (round == 0) out.initialResidual = medianAbsolute(problem.residuals(d));
+        if (round == 0) out.initialResidual = medianAbsolute(problem.residuals(d, false));
         if (family == FitFamily::SampleOffset && round == 0) {
             // Whole-pixel shifts first: the best of the offsets within two pixels.
             double best = INFINITY;
@@ -400,15 +610,16 @@ FitResult fitDeparture(const Scene& scene, const Camera& camera, const DepthMap&
                 for (int dx = -2; dx <= 2; ++dx) {
                     Departure trial = d;
                     trial.sampleOffset = glm::dvec2(dx, dy);
-                    const std::vector<double> r = problem.residuals(trial);
+                    const std::vector<double> r = problem.residuals(trial, false);
                     const double cost = robustCost(r, 1e-3);
                     if (cost < best) best = cost, start = trial;
                 }
             problem.base = start;
         }
+        if (round == 0) problem.base = linearStart(problem);
         const Departure next = levenbergMarquardt(problem);
         out.samples = problem.samples.size();
-        out.residual = medianAbsolute(problem.residuals(next));
+        out.residual = medianAbsolute(problem.residuals(next, false));
         const bool moved = glm::length(next.sampleOffset - d.sampleOffset) > 1e-4 ||
                            glm::length(next.focalScale - d.focalScale) > 1e-6 ||
                            glm::length(next.principalShift - d.principalShift) > 1e-4 ||
@@ -418,6 +629,7 @@ FitResult fitDeparture(const Scene& scene, const Camera& camera, const DepthMap&
         const double before = round == 0 ? out.initialResidual : previous;
         previous = out.residual;
         d = next;
+        last = std::make_unique<Problem>(problem);
         // Another round (new planes where surfaces moved) only for a fit that explains much of
         // the map and still improves; a scale and offset move no surface.
         if (!moved || family == FitFamily::DepthScale || out.residual > 0.5 * out.initialResidual ||
@@ -428,6 +640,12 @@ FitResult fitDeparture(const Scene& scene, const Camera& camera, const DepthMap&
         } catch (const Error&) {
             break;
         }
+    }
+    // The rounds weigh every sample pixel alike (relative depth: that finds a gross departure);
+    // a fit that explains much of the map is then polished in the comparison's own terms.
+    if (last && out.residual <= 0.5 * out.initialResidual) {
+        d = polished(scene, *last, d);
+        out.residual = medianAbsolute(last->residuals(d, false));
     }
     out.departure = d;
     return out;

@@ -99,6 +99,35 @@ MapReader::MapReader(const Scene& scene, const Camera& camera, const DepthMap& m
 {
 }
 
+MapPixel mapPixelDepth(const Camera& camera, const DepthMap& map, int col, int row, double truthDepth)
+{
+    return mapPixelDepth(camera, map.quantity, map.value[std::size_t(row) * camera.width() + col], map.valueQuantum, col,
+                         row, truthDepth);
+}
+
+MapPixel mapPixelDepth(const Camera& camera, DepthQuantity quantity, double value, double valueQuantum, int col, int row,
+                       double truthDepth)
+{
+    MapPixel out;
+    WindowDepthAt windowDepthOf(camera, windowFromPixelCentre(camera, col, row), quantity);
+    out.depth = windowDepthOf(value);
+    const double depth = out.depth;
+    // The storage step, carried into window units through the quantity's mapping.
+    const double reference = std::isfinite(depth) ? depth : truthDepth;
+    if (quantity == DepthQuantity::Window && valueQuantum == 0) {
+        out.quantum = storageQuantum(camera.depth().format, reference);
+    } else if (std::isfinite(depth)) {
+        const double step = valueQuantum > 0 ? valueQuantum
+                                             : double(std::nextafter(float(std::abs(value)), INFINITY)) - std::abs(double(float(value)));
+        const double other = windowDepthOf(value + step);
+        out.quantum = std::isfinite(other) ? std::max(std::abs(other - depth), storageQuantum(DepthFormat::Float32, depth))
+                                           : storageQuantum(camera.depth().format, depth);
+    } else {
+        out.quantum = storageQuantum(camera.depth().format, reference);
+    }
+    return out;
+}
+
 MapPixel MapReader::read(int col, int row, bool search) const
 {
     // Per thread, reused from pixel to pixel: the candidates considered and the surfaces seen.
@@ -106,24 +135,8 @@ MapPixel MapReader::read(int col, int row, bool search) const
     const int W = camera_.width(), H = camera_.height();
     const std::size_t i = std::size_t(row) * W + col;
     const glm::dvec2 pWindow = windowFromPixelCentre(camera_, col, row);
-    const double value = map_.value[i];
-    MapPixel out;
-    WindowDepthAt windowDepthOf(camera_, pWindow, map_.quantity);
-    out.depth = windowDepthOf(value);
+    MapPixel out = mapPixelDepth(camera_, map_, col, row, truth_.windowDepth.value[i]);
     const double depth = out.depth;
-    // The storage step, carried into window units through the quantity's mapping.
-    const double reference = std::isfinite(depth) ? depth : truth_.windowDepth.value[i];
-    if (map_.quantity == DepthQuantity::Window && map_.valueQuantum == 0) {
-        out.quantum = storageQuantum(camera_.depth().format, reference);
-    } else if (std::isfinite(depth)) {
-        const double step = map_.valueQuantum > 0 ? map_.valueQuantum
-                                                  : double(std::nextafter(float(std::abs(value)), INFINITY)) - std::abs(double(float(value)));
-        const double other = windowDepthOf(value + step);
-        out.quantum = std::isfinite(other) ? std::max(std::abs(other - depth), storageQuantum(DepthFormat::Float32, depth))
-                                           : storageQuantum(camera_.depth().format, depth);
-    } else {
-        out.quantum = storageQuantum(camera_.depth().format, reference);
-    }
     if (!std::isfinite(depth)) return out;
     // Which surface did the map see? The comparison's own rule decides (PixelJudge): the
     // truth's surface if the map's depth agrees with it; otherwise a surface drawn within S

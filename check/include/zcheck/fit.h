@@ -19,7 +19,15 @@
 //             relative eye depth, the same unit for every quantity.
 //   solver    Levenberg–Marquardt on the weighted normal equations, forward-difference
 //             Jacobian; then the truth is re-rendered through the fitted camera (new planes
-//             where surfaces moved) and the fit repeated, three rounds at most.
+//             where surfaces moved) and the fit repeated, three rounds at most. Near and far
+//             start from a global estimate: a window or NDC map's values lie on a line in 1/z
+//             (z for parallel projections), found by least median of squares over lines
+//             through pairs of samples, which pixels clipped by another near plane cannot pull.
+//   polish    A fit that explains the map is refined in the comparison's own terms where an
+//             inlier (≤ 4 tolerances) is beyond 0.9 of its tolerance: each residual divided by
+//             its pixel's tolerance (PixelJudge: C·q + S·m + E, so a steep surface's snapped or
+//             offset samples weigh less than a face-on one's), Cauchy's fit again, then the
+//             inliers' largest residual minimised (Lawson's iteration).
 //
 // Checker::diagnose then confirms each fitted camera with the full comparison.
 #include "zcheck/checker.h"
@@ -53,7 +61,8 @@ CameraSpec departedCameraSpec(const Camera& declared, const Departure& departure
 // off the pixel centres through the declared camera (zcheck export --sample-offset).
 RayFaults departedSampling(const Camera& declared, const Departure& departure);
 // The map as it reads once that departure's value scale and offset are undone: (v − offset) /
-// scale, its misses (as the declared camera reads them) kept as misses.
+// scale; a miss where the declared camera reads the value or, rounded to binary32, the undone
+// value as one.
 DepthMap departedReading(const Camera& declared, const DepthMap& map, const Departure& departure);
 
 enum class FitFamily {

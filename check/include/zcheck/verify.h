@@ -68,6 +68,14 @@ struct MapPixel {
     std::uint32_t primitive = kNoPrimitive;    // the surface chosen (above); kNoPrimitive for a miss
 };
 
+// The pixel's window depth and storage step as the comparison reads them (its surface left
+// kNoPrimitive); `truthDepth` is the truth's window depth there, the reference for a miss.
+MapPixel mapPixelDepth(const Camera& camera, const DepthMap& map, int col, int row, double truthDepth);
+// The same for one value of `quantity` stored with step `valueQuantum` (DepthMap's meaning: 0
+// for binary32, or for a window map the camera's depth format).
+MapPixel mapPixelDepth(const Camera& camera, DepthQuantity quantity, double value, double valueQuantum, int col, int row,
+                       double truthDepth);
+
 // Reads a map pixel by pixel against an already rendered truth: the per-pixel rule of
 // renderResultFromMap, and the comparison's class for one pixel, so that a diagnosis can
 // judge a sample of pixels without reading the whole map. Holds references; thread-safe.
