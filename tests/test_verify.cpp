@@ -417,3 +417,23 @@ TEST_CASE("a mirrored principal point, depth without near added, and a map quant
     REQUIRE(s.spec.depth.format == DepthFormat::Float32);
     REQUIRE(testing::diagnosedAs(checker, camera, testing::windowMapOf(unorm16, checker.renderRaster(unorm16)), "quantized-depth"));
 }
+
+TEST_CASE("two camera mistakes at once are diagnosed by both names: reversed and aspect inverted", "[verify][diagnose]")
+{
+    // A reversed-Z renderer that also computes its aspect as height / width: both change the
+    // camera (neither is a re-reading of the map), so the pair needs a truth of its own.
+    Setup s;
+    const Checker checker(s.scene);
+    const Camera camera(s.spec);
+    CameraSpec drawn = s.spec;
+    drawn.depth.reversed = true;
+    drawn.projection.aspect = double(s.spec.height) / s.spec.width;
+    const Camera drawnCamera(drawn);
+    const DepthMap map = mapOf(s.scene, drawnCamera, checker.renderRaster(drawnCamera), ExportQuantity::Window);
+    const std::vector<Hypothesis> diagnosis = checker.diagnose(camera, map);
+    REQUIRE_FALSE(diagnosis.empty());
+    const Hypothesis& best = diagnosis.front();
+    INFO("best: " << best.name << ", unexplained " << best.unexplained);
+    REQUIRE(best.consistent);
+    REQUIRE((best.name == "reversed-as-standard + aspect-inverted" || best.name == "aspect-inverted + reversed-as-standard"));
+}

@@ -298,6 +298,30 @@ std::optional<std::int64_t> screenUnexplained(const Scene& scene, const Camera& 
     return std::int64_t(std::llround(double(unexplained) / double(read) * suspectsInAll));
 }
 
+double probeAgreement(const Scene& scene, const RayRenderer& rays, const Camera& camera, const DepthMap& map)
+{
+    constexpr int kGrid = 16;
+    const int W = camera.width(), H = camera.height();
+    const PixelJudge judge(scene, camera, mapTolerance());
+    std::atomic<int> agree{0};
+    tbb::parallel_for(0, kGrid * kGrid, [&](int k) {
+        const int col = (2 * (k % kGrid) + 1) * W / (2 * kGrid), row = (2 * (k / kGrid) + 1) * H / (2 * kGrid);
+        const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
+        const std::uint32_t primitive = rays.primitiveAt(camera, pWindow);
+        const double truthDepth = primitive == kNoPrimitive
+                                      ? camera.clearDepth()
+                                      : planeWindowDepth(scene, camera, primitive, worldEyePlaneRayThroughWindow(camera, pWindow));
+        const MapPixel pixel = mapPixelDepth(camera, map, col, row, truthDepth);
+        double bound = 0;
+        if (primitive == kNoPrimitive ? !std::isfinite(pixel.depth)
+                                      : std::isfinite(pixel.depth) && std::isfinite(truthDepth) &&
+                                            judge.bothHit(truthDepth, primitive, pixel.depth, primitive, pixel.quantum, pWindow,
+                                                          bound) == PixelClass::Agree)
+            ++agree;
+    });
+    return double(agree) / (kGrid * kGrid);
+}
+
 VerifyResult verifyAgainst(const Scene& scene, const Camera& camera, const DepthMap& map, RenderResult truth,
                            const VertexNeighbours& neighbours)
 {
@@ -479,9 +503,15 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
         return h.consistent || h.consistentExceptEdges();
     });
     // Two mistakes at once (flipped and reversed, say), when no single one, no fit and no
-    // edge-only reading explains the map: a
-    // reading of the map composed with a reading of the map or of the camera, judged against
-    // the truth already rendered for the latter. Two camera mistakes at once are not tried.
+    // edge-only reading explains the map: a reading of the map composed with a reading of the
+    // map or of the camera, judged against the truth already rendered for the latter; and two
+    // camera mistakes, below.
+    auto pairHypothesis = [&](const Candidate& first, const Candidate& second) {
+        std::string also = second.reading.explanation;
+        if (also.rfind("consistent if ", 0) == 0) also = also.substr(14);
+        return hypothesis(first.mistake->name + " + " + second.mistake->name, second.reading.variant,
+                          first.reading.explanation + ", and " + also);
+    };
     if (!explained) {
         std::vector<std::pair<std::size_t, std::size_t>> pairs;
         auto changesQuantity = [&](const Candidate& c) { return c.reading.map && c.reading.map->quantity != map.quantity; };
@@ -502,16 +532,58 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
                 const auto same = std::find_if(again.begin(), again.end(), [&](const Rereading& r) { return r.variant == second.reading.variant; });
                 if (same == again.end()) return;
                 const DepthMap& both = same->map ? *same->map : firstMap;
-                const std::string name = first.mistake->name + " + " + second.mistake->name;
-                const std::string variant = second.reading.variant;
-                std::string also = second.reading.explanation;
-                if (also.rfind("consistent if ", 0) == 0) also = also.substr(14);
-                paired[k] = judgeAgainst(hypothesis(name, variant, first.reading.explanation + ", and " + also),
-                                         *second.camera, both, second.truth ? *second.truth : truth);
+                paired[k] = judgeAgainst(pairHypothesis(first, second), *second.camera, both, second.truth ? *second.truth : truth);
             } catch (const Error&) {
             }
         });
         for (auto& h : paired)
+            if (h) out.push_back(std::move(*h));
+        // Two camera mistakes (a reversed-Z renderer with a left-handed view, say): the second
+        // applied to the first's camera. A truth for each of a few hundred cameras would cost
+        // seconds; a grid of single rays (probeAgreement) rules out almost all of them first,
+        // and a camera that two orders of the same pair both make is judged once.
+        struct CameraPair {
+            std::size_t first, second;
+            std::optional<Camera> camera;
+        };
+        std::vector<CameraPair> cameraPairs;
+        auto changesCameraOnly = [](const Candidate& c) { return c.camera && c.reading.camera && c.reading.truthFaults.none() && !c.reading.map; };
+        for (std::size_t a = 0; a < candidates.size(); ++a)
+            for (std::size_t b = 0; b < candidates.size(); ++b)
+                if (candidates[a].mistake != candidates[b].mistake && changesCameraOnly(candidates[a]) && changesCameraOnly(candidates[b]))
+                    cameraPairs.push_back({a, b, {}});
+        tbb::parallel_for(std::size_t(0), cameraPairs.size(), [&](std::size_t k) {
+            CameraPair& pair = cameraPairs[k];
+            const Candidate& second = candidates[pair.second];
+            try {
+                for (const Rereading& r : second.mistake->reread(*candidates[pair.first].camera, map))
+                    if (r.variant == second.reading.variant && r.camera) {
+                        Camera composed(*r.camera);
+                        if (probeAgreement(scene_, rays_, composed, map) >= 0.75) pair.camera.emplace(std::move(composed));
+                    }
+            } catch (const Error&) {
+            }
+        });
+        std::vector<std::size_t> survivors;
+        for (std::size_t k = 0; k < cameraPairs.size(); ++k) {
+            const Camera* c = cameraPairs[k].camera ? &*cameraPairs[k].camera : nullptr;
+            if (c && std::none_of(survivors.begin(), survivors.end(), [&](std::size_t j) {
+                    const Camera& other = *cameraPairs[j].camera;
+                    return other.worldFromClip == c->worldFromClip && other.windowFromNdc == c->windowFromNdc &&
+                           other.depth().reversed == c->depth().reversed;
+                }))
+                survivors.push_back(k);
+        }
+        std::vector<std::optional<Hypothesis>> pairedCameras(survivors.size());
+        tbb::parallel_for(std::size_t(0), survivors.size(), [&](std::size_t k) {
+            const CameraPair& pair = cameraPairs[survivors[k]];
+            try {
+                pairedCameras[k] = judgeAgainst(pairHypothesis(candidates[pair.first], candidates[pair.second]), *pair.camera, map,
+                                                renderRay(*pair.camera));
+            } catch (const Error&) {
+            }
+        });
+        for (auto& h : pairedCameras)
             if (h) out.push_back(std::move(*h));
     }
     // A map with no surface at all, as read, is evidence for nothing: say so first.
