@@ -140,7 +140,8 @@ Command addExportCommand(CLI::App& app)
         ->check(kNonEmptyPath);
     command->add_option("--sample-offset", o->sampleOffset,
                         "DX,DY: take each pixel's depth at this offset from its centre, in pixels, x right, y down "
-                        "(ray backend): a renderer that keeps one sample of MSAA, e.g. 0.125,0.375 (4x, sample 3)")
+                        "(ray backend): a renderer that keeps one sample of MSAA, e.g. -0.125,0.375 (4x, sample 0, in an OpenGL "
+                        "camera; -0.125,-0.375 in a Direct3D or Vulkan one)")
         ->delimiter(',')
         ->expected(2);
     addThreadsOption(command, o->threads);

@@ -15,6 +15,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -50,8 +51,10 @@ CameraSpec glCameraSpec(const Scene& scene, GlDepth setup, int width, int height
 }
 
 // Mesa's depth buffer for the scene drawn with the camera's matrices in the OpenGL depth
-// set-up `setup`, as a window-depth map.
-DepthMap glDepthMap(const Scene& scene, const Camera& camera, GlDepth setup)
+// set-up `setup`, as a window-depth map; with `samples` > 1 multisampled and resolved by a
+// blit, the sample positions GL reports in `samplePositions`.
+DepthMap glDepthMap(const Scene& scene, const Camera& camera, GlDepth setup, int samples = 0,
+                    std::vector<std::array<float, 2>>* samplePositions = nullptr)
 {
     std::vector<float> positions;
     for (const glm::vec3& p : scene.positions) positions.insert(positions.end(), {p.x, p.y, p.z});
@@ -66,7 +69,9 @@ DepthMap glDepthMap(const Scene& scene, const Camera& camera, GlDepth setup)
     input.reversedZ = setup == GlDepth::Reversed;
     input.zeroToOne = setup != GlDepth::MinusOneToOne;
     input.threads = 2;
+    input.samples = samples;
     const reference::GlDepthTiming drawn = reference::timeGlDepthDraw(input, 0);
+    if (samplePositions) *samplePositions = drawn.samplePositions;
     INFO("OpenGL renderer: " << drawn.renderer);
     REQUIRE(drawn.depth.size() == std::size_t(camera.width()) * camera.height());
     return DepthMap{camera.width(), camera.height(), DepthQuantity::Window,
@@ -172,4 +177,41 @@ TEST_CASE("OpenGL depth buffers read under the wrong depth set-up are diagnosed 
                     bottomUp.value.begin() + std::ptrdiff_t(bottomUp.height - 1 - row) * bottomUp.width);
     REQUIRE_FALSE(checker.verify(classic, bottomUp).comparison.report.consistent());
     REQUIRE(testing::diagnosedAs(checker, classic, bottomUp, "y-flip"));
+}
+
+TEST_CASE("a depth buffer resolved from Mesa's multisampling is diagnosed with the sample GL reports", "[verify][diagnose][real-renderer]")
+{
+    // 4× MSAA depth (llvmpipe's most), resolved into a single-sample buffer by glBlitFramebuffer as an
+    // application reading it back would: the resolve keeps one sample's depth, so the map is a
+    // map sampled off the pixel centre, and the fit must find one of the positions GL reports
+    // (glGetMultisamplefv: x right, y up from the pixel's lower-left corner).
+    REQUIRE(reference::glReferenceAvailable());
+    const Scene scene = loadScene("builtin:default");
+    const Checker checker(scene);
+    const Camera camera(glCameraSpec(scene, GlDepth::MinusOneToOne, 320, 240));
+    for (int samples : {4}) {
+        INFO(samples << "× MSAA");
+        std::vector<std::array<float, 2>> positions;
+        const DepthMap map = glDepthMap(scene, camera, GlDepth::MinusOneToOne, samples, &positions);
+        REQUIRE(positions.size() == std::size_t(samples));
+        const std::vector<Hypothesis> diagnosis = checker.diagnose(camera, map);
+        REQUIRE_FALSE(diagnosis.empty());
+        const Hypothesis& best = diagnosis.front();
+        INFO(best.name << ": " << best.explanation << ", unexplained " << best.unexplained);
+        REQUIRE(best.consistent);
+        REQUIRE(best.name == "sample-offset");
+        double dx = NAN, dy = NAN;
+        for (const FittedValue& v : best.fitted) {
+            if (v.name == "sample_dx_px") dx = v.value;
+            if (v.name == "sample_dy_px") dy = v.value;
+        }
+        const bool reported = std::any_of(positions.begin(), positions.end(), [&](const std::array<float, 2>& p) {
+            return std::abs(dx - (p[0] - 0.5)) <= 1.0 / 256 && std::abs(dy - (0.5 - p[1])) <= 1.0 / 256;
+        });
+        REQUIRE(reported);
+        // llvmpipe's positions are the standard pattern's, from the lower-left corner: the
+        // diagnosis names the sample in the framebuffer's own axes (y up in OpenGL).
+        const std::vector<std::array<float, 2>> standard = {{0.375f, 0.125f}, {0.875f, 0.375f}, {0.125f, 0.625f}, {0.625f, 0.875f}};
+        if (positions == standard) REQUIRE(best.explanation.find("of 4× MSAA's standard pattern") != std::string::npos);
+    }
 }

@@ -667,10 +667,13 @@ std::string number(double v, int digits = 4)
     return text;
 }
 
-// The standard sample positions of 4× and 8× multisampling (Direct3D and Vulkan's, in 1/16
-// pixel, x right, y down) the offset matches within 1/64 px, as "sample k of N× MSAA".
-std::string msaaSampleOf(const glm::dvec2& offset)
+// The standard sample positions of 4× and 8× multisampling (in 1/16 pixel, x right and y away
+// from the framebuffer's first row: down in Direct3D, Vulkan and Metal, up in OpenGL, where
+// GL_SAMPLE_POSITION reports the same numbers from the lower-left corner — Mesa's llvmpipe does)
+// the offset in the image matches within 1/64 px, as "sample k of N× MSAA".
+std::string msaaSampleOf(const Camera& camera, const glm::dvec2& imageOffset)
 {
+    const glm::dvec2 offset = windowFromImageOffset(camera, imageOffset);
     static const int four[4][2] = {{-2, -6}, {6, -2}, {-6, 2}, {2, 6}};
     static const int eight[8][2] = {{1, -3}, {-1, 3}, {5, 1}, {-3, -5}, {-5, 5}, {-7, -1}, {3, 7}, {7, -7}};
     auto near = [&](const int p[2]) { return std::abs(offset.x - p[0] / 16.0) < 1.0 / 64 && std::abs(offset.y - p[1] / 16.0) < 1.0 / 64; };
@@ -745,7 +748,7 @@ std::string describeFit(const Camera& camera, const DepthMap& map, const FitResu
         const glm::dvec2 within = d.sampleOffset - whole;
         std::string text = "depth sampled at (" + signedNumber(within.x, 3) + ", " + signedNumber(within.y, 3) +
                            ") px from the pixel centre (x right, y down)";
-        if (const std::string msaa = msaaSampleOf(within); !msaa.empty()) text += " — " + msaa;
+        if (const std::string msaa = msaaSampleOf(camera, within); !msaa.empty()) text += " — " + msaa;
         if (whole != glm::dvec2(0.0))
             text += (within == glm::dvec2(0.0) ? "" : ",") + std::string(" the image shifted by (") +
                     signedNumber(whole.x) + ", " + signedNumber(whole.y) + ") px";

@@ -167,6 +167,9 @@ struct Gl {
     PFNGLGENRENDERBUFFERSPROC GenRenderbuffers;
     PFNGLBINDRENDERBUFFERPROC BindRenderbuffer;
     PFNGLRENDERBUFFERSTORAGEPROC RenderbufferStorage;
+    PFNGLRENDERBUFFERSTORAGEMULTISAMPLEPROC RenderbufferStorageMultisample;
+    PFNGLBLITFRAMEBUFFERPROC BlitFramebuffer;
+    PFNGLGETMULTISAMPLEFVPROC GetMultisamplefv;
     PFNGLDELETERENDERBUFFERSPROC DeleteRenderbuffers;
     PFNGLDRAWBUFFERPROC DrawBuffer;
     PFNGLREADBUFFERPROC ReadBuffer;
@@ -222,6 +225,9 @@ struct Gl {
         load(GenRenderbuffers, "glGenRenderbuffers");
         load(BindRenderbuffer, "glBindRenderbuffer");
         load(RenderbufferStorage, "glRenderbufferStorage");
+        load(RenderbufferStorageMultisample, "glRenderbufferStorageMultisample");
+        load(BlitFramebuffer, "glBlitFramebuffer");
+        load(GetMultisamplefv, "glGetMultisamplefv");
         load(DeleteRenderbuffers, "glDeleteRenderbuffers");
         load(DrawBuffer, "glDrawBuffer");
         load(ReadBuffer, "glReadBuffer");
@@ -273,6 +279,7 @@ struct GlObjects {
     GLuint vertexShader = 0, fragmentShader = 0, program = 0;
     GLuint vertexArray = 0, vertexBuffer = 0, indexBuffer = 0;
     GLuint framebuffer = 0, depthRenderbuffer = 0;
+    GLuint resolvedFramebuffer = 0, resolvedRenderbuffer = 0;  // multisampling only
 
     explicit GlObjects(const Gl& functions) : gl(functions) {}
     GlObjects(const GlObjects&) = delete;
@@ -290,6 +297,8 @@ struct GlObjects {
         gl.BindFramebuffer(GL_FRAMEBUFFER, 0);
         gl.DeleteFramebuffers(1, &framebuffer);
         gl.DeleteRenderbuffers(1, &depthRenderbuffer);
+        gl.DeleteFramebuffers(1, &resolvedFramebuffer);
+        gl.DeleteRenderbuffers(1, &resolvedRenderbuffer);
     }
 };
 
@@ -326,6 +335,7 @@ void validate(const GlDepthInput& input, int repeats)
     if (input.positions == nullptr || input.indices == nullptr) throw std::invalid_argument("GL reference: null mesh");
     if (input.width <= 0 || input.height <= 0) throw std::invalid_argument("GL reference: empty viewport");
     if (input.threads < 0) throw std::invalid_argument("GL reference: negative thread count");
+    if (input.samples < 0) throw std::invalid_argument("GL reference: negative sample count");
     if (repeats < 0) throw std::invalid_argument("GL reference: negative repeat count");
     if (input.triangleCount > static_cast<std::size_t>(std::numeric_limits<GLsizei>::max()) / 3)
         throw std::invalid_argument("GL reference: too many triangles for one glDrawElements");
@@ -400,18 +410,36 @@ GlDepthTiming timeGlDepthDraw(const GlDepthInput& input, int repeats)
     gl.check("uploading the mesh");
 
     // Depth-only render target. Reversed-Z keeps its precision only with a float buffer.
-    gl.GenRenderbuffers(1, &objects.depthRenderbuffer);
-    gl.BindRenderbuffer(GL_RENDERBUFFER, objects.depthRenderbuffer);
-    gl.RenderbufferStorage(GL_RENDERBUFFER, input.reversedZ ? GL_DEPTH_COMPONENT32F : GL_DEPTH_COMPONENT24, input.width,
-                           input.height);
-    gl.GenFramebuffers(1, &objects.framebuffer);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, objects.framebuffer);
-    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, objects.depthRenderbuffer);
-    gl.DrawBuffer(GL_NONE);
-    gl.ReadBuffer(GL_NONE);
-    gl.check("creating the depth framebuffer");
-    if (const GLenum status = gl.CheckFramebufferStatus(GL_FRAMEBUFFER); status != GL_FRAMEBUFFER_COMPLETE)
-        fail("depth framebuffer incomplete (status " + hex(status) + ")");
+    const GLenum depthFormat = input.reversedZ ? GL_DEPTH_COMPONENT32F : GL_DEPTH_COMPONENT24;
+    const auto depthTarget = [&](GLuint& renderbuffer, GLuint& framebuffer, int samples, const char* what) {
+        gl.GenRenderbuffers(1, &renderbuffer);
+        gl.BindRenderbuffer(GL_RENDERBUFFER, renderbuffer);
+        if (samples > 1)
+            gl.RenderbufferStorageMultisample(GL_RENDERBUFFER, samples, depthFormat, input.width, input.height);
+        else
+            gl.RenderbufferStorage(GL_RENDERBUFFER, depthFormat, input.width, input.height);
+        gl.GenFramebuffers(1, &framebuffer);
+        gl.BindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+        gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, renderbuffer);
+        gl.DrawBuffer(GL_NONE);
+        gl.ReadBuffer(GL_NONE);
+        gl.check(what);
+        if (const GLenum status = gl.CheckFramebufferStatus(GL_FRAMEBUFFER); status != GL_FRAMEBUFFER_COMPLETE)
+            fail(std::string(what) + ": framebuffer incomplete (status " + hex(status) + ")");
+    };
+    if (input.samples > 1)
+        depthTarget(objects.resolvedRenderbuffer, objects.resolvedFramebuffer, 1, "creating the resolved depth framebuffer");
+    depthTarget(objects.depthRenderbuffer, objects.framebuffer, input.samples, "creating the depth framebuffer");
+    if (input.samples > 1) {
+        GLint samples = 0;
+        gl.GetIntegerv(GL_SAMPLES, &samples);
+        for (GLint k = 0; k < samples; ++k) {
+            std::array<GLfloat, 2> position{};
+            gl.GetMultisamplefv(GL_SAMPLE_POSITION, GLuint(k), position.data());
+            timing.samplePositions.push_back({position[0], position[1]});
+        }
+        gl.check("querying the sample positions");
+    }
 
     // Fixed-function state.
     gl.Viewport(0, 0, input.width, input.height);
@@ -440,6 +468,16 @@ GlDepthTiming timeGlDepthDraw(const GlDepthInput& input, int repeats)
         timing.drawMs.push_back(std::chrono::duration<double, std::milli>(end - start).count());
     }
     gl.check("timed draws");
+
+    // A multisampled buffer is resolved as an application does it, by a blit (which sample, or
+    // what blend, a depth resolve keeps is the implementation's choice).
+    if (input.samples > 1) {
+        gl.BindFramebuffer(GL_READ_FRAMEBUFFER, objects.framebuffer);
+        gl.BindFramebuffer(GL_DRAW_FRAMEBUFFER, objects.resolvedFramebuffer);
+        gl.BlitFramebuffer(0, 0, input.width, input.height, 0, 0, input.width, input.height, GL_DEPTH_BUFFER_BIT, GL_NEAREST);
+        gl.BindFramebuffer(GL_FRAMEBUFFER, objects.resolvedFramebuffer);
+        gl.check("resolving the multisampled depth");
+    }
 
     // GL's rows run bottom-up; the result's row 0 is the top of the image.
     const auto width = static_cast<std::size_t>(input.width);

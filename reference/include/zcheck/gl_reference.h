@@ -54,6 +54,10 @@ struct GlDepthInput {
     // GL_ZERO_TO_ONE), GL_LESS, depth cleared to 1.
     bool zeroToOne = false;
     int threads = 1;  // LP_NUM_THREADS for llvmpipe (≥ 0)
+    // > 1: draw into a multisampled depth buffer of this many samples, and resolve it into a
+    // single-sample one with glBlitFramebuffer (GL_NEAREST), as an application reading back
+    // an MSAA depth buffer does; which sample the resolve keeps is the implementation's choice.
+    int samples = 0;
 };
 
 struct GlDepthTiming {
@@ -62,6 +66,9 @@ struct GlDepthTiming {
     // The last draw's depth buffer, width*height values in [0, 1], row 0 = top row of the
     // image (glReadPixels' bottom-up order flipped).
     std::vector<float> depth;
+    // Multisampling: each sample's position in the pixel as GL reports it (glGetMultisamplefv,
+    // GL_SAMPLE_POSITION): x right and y up from the pixel's lower-left corner, in [0, 1].
+    std::vector<std::array<float, 2>> samplePositions;
 };
 
 // True when this module was compiled in; the build compiles it only when EGL is found.
