@@ -213,5 +213,20 @@ TEST_CASE("a depth buffer resolved from Mesa's multisampling is diagnosed with t
         // diagnosis names the sample in the framebuffer's own axes (y up in OpenGL).
         const std::vector<std::array<float, 2>> standard = {{0.375f, 0.125f}, {0.875f, 0.375f}, {0.125f, 0.625f}, {0.625f, 0.875f}};
         if (positions == standard) REQUIRE(best.explanation.find("of 4× MSAA's standard pattern") != std::string::npos);
+        // The same buffer with glReadPixels' bottom-up rows taken as top-down: two mistakes, a
+        // re-reading and a fitted departure, named together.
+        DepthMap bottomUp = map;
+        for (int row = 0; row < map.height; ++row)
+            std::copy_n(map.value.begin() + std::ptrdiff_t(row) * map.width, map.width,
+                        bottomUp.value.begin() + std::ptrdiff_t(map.height - 1 - row) * map.width);
+        const std::vector<Hypothesis> both = checker.diagnose(camera, bottomUp);
+        REQUIRE_FALSE(both.empty());
+        INFO("flipped: " << both.front().name << ": " << both.front().explanation << ", unexplained " << both.front().unexplained);
+        REQUIRE(both.front().consistent);
+        REQUIRE(both.front().name == "y-flip + sample-offset");
+        for (const FittedValue& v : both.front().fitted) {
+            if (v.name == "sample_dx_px") REQUIRE(std::abs(v.value - dx) <= 1.0 / 256);
+            if (v.name == "sample_dy_px") REQUIRE(std::abs(v.value - dy) <= 1.0 / 256);
+        }
     }
 }

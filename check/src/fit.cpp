@@ -581,6 +581,13 @@ std::vector<FitFamily> fitFamilies(const Camera& camera, const DepthMap& map)
     return out;
 }
 
+double medianResidual(const Scene& scene, const Camera& camera, const DepthMap& map, const RenderResult& truth)
+{
+    const Problem problem{camera, map, FitFamily::DepthScale, {}, 1, 1, samplesOf(scene, camera, camera, map, truth)};
+    if (problem.samples.size() < 16) return INFINITY;
+    return medianAbsolute(problem.residuals({}, false));
+}
+
 FitResult fitDeparture(const Scene& scene, const Camera& camera, const DepthMap& map, const RenderResult& truth,
                        FitFamily family, const TruthRender& render)
 {

@@ -303,7 +303,7 @@ double probeAgreement(const Scene& scene, const RayRenderer& rays, const Camera&
     constexpr int kGrid = 16;
     const int W = camera.width(), H = camera.height();
     const PixelJudge judge(scene, camera, mapTolerance());
-    std::atomic<int> agree{0};
+    std::atomic<int> agree{0}, seen{0};
     tbb::parallel_for(0, kGrid * kGrid, [&](int k) {
         const int col = (2 * (k % kGrid) + 1) * W / (2 * kGrid), row = (2 * (k / kGrid) + 1) * H / (2 * kGrid);
         const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
@@ -312,14 +312,14 @@ double probeAgreement(const Scene& scene, const RayRenderer& rays, const Camera&
                                       ? camera.clearDepth()
                                       : planeWindowDepth(scene, camera, primitive, worldEyePlaneRayThroughWindow(camera, pWindow));
         const MapPixel pixel = mapPixelDepth(camera, map, col, row, truthDepth);
+        if (primitive == kNoPrimitive && !std::isfinite(pixel.depth)) return;  // background: says nothing
+        ++seen;
         double bound = 0;
-        if (primitive == kNoPrimitive ? !std::isfinite(pixel.depth)
-                                      : std::isfinite(pixel.depth) && std::isfinite(truthDepth) &&
-                                            judge.bothHit(truthDepth, primitive, pixel.depth, primitive, pixel.quantum, pWindow,
-                                                          bound) == PixelClass::Agree)
+        if (primitive != kNoPrimitive && std::isfinite(pixel.depth) && std::isfinite(truthDepth) &&
+            judge.bothHit(truthDepth, primitive, pixel.depth, primitive, pixel.quantum, pWindow, bound) == PixelClass::Agree)
             ++agree;
     });
-    return double(agree) / (kGrid * kGrid);
+    return seen == 0 ? 0.0 : double(agree) / double(seen);
 }
 
 VerifyResult verifyAgainst(const Scene& scene, const Camera& camera, const DepthMap& map, RenderResult truth,
@@ -481,24 +481,33 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
     }
     // The continuous families, fitted side by side, each confirmed by a full comparison; not
     // needed where a mistake of the catalogue explains the map whole.
-    const bool named = std::any_of(out.begin(), out.end(), [](const Hypothesis& h) { return h.consistent; });
-    const std::vector<FitFamily> families = named ? std::vector<FitFamily>{} : fitFamilies(camera, map);
-    std::vector<std::optional<Hypothesis>> fitted(families.size());
+    // `reading` (a catalogue mistake that re-reads the map, or none) names the map fitted.
     const TruthRender render = [&](const Camera& c, const RayFaults& faults) { return renderRay(c, faults); };
-    tbb::parallel_for(std::size_t(0), families.size(), [&](std::size_t k) {
-        try {
-            const FitResult fit = fitDeparture(scene_, camera, map, truth, families[k], render);
-            if (fit.samples == 0) return;  // too few pixels on one plane to fit anything
-            const Camera fittedCamera(departedCameraSpec(camera, fit.departure));
-            Hypothesis h = hypothesis(toString(families[k]), "", "consistent with " + describeFit(camera, map, fit));
-            h.fitted = fittedValues(camera, map, fit);
-            fitted[k] = judgeAgainst(std::move(h), fittedCamera, departedReading(camera, map, fit.departure),
-                                     renderRay(fittedCamera));
-        } catch (const Error&) {
-        }
-    });
-    for (auto& h : fitted)
-        if (h) out.push_back(std::move(*h));
+    auto fitEach = [&](const DepthMap& fittedMap, const Candidate* reading) {
+        const std::vector<FitFamily> families = fitFamilies(camera, fittedMap);
+        std::vector<std::optional<Hypothesis>> fitted(families.size());
+        tbb::parallel_for(std::size_t(0), families.size(), [&](std::size_t k) {
+            try {
+                const FitResult fit = fitDeparture(scene_, camera, fittedMap, truth, families[k], render);
+                if (fit.samples == 0) return;  // too few pixels on one plane to fit anything
+                // After a re-reading, only a fit that explains much of the map is worth its
+                // confirmation (a render and a comparison): a consistent one leaves residuals at
+                // the map's rounding, far under half those under the declared camera.
+                if (reading && !(fit.residual <= 0.5 * fit.initialResidual)) return;
+                const Camera fittedCamera(departedCameraSpec(camera, fit.departure));
+                Hypothesis h = reading ? hypothesis(reading->mistake->name + " + " + toString(families[k]), reading->reading.variant,
+                                                    reading->reading.explanation + ", and with " + describeFit(camera, fittedMap, fit))
+                                       : hypothesis(toString(families[k]), "", "consistent with " + describeFit(camera, fittedMap, fit));
+                h.fitted = fittedValues(camera, fittedMap, fit);
+                fitted[k] = judgeAgainst(std::move(h), fittedCamera, departedReading(camera, fittedMap, fit.departure),
+                                         renderRay(fittedCamera));
+            } catch (const Error&) {
+            }
+        });
+        for (auto& h : fitted)
+            if (h) out.push_back(std::move(*h));
+    };
+    if (std::none_of(out.begin(), out.end(), [](const Hypothesis& h) { return h.consistent; })) fitEach(map, nullptr);
     const bool explained = std::any_of(out.begin(), out.end(), [](const Hypothesis& h) {
         return h.consistent || h.consistentExceptEdges();
     });
@@ -585,6 +594,23 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
         });
         for (auto& h : pairedCameras)
             if (h) out.push_back(std::move(*h));
+        // A re-reading of the map and a fitted departure (a flipped map of one MSAA sample, say),
+        // when no pair explains it either: the fits run again on the map as the re-reading
+        // reads it that comes closest to the truth where the truth is one plane (medianResidual),
+        // if that is under half of how close the map as declared comes — a re-reading that is
+        // half the answer leaves only the departure's own small residuals.
+        if (std::none_of(out.begin(), out.end(), [](const Hypothesis& h) { return h.consistent || h.consistentExceptEdges(); })) {
+            std::vector<double> residual(candidates.size(), INFINITY);
+            tbb::parallel_for(std::size_t(0), candidates.size(), [&](std::size_t k) {
+                const Candidate& c = candidates[k];
+                if (c.camera && c.readsMapOnly() && c.reading.map) residual[k] = medianResidual(scene_, camera, *c.reading.map, truth);
+            });
+            const auto closest = std::min_element(residual.begin(), residual.end());
+            if (closest != residual.end() && *closest < 0.5 * medianResidual(scene_, camera, map, truth)) {
+                const Candidate& reading = candidates[std::size_t(closest - residual.begin())];
+                fitEach(*reading.reading.map, &reading);
+            }
+        }
     }
     // A map with no surface at all, as read, is evidence for nothing: say so first.
     const bool anySurface = !explained && [&] {

@@ -88,6 +88,11 @@ struct FitResult {
 // Renders the ground truth through a camera with a sampling fault (Checker::renderRay).
 using TruthRender = std::function<RenderResult(const Camera&, const RayFaults&)>;
 
+// The median relative eye-depth residual of `map` against `truth` at the fit's sample pixels
+// (FitResult::initialResidual, without fitting): how far a reading is from the truth where
+// the truth is one plane; +inf where fewer than 16 pixels qualify.
+double medianResidual(const Scene& scene, const Camera& camera, const DepthMap& map, const RenderResult& truth);
+
 // Fits one family. `truth` is the declared camera's ground truth (the first round's planes).
 FitResult fitDeparture(const Scene& scene, const Camera& camera, const DepthMap& map, const RenderResult& truth,
                        FitFamily family, const TruthRender& render);

@@ -119,11 +119,12 @@ void requireMapFits(const Camera& camera, const DepthMap& map);
 std::optional<std::int64_t> screenUnexplained(const Scene& scene, const Camera& camera, const DepthMap& map,
                                               const RenderResult& truth, const VertexNeighbours& neighbours);
 
-// The share of a 16×16 grid of pixel centres at which `map`, read through `camera`, agrees with
-// the surface the camera's own ray meets there (traced alone, RayRenderer::primitiveAt) by the
-// comparison's rule (PixelJudge), or where both see none: how near a hypothesis comes, before a
-// truth is rendered for it. A consistent reading fails only at edges and where the map shows a
-// neighbouring surface, which a coarse grid seldom meets; a share under 3/4 rules it out.
+// Of a 16×16 grid of pixel centres where the map or the truth sees a surface, the share at which
+// `map`, read through `camera`, agrees with the surface the camera's own ray meets there (traced
+// alone, RayRenderer::primitiveAt) by the comparison's rule (PixelJudge): how near a hypothesis
+// comes, before a truth is rendered for it (0 where both see only background). A consistent
+// reading fails only at edges and where the map shows a neighbouring surface, which a coarse
+// grid seldom meets; a share under 3/4 rules it out.
 double probeAgreement(const Scene& scene, const RayRenderer& rays, const Camera& camera, const DepthMap& map);
 
 // Whether the truth around pixel (col, row) is one smooth surface: its 3×3 neighbourhood
