@@ -87,6 +87,15 @@ double fittedValue(const Hypothesis& h, const std::string& name)
     return NAN;
 }
 
+// The map's values as a renderer in other units or from another origin writes them: scale ·
+// value + offset, stored in binary32.
+DepthMap scaled(DepthMap map, double scale, double offset = 0)
+{
+    for (double& v : map.value)
+        if (std::isfinite(v)) v = double(float(scale * v + offset));
+    return map;
+}
+
 // Runs `check` on every setup, naming the setup and its half in the messages.
 void forEachSetup(const std::function<void(const Bench&)>& check)
 {
@@ -193,10 +202,7 @@ TEST_CASE("a map in other units or from another origin is diagnosed with its sca
         const double n = b.camera.nearDistance();
         for (const auto& [scale, offset] : {std::pair{1.002, 0.0}, std::pair{1000.0, 0.0}, std::pair{1.0, -n}}) {
             INFO("value x " << scale << " + " << offset);
-            DepthMap map = b.mapDrawnWith(b.camera.spec());
-            for (double& v : map.value)
-                if (std::isfinite(v)) v = double(float(scale * v + offset));
-            const Hypothesis h = b.diagnosed(map, "depth-scale", "affine-depth-offset");
+            const Hypothesis h = b.diagnosed(scaled(b.mapDrawnWith(b.camera.spec()), scale, offset), "depth-scale", "affine-depth-offset");
             if (h.name == "affine-depth-offset") {
                 REQUIRE((scale == 1.0 && offset == -n));
                 continue;
@@ -297,9 +303,7 @@ TEST_CASE("regression: a rescaled NDC map's far-plane misses read as surfaces on
     // The far plane's NDC 1, scaled by 1.002 and back, is 1 − 2^−25 in double: no longer the
     // far plane, so 11232 background pixels of the map read as surfaces (departedReading).
     const Bench b({"regression", "builtin:default", "opencv", ExportQuantity::Ndc});
-    DepthMap map = b.mapDrawnWith(b.camera.spec());
-    for (double& v : map.value)
-        if (std::isfinite(v)) v = double(float(1.002 * v));
+    const DepthMap map = scaled(b.mapDrawnWith(b.camera.spec()), 1.002);
     Departure d;
     d.valueScale = 1.002;
     const ComparisonReport r = b.checker.verify(b.camera, departedReading(b.camera, map, d)).comparison.report;
@@ -331,10 +335,7 @@ TEST_CASE("regression: a fit pulled by steep surfaces' snapping left face-on pix
     // face-on pixels failed the confirmation. Residuals are now weighed in each pixel's
     // tolerance, and the largest minimised where one is still near its tolerance.
     const Bench b({"regression", "builtin:near-crossing", "metal", ExportQuantity::EyeZ});
-    DepthMap map = b.mapDrawnWith(b.camera.spec());
-    for (double& v : map.value)
-        if (std::isfinite(v)) v = double(float(1.002 * v));
-    const Hypothesis h = b.diagnosed(map, "depth-scale");
+    const Hypothesis h = b.diagnosed(scaled(b.mapDrawnWith(b.camera.spec()), 1.002), "depth-scale");
     INFO(h.explanation << ": unexplained " << h.unexplained);
     REQUIRE(h.consistent);
     REQUIRE(std::abs(fittedValue(h, "value_scale") - 1.002) <= 1e-4 * 1.002);
@@ -347,10 +348,7 @@ TEST_CASE("regression: a scaled reading's residuals were measured in the unscale
     // millimetres had residuals 1000× too large, so the fit seemed not to explain it and was
     // never polished: 71 face-on pixels stayed beyond their tolerance.
     const Bench b({"regression", "builtin:near-crossing", "metal", ExportQuantity::EyeZ});
-    DepthMap map = b.mapDrawnWith(b.camera.spec());
-    for (double& v : map.value)
-        if (std::isfinite(v)) v = double(float(1000 * v));
-    const Hypothesis h = b.diagnosed(map, "depth-scale");
+    const Hypothesis h = b.diagnosed(scaled(b.mapDrawnWith(b.camera.spec()), 1000), "depth-scale");
     INFO(h.explanation << ": unexplained " << h.unexplained);
     REQUIRE(h.consistent);
     REQUIRE(std::abs(fittedValue(h, "value_scale") - 1000) <= 1e-4 * 1000);

@@ -78,6 +78,15 @@ DepthMap glDepthMap(const Scene& scene, const Camera& camera, GlDepth setup, int
                     std::vector<double>(drawn.depth.begin(), drawn.depth.end()), 0};
 }
 
+// The map verified through the camera: consistent, with enough surface compared to mean it.
+void requireConsistent(const Checker& checker, const Camera& camera, const DepthMap& map)
+{
+    const ComparisonReport r = checker.verify(camera, map).comparison.report;
+    INFO("unexplained " << r.unexplained() << " of " << r.bothHit << " both hit, max error/tolerance " << r.maxErrorOverTolerance);
+    REQUIRE(r.bothHit > 5000);
+    REQUIRE(r.consistent());
+}
+
 std::vector<std::string> scenes()
 {
     std::vector<std::string> out = {"builtin:default", "builtin:terrain?n=48", "builtin:near-crossing"};
@@ -96,12 +105,7 @@ TEST_CASE("OpenGL depth buffers drawn by Mesa's llvmpipe verify as consistent", 
         for (GlDepth setup : {GlDepth::MinusOneToOne, GlDepth::ZeroToOne, GlDepth::Reversed}) {
             INFO(path << ", " << nameOf(setup));
             const Camera camera(glCameraSpec(scene, setup, 320, 240));
-            const DepthMap map = glDepthMap(scene, camera, setup);
-            const ComparisonReport r = checker.verify(camera, map).comparison.report;
-            INFO("unexplained " << r.unexplained() << " of " << r.bothHit << " both hit, max error/tolerance "
-                                << r.maxErrorOverTolerance);
-            REQUIRE(r.bothHit > 5000);
-            REQUIRE(r.consistent());
+            requireConsistent(checker, camera, glDepthMap(scene, camera, setup));
         }
     }
 }
@@ -142,11 +146,7 @@ TEST_CASE("OpenGL depth buffers verify as consistent in every projection model",
             CameraSpec spec = glCameraSpec(scene, setup, 320, 240);
             spec.projection = projection;
             const Camera camera(spec);
-            const ComparisonReport r = checker.verify(camera, glDepthMap(scene, camera, setup)).comparison.report;
-            INFO("unexplained " << r.unexplained() << " of " << r.bothHit << " both hit, max error/tolerance "
-                                << r.maxErrorOverTolerance);
-            REQUIRE(r.bothHit > 5000);
-            REQUIRE(r.consistent());
+            requireConsistent(checker, camera, glDepthMap(scene, camera, setup));
         }
 }
 
