@@ -298,7 +298,7 @@ std::optional<std::int64_t> screenUnexplained(const Scene& scene, const Camera& 
     return std::int64_t(std::llround(double(unexplained) / double(read) * suspectsInAll));
 }
 
-double probeAgreement(const Scene& scene, const RayRenderer& rays, const Camera& camera, const DepthMap& map)
+Probe probeAgreement(const Scene& scene, const RayRenderer& rays, const Camera& camera, const DepthMap& map)
 {
     constexpr int kGrid = 16;
     const int W = camera.width(), H = camera.height();
@@ -319,7 +319,7 @@ double probeAgreement(const Scene& scene, const RayRenderer& rays, const Camera&
             judge.bothHit(truthDepth, primitive, pixel.depth, primitive, pixel.quantum, pWindow, bound) == PixelClass::Agree)
             ++agree;
     });
-    return seen == 0 ? 0.0 : double(agree) / double(seen);
+    return {seen == 0 ? 0.0 : double(agree) / double(seen), double(seen) / (kGrid * kGrid)};
 }
 
 VerifyResult verifyAgainst(const Scene& scene, const Camera& camera, const DepthMap& map, RenderResult truth,
@@ -451,14 +451,27 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
     for (const Mistake& mistake : mistakeCatalogue())
         if (mistake.reread)
             for (Rereading& reading : mistake.reread(camera, map)) candidates.push_back({&mistake, std::move(reading), {}, {}, {}});
+    auto changesCameraOnly = [](const Candidate& c) { return c.camera && c.reading.camera && c.reading.truthFaults.none() && !c.reading.map; };
     tbb::parallel_for(std::size_t(0), candidates.size(), [&](std::size_t k) {
         Candidate& c = candidates[k];
         // A variant that is not a valid camera (a near plane behind the eye) is no hypothesis.
         try {
             c.camera.emplace(c.reading.camera ? *c.reading.camera : camera.spec());
+            Hypothesis h = hypothesis(c.mistake->name, c.reading.variant, c.reading.explanation);
+            // Another camera needs a truth of its own, unless a probe rules it out first: then
+            // its count is estimated from the probe (the pairs below render its truth if they
+            // need it).
+            if (changesCameraOnly(c)) {
+                const Probe probe = probeAgreement(scene_, rays_, *c.camera, map);
+                if (probe.agreeing < 0.75) {
+                    h.unexplained = std::llround((1 - probe.agreeing) * probe.seen * double(camera.width()) * camera.height());
+                    h.estimated = true;
+                    c.judged = std::move(h);
+                    return;
+                }
+            }
             if (!c.readsMapOnly()) c.truth = renderRay(*c.camera, c.reading.truthFaults);
-            c.judged = judgeAgainst(hypothesis(c.mistake->name, c.reading.variant, c.reading.explanation), *c.camera,
-                                    c.mapOr(map), c.truth ? *c.truth : truth);
+            c.judged = judgeAgainst(std::move(h), *c.camera, c.mapOr(map), c.truth ? *c.truth : truth);
         } catch (const Error&) {
             c.camera.reset(), c.truth.reset();
         }
@@ -531,6 +544,19 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
                 if (second.readsMapOnly() && (b <= a || (changesQuantity(first) && changesQuantity(second)))) continue;
                 pairs.emplace_back(a, b);
             }
+        // The truths of the camera mistakes the probe ruled out, where a pair needs them.
+        std::vector<std::size_t> untraced;
+        for (const auto& [a, b] : pairs)
+            if (!candidates[b].readsMapOnly() && !candidates[b].truth &&
+                std::find(untraced.begin(), untraced.end(), b) == untraced.end())
+                untraced.push_back(b);
+        tbb::parallel_for(std::size_t(0), untraced.size(), [&](std::size_t k) {
+            Candidate& c = candidates[untraced[k]];
+            try {
+                c.truth = renderRay(*c.camera, c.reading.truthFaults);
+            } catch (const Error&) {
+            }
+        });
         std::vector<std::optional<Hypothesis>> paired(pairs.size());
         tbb::parallel_for(std::size_t(0), pairs.size(), [&](std::size_t k) {
             const Candidate &first = candidates[pairs[k].first], &second = candidates[pairs[k].second];
@@ -541,6 +567,7 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
                 const auto same = std::find_if(again.begin(), again.end(), [&](const Rereading& r) { return r.variant == second.reading.variant; });
                 if (same == again.end()) return;
                 const DepthMap& both = same->map ? *same->map : firstMap;
+                if (!second.readsMapOnly() && !second.truth) return;  // its truth could not be rendered
                 paired[k] = judgeAgainst(pairHypothesis(first, second), *second.camera, both, second.truth ? *second.truth : truth);
             } catch (const Error&) {
             }
@@ -556,7 +583,6 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
             std::optional<Camera> camera;
         };
         std::vector<CameraPair> cameraPairs;
-        auto changesCameraOnly = [](const Candidate& c) { return c.camera && c.reading.camera && c.reading.truthFaults.none() && !c.reading.map; };
         for (std::size_t a = 0; a < candidates.size(); ++a)
             for (std::size_t b = 0; b < candidates.size(); ++b)
                 if (candidates[a].mistake != candidates[b].mistake && changesCameraOnly(candidates[a]) && changesCameraOnly(candidates[b]))
@@ -568,7 +594,7 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
                 for (const Rereading& r : second.mistake->reread(*candidates[pair.first].camera, map))
                     if (r.variant == second.reading.variant && r.camera) {
                         Camera composed(*r.camera);
-                        if (probeAgreement(scene_, rays_, composed, map) >= 0.75) pair.camera.emplace(std::move(composed));
+                        if (probeAgreement(scene_, rays_, composed, map).agreeing >= 0.75) pair.camera.emplace(std::move(composed));
                     }
             } catch (const Error&) {
             }

@@ -119,13 +119,17 @@ void requireMapFits(const Camera& camera, const DepthMap& map);
 std::optional<std::int64_t> screenUnexplained(const Scene& scene, const Camera& camera, const DepthMap& map,
                                               const RenderResult& truth, const VertexNeighbours& neighbours);
 
-// Of a 16×16 grid of pixel centres where the map or the truth sees a surface, the share at which
-// `map`, read through `camera`, agrees with the surface the camera's own ray meets there (traced
-// alone, RayRenderer::primitiveAt) by the comparison's rule (PixelJudge): how near a hypothesis
-// comes, before a truth is rendered for it (0 where both see only background). A consistent
-// reading fails only at edges and where the map shows a neighbouring surface, which a coarse
-// grid seldom meets; a share under 3/4 rules it out.
-double probeAgreement(const Scene& scene, const RayRenderer& rays, const Camera& camera, const DepthMap& map);
+// How near a hypothesis comes, before a truth is rendered for it: at a 16×16 grid of pixel
+// centres, one ray each (RayRenderer::primitiveAt), whether `map`, read through `camera`,
+// agrees with the surface the ray meets by the comparison's rule (PixelJudge). `agreeing`:
+// the share of the grid's pixels where the map or the truth sees a surface at which they agree
+// (0 where none does); `seen`: that share of the whole grid. A consistent reading fails only at
+// edges and where the map shows a neighbouring surface, which a coarse grid seldom meets: an
+// `agreeing` under 3/4 rules it out.
+struct Probe {
+    double agreeing = 0, seen = 0;
+};
+Probe probeAgreement(const Scene& scene, const RayRenderer& rays, const Camera& camera, const DepthMap& map);
 
 // Whether the truth around pixel (col, row) is one smooth surface: its 3×3 neighbourhood
 // (clamped at the image's border) all hit or all miss, and, where hit, window depth nearly
