@@ -544,12 +544,42 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
                 if (second.readsMapOnly() && (b <= a || (changesQuantity(first) && changesQuantity(second)))) continue;
                 pairs.emplace_back(a, b);
             }
-        // The truths of the camera mistakes the probe ruled out, where a pair needs them.
+        // The first re-reads the map; the second then re-reads that, or changes the camera.
+        auto mapOfPair = [&](const Candidate& first, const Candidate& second) -> std::optional<DepthMap> {
+            const DepthMap& firstMap = first.mapOr(map);
+            std::vector<Rereading> again = second.mistake->reread(camera, firstMap);
+            const auto same = std::find_if(again.begin(), again.end(), [&](const Rereading& r) { return r.variant == second.reading.variant; });
+            if (same == again.end()) return std::nullopt;
+            return same->map ? *same->map : firstMap;
+        };
+        // A pair whose camera the catalogue's probe ruled out (it has no truth yet) is probed
+        // itself; only those it keeps get the truth rendered, once per camera.
+        std::vector<std::optional<Hypothesis>> paired(pairs.size());
+        std::vector<char> kept(pairs.size(), 1);
+        tbb::parallel_for(std::size_t(0), pairs.size(), [&](std::size_t k) {
+            const Candidate &first = candidates[pairs[k].first], &second = candidates[pairs[k].second];
+            if (second.readsMapOnly() || second.truth) return;
+            try {
+                const std::optional<DepthMap> both = mapOfPair(first, second);
+                if (!both) return;
+                const Probe probe = probeAgreement(scene_, rays_, *second.camera, *both);
+                if (probe.agreeing >= 0.75) return;
+                kept[k] = 0;
+                Hypothesis h = pairHypothesis(first, second);
+                h.unexplained = std::llround((1 - probe.agreeing) * probe.seen * double(camera.width()) * camera.height());
+                h.estimated = true;
+                paired[k] = std::move(h);
+            } catch (const Error&) {
+                kept[k] = 0;
+            }
+        });
         std::vector<std::size_t> untraced;
-        for (const auto& [a, b] : pairs)
-            if (!candidates[b].readsMapOnly() && !candidates[b].truth &&
+        for (std::size_t k = 0; k < pairs.size(); ++k) {
+            const std::size_t b = pairs[k].second;
+            if (kept[k] && !candidates[b].readsMapOnly() && !candidates[b].truth &&
                 std::find(untraced.begin(), untraced.end(), b) == untraced.end())
                 untraced.push_back(b);
+        }
         tbb::parallel_for(std::size_t(0), untraced.size(), [&](std::size_t k) {
             Candidate& c = candidates[untraced[k]];
             try {
@@ -557,18 +587,12 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
             } catch (const Error&) {
             }
         });
-        std::vector<std::optional<Hypothesis>> paired(pairs.size());
         tbb::parallel_for(std::size_t(0), pairs.size(), [&](std::size_t k) {
             const Candidate &first = candidates[pairs[k].first], &second = candidates[pairs[k].second];
+            if (!kept[k] || (!second.readsMapOnly() && !second.truth)) return;  // probed out, or no truth
             try {
-                // The first re-reads the map; the second then re-reads that, or changes the camera.
-                const DepthMap& firstMap = first.mapOr(map);
-                std::vector<Rereading> again = second.mistake->reread(camera, firstMap);
-                const auto same = std::find_if(again.begin(), again.end(), [&](const Rereading& r) { return r.variant == second.reading.variant; });
-                if (same == again.end()) return;
-                const DepthMap& both = same->map ? *same->map : firstMap;
-                if (!second.readsMapOnly() && !second.truth) return;  // its truth could not be rendered
-                paired[k] = judgeAgainst(pairHypothesis(first, second), *second.camera, both, second.truth ? *second.truth : truth);
+                if (const std::optional<DepthMap> both = mapOfPair(first, second))
+                    paired[k] = judgeAgainst(pairHypothesis(first, second), *second.camera, *both, second.truth ? *second.truth : truth);
             } catch (const Error&) {
             }
         });
