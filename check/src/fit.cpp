@@ -41,6 +41,13 @@ double valueOfEyeZ(const Camera& camera, const glm::dvec2& pWindow, double eyeZ,
     return NAN;
 }
 
+// The value's change, as `quantity`, for a relative eye-z change at eye depth z (forward
+// difference of 1e-6).
+double valuePerRelativeEyeZ(const Camera& camera, const glm::dvec2& pWindow, double z, DepthQuantity quantity)
+{
+    return std::abs(valueOfEyeZ(camera, pWindow, z * (1 + 1e-6), quantity) - valueOfEyeZ(camera, pWindow, z, quantity)) / 1e-6;
+}
+
 bool isMissValue(const Camera& camera, const glm::dvec2& pWindow, double value, DepthQuantity quantity)
 {
     return !eyePointFromDepth(camera, pWindow, value, quantity);
@@ -83,6 +90,15 @@ struct WindowLine {
     {
         const double uz = (w - a) / b;
         return camera.spec().projection.isPerspective() ? 1 / uz : uz;
+    }
+    // `d` with the near and far where the line reaches the window's near and far depths; false
+    // (d unchanged) where they make no camera.
+    bool setNearFar(const Camera& camera, Departure& d) const
+    {
+        const double n = depthAt(camera, camera.windowDepthNear()), f = depthAt(camera, camera.windowDepthFar());
+        if (!(n > 0 && f > n && std::isfinite(f))) return false;
+        d.nearDistance = n, d.farDistance = f;
+        return true;
     }
 };
 
@@ -129,10 +145,7 @@ struct Problem {
             // where a + b·u(z) reaches the window's near and far depths.
             const WindowLine base = WindowLine::of(camera, d);
             const WindowLine line{base.a + p[0] * (camera.windowDepthFar() - camera.windowDepthNear()), base.b * (1 + p[1])};
-            d.nearDistance = line.depthAt(camera, camera.windowDepthNear());
-            d.farDistance = line.depthAt(camera, camera.windowDepthFar());
-            if (!(d.nearDistance > 0 && d.farDistance > d.nearDistance && std::isfinite(d.farDistance)))
-                d.nearDistance = d.farDistance = -1;  // no camera
+            if (!line.setNearFar(camera, d)) d.nearDistance = d.farDistance = -1;  // no camera
             break;
         }
         case FitFamily::DepthScale:
@@ -312,12 +325,12 @@ struct Line {
 Line leastMedianLine(const std::vector<LinePoint>& points, Line line)
 {
     const std::size_t n = points.size();
-    auto medianResidual = [&](const Line& l) {
+    auto medianOfLine = [&](const Line& l) {
         std::vector<double> r(n);
         for (std::size_t k = 0; k < n; ++k) r[k] = (l.a + l.b * points[k].x - points[k].y) / points[k].sigma;
         return medianAbsolute(r);
     };
-    double bestMedian = medianResidual(line);
+    double bestMedian = medianOfLine(line);
     constexpr std::size_t kPairs = 256;
     for (std::size_t k = 0; n >= 16 && k < kPairs; ++k) {
         const LinePoint& p = points[k * n / kPairs];
@@ -326,7 +339,7 @@ Line leastMedianLine(const std::vector<LinePoint>& points, Line line)
         Line trial;
         trial.b = (p.y - q.y) / (p.x - q.x);
         trial.a = p.y - trial.b * p.x;
-        const double median = medianResidual(trial);
+        const double median = medianOfLine(trial);
         if (median < bestMedian) line = trial, bestMedian = median;
     }
     return line;
@@ -367,11 +380,7 @@ Departure linearStart(const Problem& problem)
     }
     const WindowLine base = WindowLine::of(camera, problem.base);
     const Line line = leastMedianLine(points, {base.a, base.b});
-    const WindowLine best{line.a, line.b};
-    start.nearDistance = best.depthAt(camera, camera.windowDepthNear());
-    start.farDistance = best.depthAt(camera, camera.windowDepthFar());
-    if (!(start.nearDistance > 0 && start.farDistance > start.nearDistance && std::isfinite(start.farDistance)))
-        return problem.base;
+    WindowLine{line.a, line.b}.setNearFar(camera, start);  // the base where the line makes no camera
     return start;
 }
 
@@ -389,7 +398,7 @@ std::vector<Sample> withTolerances(const Scene& scene, const Camera& declared, c
                                              valueQuantum, s.col, s.row, NAN);
         const glm::dvec2 pWindow = windowFromPixelCentre(departed, s.col, s.row);
         const double z = eyeZFromWindowDepth(departed, pWindow, pixel.depth);
-        const double windowSigma = std::abs(valueOfEyeZ(departed, pWindow, z * (1 + 1e-6), DepthQuantity::Window) - pixel.depth) / 1e-6;
+        const double windowSigma = valuePerRelativeEyeZ(departed, pWindow, z, DepthQuantity::Window);
         s.tolerance = judge.surfaceTolerance(s.primitive, pixel.quantum) / windowSigma;
     });
     samples.erase(std::remove_if(samples.begin(), samples.end(),
@@ -466,9 +475,7 @@ std::vector<Sample> samplesOf(const Scene& scene, const Camera& declared, const 
             const glm::dvec3 normal = glm::cross(b - a, c - a);
             if (!onePlaneAround(truth, W, H, col, row)) continue;
             const double z = eyeZFromWindowDepth(departed, windowFromPixelCentre(departed, col, row), truth.windowDepth.value[i]);
-            const double v0 = valueOfEyeZ(declared, pWindow, z, map.quantity);
-            const double v1 = valueOfEyeZ(declared, pWindow, z * (1 + 1e-6), map.quantity);
-            const double sigma = std::abs(v1 - v0) / 1e-6;
+            const double sigma = valuePerRelativeEyeZ(declared, pWindow, z, map.quantity);
             if (!(sigma > 0) || !std::isfinite(sigma)) continue;
             ofRow[std::size_t(row)].push_back({col, row, normal, glm::dot(normal, a), map.value[i], sigma, truth.primitiveId[i]});
         }
@@ -476,9 +483,10 @@ std::vector<Sample> samplesOf(const Scene& scene, const Camera& declared, const 
     std::vector<Sample> all;
     for (auto& row : ofRow) all.insert(all.end(), row.begin(), row.end());
     constexpr std::size_t kMost = 4096;
+    if (all.size() <= kMost) return all;
     std::vector<Sample> kept;
-    kept.reserve(std::min(kMost, all.size()));
-    for (std::size_t k = 0; k < std::min(kMost, all.size()); ++k) kept.push_back(all[k * all.size() / std::min(kMost, all.size())]);
+    kept.reserve(kMost);
+    for (std::size_t k = 0; k < kMost; ++k) kept.push_back(all[k * all.size() / kMost]);
     return kept;
 }
 

@@ -451,6 +451,12 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
     for (const Mistake& mistake : mistakeCatalogue())
         if (mistake.reread)
             for (Rereading& reading : mistake.reread(camera, map)) candidates.push_back({&mistake, std::move(reading), {}, {}, {}});
+    // A hypothesis a probe ruled out, its count estimated from the probe.
+    auto probedOut = [&](Hypothesis h, const Probe& probe) {
+        h.unexplained = probe.unexplainedOf(double(camera.width()) * camera.height());
+        h.estimated = true;
+        return h;
+    };
     auto changesCameraOnly = [](const Candidate& c) { return c.camera && c.reading.camera && c.reading.truthFaults.none() && !c.reading.map; };
     tbb::parallel_for(std::size_t(0), candidates.size(), [&](std::size_t k) {
         Candidate& c = candidates[k];
@@ -459,14 +465,11 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
             c.camera.emplace(c.reading.camera ? *c.reading.camera : camera.spec());
             Hypothesis h = hypothesis(c.mistake->name, c.reading.variant, c.reading.explanation);
             // Another camera needs a truth of its own, unless a probe rules it out first: then
-            // its count is estimated from the probe (the pairs below render its truth if they
-            // need it).
+            // its count is estimated from the probe (a pair with it is probed in turn below).
             if (changesCameraOnly(c)) {
                 const Probe probe = probeAgreement(scene_, rays_, *c.camera, map);
-                if (probe.agreeing < 0.75) {
-                    h.unexplained = std::llround((1 - probe.agreeing) * probe.seen * double(camera.width()) * camera.height());
-                    h.estimated = true;
-                    c.judged = std::move(h);
+                if (probe.rulesOut()) {
+                    c.judged = probedOut(std::move(h), probe);
                     return;
                 }
             }
@@ -563,12 +566,9 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
                 const std::optional<DepthMap> both = mapOfPair(first, second);
                 if (!both) return;
                 const Probe probe = probeAgreement(scene_, rays_, *second.camera, *both);
-                if (probe.agreeing >= 0.75) return;
+                if (!probe.rulesOut()) return;
                 kept[k] = 0;
-                Hypothesis h = pairHypothesis(first, second);
-                h.unexplained = std::llround((1 - probe.agreeing) * probe.seen * double(camera.width()) * camera.height());
-                h.estimated = true;
-                paired[k] = std::move(h);
+                paired[k] = probedOut(pairHypothesis(first, second), probe);
             } catch (const Error&) {
                 kept[k] = 0;
             }
@@ -618,7 +618,7 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
                 for (const Rereading& r : second.mistake->reread(*candidates[pair.first].camera, map))
                     if (r.variant == second.reading.variant && r.camera) {
                         Camera composed(*r.camera);
-                        if (probeAgreement(scene_, rays_, composed, map).agreeing >= 0.75) pair.camera.emplace(std::move(composed));
+                        if (!probeAgreement(scene_, rays_, composed, map).rulesOut()) pair.camera.emplace(std::move(composed));
                     }
             } catch (const Error&) {
             }

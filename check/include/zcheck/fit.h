@@ -19,10 +19,11 @@
 //             relative eye depth, the same unit for every quantity.
 //   solver    Levenberg–Marquardt on the weighted normal equations, forward-difference
 //             Jacobian; then the truth is re-rendered through the fitted camera (new planes
-//             where surfaces moved) and the fit repeated, three rounds at most. Near and far
-//             start from a global estimate: a window or NDC map's values lie on a line in 1/z
-//             (z for parallel projections), found by least median of squares over lines
-//             through pairs of samples, which pixels clipped by another near plane cannot pull.
+//             where surfaces moved) and the fit repeated, three rounds at most. Near and far,
+//             and a scale and offset, start from a global estimate: a window or NDC map's
+//             values lie on a line in 1/z (z for parallel projections), a rescaled map's on a
+//             line in the expected values, found by least median of squares over lines through
+//             pairs of samples, which pixels clipped by another near plane cannot pull.
 //   polish    A fit that explains the map is refined in the comparison's own terms where an
 //             inlier (≤ 4 tolerances) is beyond 0.9 of its tolerance: each residual divided by
 //             its pixel's tolerance (PixelJudge: C·q + S·m + E, so a steep surface's snapped or

@@ -128,6 +128,9 @@ std::optional<std::int64_t> screenUnexplained(const Scene& scene, const Camera& 
 // `agreeing` under 3/4 rules it out.
 struct Probe {
     double agreeing = 0, seen = 0;
+    bool rulesOut() const { return agreeing < 0.75; }
+    // The unexplained pixels of `pixels` the probe's share stands for.
+    std::int64_t unexplainedOf(double pixels) const { return std::llround((1 - agreeing) * seen * pixels); }
 };
 Probe probeAgreement(const Scene& scene, const RayRenderer& rays, const Camera& camera, const DepthMap& map);
 
