@@ -96,6 +96,14 @@ DepthMap scaled(DepthMap map, double scale, double offset = 0)
     return map;
 }
 
+// The depth-scale hypothesis for a Metal eye-z map of builtin:near-crossing whose values are
+// scaled by `scale` (the regressions below).
+Hypothesis nearCrossingScaledDiagnosis(double scale)
+{
+    const Bench b({"regression", "builtin:near-crossing", "metal", ExportQuantity::EyeZ});
+    return b.diagnosed(scaled(b.mapDrawnWith(b.camera.spec()), scale), "depth-scale");
+}
+
 // Runs `check` on every setup, naming the setup and its half in the messages.
 void forEachSetup(const std::function<void(const Bench&)>& check)
 {
@@ -334,8 +342,7 @@ TEST_CASE("regression: a fit pulled by steep surfaces' snapping left face-on pix
     // all the same way; weighing every pixel alike, the scale fit came out 1e-5 off and 133
     // face-on pixels failed the confirmation. Residuals are now weighed in each pixel's
     // tolerance, and the largest minimised where one is still near its tolerance.
-    const Bench b({"regression", "builtin:near-crossing", "metal", ExportQuantity::EyeZ});
-    const Hypothesis h = b.diagnosed(scaled(b.mapDrawnWith(b.camera.spec()), 1.002), "depth-scale");
+    const Hypothesis h = nearCrossingScaledDiagnosis(1.002);
     INFO(h.explanation << ": unexplained " << h.unexplained);
     REQUIRE(h.consistent);
     REQUIRE(std::abs(fittedValue(h, "value_scale") - 1.002) <= 1e-4 * 1.002);
@@ -347,8 +354,7 @@ TEST_CASE("regression: a scaled reading's residuals were measured in the unscale
     // relative eye-z change, which a reading scaled by s multiplies by s. Without it a map in
     // millimetres had residuals 1000× too large, so the fit seemed not to explain it and was
     // never polished: 71 face-on pixels stayed beyond their tolerance.
-    const Bench b({"regression", "builtin:near-crossing", "metal", ExportQuantity::EyeZ});
-    const Hypothesis h = b.diagnosed(scaled(b.mapDrawnWith(b.camera.spec()), 1000), "depth-scale");
+    const Hypothesis h = nearCrossingScaledDiagnosis(1000);
     INFO(h.explanation << ": unexplained " << h.unexplained);
     REQUIRE(h.consistent);
     REQUIRE(std::abs(fittedValue(h, "value_scale") - 1000) <= 1e-4 * 1000);
