@@ -42,8 +42,22 @@ Stats timeRepeated(int repeats, F&& run)
     return {ms[ms.size() / 2], ms.front()};
 }
 
+// `phase` "raster" times the raster route alone (no BVH is built), for instruction and cycle
+// counts of the rasterizer under `perf stat`; "all" times every phase.
+void runRasterOnly(const Scene& scene, const Camera& camera, int repeats)
+{
+    const RasterRenderer raster(scene);
+    RenderResult last;
+    const Stats ms = timeRepeated(repeats, [&] {
+        last = raster.render(camera);
+        return last.renderMilliseconds;
+    });
+    std::printf("raster %7.1f ms (best %7.1f) %6.2f Mtris/s | peak RSS %6.0f MiB\n", ms.median, ms.best,
+                double(scene.triangleCount()) / ms.median / 1e3, peakResidentMiB());
+}
+
 void runWorkload(const std::string& label, const std::string& sceneName, const std::string& cameraFile, int width,
-                 int height, int repeats)
+                 int height, int repeats, const std::string& phase)
 {
     const auto loadStart = std::chrono::steady_clock::now();
     const Scene scene = loadScene(sceneName);
@@ -51,6 +65,7 @@ void runWorkload(const std::string& label, const std::string& sceneName, const s
     CameraSpec spec = cameraFile.empty() ? scene.defaultCamera : readCameraFile(cameraFile);
     if (cameraFile.empty()) spec.width = width, spec.height = height;
     const Camera camera(spec);
+    if (phase == "raster") return runRasterOnly(scene, camera, repeats);
 
     const RayRenderer rays(scene);
     const RasterRenderer raster(scene);
@@ -85,7 +100,7 @@ int main(int argc, char** argv)
 {
     CLI::App app{"zcheck_bench: throughput of the ray and raster routes on named workloads"};
     int width = 1920, height = 1080, repeats = 5, threads = 0;
-    std::string only, sceneName, cameraFile;
+    std::string only, sceneName, cameraFile, phase = "all";
     app.add_option("--width", width, "image width")->capture_default_str();
     app.add_option("--height", height, "image height")->capture_default_str();
     app.add_option("--repeat", repeats, "renders per measurement (median and best reported)")->capture_default_str();
@@ -93,6 +108,9 @@ int main(int argc, char** argv)
     app.add_option("--only", only, "run only workloads whose label contains this text");
     app.add_option("--scene", sceneName, "one workload: this scene (a built-in name or a mesh file) instead of the named ones");
     app.add_option("--camera", cameraFile, "with --scene: a camera file (its size overrides --width/--height)");
+    app.add_option("--phase", phase, "all, or raster: the raster route alone (no BVH built)")
+        ->check(CLI::IsMember({"all", "raster"}))
+        ->capture_default_str();
     CLI11_PARSE(app, argc, argv);
 
     std::unique_ptr<tbb::global_control> limit;
@@ -105,10 +123,10 @@ int main(int argc, char** argv)
         {"default", "builtin:default"},
     };
     try {
-        if (!sceneName.empty()) runWorkload("scene", sceneName, cameraFile, width, height, std::max(1, repeats));
+        if (!sceneName.empty()) runWorkload("scene", sceneName, cameraFile, width, height, std::max(1, repeats), phase);
         for (const auto& [label, scene] : workloads)
             if (sceneName.empty() && (only.empty() || label.find(only) != std::string::npos))
-                runWorkload(label, scene, "", width, height, std::max(1, repeats));
+                runWorkload(label, scene, "", width, height, std::max(1, repeats), phase);
     } catch (const Error& e) {
         std::fprintf(stderr, "zcheck_bench: error: %s\n", e.what());
         return 2;
