@@ -12,6 +12,7 @@
 #include <catch2/catch.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include <cfenv>
 #include <cmath>
 #include <cstdlib>
 #include <random>
@@ -305,6 +306,27 @@ TEST_CASE("storage quanta and quantization follow the formats' definitions", "[c
     REQUIRE(quantizeDepth(DepthFormat::Unorm16, 0.5) == 32768.0 / 65535);  // round(0.5·65535) = 32768
     REQUIRE(quantizeDepth(DepthFormat::Unorm16, 1.2) == 1.0);
     REQUIRE(quantizeDepth(DepthFormat::Float32, 0.1) == double(0.1f));
+}
+
+TEST_CASE("the inline rounding to a depth code is std::nearbyint, halves to even, in every rounding mode", "[core]")
+{
+    // Halves round to even (0.5 -> 0, 1.5 -> 2, 2.5 -> 2), as nearbyint does in the default mode;
+    // the largest unorm24 code and the values just below a half stay where nearbyint puts them.
+    const double exact[][2] = {{0.0, 0.0}, {0.5, 0.0}, {1.5, 2.0}, {2.5, 2.0}, {16777214.5, 16777214.0},
+                               {16777215.0, 16777215.0}, {std::nextafter(0.5, 0.0), 0.0}, {0.5000000000000001, 1.0}};
+    for (const auto& [x, rounded] : exact) REQUIRE(nearbyintNonNegative(x) == rounded);
+    REQUIRE(std::isnan(nearbyintNonNegative(NAN)));
+    std::mt19937_64 random(7);
+    std::uniform_real_distribution<double> depth(0.0, 1.0);
+    for (const int mode : {FE_TONEAREST, FE_DOWNWARD, FE_UPWARD, FE_TOWARDZERO}) {
+        std::fesetround(mode);
+        for (int k = 0; k < 100000; ++k) {
+            const double x = depth(random) * unormMax(DepthFormat::Unorm24);
+            if (nearbyintNonNegative(x) != std::nearbyint(x)) FAIL("mode " << mode << ": " << x);
+        }
+        for (const auto& [x, rounded] : exact) REQUIRE(nearbyintNonNegative(x) == std::nearbyint(x));
+    }
+    std::fesetround(FE_TONEAREST);
 }
 
 TEST_CASE("clipping a triangle keeps what is inside the near and far planes", "[core]")

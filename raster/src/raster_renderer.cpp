@@ -108,6 +108,16 @@ struct Viewport {
     }
 };
 
+// std::llround(x) for |x| < 2^52, inline (the library call was a tenth of the vertex work):
+// the truncation t and the fraction x − t are exact, and a fraction of ±½ or more rounds
+// away from zero, as llround does.
+std::int64_t roundHalfAwayFromZero(double x)
+{
+    const auto t = static_cast<std::int64_t>(x);
+    const double fraction = x - static_cast<double>(t);
+    return t + (fraction >= 0.5) - (fraction <= -0.5);
+}
+
 // Perspective divide, viewport, image rows top-down, snap: one vertex, the same arithmetic
 // whether the vertex is the scene's or one that clipping made.
 SnappedVertex snapVertex(const Viewport& vp, const glm::dvec4& pClip)
@@ -119,8 +129,8 @@ SnappedVertex snapVertex(const Viewport& vp, const glm::dvec4& pClip)
     // Only a fault (no near clipping) can bring w ≤ 0 here: mark what cannot be snapped.
     v.valid = std::abs(pWindow.x) < 2 * kMaxImageCoordinate && std::abs(yImage) < 2 * kMaxImageCoordinate;
     if (!v.valid) return v;
-    v.X = std::llround(pWindow.x * kSubpixel);
-    v.Y = std::llround(yImage * kSubpixel);
+    v.X = roundHalfAwayFromZero(pWindow.x * kSubpixel);  // |X|, |Y| < 2^30 (valid)
+    v.Y = roundHalfAwayFromZero(yImage * kSubpixel);
     // The fault "eye-z interpolated in screen space" interpolates eye-z instead of depth.
     if (vp.faults.screenLinearEyeZ) {
         const glm::dvec4 pEye = vp.camera.eyeFromClip * pClip;
@@ -222,6 +232,24 @@ void binChunk(const Viewport& vp, const std::vector<BinItem>& items, Chunk& chun
     for (const BinItem& item : items) forEachTile(item, [&](int tile) { chunk.binned[fill[tile]++] = item.entry; });
 }
 
+// What a tile holds per pixel while it is drawn: the depth buffer's key, which orders as the
+// stored values do — a unorm format's integer code (its value is code / (2^N − 1)), a float32
+// buffer's value itself. The depth test compares keys, and the stored value is made from the
+// key once, when the tile is copied into the frame: no division per drawn pixel.
+struct DepthKeys {
+    bool unorm;
+    DepthFormat format;
+    double maxCode;
+
+    explicit DepthKeys(DepthFormat f) : unorm(f != DepthFormat::Float32), format(f), maxCode(unorm ? unormMax(f) : 1.0) {}
+    // The key of window depth d: value(key(d)) == quantizeDepth(format, d), bit for bit.
+    double key(double windowDepth) const { return unorm ? unormCode(format, windowDepth) : double(float(windowDepth)); }
+    double value(double key) const { return unorm ? key / maxCode : key; }
+    // The key of a value the buffer can store (code / (2^N − 1) times 2^N − 1 is the code to
+    // within 1e-9, so rounding recovers it exactly).
+    double keyOfStored(double stored) const { return unorm ? nearbyintNonNegative(stored * maxCode) : stored; }
+};
+
 // The stored value under the pixel faults (never called for a clean chain).
 double faultyStoredDepth(const Viewport& vp, double interpolated, int col, int row)
 {
@@ -242,23 +270,25 @@ double faultyStoredDepth(const Viewport& vp, double interpolated, int col, int r
     return quantizeDepth(depth.format, windowDepth);
 }
 
-// One tile's depth and primitive ids while it is drawn: kept in the worker's cache (48 KB),
-// then copied into the frame once.
+// One tile's depth keys and primitive ids while it is drawn: kept in the worker's cache
+// (48 KB), then copied into the frame once.
 struct TileBuffer {
     static constexpr int kSide = RasterRenderer::kTileSize;
     int col0, row0;  // the tile's top-left pixel in the frame
-    double depth[kSide * kSide];
+    double key[kSide * kSide];
     std::uint32_t primitive[kSide * kSide];
 };
 
-// Scan one triangle inside one tile.
-void drawInTile(const Viewport& vp, const TriangleSetup& t, int tileCol0, int tileRow0, int tileCol1, int tileRow1,
-                TileBuffer& out)
+// Scan one triangle inside one tile; `PixelFaults`: a fault changes how a pixel's stored
+// depth is computed (faultyStoredDepth), the clean chain otherwise.
+template <bool PixelFaults>
+void drawInTile(const Viewport& vp, const DepthKeys& keys, const TriangleSetup& t, int tileCol0, int tileRow0,
+                int tileCol1, int tileRow1, TileBuffer& out)
 {
-    const Camera& camera = vp.camera;
     const int col0 = std::max(t.box.minCol, tileCol0), col1 = std::min(t.box.maxCol, tileCol1);
     const int row0 = std::max(t.box.minRow, tileRow0), row1 = std::min(t.box.maxRow, tileRow1);
-    const DepthSettings& depth = camera.depth();
+    const DepthSettings& depth = vp.camera.depth();
+    const bool reversed = depth.reversed;  // the depth test: LESS, or GREATER with reversed-Z
     for (int row = row0; row <= row1; ++row) {
         const std::int64_t py = row * kSubpixel + kHalfPixel, px = col0 * kSubpixel + kHalfPixel;
         std::int64_t e0 = t.A[0] * px + t.B[0] * py + t.C[0];
@@ -266,15 +296,16 @@ void drawInTile(const Viewport& vp, const TriangleSetup& t, int tileCol0, int ti
         std::int64_t e2 = t.A[2] * px + t.B[2] * py + t.C[2];
         const std::int64_t step0 = t.A[0] * kSubpixel, step1 = t.A[1] * kSubpixel, step2 = t.A[2] * kSubpixel;
         const double rowDepth = t.z0 + t.dzdy * (row + 0.5 - t.y0);
+        double* keyRow = out.key + (row - out.row0) * TileBuffer::kSide - out.col0;
+        std::uint32_t* primitiveRow = out.primitive + (row - out.row0) * TileBuffer::kSide - out.col0;
         for (int col = col0; col <= col1; ++col, e0 += step0, e1 += step1, e2 += step2) {
             if ((e0 | e1 | e2) < 0) continue;  // some edge function negative: outside
             const double interpolated = rowDepth + t.dzdx * (col + 0.5 - t.x0);
-            const double stored = vp.pixelFaults ? faultyStoredDepth(vp, interpolated, col, row)
-                                                 : quantizeDepth(depth.format, std::clamp(interpolated, depth.rangeMin, depth.rangeMax));
-            const int i = (row - out.row0) * TileBuffer::kSide + (col - out.col0);
-            if (camera.passesDepthTest(stored, out.depth[i])) {
-                out.depth[i] = stored;
-                out.primitive[i] = t.primitive;
+            const double key = PixelFaults ? keys.keyOfStored(faultyStoredDepth(vp, interpolated, col, row))
+                                           : keys.key(std::clamp(interpolated, depth.rangeMin, depth.rangeMax));
+            if (reversed ? key > keyRow[col] : key < keyRow[col]) {
+                keyRow[col] = key;
+                primitiveRow[col] = t.primitive;
             }
         }
     }
@@ -298,6 +329,8 @@ RenderResult RasterRenderer::render(const Camera& camera, const RasterFaults& fa
     const int W = camera.width(), H = camera.height();
     const double clearDepth = camera.clearDepth();
     RenderResult result = RenderResult::cleared(W, H, clearDepth);
+    const DepthKeys keys(camera.depth().format);
+    const double clearKey = keys.keyOfStored(clearDepth);
 
     // Vertices to clip space in double, their outcodes, and those inside every clip plane
     // snapped once (a vertex outside one is snapped only where clipping made it).
@@ -350,25 +383,29 @@ RenderResult RasterRenderer::render(const Camera& camera, const RasterFaults& fa
         TriangleSetup t;
         TileBuffer tileBuffer;
         tileBuffer.col0 = col0, tileBuffer.row0 = row0;
-        std::fill(std::begin(tileBuffer.depth), std::end(tileBuffer.depth), clearDepth);
+        std::fill(std::begin(tileBuffer.key), std::end(tileBuffer.key), clearKey);
         std::fill(std::begin(tileBuffer.primitive), std::end(tileBuffer.primitive), kNoPrimitive);
+        auto draw = [&](const TriangleSetup& setup) {
+            vp.pixelFaults ? drawInTile<true>(vp, keys, setup, col0, row0, col1, row1, tileBuffer)
+                           : drawInTile<false>(vp, keys, setup, col0, row0, col1, row1, tileBuffer);
+        };
         for (const Chunk& chunk : chunks)
             for (std::uint32_t k = chunk.tileStart[tile]; k < chunk.tileStart[tile + 1]; ++k) {
                 const std::uint32_t entry = chunk.binned[k];
                 if (entry & kClippedBit) {
-                    drawInTile(vp, chunk.clipped[entry & ~kClippedBit], col0, row0, col1, row1, tileBuffer);
+                    draw(chunk.clipped[entry & ~kClippedBit]);
                 } else {
                     const glm::uvec3& tri = scene_.triangles[entry];
                     setupFromSnapped(vp, snapped[tri[0]].snapped(), snapped[tri[1]].snapped(), snapped[tri[2]].snapped(),
                                      entry, t);
-                    drawInTile(vp, t, col0, row0, col1, row1, tileBuffer);
+                    draw(t);
                 }
             }
         for (int row = row0; row <= row1; ++row) {
             const int from = (row - row0) * TileBuffer::kSide, count = col1 - col0 + 1;
-            const std::size_t to = std::size_t(row) * W + col0;
-            std::copy_n(tileBuffer.depth + from, count, result.windowDepth.value.begin() + std::ptrdiff_t(to));
-            std::copy_n(tileBuffer.primitive + from, count, result.primitiveId.begin() + std::ptrdiff_t(to));
+            double* depthTo = result.windowDepth.value.data() + std::size_t(row) * W + col0;
+            for (int k = 0; k < count; ++k) depthTo[k] = keys.value(tileBuffer.key[from + k]);
+            std::copy_n(tileBuffer.primitive + from, count, result.primitiveId.data() + std::size_t(row) * W + col0);
         }
     });
     result.renderMilliseconds =

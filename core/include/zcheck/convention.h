@@ -55,15 +55,29 @@ const std::vector<std::string>& depthFormatNames();
 // The largest code of a unorm format, 2^N − 1.
 inline double unormMax(DepthFormat format) { return format == DepthFormat::Unorm24 ? 16777215.0 : 65535.0; }
 
+// std::nearbyint(x) for 0 ≤ x < 2^52 (or NaN), inline: adding 2^52 leaves no fraction bits,
+// so the sum is rounded to an integer in the current rounding mode, and subtracting 2^52
+// again is exact. (The library call costs the rasterizer a call per pixel.)
+inline double nearbyintNonNegative(double x)
+{
+    constexpr double kNoFractionBits = 4503599627370496.0;  // 2^52
+    return (x + kNoFractionBits) - kNoFractionBits;
+}
+
+// The code a unorm depth buffer stores for window depth `windowDepth`: round(clamp(d, 0, 1)·(2^N − 1)),
+// as a double (exact: at most 2^24 − 1). Codes order as the values they stand for.
+inline double unormCode(DepthFormat format, double windowDepth)
+{
+    return nearbyintNonNegative(std::clamp(windowDepth, 0.0, 1.0) * unormMax(format));
+}
+
 // The value the depth buffer stores for window depth `windowDepth` (clamped to [0,1] for
 // unorm formats, rounded to the nearest code), returned as a double so that all formats
 // compare alike. Inline: the rasterizer calls it per pixel.
 inline double quantizeDepth(DepthFormat format, double windowDepth)
 {
     if (format == DepthFormat::Float32) return static_cast<double>(static_cast<float>(windowDepth));
-    const double maxCode = unormMax(format);
-    const double code = std::nearbyint(std::clamp(windowDepth, 0.0, 1.0) * maxCode);
-    return code / maxCode;
+    return unormCode(format, windowDepth) / unormMax(format);
 }
 
 // The storage quantum q at a stored value: 1 LSB = 1/(2^N − 1) for unorm-N, the spacing of
