@@ -42,18 +42,40 @@ Stats timeRepeated(int repeats, F&& run)
     return {ms[ms.size() / 2], ms.front()};
 }
 
-// `phase` "raster" times the raster route alone (no BVH is built), for instruction and cycle
-// counts of the rasterizer under `perf stat`; "all" times every phase.
-void runRasterOnly(const Scene& scene, const Camera& camera, int repeats)
+// `phase` other than "all" times one phase alone, for A/B comparisons of its code: "raster"
+// (no BVH is built), "trace", or "compare" (both routes rendered once, the comparison repeated).
+void runPhase(const std::string& phase, const Scene& scene, const Camera& camera, int repeats)
 {
     const RasterRenderer raster(scene);
-    RenderResult last;
-    const Stats ms = timeRepeated(repeats, [&] {
-        last = raster.render(camera);
-        return last.renderMilliseconds;
-    });
-    std::printf("raster %7.1f ms (best %7.1f) %6.2f Mtris/s | peak RSS %6.0f MiB\n", ms.median, ms.best,
-                double(scene.triangleCount()) / ms.median / 1e3, peakResidentMiB());
+    if (phase == "raster") {
+        RenderResult last;
+        const Stats ms = timeRepeated(repeats, [&] {
+            last = raster.render(camera);
+            return last.renderMilliseconds;
+        });
+        std::printf("raster %7.1f ms (best %7.1f) %6.2f Mtris/s", ms.median, ms.best,
+                    double(scene.triangleCount()) / ms.median / 1e3);
+    } else {
+        const RayRenderer rays(scene);
+        RenderResult ray = rays.render(camera);
+        if (phase == "trace") {
+            const Stats ms = timeRepeated(repeats, [&] {
+                ray = rays.render(camera);
+                return ray.renderMilliseconds;
+            });
+            std::printf("trace %7.1f ms (best %7.1f) %6.2f Mrays/s", ms.median, ms.best,
+                        double(camera.width()) * camera.height() / ms.median / 1e3);
+        } else {
+            const RenderResult drawn = raster.render(camera);
+            const Stats ms = timeRepeated(repeats, [&] {
+                const auto start = std::chrono::steady_clock::now();
+                const Comparison c = compareRoutes(scene, camera, ray, drawn);
+                return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+            });
+            std::printf("compare %7.1f ms (best %7.1f)", ms.median, ms.best);
+        }
+    }
+    std::printf(" | peak RSS %6.0f MiB\n", peakResidentMiB());
 }
 
 void runWorkload(const std::string& label, const std::string& sceneName, const std::string& cameraFile, int width,
@@ -65,7 +87,7 @@ void runWorkload(const std::string& label, const std::string& sceneName, const s
     CameraSpec spec = cameraFile.empty() ? scene.defaultCamera : readCameraFile(cameraFile);
     if (cameraFile.empty()) spec.width = width, spec.height = height;
     const Camera camera(spec);
-    if (phase == "raster") return runRasterOnly(scene, camera, repeats);
+    if (phase != "all") return runPhase(phase, scene, camera, repeats);
 
     const RayRenderer rays(scene);
     const RasterRenderer raster(scene);
@@ -108,8 +130,8 @@ int main(int argc, char** argv)
     app.add_option("--only", only, "run only workloads whose label contains this text");
     app.add_option("--scene", sceneName, "one workload: this scene (a built-in name or a mesh file) instead of the named ones");
     app.add_option("--camera", cameraFile, "with --scene: a camera file (its size overrides --width/--height)");
-    app.add_option("--phase", phase, "all, or raster: the raster route alone (no BVH built)")
-        ->check(CLI::IsMember({"all", "raster"}))
+    app.add_option("--phase", phase, "all, or one phase alone: raster (no BVH built), trace, compare")
+        ->check(CLI::IsMember({"all", "raster", "trace", "compare"}))
         ->capture_default_str();
     CLI11_PARSE(app, argc, argv);
 
