@@ -3,6 +3,7 @@
 #include "zcheck/checker.h"
 #include "zcheck/error.h"
 #include "zcheck/mistakes.h"
+#include "zcheck/percentile.h"
 #include "zcheck/report.h"
 
 #include "diagnosis_helpers.h"
@@ -12,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 
 #include <set>
 #include <thread>
@@ -168,6 +170,54 @@ TEST_CASE("the comparison's report is the same for 1 and 2 threads, and its p99 
     // The worst pixel holds the largest error / tolerance.
     REQUIRE(one.comparison.errorOverTolerance[std::size_t(a.worst.row) * std::size_t(camera.width()) +
                                               std::size_t(a.worst.col)] == maxRatio);
+}
+
+// The comparison's percentiles keep only each thread's largest values; the one selected must
+// be the sorted one whatever the order the values arrive in and however they are split.
+TEST_CASE("the 99th percentile from the largest values kept is the sorted one, in any order and split", "[compare]")
+{
+    std::mt19937 random(11);
+    for (const int n : {1, 2, 99, 100, 101, 250, 5000, 100000}) {
+        std::vector<float> values(static_cast<std::size_t>(n));
+        std::uniform_int_distribution<int> fewDistinct(0, 40);  // ties, and a spread
+        for (float& v : values) v = float(fewDistinct(random)) * 0.25f + (n % 2 ? 0.0f : float(random() % 1000) * 1e-3f);
+        std::vector<float> sorted = values;
+        std::sort(sorted.begin(), sorted.end());
+        const double expected = sorted[std::size_t(std::ceil(0.99 * n)) - 1];
+        std::vector<std::vector<float>> orders = {values, sorted, std::vector<float>(sorted.rbegin(), sorted.rend())};
+        for (const std::vector<float>& order : orders)
+            for (const int parts : {1, 3}) {
+                const std::size_t keep = std::size_t(n) / 100 + 2;  // n is the most the keepers see
+                std::vector<LargestValues> keepers(static_cast<std::size_t>(parts), LargestValues(keep));
+                // Contiguous runs per keeper, as threads take blocks of rows.
+                for (std::size_t k = 0; k < order.size(); ++k) keepers[k * std::size_t(parts) / order.size()].add(order[k]);
+                std::vector<const LargestValues*> all;
+                for (const LargestValues& keeper : keepers) all.push_back(&keeper);
+                INFO("n " << n << ", " << parts << " keepers");
+                REQUIRE(LargestValues::percentile99(all) == expected);
+                // With a floor at or below the percentile, the same; above it, no answer.
+                for (const float floor : {float(expected), float(expected) + 0.125f}) {
+                    std::vector<LargestValues> floored(static_cast<std::size_t>(parts), LargestValues(keep, floor));
+                    for (std::size_t k = 0; k < order.size(); ++k) floored[k * std::size_t(parts) / order.size()].add(order[k]);
+                    std::vector<const LargestValues*> allFloored;
+                    for (const LargestValues& keeper : floored) allFloored.push_back(&keeper);
+                    const std::optional<double> p99 = LargestValues::percentile99(allFloored);
+                    if (floor == float(expected)) REQUIRE(p99 == expected);
+                    else if (sorted.back() > expected) REQUIRE_FALSE(p99.has_value());
+                }
+            }
+    }
+    REQUIRE(LargestValues::percentile99({}) == 0.0);
+    // Kept too few for the rank: no answer, not a wrong one.
+    LargestValues tooFew(1);
+    for (int k = 0; k < 1000; ++k) tooFew.add(float(k));
+    REQUIRE_FALSE(LargestValues::percentile99({&tooFew}).has_value());
+    // A sample's floor lies at its 97th percentile.
+    std::vector<float> sample(2000);
+    for (std::size_t k = 0; k < sample.size(); ++k) sample[k] = float(sample.size() - k);
+    REQUIRE(LargestValues::floorBelowPercentile99(sample) == 1941.0f);
+    std::vector<float> small(999, 5.0f);
+    REQUIRE(LargestValues::floorBelowPercentile99(small) == 0.0f);
 }
 
 TEST_CASE("judges of different cameras on one thread never share a slope", "[checker][compare]")

@@ -5,6 +5,7 @@
 #include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
 #include "zcheck/large_buffer.h"
+#include "zcheck/percentile.h"
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -13,6 +14,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <optional>
 #include <stdexcept>
 
 namespace zcheck {
@@ -76,53 +78,6 @@ double windowDepthSlope(const Camera& camera, const glm::dvec3& a, const glm::dv
 }
 
 namespace {
-
-// The 99th percentile of non-negative binary32 values, without storing them: a radix select
-// on their bit patterns (for non-negative floats they order as the values do). A first pass
-// counts the values by their top 16 bits (PrefixCounts); the prefix that holds the
-// percentile is found (PercentileBucket); a second pass regenerates the values and keeps
-// only those with that prefix, a small set, among which the rank is selected. Two 16 MB
-// arrays of values per comparison cost more to fault in than the second pass costs.
-std::uint32_t floatBits(float v)
-{
-    std::uint32_t b;
-    std::memcpy(&b, &v, sizeof b);
-    return b;
-}
-
-struct PrefixCounts {
-    std::vector<std::uint32_t> count = std::vector<std::uint32_t>(std::size_t(1) << 16, 0);  // < 2^25 pixels
-    void add(float v) { ++count[floatBits(v) >> 16]; }
-    void add(const PrefixCounts& other)
-    {
-        for (std::size_t b = 0; b < count.size(); ++b) count[b] += other.count[b];
-    }
-};
-
-struct PercentileBucket {
-    std::uint32_t prefix = 0;
-    std::size_t rank = 0;  // of the percentile among the values with this prefix
-    bool empty = true;     // no values at all
-
-    explicit PercentileBucket(const PrefixCounts& counts)
-    {
-        std::size_t n = 0;
-        for (std::uint32_t c : counts.count) n += c;
-        if (n == 0) return;
-        empty = false;
-        rank = std::min(n - 1, static_cast<std::size_t>(std::ceil(0.99 * double(n))) - 1);
-        while (rank >= counts.count[prefix]) rank -= counts.count[prefix++];
-    }
-    bool holds(float v) const { return !empty && floatBits(v) >> 16 == prefix; }
-    double select(std::vector<float>& sharing) const
-    {
-        if (empty) return 0.0;
-        // Both passes compute each value with the same code; anything else is a bug here.
-        if (rank >= sharing.size()) throw std::logic_error("percentile: the second pass lost values");
-        std::nth_element(sharing.begin(), sharing.begin() + std::ptrdiff_t(rank), sharing.end());
-        return sharing[rank];
-    }
-};
 
 // The slopes of the triangles a thread saw last, for any judge: direct-mapped on the
 // primitive, keyed by the judge's serial (0: empty). A triangle covering many pixels costs
@@ -306,12 +261,11 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
         return rasterQuantum ? (*rasterQuantum)[i] : storageQuantum(format, ray.windowDepth.value[i]);
     };
     // (d_raster − d_ray)/q at pixel i with q = quantumAt(i), of which the statistics take the
-    // absolute value: both passes must produce the same bits (|x|/q and |x/q| differ in the
-    // sign of a NaN).
+    // absolute value.
     auto signedErrorQuantaAt = [&](std::size_t i, double q) {
         return (raster.windowDepth.value[i] - ray.windowDepth.value[i]) / q;
     };
-    // The relative eye-z error of a pixel compared on depth (both passes use this one).
+    // The relative eye-z error of a pixel compared on depth.
     auto relativeEyeZErrorAt = [&](std::size_t i, int col, int row) {
         const glm::dvec2 pImage(col + 0.5, row + 0.5);
         const double rayDepth = ray.windowDepth.value[i], rasterDepth = raster.windowDepth.value[i];
@@ -319,12 +273,12 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
         const double eyeZ = camera.eyeZOf(ray.pEye[i]);
         return std::abs(cameraRays.eyeZFromWindowDepth(pImage, rasterDepth) - eyeZ) / std::abs(eyeZ);
     };
-    // The 99th percentiles' first pass: value counts by prefix, per thread (sums do not
-    // depend on the order).
+    // The 99th percentiles: each thread's largest values (what is selected does not depend
+    // on which thread saw which value).
     struct StatisticCounts {
-        PrefixCounts errorQuanta, relativeEyeZ;
+        LargestValues errorQuanta, relativeEyeZ;
     };
-    tbb::enumerable_thread_specific<StatisticCounts> statisticCounts;
+    const std::size_t keep = std::size_t(W) * std::size_t(H) / 100 + 2;  // ≥ n/100 + 1 for any n ≤ W·H
 
     // |Δ| / tolerance, as the report and the heatmap give it.
     auto ratioOf = [](double error, double bound) { return bound > 0 ? error / bound : (error > 0 ? INFINITY : 0.0); };
@@ -344,9 +298,8 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
         return worst;
     };
 
-    auto compareBlock = [&](int firstRow, int lastRow, BlockTally& tally) {
+    auto compareBlock = [&](int firstRow, int lastRow, BlockTally& tally, StatisticCounts& counts) {
         ComparisonReport& r = tally.report;
-        StatisticCounts& counts = statisticCounts.local();
         for (int row = firstRow; row < lastRow; ++row) {
             for (int col = 0; col < W; ++col) {
                 const std::size_t i = std::size_t(row) * W + col;
@@ -432,49 +385,54 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
     };
 
     const std::size_t blockCount = std::size_t((H + kBlockRows - 1) / kBlockRows);
-    std::vector<BlockTally> blocks(blockCount);
-    tbb::parallel_for(std::size_t(0), blocks.size(), [&](std::size_t b) {
-        compareBlock(int(b) * kBlockRows, std::min(H, int(b + 1) * kBlockRows), blocks[b]);
-    });
-    BlockTally total;
-    for (BlockTally& block : blocks) merge(total, block);
-    blocks.clear();
+    // The keepers' floors, from every 32nd row's single-surface pixels: the values at their
+    // 97th percentile lie below the 99th of all with overwhelming probability, and a keeper then
+    // holds ~3 % of its values instead of rebuilding its running largest as values grow down the
+    // image. A floor too high is found out at the end, and the pass run again without floors.
+    std::vector<float> errorQuantaSample, relativeEyeZSample;
+    for (int row = 0; row < H; row += 32)
+        for (int col = 0; col < W; ++col) {
+            const std::size_t i = std::size_t(row) * W + col;
+            if (!ray.hit(i) || ray.primitiveId[i] != raster.primitiveId[i]) continue;
+            errorQuantaSample.push_back(float(std::abs(signedErrorQuantaAt(i, quantumAt(i)))));
+            relativeEyeZSample.push_back(float(relativeEyeZErrorAt(i, col, row)));
+        }
+    const float errorQuantaFloor = LargestValues::floorBelowPercentile99(errorQuantaSample);
+    const float relativeEyeZFloor = LargestValues::floorBelowPercentile99(relativeEyeZSample);
 
-    // The 99th percentiles' second pass: the values in the buckets that hold them.
-    StatisticCounts allCounts;
-    for (const StatisticCounts& counts : statisticCounts) {
-        allCounts.errorQuanta.add(counts.errorQuanta);
-        allCounts.relativeEyeZ.add(counts.relativeEyeZ);
+    BlockTally total;
+    std::optional<double> p99ErrorQuanta, p99RelativeEyeZ;
+    for (const bool floors : {true, false}) {
+        tbb::enumerable_thread_specific<StatisticCounts> statisticCounts([&] {
+            return StatisticCounts{LargestValues(keep, floors ? errorQuantaFloor : 0.0f),
+                                   LargestValues(keep, floors ? relativeEyeZFloor : 0.0f)};
+        });
+        std::vector<BlockTally> blocks(blockCount);
+        tbb::parallel_for(std::size_t(0), blocks.size(), [&](std::size_t b) {
+            compareBlock(int(b) * kBlockRows, std::min(H, int(b + 1) * kBlockRows), blocks[b], statisticCounts.local());
+        });
+        total = BlockTally{};
+        for (BlockTally& block : blocks) merge(total, block);
+        std::vector<const LargestValues*> errorQuantaParts, relativeEyeZParts;
+        for (const StatisticCounts& counts : statisticCounts) {
+            errorQuantaParts.push_back(&counts.errorQuanta);
+            relativeEyeZParts.push_back(&counts.relativeEyeZ);
+        }
+        p99ErrorQuanta = LargestValues::percentile99(errorQuantaParts);
+        p99RelativeEyeZ = LargestValues::percentile99(relativeEyeZParts);
+        if (p99ErrorQuanta && p99RelativeEyeZ) break;
+        if (!floors) throw std::logic_error("comparison: the percentiles' keepers kept too few values");
     }
-    const PercentileBucket errorQuantaBucket(allCounts.errorQuanta), relativeEyeZBucket(allCounts.relativeEyeZ);
-    std::vector<std::vector<float>> errorQuantaSharing(blockCount), relativeEyeZSharing(blockCount);
-    tbb::parallel_for(std::size_t(0), blockCount, [&](std::size_t b) {
-        for (int row = int(b) * kBlockRows; row < std::min(H, int(b + 1) * kBlockRows); ++row)
-            for (int col = 0; col < W; ++col) {
-                const std::size_t i = std::size_t(row) * W + col;
-                if (out.pixelClass[i] != PixelClass::Agree && out.pixelClass[i] != PixelClass::DepthError) continue;
-                const auto errorQuanta = float(std::abs(signedErrorQuantaAt(i, quantumAt(i))));
-                if (errorQuantaBucket.holds(errorQuanta)) errorQuantaSharing[b].push_back(errorQuanta);
-                const auto relative = float(relativeEyeZErrorAt(i, col, row));
-                if (relativeEyeZBucket.holds(relative)) relativeEyeZSharing[b].push_back(relative);
-            }
-    });
-    auto joined = [](std::vector<std::vector<float>>& parts) {
-        std::vector<float> all;
-        for (const auto& part : parts) all.insert(all.end(), part.begin(), part.end());
-        return all;
-    };
-    std::vector<float> errorQuantaValues = joined(errorQuantaSharing), relativeEyeZValues = joined(relativeEyeZSharing);
 
     out.report = std::move(total.report);
     ComparisonReport& r = out.report;
     r.width = W, r.height = H;
-    r.p99ErrorQuanta = errorQuantaBucket.select(errorQuantaValues);
+    r.p99ErrorQuanta = *p99ErrorQuanta;
     if (r.biasSamples > 0) r.meanSignedErrorQuanta = total.signedErrorSum / double(r.biasSamples);
     const bool spread = std::all_of(std::begin(total.quarterCounts), std::end(total.quarterCounts),
                                     [&](std::int64_t n) { return n >= r.biasSamples / 10; });
     r.depthBias = r.biasSamples >= 1000 && spread && std::abs(r.meanSignedErrorQuanta) > 0.25;
-    r.p99RelativeEyeZError = relativeEyeZBucket.select(relativeEyeZValues);
+    r.p99RelativeEyeZError = *p99RelativeEyeZ;
     return out;
 }
 

@@ -1,0 +1,63 @@
+#pragma once
+// The 99th percentile of many non-negative binary32 values in one pass, without storing them
+// all: the comparison's p99 of |Δ|/q and of the relative eye-z error over two million pixels.
+//
+// The percentile of n values is the value at rank ⌈0.99·n⌉ − 1 of the sorted values, which
+// lies among the n − rank ≤ n/100 + 1 largest. Each thread keeps only its own `keep` largest
+// (choose keep ≥ n/100 + 1 for the largest n possible), and the percentile is selected from
+// what all threads kept: exact, and the same whichever thread saw which value. A value above
+// a keeper's threshold is appended; when 2·keep have gathered, the largest keep are selected
+// and the threshold raised: O(1) per value however the values arrive. A `floor` (for example
+// floorBelowPercentile99 of a sample) keeps nothing below it from the start: far fewer values
+// kept and no re-selection, and if it was too high after all, percentile99 says so.
+// Values are ordered by their bit patterns, as non-negative floats order (a NaN above +inf).
+//
+//   LargestValues mine(width * height / 100 + 2);                // one per thread
+//   mine.add(float(errorQuanta));                                // each value
+//   std::optional<double> p99 = LargestValues::percentile99({&mine, &other});
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <optional>
+#include <vector>
+
+namespace zcheck {
+
+class LargestValues {
+public:
+    explicit LargestValues(std::size_t keep, float floor = 0.0f);
+
+    void add(float value)
+    {
+        ++count_;
+        const std::uint32_t bits = floatBits(value);
+        if (bits < floor_ || (kept_.size() >= keep_ && bits <= threshold_)) return;  // not among the largest
+        kept_.push_back(bits);
+        if (kept_.size() == 2 * keep_) shrink();
+    }
+    std::size_t count() const { return count_; }  // values added
+
+    // The 99th percentile of every value the keepers were given (0 when there were none), or
+    // nullopt when they kept too few values to hold it: a floor above it, or keep below n/100 + 1.
+    static std::optional<double> percentile99(const std::vector<const LargestValues*>& keepers);
+    // A floor for keepers from a sample of the values (reordered): its 97th percentile, or 0 for
+    // a sample under 1000 values.
+    static float floorBelowPercentile99(std::vector<float>& sample);
+
+private:
+    static std::uint32_t floatBits(float value)
+    {
+        std::uint32_t bits;
+        std::memcpy(&bits, &value, sizeof bits);
+        return bits;
+    }
+    void shrink();
+
+    std::size_t keep_;
+    std::size_t count_ = 0;
+    std::uint32_t floor_;          // values below it are counted, never kept
+    std::uint32_t threshold_ = 0;  // the smallest kept value once keep_ are kept
+    std::vector<std::uint32_t> kept_;
+};
+
+}  // namespace zcheck
