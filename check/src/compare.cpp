@@ -186,15 +186,20 @@ bool isUnexplained(PixelClass c)
 
 namespace {
 
-// What one block of rows contributes to the report; blocks are merged in scan order.
-struct BlockTally {
+// What one tile contributes to the report; tiles are merged in tile order, and what depends
+// on scan order (the first unexplained pixels, the worst pixel among equals) is restored.
+struct TileTally {
     ComparisonReport report;  // counts, maxima, worst pixel, samples, bounding box, bias samples
     double signedErrorSum = 0;
     std::int64_t quarterCounts[4] = {0, 0, 0, 0};
 };
 
-constexpr int kBlockRows = 8;  // rows per block: fixed, so the merge order never depends on threads
 constexpr std::size_t kUnexplainedSamples = 20;  // the first ones in scan order (compare.h)
+
+bool beforeInScanOrder(const PixelFinding& a, const PixelFinding& b)
+{
+    return a.row != b.row ? a.row < b.row : a.col < b.col;
+}
 
 // Grows the bounding box of the unexplained pixels to hold (col, row).
 void extendUnexplainedBox(ComparisonReport& r, int col, int row)
@@ -215,15 +220,20 @@ void noteUnexplained(ComparisonReport& r, const PixelFinding& f)
     extendUnexplainedBox(r, f.col, f.row);
 }
 
-// Appends `block` (the rows after those of `total`) to `total`.
-void merge(BlockTally& total, BlockTally& block)
+// Adds `tile` to `total`. The worst pixel is the largest ratio, the first in scan order among
+// equals; a tile's first unexplained pixels in its own scan order hold the image's first ones
+// that lie in it, so all tiles' samples, sorted, hold the image's first 20.
+void merge(TileTally& total, TileTally& tile)
 {
     ComparisonReport& r = total.report;
-    const ComparisonReport& b = block.report;
-    const bool firstCompared = r.agree + r.depthErrors == 0 && b.agree + b.depthErrors > 0;
-    if (firstCompared || b.maxErrorOverTolerance > r.maxErrorOverTolerance) {
-        r.maxErrorOverTolerance = std::max(r.maxErrorOverTolerance, b.maxErrorOverTolerance);
-        r.worst = b.worst;
+    const ComparisonReport& b = tile.report;
+    if (b.agree + b.depthErrors > 0) {
+        const bool firstCompared = r.agree + r.depthErrors == 0;
+        if (firstCompared || b.maxErrorOverTolerance > r.maxErrorOverTolerance ||
+            (b.maxErrorOverTolerance == r.maxErrorOverTolerance && beforeInScanOrder(b.worst, r.worst))) {
+            r.maxErrorOverTolerance = b.maxErrorOverTolerance;
+            r.worst = b.worst;
+        }
     }
     r.bothHit += b.bothHit, r.bothMiss += b.bothMiss, r.rayOnly += b.rayOnly, r.rasterOnly += b.rasterOnly;
     r.agree += b.agree, r.edgeSurface += b.edgeSurface, r.depthErrors += b.depthErrors;
@@ -232,63 +242,99 @@ void merge(BlockTally& total, BlockTally& block)
     r.maxErrorQuanta = std::max(r.maxErrorQuanta, b.maxErrorQuanta);
     r.maxRelativeEyeZError = std::max(r.maxRelativeEyeZError, b.maxRelativeEyeZError);
     r.biasSamples += b.biasSamples;
-    for (const PixelFinding& f : b.unexplainedSamples)
-        if (r.unexplainedSamples.size() < kUnexplainedSamples) r.unexplainedSamples.push_back(f);
+    r.unexplainedSamples.insert(r.unexplainedSamples.end(), b.unexplainedSamples.begin(), b.unexplainedSamples.end());
     if (b.unexplainedMaxCol >= 0) {  // the box of all of them, not only of the samples
         extendUnexplainedBox(r, b.unexplainedMinCol, b.unexplainedMinRow);
         extendUnexplainedBox(r, b.unexplainedMaxCol, b.unexplainedMaxRow);
     }
-    total.signedErrorSum += block.signedErrorSum;
-    for (int k = 0; k < 4; ++k) total.quarterCounts[k] += block.quarterCounts[k];
+    total.signedErrorSum += tile.signedErrorSum;
+    for (int k = 0; k < 4; ++k) total.quarterCounts[k] += tile.quarterCounts[k];
 }
+
+// The 99th percentiles: each thread's largest values (what is selected does not depend on
+// which thread saw which value).
+struct StatisticCounts {
+    LargestValues errorQuanta, relativeEyeZ;
+};
 
 }  // namespace
 
-Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderResult& ray,
-                         const RenderResult& raster, const ToleranceModel& tolerance,
-                         const std::vector<double>* rasterQuantum)
+RoutePixels RoutePixels::of(const RenderResult& render)
 {
-    const int W = camera.width(), H = camera.height();
-    Comparison out;
-    assignLarge(out.pixelClass, std::size_t(W) * H, PixelClass::BothMiss);
-    assignLarge(out.errorOverTolerance, std::size_t(W) * H, 0.0f);
+    RoutePixels p;
+    p.windowDepth = render.windowDepth.value.data();
+    p.primitive = render.primitiveId.data();
+    p.pEye = render.pEye.empty() ? nullptr : render.pEye.data();
+    p.stride = std::size_t(render.windowDepth.width);
+    return p;
+}
 
-    const PixelJudge judge(scene, camera, tolerance);
-    const CameraRays cameraRays(camera);  // eye-z of a window depth in closed form
-    const DepthFormat format = camera.depth().format;
-    const double S = tolerance.snapPixels();
-    auto quantumAt = [&](std::size_t i) {
-        return rasterQuantum ? (*rasterQuantum)[i] : storageQuantum(format, ray.windowDepth.value[i]);
+struct TileComparison::Impl {
+    Impl(const Scene& scene, const Camera& camera, const ToleranceModel& tolerance, Comparison* perPixel,
+         float errorQuantaFloor, float relativeEyeZFloor)
+        : camera(camera),
+          perPixel(perPixel),
+          judge(scene, camera, tolerance),
+          cameraRays(camera),
+          format(camera.depth().format),
+          S(tolerance.snapPixels()),
+          W(camera.width()),
+          H(camera.height()),
+          tilesX((W + kTileSize - 1) / kTileSize),
+          tiles(std::size_t(tilesX) * std::size_t((H + kTileSize - 1) / kTileSize)),
+          statisticCounts([keep = std::size_t(W) * std::size_t(H) / 100 + 2, errorQuantaFloor, relativeEyeZFloor] {
+              // keep ≥ n/100 + 1 for any n ≤ W·H
+              return StatisticCounts{LargestValues(keep, errorQuantaFloor), LargestValues(keep, relativeEyeZFloor)};
+          })
+    {
+    }
+
+    void compare(int tile, const RoutePixels& ray, const RoutePixels& raster);
+
+    const Camera& camera;
+    Comparison* perPixel;
+    const PixelJudge judge;
+    const CameraRays cameraRays;  // eye-z of a window depth in closed form
+    const DepthFormat format;
+    const double S;
+    const int W, H, tilesX;
+    std::vector<TileTally> tiles;
+    tbb::enumerable_thread_specific<StatisticCounts> statisticCounts;
+};
+
+void TileComparison::Impl::compare(int tile, const RoutePixels& ray, const RoutePixels& raster)
+{
+    TileTally& tally = tiles[std::size_t(tile)];
+    ComparisonReport& r = tally.report;
+    StatisticCounts& counts = statisticCounts.local();
+    const int col0 = (tile % tilesX) * kTileSize, row0 = (tile / tilesX) * kTileSize;
+    const int col1 = std::min(W, col0 + kTileSize), row1 = std::min(H, row0 + kTileSize);
+
+    // Pixel (col, row): a in the ray's arrays, b in the raster's, i in the image.
+    auto quantumAt = [&](std::size_t a, std::size_t b) {
+        return raster.quantum ? raster.quantum[b] : storageQuantum(format, ray.windowDepth[a]);
     };
-    // (d_raster − d_ray)/q at pixel i with q = quantumAt(i), of which the statistics take the
-    // absolute value.
-    auto signedErrorQuantaAt = [&](std::size_t i, double q) {
-        return (raster.windowDepth.value[i] - ray.windowDepth.value[i]) / q;
+    // (d_raster − d_ray)/q, of which the statistics take the absolute value.
+    auto signedErrorQuantaAt = [&](std::size_t a, std::size_t b, double q) {
+        return (raster.windowDepth[b] - ray.windowDepth[a]) / q;
     };
     // The relative eye-z error of a pixel compared on depth.
-    auto relativeEyeZErrorAt = [&](std::size_t i, int col, int row) {
+    auto relativeEyeZErrorAt = [&](std::size_t a, std::size_t b, int col, int row) {
         const glm::dvec2 pImage(col + 0.5, row + 0.5);
-        const double rayDepth = ray.windowDepth.value[i], rasterDepth = raster.windowDepth.value[i];
-        if (ray.pEye.empty()) return cameraRays.relativeEyeZDifference(pImage, rayDepth, rasterDepth);
-        const double eyeZ = camera.eyeZOf(ray.pEye[i]);
+        const double rayDepth = ray.windowDepth[a], rasterDepth = raster.windowDepth[b];
+        if (!ray.pEye) return cameraRays.relativeEyeZDifference(pImage, rayDepth, rasterDepth);
+        const double eyeZ = camera.eyeZOf(ray.pEye[a]);
         return std::abs(cameraRays.eyeZFromWindowDepth(pImage, rasterDepth) - eyeZ) / std::abs(eyeZ);
     };
-    // The 99th percentiles: each thread's largest values (what is selected does not depend
-    // on which thread saw which value).
-    struct StatisticCounts {
-        LargestValues errorQuanta, relativeEyeZ;
-    };
-    const std::size_t keep = std::size_t(W) * std::size_t(H) / 100 + 2;  // ≥ n/100 + 1 for any n ≤ W·H
-
     // |Δ| / tolerance, as the report and the heatmap give it.
     auto ratioOf = [](double error, double bound) { return bound > 0 ? error / bound : (error > 0 ? INFINITY : 0.0); };
     // A pixel compared on depth (agree or depth error), whichever path judged it: its count, its
     // ratio, the statistics. Returns whether it is the worst so far (its finding is then r.worst).
-    auto noteCompared = [&](ComparisonReport& r, StatisticCounts& counts, std::size_t i, int col, int row, bool agree,
-                            double ratio, double errorQuanta) {
+    auto noteCompared = [&](std::size_t a, std::size_t b, std::size_t i, int col, int row, bool agree, double ratio,
+                            double errorQuanta) {
         agree ? ++r.agree : ++r.depthErrors;
-        out.errorOverTolerance[i] = static_cast<float>(ratio);
-        const double relative = relativeEyeZErrorAt(i, col, row);
+        if (perPixel) perPixel->errorOverTolerance[i] = static_cast<float>(ratio);
+        const double relative = relativeEyeZErrorAt(a, b, col, row);
         counts.errorQuanta.add(float(errorQuanta));
         counts.relativeEyeZ.add(float(relative));
         r.maxRelativeEyeZError = std::max(r.maxRelativeEyeZError, relative);
@@ -297,142 +343,179 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
         if (worst) r.maxErrorOverTolerance = std::max(r.maxErrorOverTolerance, ratio);
         return worst;
     };
-
-    auto compareBlock = [&](int firstRow, int lastRow, BlockTally& tally, StatisticCounts& counts) {
-        ComparisonReport& r = tally.report;
-        for (int row = firstRow; row < lastRow; ++row) {
-            for (int col = 0; col < W; ++col) {
-                const std::size_t i = std::size_t(row) * W + col;
-                const bool rayHit = ray.hit(i), rasterHit = raster.hit(i);
-                if (!rayHit && !rasterHit) {
-                    ++r.bothMiss;  // pixelClass is BothMiss already
-                    continue;
-                }
-                if (rayHit && rasterHit && ray.primitiveId[i] == raster.primitiveId[i]) {
-                    // The common case, kept lean: one surface, so one slope, and no edge or
-                    // clip-plane question (PixelJudge::bothHit's rule for a single surface).
-                    ++r.bothHit;
-                    const std::uint32_t primitive = ray.primitiveId[i];
-                    const double rayDepth = ray.windowDepth.value[i], rasterDepth = raster.windowDepth.value[i];
-                    const double q = quantumAt(i), m = judge.slope(primitive);
-                    const double bound = judge.toleranceForSlope(m, q);
-                    const double error = std::abs(rasterDepth - rayDepth);
-                    const double signedErrorQuanta = signedErrorQuantaAt(i, q), errorQuanta = std::abs(signedErrorQuanta);
-                    const double ratio = ratioOf(error, bound);
-                    const bool agree = error <= bound;
-                    if (S * m <= 0.1 * q) {
-                        // Quantization dominates here: feed the bias test.
-                        tally.signedErrorSum += signedErrorQuanta;
-                        const double position = rayDepth / q;
-                        ++tally.quarterCounts[std::clamp(int(4 * (position - std::floor(position))), 0, 3)];
-                        ++r.biasSamples;
-                    }
-                    out.pixelClass[i] = agree ? PixelClass::Agree : PixelClass::DepthError;
-                    const bool worst = noteCompared(r, counts, i, col, row, agree, ratio, errorQuanta);
-                    if (agree && !worst) continue;  // nothing to note: no finding is built
-                    PixelFinding f;
-                    f.col = col, f.row = row;
-                    f.rayWindowDepth = rayDepth, f.rasterWindowDepth = rasterDepth;
-                    f.rayPrimitive = f.rasterPrimitive = primitive;
-                    f.pixelClass = agree ? PixelClass::Agree : PixelClass::DepthError;
-                    f.errorQuanta = errorQuanta;
-                    f.toleranceQuanta = bound / q;
-                    if (worst) r.worst = f;
-                    if (!agree) noteUnexplained(r, f);
-                    continue;
-                }
-                const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
-                PixelFinding f;
-                f.col = col, f.row = row;
-                f.rayWindowDepth = ray.windowDepth.value[i];
-                f.rasterWindowDepth = raster.windowDepth.value[i];
-                f.rayPrimitive = ray.primitiveId[i];
-                f.rasterPrimitive = raster.primitiveId[i];
-
-                if (rayHit && rasterHit) {
-                    // Different surfaces: the raster's may legitimately win near an edge or a clip plane.
-                    ++r.bothHit;
-                    const double q = quantumAt(i);
-                    const double error = std::abs(f.rasterWindowDepth - f.rayWindowDepth);
-                    double bound = 0;
-                    f.pixelClass = judge.bothHit(f.rayWindowDepth, f.rayPrimitive, f.rasterWindowDepth,
-                                                 f.rasterPrimitive, q, pWindow, bound);
-                    f.errorQuanta = std::abs(signedErrorQuantaAt(i, q));
-                    const double ratio = ratioOf(error, bound);
-                    auto withTolerance = [&](PixelFinding& finding) -> PixelFinding& {  // a finding kept
-                        finding.toleranceQuanta = bound / q;
-                        return finding;
-                    };
-                    if (f.pixelClass == PixelClass::EdgeSurface) {
-                        ++r.edgeSurface;
-                    } else if (noteCompared(r, counts, i, col, row, f.pixelClass == PixelClass::Agree, ratio, f.errorQuanta)) {
-                        r.worst = withTolerance(f);
-                    }
-                    if (f.pixelClass == PixelClass::DepthError) withTolerance(f);
-                } else {
-                    // Coverage mismatch: only one route sees a surface (PixelJudge::oneHit).
-                    rayHit ? ++r.rayOnly : ++r.rasterOnly;
-                    f.pixelClass = judge.oneHit(rayHit, rayHit ? f.rayWindowDepth : f.rasterWindowDepth,
-                                                rayHit ? f.rayPrimitive : f.rasterPrimitive, quantumAt(i), pWindow);
-                    if (f.pixelClass == PixelClass::RayOnlyAtClear) ++r.lostAtClearValue;
-                    if (f.pixelClass == PixelClass::AtClipPlane) ++r.atClipPlane;
-                    isUnexplained(f.pixelClass) ? ++r.coverageUnexplained : ++r.coverageExplained;
-                }
-                out.pixelClass[i] = f.pixelClass;
-                if (isUnexplained(f.pixelClass)) noteUnexplained(r, f);
-            }
-        }
+    auto setClass = [&](std::size_t i, PixelClass c) {
+        if (perPixel) perPixel->pixelClass[i] = c;
     };
 
-    const std::size_t blockCount = std::size_t((H + kBlockRows - 1) / kBlockRows);
+    for (int row = row0; row < row1; ++row) {
+        for (int col = col0; col < col1; ++col) {
+            const std::size_t a = ray.at(col, row), b = raster.at(col, row), i = std::size_t(row) * W + col;
+            const std::uint32_t rayPrimitive = ray.primitive[a], rasterPrimitive = raster.primitive[b];
+            const bool rayHit = rayPrimitive != kNoPrimitive, rasterHit = rasterPrimitive != kNoPrimitive;
+            if (!rayHit && !rasterHit) {
+                ++r.bothMiss;  // pixelClass is BothMiss already
+                continue;
+            }
+            if (rayHit && rasterHit && rayPrimitive == rasterPrimitive) {
+                // The common case, kept lean: one surface, so one slope, and no edge or
+                // clip-plane question (PixelJudge::bothHit's rule for a single surface).
+                ++r.bothHit;
+                const double rayDepth = ray.windowDepth[a], rasterDepth = raster.windowDepth[b];
+                const double q = quantumAt(a, b), m = judge.slope(rayPrimitive);
+                const double bound = judge.toleranceForSlope(m, q);
+                const double error = std::abs(rasterDepth - rayDepth);
+                const double signedErrorQuanta = signedErrorQuantaAt(a, b, q), errorQuanta = std::abs(signedErrorQuanta);
+                const double ratio = ratioOf(error, bound);
+                const bool agree = error <= bound;
+                if (S * m <= 0.1 * q) {
+                    // Quantization dominates here: feed the bias test.
+                    tally.signedErrorSum += signedErrorQuanta;
+                    const double position = rayDepth / q;
+                    ++tally.quarterCounts[std::clamp(int(4 * (position - std::floor(position))), 0, 3)];
+                    ++r.biasSamples;
+                }
+                setClass(i, agree ? PixelClass::Agree : PixelClass::DepthError);
+                const bool worst = noteCompared(a, b, i, col, row, agree, ratio, errorQuanta);
+                if (agree && !worst) continue;  // nothing to note: no finding is built
+                PixelFinding f;
+                f.col = col, f.row = row;
+                f.rayWindowDepth = rayDepth, f.rasterWindowDepth = rasterDepth;
+                f.rayPrimitive = f.rasterPrimitive = rayPrimitive;
+                f.pixelClass = agree ? PixelClass::Agree : PixelClass::DepthError;
+                f.errorQuanta = errorQuanta;
+                f.toleranceQuanta = bound / q;
+                if (worst) r.worst = f;
+                if (!agree) noteUnexplained(r, f);
+                continue;
+            }
+            const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
+            PixelFinding f;
+            f.col = col, f.row = row;
+            f.rayWindowDepth = ray.windowDepth[a];
+            f.rasterWindowDepth = raster.windowDepth[b];
+            f.rayPrimitive = rayPrimitive;
+            f.rasterPrimitive = rasterPrimitive;
+
+            if (rayHit && rasterHit) {
+                // Different surfaces: the raster's may legitimately win near an edge or a clip plane.
+                ++r.bothHit;
+                const double q = quantumAt(a, b);
+                const double error = std::abs(f.rasterWindowDepth - f.rayWindowDepth);
+                double bound = 0;
+                f.pixelClass = judge.bothHit(f.rayWindowDepth, f.rayPrimitive, f.rasterWindowDepth, f.rasterPrimitive, q,
+                                             pWindow, bound);
+                f.errorQuanta = std::abs(signedErrorQuantaAt(a, b, q));
+                const double ratio = ratioOf(error, bound);
+                auto withTolerance = [&](PixelFinding& finding) -> PixelFinding& {  // a finding kept
+                    finding.toleranceQuanta = bound / q;
+                    return finding;
+                };
+                if (f.pixelClass == PixelClass::EdgeSurface) {
+                    ++r.edgeSurface;
+                } else if (noteCompared(a, b, i, col, row, f.pixelClass == PixelClass::Agree, ratio, f.errorQuanta)) {
+                    r.worst = withTolerance(f);
+                }
+                if (f.pixelClass == PixelClass::DepthError) withTolerance(f);
+            } else {
+                // Coverage mismatch: only one route sees a surface (PixelJudge::oneHit).
+                rayHit ? ++r.rayOnly : ++r.rasterOnly;
+                f.pixelClass = judge.oneHit(rayHit, rayHit ? f.rayWindowDepth : f.rasterWindowDepth,
+                                            rayHit ? f.rayPrimitive : f.rasterPrimitive, quantumAt(a, b), pWindow);
+                if (f.pixelClass == PixelClass::RayOnlyAtClear) ++r.lostAtClearValue;
+                if (f.pixelClass == PixelClass::AtClipPlane) ++r.atClipPlane;
+                isUnexplained(f.pixelClass) ? ++r.coverageUnexplained : ++r.coverageExplained;
+            }
+            setClass(i, f.pixelClass);
+            if (isUnexplained(f.pixelClass)) noteUnexplained(r, f);
+        }
+    }
+}
+
+TileComparison::TileComparison(const Scene& scene, const Camera& camera, const ToleranceModel& tolerance,
+                               Comparison* perPixel, float errorQuantaFloor, float relativeEyeZFloor)
+    : impl_(std::make_unique<Impl>(scene, camera, tolerance, perPixel, errorQuantaFloor, relativeEyeZFloor))
+{
+    if (perPixel) {
+        const std::size_t pixels = std::size_t(camera.width()) * std::size_t(camera.height());
+        assignLarge(perPixel->pixelClass, pixels, PixelClass::BothMiss);
+        assignLarge(perPixel->errorOverTolerance, pixels, 0.0f);
+    }
+}
+
+TileComparison::~TileComparison() = default;
+
+int TileComparison::tileCount() const { return int(impl_->tiles.size()); }
+
+void TileComparison::compareTile(int tile, const RoutePixels& ray, const RoutePixels& raster)
+{
+    impl_->compare(tile, ray, raster);
+}
+
+std::optional<ComparisonReport> TileComparison::finish()
+{
+    Impl& c = *impl_;
+    TileTally total;
+    for (TileTally& tile : c.tiles) merge(total, tile);
+    std::vector<const LargestValues*> errorQuantaParts, relativeEyeZParts;
+    for (const StatisticCounts& counts : c.statisticCounts) {
+        errorQuantaParts.push_back(&counts.errorQuanta);
+        relativeEyeZParts.push_back(&counts.relativeEyeZ);
+    }
+    const std::optional<double> p99ErrorQuanta = LargestValues::percentile99(errorQuantaParts);
+    const std::optional<double> p99RelativeEyeZ = LargestValues::percentile99(relativeEyeZParts);
+    if (!p99ErrorQuanta || !p99RelativeEyeZ) return std::nullopt;
+
+    ComparisonReport r = std::move(total.report);
+    std::vector<PixelFinding>& samples = r.unexplainedSamples;
+    std::sort(samples.begin(), samples.end(), beforeInScanOrder);
+    if (samples.size() > kUnexplainedSamples) samples.resize(kUnexplainedSamples);
+    r.width = c.W, r.height = c.H;
+    r.p99ErrorQuanta = *p99ErrorQuanta;
+    r.p99RelativeEyeZError = *p99RelativeEyeZ;
+    if (r.biasSamples > 0) r.meanSignedErrorQuanta = total.signedErrorSum / double(r.biasSamples);
+    const bool spread = std::all_of(std::begin(total.quarterCounts), std::end(total.quarterCounts),
+                                    [&](std::int64_t n) { return n >= r.biasSamples / 10; });
+    r.depthBias = r.biasSamples >= 1000 && spread && std::abs(r.meanSignedErrorQuanta) > 0.25;
+    return r;
+}
+
+Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderResult& ray,
+                         const RenderResult& raster, const ToleranceModel& tolerance,
+                         const std::vector<double>* rasterQuantum)
+{
+    const int W = camera.width(), H = camera.height();
+    RoutePixels rayPixels = RoutePixels::of(ray), rasterPixels = RoutePixels::of(raster);
+    if (rasterQuantum) rasterPixels.quantum = rasterQuantum->data();
+
     // The keepers' floors, from every 32nd row's single-surface pixels: the values at their
     // 97th percentile lie below the 99th of all with overwhelming probability, and a keeper then
     // holds ~3 % of its values instead of rebuilding its running largest as values grow down the
-    // image. A floor too high is found out at the end, and the pass run again without floors.
+    // image. A floor too high is found out at the end, and the comparison run again without.
+    const CameraRays cameraRays(camera);
     std::vector<float> errorQuantaSample, relativeEyeZSample;
     for (int row = 0; row < H; row += 32)
         for (int col = 0; col < W; ++col) {
             const std::size_t i = std::size_t(row) * W + col;
             if (!ray.hit(i) || ray.primitiveId[i] != raster.primitiveId[i]) continue;
-            errorQuantaSample.push_back(float(std::abs(signedErrorQuantaAt(i, quantumAt(i)))));
-            relativeEyeZSample.push_back(float(relativeEyeZErrorAt(i, col, row)));
+            const double q = rasterQuantum ? (*rasterQuantum)[i] : storageQuantum(camera.depth().format, ray.windowDepth.value[i]);
+            errorQuantaSample.push_back(float(std::abs((raster.windowDepth.value[i] - ray.windowDepth.value[i]) / q)));
+            relativeEyeZSample.push_back(float(
+                cameraRays.relativeEyeZDifference({col + 0.5, row + 0.5}, ray.windowDepth.value[i], raster.windowDepth.value[i])));
         }
     const float errorQuantaFloor = LargestValues::floorBelowPercentile99(errorQuantaSample);
     const float relativeEyeZFloor = LargestValues::floorBelowPercentile99(relativeEyeZSample);
 
-    BlockTally total;
-    std::optional<double> p99ErrorQuanta, p99RelativeEyeZ;
+    Comparison out;
     for (const bool floors : {true, false}) {
-        tbb::enumerable_thread_specific<StatisticCounts> statisticCounts([&] {
-            return StatisticCounts{LargestValues(keep, floors ? errorQuantaFloor : 0.0f),
-                                   LargestValues(keep, floors ? relativeEyeZFloor : 0.0f)};
-        });
-        std::vector<BlockTally> blocks(blockCount);
-        tbb::parallel_for(std::size_t(0), blocks.size(), [&](std::size_t b) {
-            compareBlock(int(b) * kBlockRows, std::min(H, int(b + 1) * kBlockRows), blocks[b], statisticCounts.local());
-        });
-        total = BlockTally{};
-        for (BlockTally& block : blocks) merge(total, block);
-        std::vector<const LargestValues*> errorQuantaParts, relativeEyeZParts;
-        for (const StatisticCounts& counts : statisticCounts) {
-            errorQuantaParts.push_back(&counts.errorQuanta);
-            relativeEyeZParts.push_back(&counts.relativeEyeZ);
+        TileComparison tiles(scene, camera, tolerance, &out, floors ? errorQuantaFloor : 0.0f,
+                             floors ? relativeEyeZFloor : 0.0f);
+        tbb::parallel_for(0, tiles.tileCount(), [&](int tile) { tiles.compareTile(tile, rayPixels, rasterPixels); });
+        if (std::optional<ComparisonReport> report = tiles.finish()) {
+            out.report = std::move(*report);
+            return out;
         }
-        p99ErrorQuanta = LargestValues::percentile99(errorQuantaParts);
-        p99RelativeEyeZ = LargestValues::percentile99(relativeEyeZParts);
-        if (p99ErrorQuanta && p99RelativeEyeZ) break;
         if (!floors) throw std::logic_error("comparison: the percentiles' keepers kept too few values");
     }
-
-    out.report = std::move(total.report);
-    ComparisonReport& r = out.report;
-    r.width = W, r.height = H;
-    r.p99ErrorQuanta = *p99ErrorQuanta;
-    if (r.biasSamples > 0) r.meanSignedErrorQuanta = total.signedErrorSum / double(r.biasSamples);
-    const bool spread = std::all_of(std::begin(total.quarterCounts), std::end(total.quarterCounts),
-                                    [&](std::int64_t n) { return n >= r.biasSamples / 10; });
-    r.depthBias = r.biasSamples >= 1000 && spread && std::abs(r.meanSignedErrorQuanta) > 0.25;
-    r.p99RelativeEyeZError = *p99RelativeEyeZ;
     return out;
 }
 

@@ -39,6 +39,8 @@
 #include "zcheck/scene.h"
 
 #include <cstdint>
+#include <memory>
+#include <optional>
 #include <vector>
 
 namespace zcheck {
@@ -185,8 +187,50 @@ private:
     std::uint64_t serial_;  // this judge's key in the per-thread slope memo
 };
 
-// Compares two renders of `scene` through `camera`, rows in parallel (fixed blocks merged in
-// scan order, so the report is the same for any number of threads). `ray` must carry exact
+// One route's results over a rectangle of the image, as the comparison reads them: pixel
+// (col, row) is entry at(col, row) of each array. A whole render is the rectangle at (0, 0)
+// with the image's width as stride (of()); a check that draws tile by tile passes its tile.
+struct RoutePixels {
+    const double* windowDepth = nullptr;
+    const std::uint32_t* primitive = nullptr;  // kNoPrimitive where nothing was hit
+    const glm::dvec3* pEye = nullptr;          // ray route, optional: exact hit points in eye space
+    const double* quantum = nullptr;           // optional: each pixel's storage quantum (compareRoutes)
+    int col0 = 0, row0 = 0;                    // the rectangle's first pixel
+    std::size_t stride = 0;                    // entries from one row to the next
+
+    std::size_t at(int col, int row) const { return std::size_t(row - row0) * stride + std::size_t(col - col0); }
+    static RoutePixels of(const RenderResult& render);
+};
+
+// The comparison tile by tile (squares of kTileSize pixels, numbered row by row): call
+// compareTile for every tile, in any order and from several threads at once, then finish().
+// Tiles are merged in tile order and what depends on scan order is restored (the first
+// unexplained pixels, the worst pixel among equals), so the report is the same for any
+// order and thread count, and the same as compareRoutes'. `perPixel`, when given, receives
+// the classes and ratios (sized here); without it nothing per pixel is kept. Keepers' floors:
+// see percentile.h; finish() returns nullopt when one was too high (compare again without).
+class TileComparison {
+public:
+    static constexpr int kTileSize = 64;
+
+    TileComparison(const Scene& scene, const Camera& camera, const ToleranceModel& tolerance, Comparison* perPixel,
+                   float errorQuantaFloor = 0.0f, float relativeEyeZFloor = 0.0f);
+    ~TileComparison();
+    TileComparison(const TileComparison&) = delete;
+    TileComparison& operator=(const TileComparison&) = delete;
+
+    int tileCount() const;
+    // `ray` and `raster` must cover the tile (they may cover more).
+    void compareTile(int tile, const RoutePixels& ray, const RoutePixels& raster);
+    std::optional<ComparisonReport> finish();
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+// Compares two renders of `scene` through `camera`, tiles in parallel (TileComparison: the
+// report is the same for any number of threads). `ray` must carry exact
 // depths (the ray route); `raster` holds stored depth-buffer values. `rasterQuantum`, when given, is the
 // storage quantum of each raster pixel in window-depth units (a map stored as eye-z or
 // distance, or as scaled integers); otherwise q comes from the camera's depth format.
