@@ -315,30 +315,36 @@ void drawInTile(const Viewport& vp, const DepthKeys& keys, const TriangleSetup& 
 
 RasterRenderer::RasterRenderer(const Scene& scene) : scene_(scene) { validateScene(scene); }
 
-RenderResult RasterRenderer::render(const Camera& camera, const RasterFaults& faults) const
-{
-    if (faults.otherDepthMapping && camera.spec().projection.type != ProjectionType::Matrix) {
-        CameraSpec other = camera.spec();
-        other.depth.reversed = !other.depth.reversed;
-        RasterFaults rest = faults;
-        rest.otherDepthMapping = false;
-        return render(Camera(other), rest);
+// One camera's set-up: vertices snapped, triangles set up and binned into tiles. The camera
+// and faults are the frame's own copies (the Viewport refers to them).
+struct RasterFrame::Impl {
+    Impl(const Scene& s, const Camera& c, const RasterFaults& f)
+        : scene(s), camera(c), faults(f), vp(camera, faults), keys(camera.depth().format),
+          clearKey(keys.keyOfStored(camera.clearDepth()))
+    {
     }
-    const auto start = std::chrono::steady_clock::now();
-    const Viewport vp(camera, faults);
-    const int W = camera.width(), H = camera.height();
-    const double clearDepth = camera.clearDepth();
-    RenderResult result = RenderResult::cleared(W, H, clearDepth);
-    const DepthKeys keys(camera.depth().format);
-    const double clearKey = keys.keyOfStored(clearDepth);
 
+    glm::dvec4 clipOf(std::uint32_t v) const { return vp.clipFromWorld * glm::dvec4(glm::dvec3(scene.positions[v]), 1.0); }
+    void prepare();
+    void drawTile(int tile, double* windowDepth, std::uint32_t* primitive, std::size_t stride) const;
+
+    const Scene& scene;
+    const Camera camera;
+    const RasterFaults faults;
+    const Viewport vp;
+    const DepthKeys keys;
+    const double clearKey;
+    std::vector<StoredVertex> snapped;  // per vertex, where inside every clip plane
+    std::vector<unsigned char> outcode;
+    std::vector<Chunk> chunks;
+};
+
+void RasterFrame::Impl::prepare()
+{
     // Vertices to clip space in double, their outcodes, and those inside every clip plane
     // snapped once (a vertex outside one is snapped only where clipping made it).
-    const auto clipOf = [&](std::uint32_t v) { return vp.clipFromWorld * glm::dvec4(glm::dvec3(scene_.positions[v]), 1.0); };
-    std::vector<StoredVertex> snapped;
-    std::vector<unsigned char> outcode;
-    assignLarge(snapped, scene_.positions.size(), StoredVertex{});
-    assignLarge(outcode, scene_.positions.size(), static_cast<unsigned char>(0));
+    assignLarge(snapped, scene.positions.size(), StoredVertex{});
+    assignLarge(outcode, scene.positions.size(), static_cast<unsigned char>(0));
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, snapped.size(), 4096), [&](const auto& range) {
         for (std::size_t v = range.begin(); v != range.end(); ++v) {
             const glm::dvec4 pClip = clipOf(std::uint32_t(v));
@@ -348,9 +354,10 @@ RenderResult RasterRenderer::render(const Camera& camera, const RasterFaults& fa
     });
 
     // Set-up and binning, one fixed-size chunk of triangles per task.
-    const std::size_t triangleCount = scene_.triangles.size();
+    const std::size_t triangleCount = scene.triangles.size();
     if (triangleCount >= kClippedBit) throw Error("the raster route draws at most 2^31 - 1 triangles");
-    std::vector<Chunk> chunks((triangleCount + kChunkTriangles - 1) / kChunkTriangles);
+    constexpr std::size_t kChunkTriangles = RasterRenderer::kChunkTriangles;
+    chunks.resize((triangleCount + kChunkTriangles - 1) / kChunkTriangles);
     tbb::parallel_for(std::size_t(0), chunks.size(), [&](std::size_t c) {
         Chunk& chunk = chunks[c];
         const std::size_t first = c * kChunkTriangles, last = std::min(triangleCount, first + kChunkTriangles);
@@ -359,7 +366,7 @@ RenderResult RasterRenderer::render(const Camera& camera, const RasterFaults& fa
         PixelBox box;
         std::int64_t area2;
         for (std::size_t p = first; p < last; ++p) {
-            const glm::uvec3& tri = scene_.triangles[p];
+            const glm::uvec3& tri = scene.triangles[p];
             const unsigned codeA = outcode[tri[0]], codeB = outcode[tri[1]], codeC = outcode[tri[2]];
             if (codeA & codeB & codeC) continue;  // wholly outside one plane
             if ((codeA | codeB | codeC) == 0) {
@@ -374,39 +381,80 @@ RenderResult RasterRenderer::render(const Camera& camera, const RasterFaults& fa
         }
         binChunk(vp, items, chunk);
     });
+}
 
-    // Tiles in parallel; inside a tile, chunks and their triangles in submission order. A
-    // triangle that needed no clipping is set up again from its snapped vertices.
-    tbb::parallel_for(0, vp.tilesX * vp.tilesY, [&](int tile) {
-        const int col0 = (tile % vp.tilesX) * kTileSize, row0 = (tile / vp.tilesX) * kTileSize;
-        const int col1 = std::min(W, col0 + kTileSize) - 1, row1 = std::min(H, row0 + kTileSize) - 1;
-        TriangleSetup t;
-        TileBuffer tileBuffer;
-        tileBuffer.col0 = col0, tileBuffer.row0 = row0;
-        std::fill(std::begin(tileBuffer.key), std::end(tileBuffer.key), clearKey);
-        std::fill(std::begin(tileBuffer.primitive), std::end(tileBuffer.primitive), kNoPrimitive);
-        auto draw = [&](const TriangleSetup& setup) {
-            vp.pixelFaults ? drawInTile<true>(vp, keys, setup, col0, row0, col1, row1, tileBuffer)
-                           : drawInTile<false>(vp, keys, setup, col0, row0, col1, row1, tileBuffer);
-        };
-        for (const Chunk& chunk : chunks)
-            for (std::uint32_t k = chunk.tileStart[tile]; k < chunk.tileStart[tile + 1]; ++k) {
-                const std::uint32_t entry = chunk.binned[k];
-                if (entry & kClippedBit) {
-                    draw(chunk.clipped[entry & ~kClippedBit]);
-                } else {
-                    const glm::uvec3& tri = scene_.triangles[entry];
-                    setupFromSnapped(vp, snapped[tri[0]].snapped(), snapped[tri[1]].snapped(), snapped[tri[2]].snapped(),
-                                     entry, t);
-                    draw(t);
-                }
+// Inside a tile, chunks and their triangles in submission order. A triangle that needed no
+// clipping is set up again from its snapped vertices.
+void RasterFrame::Impl::drawTile(int tile, double* windowDepth, std::uint32_t* primitive, std::size_t stride) const
+{
+    constexpr int kTileSize = RasterRenderer::kTileSize;
+    const int col0 = (tile % vp.tilesX) * kTileSize, row0 = (tile / vp.tilesX) * kTileSize;
+    const int col1 = std::min(vp.width, col0 + kTileSize) - 1, row1 = std::min(vp.height, row0 + kTileSize) - 1;
+    TriangleSetup t;
+    TileBuffer tileBuffer;
+    tileBuffer.col0 = col0, tileBuffer.row0 = row0;
+    std::fill(std::begin(tileBuffer.key), std::end(tileBuffer.key), clearKey);
+    std::fill(std::begin(tileBuffer.primitive), std::end(tileBuffer.primitive), kNoPrimitive);
+    auto draw = [&](const TriangleSetup& setup) {
+        vp.pixelFaults ? drawInTile<true>(vp, keys, setup, col0, row0, col1, row1, tileBuffer)
+                       : drawInTile<false>(vp, keys, setup, col0, row0, col1, row1, tileBuffer);
+    };
+    for (const Chunk& chunk : chunks)
+        for (std::uint32_t k = chunk.tileStart[tile]; k < chunk.tileStart[tile + 1]; ++k) {
+            const std::uint32_t entry = chunk.binned[k];
+            if (entry & kClippedBit) {
+                draw(chunk.clipped[entry & ~kClippedBit]);
+            } else {
+                const glm::uvec3& tri = scene.triangles[entry];
+                setupFromSnapped(vp, snapped[tri[0]].snapped(), snapped[tri[1]].snapped(), snapped[tri[2]].snapped(),
+                                 entry, t);
+                draw(t);
             }
-        for (int row = row0; row <= row1; ++row) {
-            const int from = (row - row0) * TileBuffer::kSide, count = col1 - col0 + 1;
-            double* depthTo = result.windowDepth.value.data() + std::size_t(row) * W + col0;
-            for (int k = 0; k < count; ++k) depthTo[k] = keys.value(tileBuffer.key[from + k]);
-            std::copy_n(tileBuffer.primitive + from, count, result.primitiveId.data() + std::size_t(row) * W + col0);
         }
+    for (int row = row0; row <= row1; ++row) {
+        const int from = (row - row0) * TileBuffer::kSide, count = col1 - col0 + 1;
+        double* depthTo = windowDepth + std::size_t(row - row0) * stride;
+        for (int k = 0; k < count; ++k) depthTo[k] = keys.value(tileBuffer.key[from + k]);
+        std::copy_n(tileBuffer.primitive + from, count, primitive + std::size_t(row - row0) * stride);
+    }
+}
+
+RasterFrame::RasterFrame(const Scene& scene, const Camera& camera, const RasterFaults& faults)
+    : impl_(std::make_unique<Impl>(scene, camera, faults))
+{
+    impl_->prepare();
+}
+
+RasterFrame::~RasterFrame() = default;
+
+int RasterFrame::tileCount() const { return impl_->vp.tilesX * impl_->vp.tilesY; }
+
+void RasterFrame::drawTile(int tile, double* windowDepth, std::uint32_t* primitive, std::size_t stride) const
+{
+    impl_->drawTile(tile, windowDepth, primitive, stride);
+}
+
+RasterFrame RasterRenderer::prepare(const Camera& camera, const RasterFaults& faults) const
+{
+    if (faults.otherDepthMapping && camera.spec().projection.type != ProjectionType::Matrix) {
+        CameraSpec other = camera.spec();
+        other.depth.reversed = !other.depth.reversed;
+        RasterFaults rest = faults;
+        rest.otherDepthMapping = false;
+        return RasterFrame(scene_, Camera(other), rest);
+    }
+    return RasterFrame(scene_, camera, faults);
+}
+
+RenderResult RasterRenderer::render(const Camera& camera, const RasterFaults& faults) const
+{
+    const auto start = std::chrono::steady_clock::now();
+    const RasterFrame frame = prepare(camera, faults);
+    const int W = camera.width(), H = camera.height(), tilesX = (W + kTileSize - 1) / kTileSize;
+    RenderResult result = RenderResult::cleared(W, H, camera.clearDepth());
+    tbb::parallel_for(0, frame.tileCount(), [&](int tile) {
+        const std::size_t first = std::size_t(tile / tilesX) * kTileSize * W + std::size_t(tile % tilesX) * kTileSize;
+        frame.drawTile(tile, result.windowDepth.value.data() + first, result.primitiveId.data() + first, std::size_t(W));
     });
     result.renderMilliseconds =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

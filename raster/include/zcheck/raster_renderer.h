@@ -24,6 +24,8 @@
 #include "zcheck/render.h"
 #include "zcheck/scene.h"
 
+#include <memory>
+
 namespace zcheck {
 
 // Classic mistakes injected into the raster route (the mistake catalogue passes them to
@@ -41,6 +43,27 @@ struct RasterFaults {
                                          // the reverse (not for raw-matrix cameras: ignored there)
 };
 
+// One camera's frame made ready to draw (RasterRenderer::prepare): vertices snapped, triangles
+// set up and binned. Its tiles (kTileSize squares numbered row by row) can then be drawn in
+// any order, from several threads at once: a check that compares tile by tile draws a tile
+// into a buffer of its own. Holds copies of the camera and faults; the scene must outlive it.
+class RasterFrame {
+public:
+    RasterFrame(const Scene& scene, const Camera& camera, const RasterFaults& faults);
+    ~RasterFrame();
+    RasterFrame(RasterFrame&&) noexcept = default;
+
+    int tileCount() const;
+    // The tile's stored depth values and primitive ids (kNoPrimitive where nothing was drawn)
+    // into windowDepth/primitive, which point at the tile's first pixel: pixel (col, row) of
+    // the tile goes to entry (row − row0)·stride + (col − col0). Thread-safe (const).
+    void drawTile(int tile, double* windowDepth, std::uint32_t* primitive, std::size_t stride) const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
 class RasterRenderer {
 public:
     static constexpr int kSubpixelBits = 8;          // 16.8 fixed point
@@ -50,6 +73,8 @@ public:
     explicit RasterRenderer(const Scene& scene);     // the scene must outlive the renderer
     // Thread-safety: const, and may run from several threads at once.
     RenderResult render(const Camera& camera, const RasterFaults& faults = {}) const;
+    // The frame render() draws, made ready for drawing tile by tile.
+    RasterFrame prepare(const Camera& camera, const RasterFaults& faults = {}) const;
 
 private:
     const Scene& scene_;
