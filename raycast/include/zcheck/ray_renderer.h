@@ -4,8 +4,8 @@
 // Rays come from the camera's definition (camera_rays.h, double), are handed to Embree in
 // binary32 from the eye plane with [tNear, tFar] spanning near to far plane (for every model
 // but a raw matrix the direction gains one unit of eye-z per unit of t: AffineRays), traced
-// as coherent 4×4 packets (rtcIntersect16), four packets per 8×8 tile, tiles in parallel
-// with TBB. Each hit is then recomputed in double against the hit triangle's plane,
+// as coherent 4×4 packets (rtcIntersect16), row by row of packets over 64×64 regions, the
+// regions in parallel with TBB (traceRect traces one rectangle). Each hit is then recomputed in double against the hit triangle's plane,
 // and its eye-z turned into the exact window depth the depth buffer should hold by the
 // convention's depth mapping in closed form — never through the raster route's matrices.
 //
@@ -50,6 +50,15 @@ public:
 
     // EyePoints::Keep also fills RenderResult::pEye (24 bytes per pixel more).
     RenderResult render(const Camera& camera, const RayFaults& faults = {}, EyePoints eyePoints = EyePoints::Omit) const;
+
+    // The pixels [col0, col1) × [row0, row1) of render(camera, faults), each one written
+    // (a miss: the clear value and kNoPrimitive, pEye NaN): pixel (col, row) to entry
+    // (row − row0)·stride + (col − col0) of windowDepth, primitiveId and, when given, pEye.
+    // col0 and row0 must be multiples of 8 (render's tiles), the rectangle inside the image.
+    // For a check that compares tile by tile.
+    void traceRect(const Camera& camera, int col0, int row0, int col1, int row1, double* windowDepth,
+                   std::uint32_t* primitiveId, std::size_t stride, const RayFaults& faults = {},
+                   glm::dvec3* pEye = nullptr) const;
 
     // The triangle the viewing ray through one window point hits first (kNoPrimitive on a
     // miss), traced alone: for questions about single points, not for images.
