@@ -43,9 +43,22 @@ Stats timeRepeated(int repeats, F&& run)
 }
 
 // `phase` other than "all" times one phase alone, for A/B comparisons of its code: "raster"
-// (no BVH is built), "trace", or "compare" (both routes rendered once, the comparison repeated).
+// (no BVH is built), "trace", "compare" (both routes rendered once, the comparison repeated),
+// or "tiles" (the whole check drawn, traced and compared tile by tile, as `zcheck check` runs).
 void runPhase(const std::string& phase, const Scene& scene, const Camera& camera, int repeats)
 {
+    if (phase == "tiles") {  // a whole check drawn, traced and compared tile by tile
+        const Checker checker(scene);
+        CheckOptions options;
+        options.keepPixels = false;
+        const Stats ms = timeRepeated(repeats, [&] {
+            const auto start = std::chrono::steady_clock::now();
+            const CheckResult run = checker.check(camera, options);
+            return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        });
+        std::printf("check tile by tile %7.1f ms (best %7.1f) | peak RSS %6.0f MiB\n", ms.median, ms.best, peakResidentMiB());
+        return;
+    }
     const RasterRenderer raster(scene);
     if (phase == "raster") {
         RenderResult last;
@@ -130,8 +143,8 @@ int main(int argc, char** argv)
     app.add_option("--only", only, "run only workloads whose label contains this text");
     app.add_option("--scene", sceneName, "one workload: this scene (a built-in name or a mesh file) instead of the named ones");
     app.add_option("--camera", cameraFile, "with --scene: a camera file (its size overrides --width/--height)");
-    app.add_option("--phase", phase, "all, or one phase alone: raster (no BVH built), trace, compare")
-        ->check(CLI::IsMember({"all", "raster", "trace", "compare"}))
+    app.add_option("--phase", phase, "all, or one phase alone: raster (no BVH built), trace, compare, or tiles (a check tile by tile)")
+        ->check(CLI::IsMember({"all", "raster", "trace", "compare", "tiles"}))
         ->capture_default_str();
     CLI11_PARSE(app, argc, argv);
 

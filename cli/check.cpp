@@ -37,7 +37,9 @@ int runCheckCommand(const CheckCommandOptions& o)
     const Camera camera(spec);  // validated before the BVH is built
 
     const Checker checker(std::move(scene));
-    const CheckResult run = checker.check(camera);
+    CheckOptions options;
+    options.keepPixels = !o.outDir.empty();  // pictures and maps need them; the report does not
+    const CheckResult run = checker.check(camera, options);
     requireSomethingCompared(run.report.comparison, checker.scene().name);
     const std::string reportJson = checkReportJson(run.report);
     if (!o.outDir.empty()) {

@@ -172,6 +172,40 @@ TEST_CASE("the comparison's report is the same for 1 and 2 threads, and its p99 
                                               std::size_t(a.worst.col)] == maxRatio);
 }
 
+// `zcheck check` without pictures draws, traces and compares tile by tile; its report must be
+// the full-frame check's, field for field, clean or not, for any thread count.
+TEST_CASE("a check tile by tile reports what the full-frame check reports", "[checker][threads]")
+{
+    for (const char* name : {"builtin:default", "builtin:near-crossing", "builtin:terrain?n=40"}) {
+        const Checker checker(builtinScene(name));
+        CameraSpec spec = smallCamera(checker.scene());
+        spec.width = 203, spec.height = 131;  // tiles cut by both edges
+        for (const DepthFormat format : {DepthFormat::Unorm16, DepthFormat::Float32}) {
+            spec.depth.format = format;
+            const Camera camera(spec);
+            std::vector<CheckOptions> runs(3);
+            runs[1].faults.ray.flipRows = true;                // thousands of unexplained pixels
+            runs[2].faults.raster.truncateUnorm = true;        // a depth bias
+            runs[2].faults.ray.shiftPixels = {0.5, 0.0};
+            for (CheckOptions& options : runs) {
+                CheckResult full = checker.check(camera, options);
+                options.keepPixels = false;
+                for (const int threads : {1, 2}) {
+                    const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+                    CheckResult tiled = checker.check(camera, options);
+                    INFO(name << ", " << toString(format) << ", " << threads << " threads");
+                    REQUIRE(tiled.report.timings.tileByTile);
+                    REQUIRE(tiled.ray.primitiveId.empty());
+                    REQUIRE(tiled.comparison.pixelClass.empty());
+                    tiled.report.timings = full.report.timings = Timings{};
+                    REQUIRE(checkReportJson(tiled.report) == checkReportJson(full.report));
+                    REQUIRE(formatSummary(tiled.report) == formatSummary(full.report));
+                }
+            }
+        }
+    }
+}
+
 // The comparison's percentiles keep only each thread's largest values; the one selected must
 // be the sorted one whatever the order the values arrive in and however they are split.
 TEST_CASE("the 99th percentile from the largest values kept is the sorted one, in any order and split", "[compare]")

@@ -4,7 +4,13 @@
 #include "zcheck/export.h"
 #include "zcheck/verify.h"
 
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
 #include <chrono>
+#include <memory>
+#include <optional>
+#include <stdexcept>
 
 namespace zcheck {
 
@@ -28,8 +34,78 @@ Checker::Checker(Scene scene) : scene_(std::move(scene)), rays_(scene_), raster_
 
 Checker::~Checker() = default;
 
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double millisecondsSince(Clock::time_point start)
+{
+    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+}  // namespace
+
+// Tile by tile: each worker traces a tile's rays, draws the same tile of the raster and
+// compares them while both are in its cache; no full-frame buffer is made.
+CheckResult Checker::checkTileByTile(const Camera& camera, const CheckOptions& options) const
+{
+    constexpr int kTile = TileComparison::kTileSize;
+    static_assert(kTile == RasterRenderer::kTileSize, "the raster's tiles are the comparison's");
+    CheckResult run;
+    Timings& timings = run.report.timings;
+    const auto start = Clock::now();
+    const RasterFrame frame = raster_.prepare(camera, options.faults.raster);
+    const double setUpMs = millisecondsSince(start);
+    const int W = camera.width(), H = camera.height(), tilesX = (W + kTile - 1) / kTile;
+
+    struct Worker {
+        double ray[kTile * kTile], raster[kTile * kTile];
+        std::uint32_t rayPrimitive[kTile * kTile], rasterPrimitive[kTile * kTile];
+        double traceMs = 0, rasterMs = 0, compareMs = 0;
+    };
+    tbb::enumerable_thread_specific<std::unique_ptr<Worker>> workers([] { return std::make_unique<Worker>(); });
+    std::optional<ComparisonReport> report;
+    const auto passStart = Clock::now();
+    TileComparison tiles(scene_, camera, options.tolerance, nullptr);
+    tbb::parallel_for(0, tiles.tileCount(), [&](int tile) {
+        Worker& w = *workers.local();
+        const int col0 = (tile % tilesX) * kTile, row0 = (tile / tilesX) * kTile;
+        const auto t0 = Clock::now();
+        rays_.traceRect(camera, col0, row0, std::min(W, col0 + kTile), std::min(H, row0 + kTile), w.ray, w.rayPrimitive,
+                        kTile, options.faults.ray);
+        const auto t1 = Clock::now();
+        frame.drawTile(tile, w.raster, w.rasterPrimitive, kTile);
+        const auto t2 = Clock::now();
+        RoutePixels ray, raster;
+        ray.windowDepth = w.ray, ray.primitive = w.rayPrimitive;
+        raster.windowDepth = w.raster, raster.primitive = w.rasterPrimitive;
+        ray.col0 = raster.col0 = col0, ray.row0 = raster.row0 = row0;
+        ray.stride = raster.stride = kTile;
+        tiles.compareTile(tile, ray, raster);
+        const auto t3 = Clock::now();
+        w.traceMs += std::chrono::duration<double, std::milli>(t1 - t0).count();
+        w.rasterMs += std::chrono::duration<double, std::milli>(t2 - t1).count();
+        w.compareMs += std::chrono::duration<double, std::milli>(t3 - t2).count();
+    });
+    report = tiles.finish();
+    if (!report) throw std::logic_error("comparison: the percentiles' keepers kept too few values");
+    const double passMs = millisecondsSince(passStart);
+    double traceMs = 0, rasterMs = 0, compareMs = 0;
+    for (const auto& w : workers) traceMs += w->traceMs, rasterMs += w->rasterMs, compareMs += w->compareMs;
+    const double busyMs = std::max(traceMs + rasterMs + compareMs, 1e-9);
+    timings.tileByTile = true;
+    timings.traceMs = passMs * traceMs / busyMs;
+    timings.rasterMs = setUpMs + passMs * rasterMs / busyMs;
+    timings.compareMs = passMs * compareMs / busyMs;
+    timings.bvhBuildMs = rays_.buildMilliseconds();
+    run.comparison.report = std::move(*report);
+    run.report.describeInputs(scene_, camera, options.tolerance);
+    run.report.comparison = run.comparison.report;
+    return run;
+}
+
 CheckResult Checker::check(const Camera& camera, const CheckOptions& options) const
 {
+    if (!options.keepPixels) return checkTileByTile(camera, options);
     CheckResult run;
     run.ray = rays_.render(camera, options.faults.ray);
     run.raster = raster_.render(camera, options.faults.raster);

@@ -93,7 +93,8 @@ nlohmann::json toJson(const CheckReport& report)
          {{"bvh_build", report.timings.bvhBuildMs},
           {"trace", report.timings.traceMs},
           {"raster", report.timings.rasterMs},
-          {"compare", report.timings.compareMs}}},
+          {"compare", report.timings.compareMs},
+          {"tile_by_tile", report.timings.tileByTile}}},
         {"consistent", c.consistent()},
     };
 }
@@ -174,9 +175,9 @@ std::string formatSummary(const CheckReport& report, const std::string& comparin
                       static_cast<long long>(c.lostAtClearValue), toString(cam.depth.format).c_str());
         out << line;
     }
-    std::snprintf(line, sizeof line, "\ntimings    BVH build %.1f ms, trace %.1f ms, raster %.1f ms, compare %.1f ms\n",
+    std::snprintf(line, sizeof line, "\ntimings    BVH build %.1f ms, trace %.1f ms, raster %.1f ms, compare %.1f ms%s\n",
                   report.timings.bvhBuildMs, report.timings.traceMs, report.timings.rasterMs,
-                  report.timings.compareMs);
+                  report.timings.compareMs, report.timings.tileByTile ? " (tile by tile, interleaved)" : "");
     out << line;
     out << "verdict    " << (c.consistent() ? "CONSISTENT" : "INCONSISTENT") << "\n";
     return out.str();
