@@ -121,7 +121,7 @@ TEST_CASE("verify refuses a map whose size is not the camera's", "[checker]")
     REQUIRE_THROWS_WITH(checker.verify(camera, map), Catch::Contains("10x10") && Catch::Contains("160x120"));
 }
 
-// The comparison runs in fixed blocks of rows merged in scan order; its report must not
+// The comparison runs in fixed 64×64 tiles merged in tile order; its report must not
 // depend on the thread count, and its statistics must equal the ones computed the plain way.
 TEST_CASE("the comparison's report is the same for 1 and 2 threads, and its p99 is the sorted one", "[checker][threads]")
 {
@@ -223,7 +223,7 @@ TEST_CASE("the 99th percentile from the largest values kept is the sorted one, i
             for (const int parts : {1, 3}) {
                 const std::size_t keep = std::size_t(n) / 100 + 2;  // n is the most the keepers see
                 std::vector<LargestValues> keepers(static_cast<std::size_t>(parts), LargestValues(keep));
-                // Contiguous runs per keeper, as threads take blocks of rows.
+                // Contiguous runs per keeper, as threads take runs of tiles.
                 for (std::size_t k = 0; k < order.size(); ++k) keepers[k * std::size_t(parts) / order.size()].add(order[k]);
                 std::vector<const LargestValues*> all;
                 for (const LargestValues& keeper : keepers) all.push_back(&keeper);

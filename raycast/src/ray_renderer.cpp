@@ -148,7 +148,7 @@ RenderResult RayRenderer::render(const Camera& camera, const RayFaults& fault, E
     const int W = camera.width(), H = camera.height();
     RenderResult result = RenderResult::cleared(W, H, camera.clearDepth());
     if (eyePoints == EyePoints::Keep) assignLarge(result.pEye, std::size_t(W) * H, glm::dvec3(NAN));
-    // Regions of 8×8 tiles in parallel (a region's set-up, the camera's rays, is made once).
+    // 64×64 regions in parallel (a region's set-up, the camera's rays, is made once).
     const int regionsX = (W + kRegion - 1) / kRegion, regionsY = (H + kRegion - 1) / kRegion;
     tbb::parallel_for(0, regionsX * regionsY, [&](int region) {
         const int col0 = (region % regionsX) * kRegion, row0 = (region / regionsX) * kRegion;

@@ -12,7 +12,9 @@
 //
 // check() draws the scene through the camera by both routes — the ray route follows the
 // camera's definition (camera_rays.h), the raster route its matrices — and compares them per
-// pixel with the tolerance model (compare.h). verify() and diagnose() judge a depth map
+// pixel with the tolerance model (compare.h); asked to keep no per-pixel result
+// (CheckOptions::keepPixels), it does so 64×64 tile by tile, each tile traced, drawn and
+// compared while in the cache, for the same report. verify() and diagnose() judge a depth map
 // rendered elsewhere against the ray route (verify.h).
 //
 // Thread-safety: a Checker is immutable after construction; every member function is const
