@@ -41,6 +41,7 @@ struct PyReport {
     bool verify = false;
     std::string json;     // exactly what `zcheck check --json` / `zcheck verify --json` prints
     std::string summary;  // exactly what they print without --json
+    bool pixelsKept = true;  // Checker.check(..., keep_pixels=False) keeps none: the arrays refuse
     std::vector<std::uint8_t> pixelClass;
     std::vector<float> errorOverTolerance;
     std::vector<double> rayWindowDepth, comparedWindowDepth;

@@ -40,6 +40,16 @@ using namespace zcheck::python;
 
 namespace {
 
+// A Report's per-pixel array; refused for a check made with keep_pixels=False.
+template <class T>
+const std::vector<T>& pixelsOf(const PyReport& r, const std::vector<T>& values)
+{
+    if (!r.pixelsKept)
+        fail("this report keeps no per-pixel arrays: it was made with keep_pixels=False "
+             "(check again with keep_pixels=True for pixel_classes, error_over_tolerance and the depths)");
+    return values;
+}
+
 
 // ---------------------------------------------------------------------------------------------
 // numpy helpers
@@ -811,22 +821,22 @@ verdict, and per-pixel images. to_dict() is the document `zcheck check --json` (
             "Wall times in milliseconds: bvh_build, trace, raster, compare.")
         .def_property_readonly(
             "pixel_classes",
-            [](const PyReport& r) { return image(r.pixelClass, r.report.comparison.width, r.report.comparison.height); },
+            [](const PyReport& r) { return image(pixelsOf(r, r.pixelClass), r.report.comparison.width, r.report.comparison.height); },
             "(H, W) uint8: each pixel's class, an index into zcheck.pixel_classes (row 0 at the top).")
         .def_property_readonly(
             "error_over_tolerance",
             [](const PyReport& r) {
-                return image(r.errorOverTolerance, r.report.comparison.width, r.report.comparison.height);
+                return image(pixelsOf(r, r.errorOverTolerance), r.report.comparison.width, r.report.comparison.height);
             },
             "(H, W) float32: |d_compared - d_ray| / tolerance where both hit, 0 elsewhere.")
         .def_property_readonly(
             "ray_window_depth",
-            [](const PyReport& r) { return image(r.rayWindowDepth, r.report.comparison.width, r.report.comparison.height); },
+            [](const PyReport& r) { return image(pixelsOf(r, r.rayWindowDepth), r.report.comparison.width, r.report.comparison.height); },
             "(H, W) float64: the ray route's exact window depth (the clear value where it misses).")
         .def_property_readonly(
             "compared_window_depth",
             [](const PyReport& r) {
-                return image(r.comparedWindowDepth, r.report.comparison.width, r.report.comparison.height);
+                return image(pixelsOf(r, r.comparedWindowDepth), r.report.comparison.width, r.report.comparison.height);
             },
             "(H, W) float64: the other side's window depth: the raster route's stored values (check) or the "
             "verified map as window depth (verify); the clear value where it misses.")
@@ -866,25 +876,32 @@ called from several Python threads at once.)doc")
         .def_property_readonly("scene", &Checker::scene, py::return_value_policy::reference_internal)
         .def(
             "check",
-            [](const Checker& checker, std::optional<Camera> camera, std::optional<int> threads) {
+            [](const Checker& checker, std::optional<Camera> camera, std::optional<int> threads, bool keepPixels) {
                 auto r = std::make_unique<PyReport>();
                 {
                     py::gil_scoped_release release;
                     const auto limit = threadLimit(threads);
                     const Camera cam = camera ? *camera : Camera(checker.scene().defaultCamera);
-                    const CheckResult run = checker.check(cam);
+                    CheckOptions options;
+                    options.keepPixels = keepPixels;
+                    const CheckResult run = checker.check(cam, options);
                     requireSomethingCompared(run.report.comparison, checker.scene().name);
                     r->report = run.report;
                     r->json = checkReportJson(run.report);
                     r->summary = formatSummary(run.report);
-                    fillComparison(*r, run.comparison, run.ray, run.raster);
+                    r->pixelsKept = keepPixels;
+                    if (keepPixels) fillComparison(*r, run.comparison, run.ray, run.raster);
                 }
                 return r;
             },
-            py::arg("camera") = py::none(), py::arg("threads") = py::none(),
+            py::arg("camera") = py::none(), py::arg("threads") = py::none(), py::arg("keep_pixels") = true,
             R"doc(Both routes through `camera` (default: the scene's own camera), compared per pixel: what
 `zcheck check` does. Returns a Report. Raises zcheck.Error "nothing to compare" when neither route
-sees any surface, as the command does. threads: at most this many worker threads (1..1024).)doc")
+sees any surface, as the command does. threads: at most this many worker threads (1..1024).
+keep_pixels=False: the check is drawn, traced and compared tile by tile and keeps no per-pixel
+array (the same report, faster, ~60 MB less memory at 1080p: for checking many cameras); the
+Report's pixel_classes, error_over_tolerance, ray_window_depth and compared_window_depth then
+raise zcheck.Error.)doc")
         .def(
             "render",
             [](const Checker& checker, const Camera& camera, const std::string& quantityName, const std::string& routeName,

@@ -89,6 +89,22 @@ def test_report_images(default_checker, small_camera):
     assert np.allclose(report.compared_window_depth[agree], ray[agree], rtol=0, atol=1e-5)
 
 
+def test_check_without_pixels_reports_the_same_and_refuses_the_arrays(default_checker, small_camera):
+    """keep_pixels=False: tile by tile, as `zcheck check` without --out; the same report."""
+    kept = default_checker.check(small_camera)
+    tiled = default_checker.check(small_camera, keep_pixels=False)
+    assert_documents_equal(without_timings(tiled.to_dict()), without_timings(kept.to_dict()), rel=0)
+    assert tiled.to_dict()["timings_ms"]["tile_by_tile"] is True
+    assert kept.to_dict()["timings_ms"]["tile_by_tile"] is False
+    for name in ("pixel_classes", "error_over_tolerance", "ray_window_depth", "compared_window_depth"):
+        with pytest.raises(zcheck.Error, match="keep_pixels=False"):
+            getattr(tiled, name)
+    # and the command, which checks tile by tile without --out, prints that same report
+    _, out, _ = run_cli("check", "--json", check_rc=0)
+    assert_documents_equal(without_timings(json.loads(out)),
+                           without_timings(default_checker.check(keep_pixels=False).to_dict()), rel=0)
+
+
 def test_nothing_to_compare_is_refused_like_the_cli(default_checker, tmp_path):
     camera = {"image": {"width": W, "height": H},
               "projection": {"type": "perspective", "fovy_deg": 40, "near": 0.1, "far": 100},
