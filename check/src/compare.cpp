@@ -257,6 +257,37 @@ struct StatisticCounts {
     LargestValues errorQuanta, relativeEyeZ;
 };
 
+// What the comparison measures at pixel (col, row), entry a of the ray's arrays and b of the
+// raster's: in one place for the comparison and for the sample its keepers' floors come from.
+struct PixelMeasures {
+    explicit PixelMeasures(const Camera& c) : camera(c), cameraRays(c), format(c.depth().format) {}
+
+    // The storage quantum q.
+    double quantum(const RoutePixels& ray, const RoutePixels& raster, std::size_t a, std::size_t b) const
+    {
+        return raster.quantum ? raster.quantum[b] : storageQuantum(format, ray.windowDepth[a]);
+    }
+    // (d_raster − d_ray)/q, of which the statistics take the absolute value.
+    static double signedErrorQuanta(const RoutePixels& ray, const RoutePixels& raster, std::size_t a, std::size_t b, double q)
+    {
+        return (raster.windowDepth[b] - ray.windowDepth[a]) / q;
+    }
+    // The relative eye-z error of a pixel compared on depth.
+    double relativeEyeZError(const RoutePixels& ray, const RoutePixels& raster, std::size_t a, std::size_t b, int col,
+                             int row) const
+    {
+        const glm::dvec2 pImage(col + 0.5, row + 0.5);
+        const double rayDepth = ray.windowDepth[a], rasterDepth = raster.windowDepth[b];
+        if (!ray.pEye) return cameraRays.relativeEyeZDifference(pImage, rayDepth, rasterDepth);
+        const double eyeZ = camera.eyeZOf(ray.pEye[a]);
+        return std::abs(cameraRays.eyeZFromWindowDepth(pImage, rasterDepth) - eyeZ) / std::abs(eyeZ);
+    }
+
+    const Camera& camera;
+    const CameraRays cameraRays;  // eye-z of a window depth in closed form
+    const DepthFormat format;
+};
+
 }  // namespace
 
 RoutePixels RoutePixels::of(const RenderResult& render)
@@ -275,8 +306,7 @@ struct TileComparison::Impl {
         : camera(camera),
           perPixel(perPixel),
           judge(scene, camera, tolerance),
-          cameraRays(camera),
-          format(camera.depth().format),
+          measures(camera),
           S(tolerance.snapPixels()),
           W(camera.width()),
           H(camera.height()),
@@ -294,8 +324,7 @@ struct TileComparison::Impl {
     const Camera& camera;
     Comparison* perPixel;
     const PixelJudge judge;
-    const CameraRays cameraRays;  // eye-z of a window depth in closed form
-    const DepthFormat format;
+    const PixelMeasures measures;
     const double S;
     const int W, H, tilesX;
     std::vector<TileTally> tiles;
@@ -311,20 +340,9 @@ void TileComparison::Impl::compare(int tile, const RoutePixels& ray, const Route
     const int col1 = std::min(W, col0 + kTileSize), row1 = std::min(H, row0 + kTileSize);
 
     // Pixel (col, row): a in the ray's arrays, b in the raster's, i in the image.
-    auto quantumAt = [&](std::size_t a, std::size_t b) {
-        return raster.quantum ? raster.quantum[b] : storageQuantum(format, ray.windowDepth[a]);
-    };
-    // (d_raster − d_ray)/q, of which the statistics take the absolute value.
+    auto quantumAt = [&](std::size_t a, std::size_t b) { return measures.quantum(ray, raster, a, b); };
     auto signedErrorQuantaAt = [&](std::size_t a, std::size_t b, double q) {
-        return (raster.windowDepth[b] - ray.windowDepth[a]) / q;
-    };
-    // The relative eye-z error of a pixel compared on depth.
-    auto relativeEyeZErrorAt = [&](std::size_t a, std::size_t b, int col, int row) {
-        const glm::dvec2 pImage(col + 0.5, row + 0.5);
-        const double rayDepth = ray.windowDepth[a], rasterDepth = raster.windowDepth[b];
-        if (!ray.pEye) return cameraRays.relativeEyeZDifference(pImage, rayDepth, rasterDepth);
-        const double eyeZ = camera.eyeZOf(ray.pEye[a]);
-        return std::abs(cameraRays.eyeZFromWindowDepth(pImage, rasterDepth) - eyeZ) / std::abs(eyeZ);
+        return PixelMeasures::signedErrorQuanta(ray, raster, a, b, q);
     };
     // |Δ| / tolerance, as the report and the heatmap give it.
     auto ratioOf = [](double error, double bound) { return bound > 0 ? error / bound : (error > 0 ? INFINITY : 0.0); };
@@ -334,7 +352,7 @@ void TileComparison::Impl::compare(int tile, const RoutePixels& ray, const Route
                             double errorQuanta) {
         agree ? ++r.agree : ++r.depthErrors;
         if (perPixel) perPixel->errorOverTolerance[i] = static_cast<float>(ratio);
-        const double relative = relativeEyeZErrorAt(a, b, col, row);
+        const double relative = measures.relativeEyeZError(ray, raster, a, b, col, row);
         counts.errorQuanta.add(float(errorQuanta));
         counts.relativeEyeZ.add(float(relative));
         r.maxRelativeEyeZError = std::max(r.maxRelativeEyeZError, relative);
@@ -491,16 +509,15 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
     // 97th percentile lie below the 99th of all with overwhelming probability, and a keeper then
     // holds ~3 % of its values instead of rebuilding its running largest as values grow down the
     // image. A floor too high is found out at the end, and the comparison run again without.
-    const CameraRays cameraRays(camera);
+    const PixelMeasures measures(camera);
     std::vector<float> errorQuantaSample, relativeEyeZSample;
     for (int row = 0; row < H; row += 32)
         for (int col = 0; col < W; ++col) {
             const std::size_t i = std::size_t(row) * W + col;
             if (!ray.hit(i) || ray.primitiveId[i] != raster.primitiveId[i]) continue;
-            const double q = rasterQuantum ? (*rasterQuantum)[i] : storageQuantum(camera.depth().format, ray.windowDepth.value[i]);
-            errorQuantaSample.push_back(float(std::abs((raster.windowDepth.value[i] - ray.windowDepth.value[i]) / q)));
-            relativeEyeZSample.push_back(float(
-                cameraRays.relativeEyeZDifference({col + 0.5, row + 0.5}, ray.windowDepth.value[i], raster.windowDepth.value[i])));
+            const double q = measures.quantum(rayPixels, rasterPixels, i, i);
+            errorQuantaSample.push_back(float(std::abs(PixelMeasures::signedErrorQuanta(rayPixels, rasterPixels, i, i, q))));
+            relativeEyeZSample.push_back(float(measures.relativeEyeZError(rayPixels, rasterPixels, i, i, col, row)));
         }
     const float errorQuantaFloor = LargestValues::floorBelowPercentile99(errorQuantaSample);
     const float relativeEyeZFloor = LargestValues::floorBelowPercentile99(relativeEyeZSample);

@@ -60,8 +60,7 @@ private:
     unsigned saved_;
 };
 
-constexpr int kTile = 8;         // 8×8 pixels per tile
-constexpr int kRegion = 8 * kTile;  // render() traces 64×64 regions in parallel
+constexpr int kRegion = 64;      // render() traces 64×64 regions in parallel
 constexpr int kPacketSide = 4;   // a packet covers 4×4 pixels (rtcIntersect16)
 constexpr int kPacketRays = kPacketSide * kPacketSide;
 

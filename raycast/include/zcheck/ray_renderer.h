@@ -54,7 +54,8 @@ public:
     // The pixels [col0, col1) × [row0, row1) of render(camera, faults), each one written
     // (a miss: the clear value and kNoPrimitive, pEye NaN): pixel (col, row) to entry
     // (row − row0)·stride + (col − col0) of windowDepth, primitiveId and, when given, pEye.
-    // col0 and row0 must be multiples of 8 (render's tiles), the rectangle inside the image.
+    // col0 and row0 must be multiples of 4, so that its 4×4 packets are render()'s (whose
+    // regions start at multiples of 64), and the rectangle must lie inside the image.
     // For a check that compares tile by tile.
     void traceRect(const Camera& camera, int col0, int row0, int col1, int row1, double* windowDepth,
                    std::uint32_t* primitiveId, std::size_t stride, const RayFaults& faults = {},
