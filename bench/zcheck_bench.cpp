@@ -6,6 +6,7 @@
 #include "zcheck/camera_file.h"
 #include "zcheck/checker.h"
 
+#include "zcheck/embree_reference.h"
 #include "zcheck/error.h"
 #include "zcheck/mesh_loader.h"
 
@@ -57,6 +58,14 @@ void runPhase(const std::string& phase, const Scene& scene, const Camera& camera
             return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
         });
         std::printf("check tile by tile %7.1f ms (best %7.1f) | peak RSS %6.0f MiB\n", ms.median, ms.best, peakResidentMiB());
+        return;
+    }
+    if (phase == "embree") {  // the yardstick of the trace: Embree's own best packet trace
+        const reference::EmbreeReference embree(scene);
+        std::vector<std::uint32_t> primitiveId;
+        const Stats ms = timeRepeated(repeats, [&] { return embree.trace(camera, primitiveId); });
+        std::printf("embree trace %7.1f ms (best %7.1f) %6.2f Mrays/s | peak RSS %6.0f MiB\n", ms.median, ms.best,
+                    double(camera.width()) * camera.height() / ms.median / 1e3, peakResidentMiB());
         return;
     }
     const RasterRenderer raster(scene);
@@ -143,8 +152,9 @@ int main(int argc, char** argv)
     app.add_option("--only", only, "run only workloads whose label contains this text");
     app.add_option("--scene", sceneName, "one workload: this scene (a built-in name or a mesh file) instead of the named ones");
     app.add_option("--camera", cameraFile, "with --scene: a camera file (its size overrides --width/--height)");
-    app.add_option("--phase", phase, "all, or one phase alone: raster (no BVH built), trace, compare, or tiles (a check tile by tile)")
-        ->check(CLI::IsMember({"all", "raster", "trace", "compare", "tiles"}))
+    app.add_option("--phase", phase, "all, or one phase alone: raster (no BVH built), trace, compare, tiles (a check tile by tile), "
+                   "or embree (the trace's yardstick: Embree's own best packet trace)")
+        ->check(CLI::IsMember({"all", "raster", "trace", "compare", "tiles", "embree"}))
         ->capture_default_str();
     CLI11_PARSE(app, argc, argv);
 
