@@ -11,6 +11,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <mutex>
 
 namespace zcheck {
@@ -63,6 +64,21 @@ private:
 constexpr int kRegion = 64;      // render() traces 64×64 regions in parallel
 constexpr int kPacketSide = 4;   // a packet covers 4×4 pixels (rtcIntersect16)
 constexpr int kPacketRays = kPacketSide * kPacketSide;
+
+// A packet of rays between its trace and its re-evaluation in double (traceRect keeps three
+// in flight): its rays in double and as Embree traced them, and Embree's hits.
+struct PacketInFlight {
+    int col0, row0;  // the packet's top-left pixel
+    alignas(64) int valid[kPacketRays];
+    alignas(64) RTCRayHit16 packet;
+    alignas(64) double imageX[kPacketRays], imageY[kPacketRays];  // the rays' image points
+    alignas(64) double lane[6][kPacketRays];  // origin x, y, z and direction x, y, z, in double
+
+    glm::dvec2 pImage(int k) const { return {imageX[k], imageY[k]}; }
+    glm::dvec3 origin(int k) const { return {lane[0][k], lane[1][k], lane[2][k]}; }
+    glm::dvec3 direction(int k) const { return {lane[3][k], lane[4][k], lane[5][k]}; }
+    bool hit(int k) const { return valid[k] && packet.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID; }
+};
 
 }  // namespace
 
@@ -174,109 +190,124 @@ void RayRenderer::traceRect(const Camera& camera, int col0, int row0, int col1, 
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-    alignas(64) int valid[kPacketRays];
-    alignas(64) RTCRayHit16 packet;
-    alignas(64) double imageX[kPacketRays], imageY[kPacketRays];  // the rays' image points
-    alignas(64) double lane[6][kPacketRays];  // origin x, y, z and direction x, y, z, in double
-    auto originOf = [&](int k) { return glm::dvec3(lane[0][k], lane[1][k], lane[2][k]); };
-    auto directionOf = [&](int k) { return glm::dvec3(lane[3][k], lane[4][k], lane[5][k]); };
-    auto pImageOf = [&](int k) { return glm::dvec2(imageX[k], imageY[k]); };
 
-    for (int py = row0; py < row1; py += kPacketSide) {
-        for (int px = col0; px < col1; px += kPacketSide) {
-            // Lanes as plain arrays, one quantity at a time, so that the compiler can compute
-            // several lanes per instruction. Every field of every lane is initialised, valid
-            // or not; an invalid lane (outside the rectangle) is a zero-length ray.
-            for (int k = 0; k < kPacketRays; ++k) {
-                const int col = px + k % kPacketSide, row = py + k / kPacketSide;
-                valid[k] = (col < col1 && row < row1) ? -1 : 0;
-                const int sampleRow = fault.flipRows ? H - 1 - row : row;
-                const int sampleCol = fault.flipCols ? W - 1 - col : col;
-                const glm::dvec2 pWindow = windowFromPixelCentre(camera, sampleCol, sampleRow) + fault.shiftPixels;
-                imageX[k] = pWindow.x, imageY[k] = camera.imageYFromWindowY(pWindow.y);
-            }
-            float tNear[kPacketRays], tFar[kPacketRays];
-            if (affine) {  // t is eye-z: the near and far planes lie at t = near and far
-                for (int c = 0; c < 3; ++c) {
-                    const double o = affine->origin[c], oX = affine->originPerX[c], oY = affine->originPerY[c];
-                    const double d = affine->direction[c], dX = affine->directionPerX[c], dY = affine->directionPerY[c];
-                    for (int k = 0; k < kPacketRays; ++k) {
-                        lane[c][k] = o + imageX[k] * oX + imageY[k] * oY;
-                        lane[3 + c][k] = d + imageX[k] * dX + imageY[k] * dY;
-                    }
-                }
-                const float nearT = float(near), farT = std::isinf(far) ? INFINITY : float(far);
-                for (int k = 0; k < kPacketRays; ++k) tNear[k] = nearT, tFar[k] = farT;
-            } else {
+    // Rays made and traced: lanes as plain arrays, one quantity at a time, so that the
+    // compiler can compute several lanes per instruction. Every field of every lane is
+    // initialised, valid or not; an invalid lane (outside the rectangle) is a zero-length ray.
+    auto trace = [&](PacketInFlight& p, int px, int py) {
+        p.col0 = px, p.row0 = py;
+        for (int k = 0; k < kPacketRays; ++k) {
+            const int col = px + k % kPacketSide, row = py + k / kPacketSide;
+            p.valid[k] = (col < col1 && row < row1) ? -1 : 0;
+            const int sampleRow = fault.flipRows ? H - 1 - row : row;
+            const int sampleCol = fault.flipCols ? W - 1 - col : col;
+            const glm::dvec2 pWindow = windowFromPixelCentre(camera, sampleCol, sampleRow) + fault.shiftPixels;
+            p.imageX[k] = pWindow.x, p.imageY[k] = camera.imageYFromWindowY(pWindow.y);
+        }
+        RTCRay16& ray = p.packet.ray;
+        if (affine) {  // t is eye-z: the near and far planes lie at t = near and far
+            for (int c = 0; c < 3; ++c) {
+                const double o = affine->origin[c], oX = affine->originPerX[c], oY = affine->originPerY[c];
+                const double d = affine->direction[c], dX = affine->directionPerX[c], dY = affine->directionPerY[c];
                 for (int k = 0; k < kPacketRays; ++k) {
-                    const EyePlaneRay r = cameraRays.worldRay(pImageOf(k));
-                    for (int c = 0; c < 3; ++c) lane[c][k] = r.origin[c], lane[3 + c][k] = r.direction[c];
-                    tNear[k] = float(r.tNear), tFar[k] = std::isinf(r.tFar) ? INFINITY : float(r.tFar);
+                    p.lane[c][k] = o + p.imageX[k] * oX + p.imageY[k] * oY;
+                    p.lane[3 + c][k] = d + p.imageX[k] * dX + p.imageY[k] * dY;
                 }
             }
+            const float nearT = float(near), farT = std::isinf(far) ? INFINITY : float(far);
+            for (int k = 0; k < kPacketRays; ++k) ray.tnear[k] = nearT, ray.tfar[k] = farT;
+        } else {
             for (int k = 0; k < kPacketRays; ++k) {
-                if (valid[k]) continue;
-                for (int c = 0; c < 3; ++c) lane[c][k] = frameOrigin[c], lane[3 + c][k] = c == 2 ? 1.0 : 0.0;
-                tNear[k] = 0, tFar[k] = 0;
-            }
-            for (int k = 0; k < kPacketRays; ++k) {
-                packet.ray.org_x[k] = float(lane[0][k] - frameOrigin.x);
-                packet.ray.org_y[k] = float(lane[1][k] - frameOrigin.y);
-                packet.ray.org_z[k] = float(lane[2][k] - frameOrigin.z);
-                packet.ray.dir_x[k] = float(lane[3][k]);
-                packet.ray.dir_y[k] = float(lane[4][k]);
-                packet.ray.dir_z[k] = float(lane[5][k]);
-                packet.ray.tnear[k] = tNear[k];
-                packet.ray.tfar[k] = tFar[k];
-                packet.ray.time[k] = 0.0f;
-                packet.ray.mask[k] = 0xFFFFFFFFu;  // Debian's Embree has ray masks on
-                packet.ray.id[k] = unsigned(k);
-                packet.ray.flags[k] = 0;
-                packet.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-                packet.hit.primID[k] = RTC_INVALID_GEOMETRY_ID;
-                packet.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
-            }
-            rtcIntersect16(valid, rtcScene, &context, &packet);
-            // The hit triangles' indices and vertices lie scattered over the scene's arrays:
-            // ask for all of them before using any, so their cache misses overlap.
-            auto hitAt = [&](int k) { return valid[k] && packet.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID; };
-            for (int k = 0; k < kPacketRays; ++k)
-                if (hitAt(k)) __builtin_prefetch(&scene_.triangles[packet.hit.primID[k]]);
-            for (int k = 0; k < kPacketRays; ++k)
-                if (hitAt(k))
-                    for (int corner = 0; corner < 3; ++corner)
-                        __builtin_prefetch(&scene_.positions[scene_.triangles[packet.hit.primID[k]][corner]]);
-            // Neighbouring rays mostly hit the same triangle: its plane is kept.
-            std::uint32_t planeOf = RTC_INVALID_GEOMETRY_ID;
-            glm::dvec3 a(0.0), normal(0.0);
-            for (int k = 0; k < kPacketRays; ++k) {
-                if (!valid[k]) continue;
-                const std::size_t i = std::size_t(py + k / kPacketSide - row0) * stride + std::size_t(px + k % kPacketSide - col0);
-                if (!hitAt(k)) {  // every pixel of the rectangle is written
-                    primitiveId[i] = kNoPrimitive;
-                    windowDepth[i] = clearDepth;
-                    if (pEye) pEye[i] = glm::dvec3(NAN);
-                    continue;
-                }
-                const std::uint32_t primitive = packet.hit.primID[k];
-                if (primitive != planeOf) {
-                    const glm::uvec3& tri = scene_.triangles[primitive];
-                    a = glm::dvec3(scene_.positions[tri[0]]);
-                    normal = glm::cross(glm::dvec3(scene_.positions[tri[1]]) - a, glm::dvec3(scene_.positions[tri[2]]) - a);
-                    planeOf = primitive;
-                }
-                // The hit again, in double: the ray against the hit triangle's plane.
-                const glm::dvec3 origin = originOf(k), direction = directionOf(k);
-                double t = glm::dot(normal, a - origin) / glm::dot(normal, direction);
-                if (!std::isfinite(t)) t = packet.ray.tfar[k];
-                const glm::dvec3 pWorld = origin + t * direction;
-                primitiveId[i] = primitive;
-                if (pEye) pEye[i] = cameraRays.eyeFromWorld(pWorld);
-                // The fault "distance as eye-z" takes the distance along the ray for eye-z.
-                const double eyeZ = fault.distanceAsEyeZ ? t * glm::length(direction) : cameraRays.eyeZ(pWorld);
-                windowDepth[i] = cameraRays.windowDepth(pImageOf(k), eyeZ);
+                const EyePlaneRay r = cameraRays.worldRay(p.pImage(k));
+                for (int c = 0; c < 3; ++c) p.lane[c][k] = r.origin[c], p.lane[3 + c][k] = r.direction[c];
+                ray.tnear[k] = float(r.tNear), ray.tfar[k] = std::isinf(r.tFar) ? INFINITY : float(r.tFar);
             }
         }
+        for (int k = 0; k < kPacketRays; ++k) {
+            if (p.valid[k]) continue;
+            for (int c = 0; c < 3; ++c) p.lane[c][k] = frameOrigin[c], p.lane[3 + c][k] = c == 2 ? 1.0 : 0.0;
+            ray.tnear[k] = 0, ray.tfar[k] = 0;
+        }
+        for (int k = 0; k < kPacketRays; ++k) {
+            ray.org_x[k] = float(p.lane[0][k] - frameOrigin.x);
+            ray.org_y[k] = float(p.lane[1][k] - frameOrigin.y);
+            ray.org_z[k] = float(p.lane[2][k] - frameOrigin.z);
+            ray.dir_x[k] = float(p.lane[3][k]);
+            ray.dir_y[k] = float(p.lane[4][k]);
+            ray.dir_z[k] = float(p.lane[5][k]);
+            ray.time[k] = 0.0f;
+            ray.mask[k] = 0xFFFFFFFFu;  // Debian's Embree has ray masks on
+            ray.id[k] = unsigned(k);
+            ray.flags[k] = 0;
+            p.packet.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+            p.packet.hit.primID[k] = RTC_INVALID_GEOMETRY_ID;
+            p.packet.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+        }
+        rtcIntersect16(p.valid, rtcScene, &context, &p.packet);
+        for (int k = 0; k < kPacketRays; ++k)
+            if (p.hit(k)) __builtin_prefetch(&scene_.triangles[p.packet.hit.primID[k]]);
+    };
+    // The hit triangles' vertices asked for (their indices were asked for one packet earlier).
+    auto fetchVertices = [&](const PacketInFlight& p) {
+        for (int k = 0; k < kPacketRays; ++k)
+            if (p.hit(k))
+                for (int corner = 0; corner < 3; ++corner)
+                    __builtin_prefetch(&scene_.positions[scene_.triangles[p.packet.hit.primID[k]][corner]]);
+    };
+    // Each hit again, in double: the ray against the hit triangle's plane; then the pixels written.
+    auto finish = [&](const PacketInFlight& p) {
+        // The planes, lane by lane (neighbouring rays mostly hit the same triangle: its
+        // plane is kept); a miss keeps whatever plane came before, its result is not used.
+        alignas(64) double plane[6][kPacketRays];  // a vertex x, y, z and the normal x, y, z
+        std::uint32_t planeOf = RTC_INVALID_GEOMETRY_ID;
+        glm::dvec3 a(0.0), normal(0.0);
+        for (int k = 0; k < kPacketRays; ++k) {
+            if (p.hit(k) && p.packet.hit.primID[k] != planeOf) {
+                planeOf = p.packet.hit.primID[k];
+                const glm::uvec3& tri = scene_.triangles[planeOf];
+                a = glm::dvec3(scene_.positions[tri[0]]);
+                normal = glm::cross(glm::dvec3(scene_.positions[tri[1]]) - a, glm::dvec3(scene_.positions[tri[2]]) - a);
+            }
+            for (int c = 0; c < 3; ++c) plane[c][k] = a[c], plane[3 + c][k] = normal[c];
+        }
+        // Lane by lane in plain arrays (several lanes per instruction): the ray parameter t
+        // of the hit (Embree's, where the plane gives none), its eye-z and window depth.
+        alignas(64) double tEmbree[kPacketRays], t[kPacketRays], eyeZ[kPacketRays], depth[kPacketRays];
+        for (int k = 0; k < kPacketRays; ++k) tEmbree[k] = p.packet.ray.tfar[k];  // apart: the loop below stays SIMD
+        for (int k = 0; k < kPacketRays; ++k) {
+            const glm::dvec3 vertex(plane[0][k], plane[1][k], plane[2][k]), n(plane[3][k], plane[4][k], plane[5][k]);
+            const double tPlane = glm::dot(n, vertex - p.origin(k)) / glm::dot(n, p.direction(k));
+            t[k] = std::abs(tPlane) <= std::numeric_limits<double>::max() ? tPlane : tEmbree[k];  // isfinite, branch-free
+        }
+        if (fault.distanceAsEyeZ) {  // the fault "distance as eye-z": the distance along the ray for eye-z
+            for (int k = 0; k < kPacketRays; ++k) eyeZ[k] = t[k] * glm::length(p.direction(k));
+        } else {
+            for (int k = 0; k < kPacketRays; ++k) eyeZ[k] = cameraRays.eyeZ(p.origin(k) + t[k] * p.direction(k));
+        }
+        cameraRays.windowDepths(p.imageX, p.imageY, eyeZ, depth, kPacketRays);
+        for (int k = 0; k < kPacketRays; ++k) {
+            if (!p.valid[k]) continue;
+            const std::size_t i = std::size_t(p.row0 + k / kPacketSide - row0) * stride + std::size_t(p.col0 + k % kPacketSide - col0);
+            const bool hit = p.hit(k);
+            primitiveId[i] = hit ? p.packet.hit.primID[k] : kNoPrimitive;
+            windowDepth[i] = hit ? depth[k] : clearDepth;
+            if (pEye) pEye[i] = hit ? cameraRays.eyeFromWorld(p.origin(k) + t[k] * p.direction(k)) : glm::dvec3(NAN);
+        }
+    };
+
+    // Packets row by row over the rectangle, three in flight: packet i is traced and its hit
+    // triangles' indices asked for; while packet i + 1 is traced they arrive, and its
+    // vertices are asked for; while packet i + 2 is traced those arrive, and packet i is
+    // finished. (Finishing each packet straight after its trace waited on those reads.)
+    constexpr int kInFlight = 3;
+    PacketInFlight inFlight[kInFlight];
+    const int packetsX = (col1 - col0 + kPacketSide - 1) / kPacketSide;
+    const int packets = packetsX * ((row1 - row0 + kPacketSide - 1) / kPacketSide);
+    for (int i = 0; i < packets + kInFlight - 1; ++i) {
+        if (i < packets)
+            trace(inFlight[i % kInFlight], col0 + (i % packetsX) * kPacketSide, row0 + (i / packetsX) * kPacketSide);
+        if (i >= 1 && i - 1 < packets) fetchVertices(inFlight[(i - 1) % kInFlight]);
+        if (i >= 2) finish(inFlight[(i - 2) % kInFlight]);
     }
 }
 
