@@ -6,6 +6,7 @@
 #include "zcheck/clip.h"
 #include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
+#include "zcheck/tile_grid.h"
 
 #include "matrix_assert.h"
 
@@ -16,6 +17,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <random>
+#include <vector>
 
 using namespace zcheck;
 
@@ -471,4 +473,42 @@ TEST_CASE("regression: prettyJson rewrote number lists inside strings", "[json]"
     REQUIRE(text.find("[3,4]") != std::string::npos);
     REQUIRE(text.find("[1, 2.5, -3]") != std::string::npos);  // numbers still fold onto one line
     REQUIRE(nlohmann::json::parse(text) == document);
+}
+
+TEST_CASE("a tile grid cuts the image into row-major tiles, the last ones cut by its edges", "[core][tiles]")
+{
+    // 203×131 pixels in 64-pixel tiles: 4 columns (64, 64, 64, 11 wide), 3 rows (64, 64, 3 high).
+    const zcheck::TileGrid grid(203, 131, 64);
+    CHECK(grid.tilesX() == 4);
+    CHECK(grid.tilesY() == 3);
+    CHECK(grid.count() == 12);
+    auto same = [](const zcheck::PixelRect& r, int col0, int row0, int col1, int row1) {
+        return r.col0 == col0 && r.row0 == row0 && r.col1 == col1 && r.row1 == row1;
+    };
+    CHECK(same(grid.rect(0), 0, 0, 64, 64));
+    CHECK(same(grid.rect(3), 192, 0, 203, 64));
+    CHECK(same(grid.rect(5), 64, 64, 128, 128));
+    CHECK(same(grid.rect(11), 192, 128, 203, 131));
+    CHECK(grid.rect(11).width() == 11);
+    CHECK(grid.rect(11).height() == 3);
+    CHECK(grid.firstPixel(5) == 64u * 203u + 64u);
+    CHECK(grid.firstPixel(11) == 128u * 203u + 192u);
+
+    // Every pixel lies in exactly one tile: tile (col / 64) + 4·(row / 64).
+    std::vector<int> owner(203 * 131, -1);
+    for (int tile = 0; tile < grid.count(); ++tile) {
+        const zcheck::PixelRect r = grid.rect(tile);
+        for (int row = r.row0; row < r.row1; ++row)
+            for (int col = r.col0; col < r.col1; ++col) {
+                REQUIRE(owner[std::size_t(row) * 203 + col] == -1);
+                owner[std::size_t(row) * 203 + col] = tile;
+            }
+    }
+    for (int row = 0; row < 131; ++row)
+        for (int col = 0; col < 203; ++col) REQUIRE(owner[std::size_t(row) * 203 + col] == col / 64 + 4 * (row / 64));
+
+    // An image smaller than one tile is one tile.
+    const zcheck::TileGrid small(5, 3, 64);
+    CHECK(small.count() == 1);
+    CHECK(same(small.rect(0), 0, 0, 5, 3));
 }

@@ -55,7 +55,6 @@ CheckResult Checker::checkTileByTile(const Camera& camera, const CheckOptions& o
     const auto start = Clock::now();
     const RasterFrame frame = raster_.prepare(camera, options.faults.raster);
     const double setUpMs = millisecondsSince(start);
-    const int W = camera.width(), H = camera.height(), tilesX = (W + kTile - 1) / kTile;
 
     struct Worker {
         double ray[kTile * kTile], raster[kTile * kTile];
@@ -65,19 +64,18 @@ CheckResult Checker::checkTileByTile(const Camera& camera, const CheckOptions& o
     tbb::enumerable_thread_specific<std::unique_ptr<Worker>> workers([] { return std::make_unique<Worker>(); });
     const auto passStart = Clock::now();
     TileComparison tiles(scene_, camera, options.tolerance, nullptr);
-    tbb::parallel_for(0, tiles.tileCount(), [&](int tile) {
+    tbb::parallel_for(0, tiles.tiles().count(), [&](int tile) {
         Worker& w = *workers.local();
-        const int col0 = (tile % tilesX) * kTile, row0 = (tile / tilesX) * kTile;
+        const PixelRect rect = tiles.tiles().rect(tile);
         const auto t0 = Clock::now();
-        rays_.traceRect(camera, col0, row0, std::min(W, col0 + kTile), std::min(H, row0 + kTile), w.ray, w.rayPrimitive,
-                        kTile, options.faults.ray);
+        rays_.traceRect(camera, rect, w.ray, w.rayPrimitive, kTile, options.faults.ray);
         const auto t1 = Clock::now();
         frame.drawTile(tile, w.raster, w.rasterPrimitive, kTile);
         const auto t2 = Clock::now();
         RoutePixels ray, raster;
         ray.windowDepth = w.ray, ray.primitive = w.rayPrimitive;
         raster.windowDepth = w.raster, raster.primitive = w.rasterPrimitive;
-        ray.col0 = raster.col0 = col0, ray.row0 = raster.row0 = row0;
+        ray.col0 = raster.col0 = rect.col0, ray.row0 = raster.row0 = rect.row0;
         ray.stride = raster.stride = kTile;
         tiles.compareTile(tile, ray, raster);
         const auto t3 = Clock::now();

@@ -310,8 +310,8 @@ struct TileComparison::Impl {
           S(tolerance.snapPixels()),
           W(camera.width()),
           H(camera.height()),
-          tilesX((W + kTileSize - 1) / kTileSize),
-          tiles(std::size_t(tilesX) * std::size_t((H + kTileSize - 1) / kTileSize)),
+          grid(W, H, kTileSize),
+          tallies(std::size_t(grid.count())),
           statisticCounts([keep = std::size_t(W) * std::size_t(H) / 100 + 2, errorQuantaFloor, relativeEyeZFloor] {
               // keep ≥ n/100 + 1 for any n ≤ W·H
               return StatisticCounts{LargestValues(keep, errorQuantaFloor), LargestValues(keep, relativeEyeZFloor)};
@@ -326,18 +326,19 @@ struct TileComparison::Impl {
     const PixelJudge judge;
     const PixelMeasures measures;
     const double S;
-    const int W, H, tilesX;
-    std::vector<TileTally> tiles;
+    const int W, H;
+    const TileGrid grid;
+    std::vector<TileTally> tallies;  // one per tile
     tbb::enumerable_thread_specific<StatisticCounts> statisticCounts;
 };
 
 void TileComparison::Impl::compare(int tile, const RoutePixels& ray, const RoutePixels& raster)
 {
-    TileTally& tally = tiles[std::size_t(tile)];
+    TileTally& tally = tallies[std::size_t(tile)];
     ComparisonReport& r = tally.report;
     StatisticCounts& counts = statisticCounts.local();
-    const int col0 = (tile % tilesX) * kTileSize, row0 = (tile / tilesX) * kTileSize;
-    const int col1 = std::min(W, col0 + kTileSize), row1 = std::min(H, row0 + kTileSize);
+    const PixelRect rect = grid.rect(tile);
+    const int col0 = rect.col0, row0 = rect.row0, col1 = rect.col1, row1 = rect.row1;
 
     // Pixel (col, row): a in the ray's arrays, b in the raster's, i in the image.
     auto quantumAt = [&](std::size_t a, std::size_t b) { return measures.quantum(ray, raster, a, b); };
@@ -462,7 +463,7 @@ TileComparison::TileComparison(const Scene& scene, const Camera& camera, const T
 
 TileComparison::~TileComparison() = default;
 
-int TileComparison::tileCount() const { return int(impl_->tiles.size()); }
+const TileGrid& TileComparison::tiles() const { return impl_->grid; }
 
 void TileComparison::compareTile(int tile, const RoutePixels& ray, const RoutePixels& raster)
 {
@@ -473,7 +474,7 @@ std::optional<ComparisonReport> TileComparison::finish()
 {
     Impl& c = *impl_;
     TileTally total;
-    for (TileTally& tile : c.tiles) merge(total, tile);
+    for (TileTally& tile : c.tallies) merge(total, tile);
     std::vector<const LargestValues*> errorQuantaParts, relativeEyeZParts;
     for (const StatisticCounts& counts : c.statisticCounts) {
         errorQuantaParts.push_back(&counts.errorQuanta);
@@ -526,7 +527,7 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
     for (const bool floors : {true, false}) {
         TileComparison tiles(scene, camera, tolerance, &out, floors ? errorQuantaFloor : 0.0f,
                              floors ? relativeEyeZFloor : 0.0f);
-        tbb::parallel_for(0, tiles.tileCount(), [&](int tile) { tiles.compareTile(tile, rayPixels, rasterPixels); });
+        tbb::parallel_for(0, tiles.tiles().count(), [&](int tile) { tiles.compareTile(tile, rayPixels, rasterPixels); });
         if (std::optional<ComparisonReport> report = tiles.finish()) {
             out.report = std::move(*report);
             return out;

@@ -76,15 +76,15 @@ struct Chunk {
 struct Viewport {
     const Camera& camera;
     const RasterFaults& faults;
-    int width, height, tilesX, tilesY;
+    int width, height;
+    TileGrid tiles;  // kTileSize squares
     ClipPlanes planes;  // near, far, guard band
     glm::dmat4 clipFromWorld, windowFromNdc;
     bool pixelFaults;   // a fault that changes the per-pixel depth computation
 
-    Viewport(const Camera& c, const RasterFaults& f) : camera(c), faults(f), width(c.width()), height(c.height())
+    Viewport(const Camera& c, const RasterFaults& f)
+        : camera(c), faults(f), width(c.width()), height(c.height()), tiles(width, height, RasterRenderer::kTileSize)
     {
-        tilesX = (width + RasterRenderer::kTileSize - 1) / RasterRenderer::kTileSize;
-        tilesY = (height + RasterRenderer::kTileSize - 1) / RasterRenderer::kTileSize;
         const ClipPlanes depthPlanes = depthClipPlanes(c.convention().ndcZMin());
         planes = depthPlanes;
         if (f.noNearClip) planes.size = 0, planes.plane[planes.size++] = depthPlanes.plane[1];  // far only
@@ -217,13 +217,16 @@ struct BinItem {
 
 void binChunk(const Viewport& vp, const std::vector<BinItem>& items, Chunk& chunk)
 {
-    const int tiles = vp.tilesX * vp.tilesY;
-    const int T = RasterRenderer::kTileSize;
+    const int tiles = vp.tiles.count();
     chunk.tileStart.assign(std::size_t(tiles) + 1, 0);
+    // The tiles a box overlaps, per triangle: with the tile side a compile-time constant these
+    // divisions are shifts (dividing by the TileGrid's run-time side made the raster 13 % slower).
+    constexpr int T = RasterRenderer::kTileSize;
+    const int tilesX = vp.tiles.tilesX();
     auto forEachTile = [&](const BinItem& item, auto&& visit) {
         const PixelBox& b = item.box;
         for (int ty = b.minRow / T; ty <= b.maxRow / T; ++ty)
-            for (int tx = b.minCol / T; tx <= b.maxCol / T; ++tx) visit(ty * vp.tilesX + tx);
+            for (int tx = b.minCol / T; tx <= b.maxCol / T; ++tx) visit(ty * tilesX + tx);
     };
     for (const BinItem& item : items) forEachTile(item, [&](int tile) { ++chunk.tileStart[std::size_t(tile) + 1]; });
     for (int tile = 0; tile < tiles; ++tile) chunk.tileStart[tile + 1] += chunk.tileStart[tile];
@@ -387,9 +390,8 @@ void RasterFrame::Impl::prepare()
 // clipping is set up again from its snapped vertices.
 void RasterFrame::Impl::drawTile(int tile, double* windowDepth, std::uint32_t* primitive, std::size_t stride) const
 {
-    constexpr int kTileSize = RasterRenderer::kTileSize;
-    const int col0 = (tile % vp.tilesX) * kTileSize, row0 = (tile / vp.tilesX) * kTileSize;
-    const int col1 = std::min(vp.width, col0 + kTileSize) - 1, row1 = std::min(vp.height, row0 + kTileSize) - 1;
+    const PixelRect rect = vp.tiles.rect(tile);
+    const int col0 = rect.col0, row0 = rect.row0, col1 = rect.col1 - 1, row1 = rect.row1 - 1;  // inclusive
     TriangleSetup t;
     TileBuffer tileBuffer;
     tileBuffer.col0 = col0, tileBuffer.row0 = row0;
@@ -427,7 +429,7 @@ RasterFrame::RasterFrame(const Scene& scene, const Camera& camera, const RasterF
 
 RasterFrame::~RasterFrame() = default;
 
-int RasterFrame::tileCount() const { return impl_->vp.tilesX * impl_->vp.tilesY; }
+const TileGrid& RasterFrame::tiles() const { return impl_->vp.tiles; }
 
 void RasterFrame::drawTile(int tile, double* windowDepth, std::uint32_t* primitive, std::size_t stride) const
 {
@@ -450,10 +452,10 @@ RenderResult RasterRenderer::render(const Camera& camera, const RasterFaults& fa
 {
     const auto start = std::chrono::steady_clock::now();
     const RasterFrame frame = prepare(camera, faults);
-    const int W = camera.width(), H = camera.height(), tilesX = (W + kTileSize - 1) / kTileSize;
+    const int W = camera.width(), H = camera.height();
     RenderResult result = RenderResult::cleared(W, H, camera.clearDepth());
-    tbb::parallel_for(0, frame.tileCount(), [&](int tile) {
-        const std::size_t first = std::size_t(tile / tilesX) * kTileSize * W + std::size_t(tile % tilesX) * kTileSize;
+    tbb::parallel_for(0, frame.tiles().count(), [&](int tile) {
+        const std::size_t first = frame.tiles().firstPixel(tile);
         frame.drawTile(tile, result.windowDepth.value.data() + first, result.primitiveId.data() + first, std::size_t(W));
     });
     result.renderMilliseconds =

@@ -164,21 +164,20 @@ RenderResult RayRenderer::render(const Camera& camera, const RayFaults& fault, E
     RenderResult result = RenderResult::cleared(W, H, camera.clearDepth());
     if (eyePoints == EyePoints::Keep) assignLarge(result.pEye, std::size_t(W) * H, glm::dvec3(NAN));
     // 64×64 regions in parallel (a region's set-up, the camera's rays, is made once).
-    const int regionsX = (W + kRegion - 1) / kRegion, regionsY = (H + kRegion - 1) / kRegion;
-    tbb::parallel_for(0, regionsX * regionsY, [&](int region) {
-        const int col0 = (region % regionsX) * kRegion, row0 = (region / regionsX) * kRegion;
-        const std::size_t first = std::size_t(row0) * W + col0;
-        traceRect(camera, col0, row0, std::min(W, col0 + kRegion), std::min(H, row0 + kRegion),
-                  result.windowDepth.value.data() + first, result.primitiveId.data() + first, std::size_t(W), fault,
-                  eyePoints == EyePoints::Keep ? result.pEye.data() + first : nullptr);
+    const TileGrid regions(W, H, kRegion);
+    tbb::parallel_for(0, regions.count(), [&](int region) {
+        const std::size_t first = regions.firstPixel(region);
+        traceRect(camera, regions.rect(region), result.windowDepth.value.data() + first, result.primitiveId.data() + first,
+                  std::size_t(W), fault, eyePoints == EyePoints::Keep ? result.pEye.data() + first : nullptr);
     });
     result.renderMilliseconds = millisecondsSince(start);
     return result;
 }
 
-void RayRenderer::traceRect(const Camera& camera, int col0, int row0, int col1, int row1, double* windowDepth,
-                            std::uint32_t* primitiveId, std::size_t stride, const RayFaults& fault, glm::dvec3* pEye) const
+void RayRenderer::traceRect(const Camera& camera, const PixelRect& rect, double* windowDepth, std::uint32_t* primitiveId,
+                            std::size_t stride, const RayFaults& fault, glm::dvec3* pEye) const
 {
+    const int col0 = rect.col0, row0 = rect.row0, col1 = rect.col1, row1 = rect.row1;
     const int W = camera.width(), H = camera.height();
     RTCScene rtcScene = embree_->scene.get();
     const CameraRays cameraRays(camera);

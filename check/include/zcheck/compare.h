@@ -37,6 +37,7 @@
 #include "zcheck/camera.h"
 #include "zcheck/render.h"
 #include "zcheck/scene.h"
+#include "zcheck/tile_grid.h"
 
 #include <cstdint>
 #include <memory>
@@ -219,7 +220,7 @@ public:
     TileComparison(const TileComparison&) = delete;
     TileComparison& operator=(const TileComparison&) = delete;
 
-    int tileCount() const;
+    const TileGrid& tiles() const;  // kTileSize squares over the camera's image
     // `ray` and `raster` must cover the tile (they may cover more).
     void compareTile(int tile, const RoutePixels& ray, const RoutePixels& raster);
     std::optional<ComparisonReport> finish();

@@ -23,6 +23,7 @@
 //   const zcheck::RenderResult drawn = raster.render(camera);   // drawn.windowDepth: stored values
 #include "zcheck/render.h"
 #include "zcheck/scene.h"
+#include "zcheck/tile_grid.h"
 
 #include <memory>
 
@@ -53,7 +54,7 @@ public:
     ~RasterFrame();
     RasterFrame(RasterFrame&&) noexcept = default;
 
-    int tileCount() const;
+    const TileGrid& tiles() const;  // kTileSize squares over the camera's image
     // The tile's stored depth values and primitive ids (kNoPrimitive where nothing was drawn)
     // into windowDepth/primitive, which point at the tile's first pixel: pixel (col, row) of
     // the tile goes to entry (row − row0)·stride + (col − col0). Thread-safe (const).

@@ -21,6 +21,7 @@
 // its callback becomes an Error.
 #include "zcheck/render.h"
 #include "zcheck/scene.h"
+#include "zcheck/tile_grid.h"
 
 #include <memory>
 
@@ -53,15 +54,14 @@ public:
     // EyePoints::Keep also fills RenderResult::pEye (24 bytes per pixel more).
     RenderResult render(const Camera& camera, const RayFaults& faults = {}, EyePoints eyePoints = EyePoints::Omit) const;
 
-    // The pixels [col0, col1) × [row0, row1) of render(camera, faults), each one written
-    // (a miss: the clear value and kNoPrimitive, pEye NaN): pixel (col, row) to entry
-    // (row − row0)·stride + (col − col0) of windowDepth, primitiveId and, when given, pEye.
-    // col0 and row0 must be multiples of 4, so that its 4×4 packets are render()'s (whose
-    // regions start at multiples of 64), and the rectangle must lie inside the image.
-    // For a check that compares tile by tile.
-    void traceRect(const Camera& camera, int col0, int row0, int col1, int row1, double* windowDepth,
-                   std::uint32_t* primitiveId, std::size_t stride, const RayFaults& faults = {},
-                   glm::dvec3* pEye = nullptr) const;
+    // The pixels `rect` of render(camera, faults), each one written (a miss: the clear value
+    // and kNoPrimitive, pEye NaN): pixel (col, row) to entry (row − rect.row0)·stride +
+    // (col − rect.col0) of windowDepth, primitiveId and, when given, pEye. rect.col0 and
+    // rect.row0 must be multiples of 4, so that its 4×4 packets are render()'s (whose regions
+    // are 64×64 tiles), and the rectangle must lie inside the image. For a check that
+    // compares tile by tile.
+    void traceRect(const Camera& camera, const PixelRect& rect, double* windowDepth, std::uint32_t* primitiveId,
+                   std::size_t stride, const RayFaults& faults = {}, glm::dvec3* pEye = nullptr) const;
 
     // The triangle the viewing ray through one window point hits first (kNoPrimitive on a
     // miss), traced alone: for questions about single points, not for images.
