@@ -297,7 +297,9 @@ void RayRenderer::traceRect(const Camera& camera, const PixelRect& rect, double*
     // Packets row by row over the rectangle, three in flight: packet i is traced and its hit
     // triangles' indices asked for; while packet i + 1 is traced they arrive, and its
     // vertices are asked for; while packet i + 2 is traced those arrive, and packet i is
-    // finished. (Finishing each packet straight after its trace waited on those reads.)
+    // finished. (Finishing each packet straight after its trace waited on those reads: this
+    // order measured 1-3 % faster for the trace, 3 % for a check tile by tile; the reads are
+    // still most of what the trace spends beyond Embree's own, see README "Speed".)
     constexpr int kInFlight = 3;
     PacketInFlight inFlight[kInFlight];
     const int packetsX = (col1 - col0 + kPacketSide - 1) / kPacketSide;
