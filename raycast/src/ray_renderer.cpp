@@ -270,8 +270,8 @@ void RayRenderer::traceRect(const Camera& camera, const PixelRect& rect, double*
             for (int c = 0; c < 3; ++c) plane[c][k] = a[c], plane[3 + c][k] = normal[c];
         }
         // Lane by lane in plain arrays (several lanes per instruction): the ray parameter t
-        // of the hit (Embree's, where the plane gives none), its eye-z and window depth.
-        alignas(64) double tEmbree[kPacketRays], t[kPacketRays], eyeZ[kPacketRays], depth[kPacketRays];
+        // of the hit (Embree's, where the plane gives none) and its eye-z.
+        alignas(64) double tEmbree[kPacketRays], t[kPacketRays], eyeZ[kPacketRays];
         for (int k = 0; k < kPacketRays; ++k) tEmbree[k] = p.packet.ray.tfar[k];  // apart: the loop below stays SIMD
         for (int k = 0; k < kPacketRays; ++k) {
             const glm::dvec3 vertex(plane[0][k], plane[1][k], plane[2][k]), n(plane[3][k], plane[4][k], plane[5][k]);
@@ -283,13 +283,12 @@ void RayRenderer::traceRect(const Camera& camera, const PixelRect& rect, double*
         } else {
             for (int k = 0; k < kPacketRays; ++k) eyeZ[k] = cameraRays.eyeZ(p.origin(k) + t[k] * p.direction(k));
         }
-        cameraRays.windowDepths(p.imageX, p.imageY, eyeZ, depth, kPacketRays);
         for (int k = 0; k < kPacketRays; ++k) {
             if (!p.valid[k]) continue;
             const std::size_t i = std::size_t(p.row0 + k / kPacketSide - row0) * stride + std::size_t(p.col0 + k % kPacketSide - col0);
             const bool hit = p.hit(k);
             primitiveId[i] = hit ? p.packet.hit.primID[k] : kNoPrimitive;
-            windowDepth[i] = hit ? depth[k] : clearDepth;
+            windowDepth[i] = hit ? cameraRays.windowDepth(p.pImage(k), eyeZ[k]) : clearDepth;
             if (pEye) pEye[i] = hit ? cameraRays.eyeFromWorld(p.origin(k) + t[k] * p.direction(k)) : glm::dvec3(NAN);
         }
     };

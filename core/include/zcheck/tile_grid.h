@@ -30,7 +30,6 @@ public:
     {
     }
 
-    int side() const { return side_; }
     int tilesX() const { return tilesX_; }
     int tilesY() const { return tilesY_; }
     int count() const { return tilesX_ * tilesY_; }

@@ -63,19 +63,8 @@ public:
     // (Inline: the trace and the comparison call these per pixel.)
     double windowDepth(const glm::dvec2& pImage, double eyeZ) const
     {
-        return fromMatrix_ ? matrixWindowDepth(pImage, eyeZ) : closedFormWindowDepth(eyeZ);
-    }
-    // windowDepth of n points at once, depth[k] of ((imageX[k], imageY[k]), eyeZ[k]): the
-    // trace's packets, the model's branch taken once, several points per instruction.
-    void windowDepths(const double* imageX, const double* imageY, const double* eyeZ, double* depth, int n) const
-    {
-        if (fromMatrix_) {
-            for (int k = 0; k < n; ++k) depth[k] = matrixWindowDepth({imageX[k], imageY[k]}, eyeZ[k]);
-        } else if (parallel_) {  // closedFormWindowDepth, its branch taken once
-            for (int k = 0; k < n; ++k) depth[k] = depthA_ + depthB_ * eyeZ[k];
-        } else {
-            for (int k = 0; k < n; ++k) depth[k] = depthA_ + depthB_ / eyeZ[k];
-        }
+        if (fromMatrix_) return matrixWindowDepth(pImage, eyeZ);
+        return depthA_ + (parallel_ ? depthB_ * eyeZ : depthB_ / eyeZ);
     }
     // Its inverse: the eye-z at which the ray through pImage has window depth `windowDepth`.
     double eyeZFromWindowDepth(const glm::dvec2& pImage, double windowDepth) const
@@ -101,7 +90,6 @@ private:
     // A raw-matrix camera's depth mapping, through the inverse-projection module.
     double matrixWindowDepth(const glm::dvec2& pImage, double eyeZ) const;
     double matrixEyeZFromWindowDepth(const glm::dvec2& pImage, double windowDepth) const;
-    double closedFormWindowDepth(double eyeZ) const { return depthA_ + (parallel_ ? depthB_ * eyeZ : depthB_ / eyeZ); }
     // The ray through pImage in OpenGL's eye axes: eye-plane origin and direction (z = −1).
     void eyeRay(const glm::dvec2& pImage, glm::dvec3& origin, glm::dvec3& direction) const;
     glm::dvec3 worldFromEyeVector(const glm::dvec3& v) const { return v.x * right_ + v.y * up_ - v.z * forward_; }
