@@ -37,7 +37,8 @@ TEST_CASE("one Checker used from several threads at once gives each the same ans
     REQUIRE(alone.report.comparison.consistent());
     std::vector<CheckResult> results(4);
     std::vector<VerifyResult> verified(4);
-    DepthMap map{camera.width(), camera.height(), DepthQuantity::Window, alone.raster.windowDepth.value, 0};
+    const LargeVector<double>& drawn = alone.raster.windowDepth.value;
+    DepthMap map{camera.width(), camera.height(), DepthQuantity::Window, {drawn.begin(), drawn.end()}, 0};
     std::vector<std::thread> threads;
     for (std::size_t k = 0; k < results.size(); ++k)
         threads.emplace_back([&, k] {

@@ -6,6 +6,7 @@
 #include "zcheck/clip.h"
 #include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
+#include "zcheck/large_buffer.h"
 #include "zcheck/tile_grid.h"
 
 #include "matrix_assert.h"
@@ -13,8 +14,10 @@
 #include <catch2/catch.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include <algorithm>
 #include <cfenv>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <random>
 #include <vector>
@@ -511,4 +514,30 @@ TEST_CASE("a tile grid cuts the image into row-major tiles, the last ones cut by
     const zcheck::TileGrid small(5, 3, 64);
     CHECK(small.count() == 1);
     CHECK(same(small.rect(0), 0, 0, 5, 3));
+}
+
+TEST_CASE("a LargeVector sits on 2 MiB boundaries and leaves elements made without a value as they were",
+          "[core][large_buffer]")
+{
+    constexpr std::size_t kHugePage = std::size_t(2) << 20;
+    // A 1080p window-depth buffer: on a huge-page boundary, where the advice can take effect.
+    LargeVector<double> depth;
+    depth.resize(1920 * 1080);
+    REQUIRE(reinterpret_cast<std::uintptr_t>(depth.data()) % kHugePage == 0);
+    // resize() default-initialises: within the capacity, elements made again keep what the
+    // memory held (std::vector's value-initialisation would have zeroed them; a renderer
+    // writes every pixel and must not pay for a clear first).
+    std::fill(depth.begin(), depth.end(), 0.25);
+    depth.resize(10);
+    depth.resize(1920 * 1080);
+    REQUIRE(depth.back() == 0.25);
+    REQUIRE(depth[1000] == 0.25);
+    // Values given are values kept; small buffers come from operator new.
+    const LargeVector<std::uint32_t> small(5, 7u);
+    REQUIRE(std::vector<std::uint32_t>(small.begin(), small.end()) == std::vector<std::uint32_t>{7, 7, 7, 7, 7});
+    LargeVector<float> filled;
+    assignLarge(filled, kHugePage, 1.5f);
+    REQUIRE(filled.size() == kHugePage);
+    REQUIRE(reinterpret_cast<std::uintptr_t>(filled.data()) % kHugePage == 0);
+    REQUIRE(std::all_of(filled.begin(), filled.end(), [](float v) { return v == 1.5f; }));
 }

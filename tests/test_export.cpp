@@ -310,7 +310,7 @@ TEST_CASE("exports of the ray and raster routes agree within the tolerance model
                                    quantityImage(f.scene, camera, route, ExportQuantity::PrimitiveId)},
                                   0);
                 const std::vector<double> window = readChannel(path, "window"), id = readChannel(path, "id", true);
-                fromFile[r].windowDepth = {camera.width(), camera.height(), DepthQuantity::Window, window};
+                fromFile[r].windowDepth = {camera.width(), camera.height(), DepthQuantity::Window, {window.begin(), window.end()}};
                 for (double v : id) fromFile[r].primitiveId.push_back(std::uint32_t(v));
             }
             const ComparisonReport report = compareRoutes(f.scene, camera, fromFile[0], fromFile[1]).report;

@@ -24,7 +24,7 @@ QuantityImage quantityImage(const Scene& scene, const Camera& camera, const Rend
     }
     const std::size_t C = image.channels.size();
     if (quantity == ExportQuantity::PrimitiveId) {
-        image.id = route.primitiveId;
+        image.id.assign(route.primitiveId.begin(), route.primitiveId.end());
         return image;
     }
     image.value.assign(pixels * C, image.missValue);

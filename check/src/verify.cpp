@@ -223,9 +223,7 @@ RenderResult renderResultFromMap(const Scene& scene, const Camera& camera, const
                                  std::vector<double>& quantum)
 {
     const int W = camera.width(), H = camera.height();
-    RenderResult out;
-    out.windowDepth = {W, H, DepthQuantity::Window, std::vector<double>(std::size_t(W) * H, camera.clearDepth())};
-    out.primitiveId.assign(std::size_t(W) * H, kNoPrimitive);
+    RenderResult out = RenderResult::cleared(W, H, camera.clearDepth());
     quantum.assign(std::size_t(W) * H, 0.0);
     const MapReader reader(scene, camera, map, truth, neighbours);
     // Rows in parallel: each pixel's choice reads only the truth and the map.

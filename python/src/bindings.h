@@ -43,8 +43,8 @@ struct PyReport {
     std::string summary;  // exactly what they print without --json
     bool pixelsKept = true;  // Checker.check(..., keep_pixels=False) keeps none: the arrays refuse
     std::vector<std::uint8_t> pixelClass;
-    std::vector<float> errorOverTolerance;
-    std::vector<double> rayWindowDepth, comparedWindowDepth;
+    LargeVector<float> errorOverTolerance;
+    LargeVector<double> rayWindowDepth, comparedWindowDepth;
     std::optional<std::vector<Hypothesis>> diagnosis;
 };
 void fillComparison(PyReport& r, const Comparison& c, const RenderResult& ray, const RenderResult& compared);
@@ -52,8 +52,8 @@ void fillComparison(PyReport& r, const Comparison& c, const RenderResult& ray, c
 void fillVerification(PyReport& r, VerifyOutcome verified);
 
 // An (height, width) array of `values` (row 0 at the top).
-template <class T>
-py::array_t<T> image(const std::vector<T>& values, int width, int height)
+template <class T, class Allocator>
+py::array_t<T> image(const std::vector<T, Allocator>& values, int width, int height)
 {
     py::array_t<T> out({py::ssize_t(height), py::ssize_t(width)});
     std::copy(values.begin(), values.end(), out.mutable_data());

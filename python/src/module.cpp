@@ -41,8 +41,8 @@ using namespace zcheck::python;
 namespace {
 
 // A Report's per-pixel array; refused for a check made with keep_pixels=False.
-template <class T>
-const std::vector<T>& pixelsOf(const PyReport& r, const std::vector<T>& values)
+template <class Values>
+const Values& pixelsOf(const PyReport& r, const Values& values)
 {
     if (!r.pixelsKept)
         fail("this report keeps no per-pixel arrays: it was made with keep_pixels=False "

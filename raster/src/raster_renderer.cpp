@@ -337,8 +337,8 @@ struct RasterFrame::Impl {
     const Viewport vp;
     const DepthKeys keys;
     const double clearKey;
-    std::vector<StoredVertex> snapped;  // per vertex, where inside every clip plane
-    std::vector<unsigned char> outcode;
+    LargeVector<StoredVertex> snapped;  // per vertex, set where inside every clip plane (outcode 0)
+    LargeVector<unsigned char> outcode;
     std::vector<Chunk> chunks;
 };
 
@@ -346,8 +346,10 @@ void RasterFrame::Impl::prepare()
 {
     // Vertices to clip space in double, their outcodes, and those inside every clip plane
     // snapped once (a vertex outside one is snapped only where clipping made it).
-    assignLarge(snapped, scene.positions.size(), StoredVertex{});
-    assignLarge(outcode, scene.positions.size(), static_cast<unsigned char>(0));
+    // Uninitialised: the loop below writes every outcode, and every snapped vertex that is
+    // ever read (a triangle's vertices are read only when all three have outcode 0).
+    snapped.resize(scene.positions.size());
+    outcode.resize(scene.positions.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, snapped.size(), 4096), [&](const auto& range) {
         for (std::size_t v = range.begin(); v != range.end(); ++v) {
             const glm::dvec4 pClip = clipOf(std::uint32_t(v));
@@ -453,7 +455,7 @@ RenderResult RasterRenderer::render(const Camera& camera, const RasterFaults& fa
     const auto start = std::chrono::steady_clock::now();
     const RasterFrame frame = prepare(camera, faults);
     const int W = camera.width(), H = camera.height();
-    RenderResult result = RenderResult::cleared(W, H, camera.clearDepth());
+    RenderResult result = RenderResult::allocated(W, H);  // drawTile writes every pixel
     tbb::parallel_for(0, frame.tiles().count(), [&](int tile) {
         const std::size_t first = frame.tiles().firstPixel(tile);
         frame.drawTile(tile, result.windowDepth.value.data() + first, result.primitiveId.data() + first, std::size_t(W));

@@ -344,7 +344,7 @@ std::string suiteReportHtml(const SuiteResult& result, double seconds)
         const Comparison& c = failure.run.comparison;
         QuantityImage depth;
         depth.quantity = ExportQuantity::Window, depth.width = c.report.width, depth.height = c.report.height;
-        depth.channels = {"window"}, depth.value = failure.run.raster.windowDepth.value;
+        depth.channels = {"window"}, depth.value.assign(failure.run.raster.windowDepth.value.begin(), failure.run.raster.windowDepth.value.end());
         depth.missValue = failure.run.raster.windowDepth.value.empty() ? 0 : NAN;
         html << "<div class=\"failure\"><h3>" << htmlEscape(failure.label) << "</h3><p>" << htmlEscape(failure.what)
              << "</p><img title=\"raster depth\" src=\"" << pngDataUri(depth.width, depth.height, previewRgb(depth))

@@ -35,6 +35,7 @@
 //
 // Verdict: consistent ⇔ no unexplained coverage mismatch, no depth error and no bias.
 #include "zcheck/camera.h"
+#include "zcheck/large_buffer.h"
 #include "zcheck/render.h"
 #include "zcheck/scene.h"
 #include "zcheck/tile_grid.h"
@@ -132,8 +133,8 @@ struct ComparisonReport {
 
 struct Comparison {
     ComparisonReport report;
-    std::vector<PixelClass> pixelClass;      // per pixel
-    std::vector<float> errorOverTolerance;   // per pixel: |Δ| / tolerance for both-hit, 0 elsewhere
+    LargeVector<PixelClass> pixelClass;      // per pixel
+    LargeVector<float> errorOverTolerance;   // per pixel: |Δ| / tolerance for both-hit, 0 elsewhere
 };
 
 // Window-depth slope m of a world-space triangle's plane, per pixel (may be +inf for a plane

@@ -8,13 +8,77 @@
 // `madvise` or `always`) cuts the faults 512-fold. Elsewhere the advice is ignored and only
 // the speed differs.
 //
-//   std::vector<double> depth;
+// The advice works only on whole 2 MiB pages: a buffer that std::allocator places on a 4 KiB
+// boundary (glibc's mmap) or in the heap was faulted in 4 KiB at a time after all, 7-30 ms
+// for 16 MiB here against 1.3-1.5 ms on aligned huge pages (the 1080p window depth cleared
+// before each render took 12-30 ms of the raster's 45). LargeVector's allocator places large
+// buffers on 2 MiB boundaries, and leaves elements it makes with no value uninitialised, so
+// that a buffer every element of which is written anyway (a render's pixels) is faulted in
+// by the threads that write it, once, and not cleared first by one thread.
+//
+//   zcheck::LargeVector<double> depth;
+//   depth.resize(width * height);                            // uninitialised: write every element
 //   zcheck::assignLarge(depth, width * height, clearValue);  // = depth.assign(n, clearValue)
 //   zcheck::reserveLarge(scene.triangles, faceCount);        // = triangles.reserve(faceCount)
 #include <cstddef>
+#include <new>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace zcheck {
+
+// Memory for `bytes`: from 2 MiB up on a 2 MiB boundary, advised huge pages; smaller from
+// operator new. Release with releaseLarge and the same byte count. Throws std::bad_alloc.
+void* allocateLarge(std::size_t bytes);
+void releaseLarge(void* data, std::size_t bytes) noexcept;
+
+// std::allocator's contract, with memory from allocateLarge and elements made with no value
+// default-initialised (an int or a double is then left as it was, not zeroed).
+template <class T>
+struct LargeBufferAllocator {
+    using value_type = T;
+
+    LargeBufferAllocator() = default;
+    template <class U>
+    LargeBufferAllocator(const LargeBufferAllocator<U>&) noexcept {}
+
+    T* allocate(std::size_t n)
+    {
+        if (n > std::size_t(-1) / sizeof(T)) throw std::bad_alloc();
+        return static_cast<T*>(allocateLarge(n * sizeof(T)));
+    }
+    void deallocate(T* data, std::size_t n) noexcept { releaseLarge(data, n * sizeof(T)); }
+
+    template <class U>
+    void construct(U* p) noexcept(std::is_nothrow_default_constructible<U>::value)
+    {
+        ::new (static_cast<void*>(p)) U;
+    }
+    template <class U, class... Args>
+    void construct(U* p, Args&&... args)
+    {
+        ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+    }
+
+    template <class U>
+    bool operator==(const LargeBufferAllocator<U>&) const noexcept { return true; }
+    template <class U>
+    bool operator!=(const LargeBufferAllocator<U>&) const noexcept { return false; }
+};
+
+// A per-frame buffer: a std::vector on aligned huge pages whose resize() leaves new elements
+// of trivial types uninitialised.
+template <class T>
+using LargeVector = std::vector<T, LargeBufferAllocator<T>>;
+
+// v.assign(n, value) on fresh storage (a LargeVector places it on huge pages itself).
+template <class T>
+void assignLarge(LargeVector<T>& v, std::size_t n, const T& value)
+{
+    LargeVector<T>().swap(v);
+    v.assign(n, value);
+}
 
 // Advises huge pages for the whole pages inside [data, data + bytes); small ranges are left alone.
 void adviseHugePages(void* data, std::size_t bytes);

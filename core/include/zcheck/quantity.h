@@ -16,6 +16,8 @@
 // is the Euclidean range from the centre of projection (for parallel projections, from the
 // eye plane along the ray). Images are stored row by row, row 0 at the top of the picture;
 // pixel (col,row) is entry row·width + col.
+#include "zcheck/large_buffer.h"
+
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -38,7 +40,7 @@ struct DepthImage {
     int width = 0;
     int height = 0;
     DepthQuantity quantity = DepthQuantity::Window;
-    std::vector<double> value;  // width·height, row 0 at the top
+    LargeVector<double> value;  // width·height, row 0 at the top
 
     double at(int col, int row) const { return value[std::size_t(row) * width + col]; }
 };
