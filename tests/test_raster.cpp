@@ -214,6 +214,45 @@ TEST_CASE("the raster result is bit-identical for any number of threads", "[rast
     REQUIRE(one.windowDepth.value == two.windowDepth.value);
 }
 
+TEST_CASE("both routes write every pixel of a render, whose buffers are not cleared first", "[raster][ray][allocated]")
+{
+    // RenderResult::allocated leaves the buffers as the allocator found them: a pixel a route
+    // failed to write would show what the memory held. A triangle facing the eye at eye depth
+    // D covers part of an image cut by the 64×64 tiles on both edges; memory of the same size
+    // is filled with garbage and freed before each render, so that it may be handed back.
+    const double D = 3.5;
+    const Scene tri = sceneOf({{-1, -1, float(-D)}, {1.5f, -0.5f, float(-D)}, {0, 1.2f, float(-D)}}, {{0, 1, 2}});
+    CameraSpec spec;
+    spec.width = 131, spec.height = 70;
+    spec.projection.fovyDeg = 45, spec.projection.near = 0.5, spec.projection.far = 20;
+    spec.view = View::lookAt({0, 0, 0}, {0, 0, -1}, {0, 1, 0});
+    spec.depth.format = DepthFormat::Float32;
+    const Camera camera(spec);
+    const double expected = 20 * (D - 0.5) / (D * (20 - 0.5));  // gluPerspective's window depth at eye depth D
+    const Checker checker(tri);
+    const std::size_t pixels = std::size_t(spec.width) * spec.height;
+    for (int route = 0; route < 2; ++route) {
+        {
+            LargeVector<double> depthGarbage(pixels, -123.0);
+            LargeVector<std::uint32_t> idGarbage(pixels, 77u);
+        }
+        const RenderResult image = route == 0 ? checker.renderRay(camera) : checker.renderRaster(camera);
+        INFO((route == 0 ? "ray" : "raster"));
+        std::size_t hits = 0;
+        for (std::size_t i = 0; i < pixels; ++i) {
+            if (image.primitiveId[i] == kNoPrimitive) {
+                REQUIRE(image.windowDepth.value[i] == camera.clearDepth());
+            } else {
+                REQUIRE(image.primitiveId[i] == 0u);
+                REQUIRE(image.windowDepth.value[i] == Approx(expected).epsilon(1e-6));
+                ++hits;
+            }
+        }
+        REQUIRE(hits > pixels / 10);   // the triangle is there
+        REQUIRE(hits < pixels / 2);    // and so are misses
+    }
+}
+
 TEST_CASE("a plane at a known eye depth yields exactly that depth through each route", "[analytic]")
 {
     // Eye at the origin looking down −z; a quad at z = −D covers the whole view. The expected
