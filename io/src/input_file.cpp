@@ -45,7 +45,11 @@ std::uint64_t checkInputFile(const std::string& path, const InputKind& kind)
     return size;
 }
 
-std::string readInputFile(const std::string& path, const InputKind& kind)
+namespace {
+
+// checkInputFile, then the whole content into a Bytes (std::string or LargeVector<char>).
+template <class Bytes>
+Bytes readWhole(const std::string& path, const InputKind& kind)
 {
     checkInputFile(path, kind);
     // O_NONBLOCK: should the path have been swapped for a FIFO since the check, open does
@@ -62,7 +66,7 @@ std::string readInputFile(const std::string& path, const InputKind& kind)
         ::close(fd);
         refuse(path, kind, "it grew over the " + sizeText(kind.maxBytes) + " limit while being read");
     }
-    std::string bytes;
+    Bytes bytes;
     bytes.reserve(size);
     adviseHugePages(bytes.data(), size);  // a mesh of tens of megabytes: see large_buffer.h
     bytes.resize(size);
@@ -79,6 +83,15 @@ std::string readInputFile(const std::string& path, const InputKind& kind)
     }
     ::close(fd);
     return bytes;
+}
+
+}  // namespace
+
+std::string readInputFile(const std::string& path, const InputKind& kind) { return readWhole<std::string>(path, kind); }
+
+LargeVector<char> readInputBytes(const std::string& path, const InputKind& kind)
+{
+    return readWhole<LargeVector<char>>(path, kind);
 }
 
 std::string lowerExtension(const std::string& path)

@@ -257,7 +257,7 @@ struct Mesh {
 
 class GltfReader {
 public:
-    GltfReader(const std::string& path, const std::string& bytes) : path_(path), bytes_(bytes) {}
+    GltfReader(const std::string& path, std::string_view bytes) : path_(path), bytes_(bytes) {}
 
     Scene read()
     {
@@ -1009,7 +1009,7 @@ private:
     }
 
     const std::string& path_;
-    const std::string& bytes_;
+    std::string_view bytes_;
     json root_;
     Bytes bin_;
     bool hasBin_ = false;
@@ -1029,7 +1029,7 @@ private:
 
 }  // namespace
 
-Scene readGltf(const std::string& path, const std::string& bytes)
+Scene readGltf(const std::string& path, std::string_view bytes)
 {
     return GltfReader(path, bytes).read();
 }

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string_view>
 
 namespace zcheck {
 
@@ -22,7 +23,8 @@ Scene framed(Scene scene)
 
 Scene loadMesh(const std::string& path)
 {
-    const std::string bytes = readInputFile(path, kMeshInput);
+    const LargeVector<char> file = readInputBytes(path, kMeshInput);
+    const std::string_view bytes(file.data(), file.size());
     const std::string ext = lowerExtension(path);
     // The content decides where it can (a .ply renamed .obj is still a PLY); else the extension.
     if (bytes.rfind("ply\n", 0) == 0 || bytes.rfind("ply\r\n", 0) == 0 || ext == ".ply") return framed(readPly(path, bytes));

@@ -4,6 +4,8 @@
 // Every input zcheck reads (mesh, camera file, depth map, sidecar) must be a regular file
 // (not a directory, FIFO, socket or device: a FIFO would block forever) no larger than the
 // limit for its kind. Violations throw Error naming the kind, the path and the rule.
+#include "zcheck/large_buffer.h"
+
 #include <cstdint>
 #include <string>
 
@@ -24,6 +26,9 @@ std::uint64_t checkInputFile(const std::string& path, const InputKind& kind);
 
 // checkInputFile, then the whole content. A short read is an Error, not a shorter string.
 std::string readInputFile(const std::string& path, const InputKind& kind);
+// The same into a LargeVector: for files of tens of megabytes (meshes), whose buffer is then
+// faulted in on huge pages by the read itself instead of zeroed first 4 KiB at a time.
+LargeVector<char> readInputBytes(const std::string& path, const InputKind& kind);
 
 // The file name's extension in lower case with its dot (".ply"), or "" if it has none.
 std::string lowerExtension(const std::string& path);

@@ -24,6 +24,6 @@ namespace zcheck {
 Scene readPly(const std::string& path, std::string_view bytes);
 Scene readObj(const std::string& path, std::string_view bytes);
 Scene readStl(const std::string& path, std::string_view bytes);
-Scene readGltf(const std::string& path, const std::string& bytes);
+Scene readGltf(const std::string& path, std::string_view bytes);
 
 }  // namespace zcheck
