@@ -68,7 +68,7 @@ Bytes readWhole(const std::string& path, const InputKind& kind)
     }
     Bytes bytes;
     bytes.reserve(size);
-    adviseHugePages(bytes.data(), size);  // a mesh of tens of megabytes: see large_buffer.h
+    adviseHugePages(bytes.data(), size);  // for std::string (a LargeVector advises its own): large_buffer.h
     bytes.resize(size);
     std::uint64_t done = 0;
     while (done < size) {

@@ -45,6 +45,7 @@ struct LargeBufferAllocator {
 
     T* allocate(std::size_t n)
     {
+        static_assert(alignof(T) <= __STDCPP_DEFAULT_NEW_ALIGNMENT__, "small blocks come from plain operator new");
         if (n > std::size_t(-1) / sizeof(T)) throw std::bad_alloc();
         return static_cast<T*>(allocateLarge(n * sizeof(T)));
     }
