@@ -536,7 +536,7 @@ TEST_CASE("a LargeVector sits on 2 MiB boundaries and leaves elements made witho
     const LargeVector<std::uint32_t> small(5, 7u);
     REQUIRE(std::vector<std::uint32_t>(small.begin(), small.end()) == std::vector<std::uint32_t>{7, 7, 7, 7, 7});
     LargeVector<float> filled;
-    assignLarge(filled, kHugePage, 1.5f);
+    filled.assign(kHugePage, 1.5f);
     REQUIRE(filled.size() == kHugePage);
     REQUIRE(reinterpret_cast<std::uintptr_t>(filled.data()) % kHugePage == 0);
     REQUIRE(std::all_of(filled.begin(), filled.end(), [](float v) { return v == 1.5f; }));

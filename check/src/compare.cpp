@@ -456,8 +456,8 @@ TileComparison::TileComparison(const Scene& scene, const Camera& camera, const T
 {
     if (perPixel) {
         const std::size_t pixels = std::size_t(camera.width()) * std::size_t(camera.height());
-        assignLarge(perPixel->pixelClass, pixels, PixelClass::BothMiss);
-        assignLarge(perPixel->errorOverTolerance, pixels, 0.0f);
+        perPixel->pixelClass.assign(pixels, PixelClass::BothMiss);
+        perPixel->errorOverTolerance.assign(pixels, 0.0f);
     }
 }
 

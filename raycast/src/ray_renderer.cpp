@@ -162,7 +162,7 @@ RenderResult RayRenderer::render(const Camera& camera, const RayFaults& fault, E
     const auto start = Clock::now();
     const int W = camera.width(), H = camera.height();
     RenderResult result = RenderResult::allocated(W, H);  // traceRect writes every pixel, hit or not
-    if (eyePoints == EyePoints::Keep) assignLarge(result.pEye, std::size_t(W) * H, glm::dvec3(NAN));
+    if (eyePoints == EyePoints::Keep) result.pEye.assign(std::size_t(W) * H, glm::dvec3(NAN));
     // 64×64 regions in parallel (a region's set-up, the camera's rays, is made once).
     const TileGrid regions(W, H, kRegion);
     tbb::parallel_for(0, regions.count(), [&](int region) {

@@ -18,7 +18,7 @@
 //
 //   zcheck::LargeVector<double> depth;
 //   depth.resize(width * height);                            // uninitialised: write every element
-//   zcheck::assignLarge(depth, width * height, clearValue);  // = depth.assign(n, clearValue)
+//   depth.assign(width * height, clearValue);                // on huge pages, every element set
 //   zcheck::reserveLarge(scene.triangles, faceCount);        // = triangles.reserve(faceCount)
 #include <cstddef>
 #include <new>
@@ -73,26 +73,8 @@ struct LargeBufferAllocator {
 template <class T>
 using LargeVector = std::vector<T, LargeBufferAllocator<T>>;
 
-// v.assign(n, value) on fresh storage (a LargeVector places it on huge pages itself).
-template <class T>
-void assignLarge(LargeVector<T>& v, std::size_t n, const T& value)
-{
-    LargeVector<T>().swap(v);
-    v.assign(n, value);
-}
-
 // Advises huge pages for the whole pages inside [data, data + bytes); small ranges are left alone.
 void adviseHugePages(void* data, std::size_t bytes);
-
-// v.assign(n, value), with the new storage advised huge pages before it is first touched.
-template <class T>
-void assignLarge(std::vector<T>& v, std::size_t n, const T& value)
-{
-    std::vector<T>().swap(v);
-    v.reserve(n);  // allocates, touches nothing
-    adviseHugePages(v.data(), n * sizeof(T));
-    v.assign(n, value);
-}
 
 // v.reserve(n), with the new storage (if any) advised huge pages before it is first touched.
 // For a reader that knows its item count up front: one allocation, no growth by copying into
