@@ -8,6 +8,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <random>
 
 using namespace zcheck;
@@ -212,6 +214,87 @@ TEST_CASE("the raster result is bit-identical for any number of threads", "[rast
     }
     REQUIRE(one.primitiveId == two.primitiveId);
     REQUIRE(one.windowDepth.value == two.windowDepth.value);
+}
+
+namespace {
+
+// Renders with ZCHECK_RASTER_KERNEL set to `kernel` (nullptr: unset, the default choice).
+RenderResult renderWithKernel(const RasterRenderer& raster, const Camera& camera, const char* kernel,
+                              const RasterFaults& faults = {})
+{
+    if (kernel) setenv("ZCHECK_RASTER_KERNEL", kernel, 1);
+    else unsetenv("ZCHECK_RASTER_KERNEL");
+    RenderResult result = raster.render(camera, faults);
+    unsetenv("ZCHECK_RASTER_KERNEL");
+    return result;
+}
+
+}  // namespace
+
+TEST_CASE("the vector drawing kernel is bit-identical to the scalar loop", "[raster][kernel]")
+{
+    // A soup of triangles from sub-pixel slivers to ones spanning several 64×64 tiles, some
+    // crossing the near or far plane (clipped, depths at the ends of the range), exact
+    // duplicates under other ids (equal keys: the first drawn keeps the pixel), both windings.
+    // Every convention, format, reversed-Z and a narrowed depth range, on an image the tiles
+    // cut on both edges; and with the fault "no near clipping", whose depths in front of the
+    // near plane leave the depth range (the clamp to it then decides). Compared bit for bit
+    // (memcmp), so a signed zero would show.
+    std::mt19937 random(20261126);
+    std::uniform_real_distribution<float> unit(-1.0f, 1.0f), depth(-12.0f, -0.2f);
+    std::vector<glm::vec3> positions;
+    std::vector<glm::uvec3> triangles;
+    for (int k = 0; k < 3000; ++k) {
+        const float size = std::pow(10.0f, unit(random) * 1.5f - 1.0f);  // 0.003 to 3 (image ≈ 2 wide)
+        const glm::vec3 centre(unit(random) * 1.2f, unit(random) * 1.2f, depth(random));
+        const std::uint32_t first = std::uint32_t(positions.size());
+        for (int v = 0; v < 3; ++v)
+            positions.push_back(centre + glm::vec3(unit(random) * size, unit(random) * size, unit(random) * 4.0f));
+        triangles.push_back({first, first + 1, first + 2});
+        if (k % 7 == 0) triangles.push_back({first, first + 1, first + 2});  // a duplicate
+        if (k % 11 == 0) triangles.push_back({first, first + 2, first + 1});  // the other winding
+    }
+    const Scene soup = sceneOf(positions, triangles);
+    const RasterRenderer raster(soup);
+    for (const char* convention : {"opengl", "direct3d", "vulkan", "metal", "opencv"})
+        for (DepthFormat format : {DepthFormat::Unorm16, DepthFormat::Unorm24, DepthFormat::Float32})
+            for (bool reversed : {false, true})
+                for (int variant = 0; variant < 3; ++variant) {
+                    const bool narrowRange = variant == 1;
+                    RasterFaults faults;
+                    faults.noNearClip = variant == 2;
+                    CameraSpec spec;
+                    spec.convention = Convention::preset(convention);
+                    spec.width = 203, spec.height = 141;
+                    spec.projection.fovyDeg = 70, spec.projection.near = 0.5, spec.projection.far = 9;
+                    spec.view = View::lookAt({0, 0, 0}, {0, 0, -1}, {0, 1, 0});
+                    spec.depth.format = format, spec.depth.reversed = reversed;
+                    if (narrowRange) spec.depth.rangeMin = 0.25, spec.depth.rangeMax = 0.75;
+                    const Camera camera(spec);
+                    INFO(convention << ' ' << toString(format) << (reversed ? " reversed" : "")
+                                    << (narrowRange ? " range [0.25, 0.75]" : "") << (faults.noNearClip ? " no near clipping" : ""));
+                    const RenderResult scalar = renderWithKernel(raster, camera, "scalar", faults);
+                    const RenderResult chosen = renderWithKernel(raster, camera, nullptr, faults);
+                    const std::size_t pixels = std::size_t(spec.width) * spec.height;
+                    REQUIRE(std::count_if(scalar.primitiveId.begin(), scalar.primitiveId.end(),
+                                          [](std::uint32_t id) { return id != kNoPrimitive; }) > std::ptrdiff_t(pixels / 2));
+                    REQUIRE(std::memcmp(scalar.primitiveId.data(), chosen.primitiveId.data(), pixels * sizeof(std::uint32_t)) == 0);
+                    REQUIRE(std::memcmp(scalar.windowDepth.value.data(), chosen.windowDepth.value.data(),
+                                        pixels * sizeof(double)) == 0);
+                }
+    if (!__builtin_cpu_supports("avx512f") || !__builtin_cpu_supports("avx512dq") || !__builtin_cpu_supports("avx512vl"))
+        WARN("this processor has no AVX-512 (F, DQ, VL): both renders used the scalar loop");
+}
+
+TEST_CASE("ZCHECK_RASTER_KERNEL takes auto or scalar and nothing else", "[raster][kernel]")
+{
+    const Scene triangle = sceneOf({{0, 0, -1}, {1, 0, -1}, {0, 1, -1}}, {{0, 1, 2}});
+    const RasterRenderer raster(triangle);  // keeps a reference to the scene
+    const Camera camera(pixelExactCamera(8));
+    REQUIRE_NOTHROW(renderWithKernel(raster, camera, "auto"));
+    REQUIRE_NOTHROW(renderWithKernel(raster, camera, "scalar"));
+    REQUIRE_THROWS_WITH(renderWithKernel(raster, camera, "avx2"),
+                        Catch::Contains("ZCHECK_RASTER_KERNEL=avx2") && Catch::Contains("'auto' or 'scalar'"));
 }
 
 TEST_CASE("both routes write every pixel of a render, whose buffers are not cleared first", "[raster][ray][allocated]")

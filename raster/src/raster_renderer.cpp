@@ -13,6 +13,13 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define ZCHECK_RASTER_AVX512 1
+#include <immintrin.h>
+#endif
 
 namespace zcheck {
 
@@ -314,6 +321,88 @@ void drawInTile(const Viewport& vp, const DepthKeys& keys, const TriangleSetup& 
     }
 }
 
+#ifdef ZCHECK_RASTER_AVX512
+#define ZCHECK_TARGET_AVX512 __attribute__((target("avx512f,avx512dq,avx512vl")))
+
+// std::clamp(v, lo, hi) per lane: v < lo ? lo : hi < v ? hi : v, NaN and signed zeros included.
+ZCHECK_TARGET_AVX512 inline __m512d clamp(__m512d v, __m512d lo, __m512d hi)
+{
+    v = _mm512_mask_blend_pd(_mm512_cmp_pd_mask(v, lo, _CMP_LT_OQ), v, lo);
+    return _mm512_mask_blend_pd(_mm512_cmp_pd_mask(hi, v, _CMP_LT_OQ), v, hi);
+}
+
+// drawInTile<false> with eight pixels of a row at a time: the same integer edge functions
+// and the same double operations in the same order per pixel (the build forbids contracting
+// them into fused multiply-adds), so its output is bit-identical to the scalar loop's. A
+// triangle's pixels are distinct within a row, so lanes never depend on each other.
+ZCHECK_TARGET_AVX512 void drawInTileAvx512(const DepthSettings& depth, const DepthKeys& keys, const TriangleSetup& t,
+                                           int tileCol0, int tileRow0, int tileCol1, int tileRow1, TileBuffer& out)
+{
+    const int col0 = std::max(t.box.minCol, tileCol0), col1 = std::min(t.box.maxCol, tileCol1);
+    const int row0 = std::max(t.box.minRow, tileRow0), row1 = std::min(t.box.maxRow, tileRow1);
+    const __m512i lane = _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0);
+    const __m256i laneColumn = _mm256_set_epi32(7, 6, 5, 4, 3, 2, 1, 0);
+    // Edge function k at lane j of a group: its value at the group's first pixel + j·A_k·256.
+    const __m512i laneStep0 = _mm512_mullo_epi64(lane, _mm512_set1_epi64(t.A[0] * kSubpixel));
+    const __m512i laneStep1 = _mm512_mullo_epi64(lane, _mm512_set1_epi64(t.A[1] * kSubpixel));
+    const __m512i laneStep2 = _mm512_mullo_epi64(lane, _mm512_set1_epi64(t.A[2] * kSubpixel));
+    const __m512d half = _mm512_set1_pd(0.5), x0 = _mm512_set1_pd(t.x0), dzdx = _mm512_set1_pd(t.dzdx);
+    const __m512d rangeMin = _mm512_set1_pd(depth.rangeMin), rangeMax = _mm512_set1_pd(depth.rangeMax);
+    const __m512d maxCode = _mm512_set1_pd(keys.maxCode);
+    const __m512d noFractionBits = _mm512_set1_pd(4503599627370496.0);  // nearbyintNonNegative's 2^52
+    const __m256i primitive = _mm256_set1_epi32(int(t.primitive));
+    // The zero-masking forms with every lane on: the plain ones trip GCC 12's
+    // -Wmaybe-uninitialized inside its own headers (GCC bug 105593).
+    const __mmask8 all = 0xFF;
+    for (int row = row0; row <= row1; ++row) {
+        const std::int64_t py = row * kSubpixel + kHalfPixel;
+        const __m512d rowDepth = _mm512_set1_pd(t.z0 + t.dzdy * (row + 0.5 - t.y0));
+        double* keyRow = out.key + (row - out.row0) * TileBuffer::kSide - out.col0;
+        std::uint32_t* primitiveRow = out.primitive + (row - out.row0) * TileBuffer::kSide - out.col0;
+        for (int col = col0; col <= col1; col += 8) {
+            const std::int64_t px = col * kSubpixel + kHalfPixel;
+            const __m512i e0 = _mm512_add_epi64(_mm512_set1_epi64(t.A[0] * px + t.B[0] * py + t.C[0]), laneStep0);
+            const __m512i e1 = _mm512_add_epi64(_mm512_set1_epi64(t.A[1] * px + t.B[1] * py + t.C[1]), laneStep1);
+            const __m512i e2 = _mm512_add_epi64(_mm512_set1_epi64(t.A[2] * px + t.B[2] * py + t.C[2]), laneStep2);
+            const __mmask8 inBox = __mmask8((1u << std::min(8, col1 - col + 1)) - 1);
+            const __mmask8 covered = _mm512_mask_cmpge_epi64_mask(
+                inBox, _mm512_or_si512(_mm512_or_si512(e0, e1), e2), _mm512_setzero_si512());
+            if (!covered) continue;
+            const __m512d column = _mm512_maskz_cvtepi32_pd(all, _mm256_add_epi32(_mm256_set1_epi32(col), laneColumn));
+            const __m512d interpolated =
+                _mm512_add_pd(rowDepth, _mm512_mul_pd(dzdx, _mm512_sub_pd(_mm512_add_pd(column, half), x0)));
+            const __m512d windowDepth = clamp(interpolated, rangeMin, rangeMax);
+            // unormCode's own clamp to [0, 1] is left out: the camera holds 0 ≤ rangeMin < rangeMax ≤ 1,
+            // so it returns every clamped value unchanged (NaN and −0 included).
+            const __m512d key =
+                keys.unorm ? _mm512_sub_pd(_mm512_add_pd(_mm512_mul_pd(windowDepth, maxCode), noFractionBits), noFractionBits)
+                           : _mm512_maskz_cvtps_pd(all, _mm512_maskz_cvtpd_ps(all, windowDepth));
+            const __m512d stored = _mm512_maskz_loadu_pd(covered, keyRow + col);
+            const __mmask8 nearer = depth.reversed ? _mm512_mask_cmp_pd_mask(covered, stored, key, _CMP_LT_OQ)
+                                                   : _mm512_mask_cmp_pd_mask(covered, key, stored, _CMP_LT_OQ);
+            _mm512_mask_storeu_pd(keyRow + col, nearer, key);
+            _mm256_mask_storeu_epi32(primitiveRow + col, nearer, primitive);
+        }
+    }
+}
+#endif
+
+// How the clean chain's pixels are drawn: eight at a time where the processor has AVX-512
+// (F, DQ, VL), one at a time otherwise. ZCHECK_RASTER_KERNEL=scalar forces the scalar loop
+// (tests compare the two bit for bit); any other value but "auto" is an error.
+bool useVectorDraw()
+{
+    const char* requested = std::getenv("ZCHECK_RASTER_KERNEL");
+    if (requested && std::strcmp(requested, "scalar") == 0) return false;
+    if (requested && *requested && std::strcmp(requested, "auto") != 0)
+        throw Error(std::string("ZCHECK_RASTER_KERNEL=") + requested + ": must be 'auto' or 'scalar'");
+#ifdef ZCHECK_RASTER_AVX512
+    return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512vl");
+#else
+    return false;
+#endif
+}
+
 }  // namespace
 
 RasterRenderer::RasterRenderer(const Scene& scene) : scene_(scene) { validateScene(scene); }
@@ -323,7 +412,7 @@ RasterRenderer::RasterRenderer(const Scene& scene) : scene_(scene) { validateSce
 struct RasterFrame::Impl {
     Impl(const Scene& s, const Camera& c, const RasterFaults& f)
         : scene(s), camera(c), faults(f), vp(camera, faults), keys(camera.depth().format),
-          clearKey(keys.keyOfStored(camera.clearDepth()))
+          clearKey(keys.keyOfStored(camera.clearDepth())), vectorDraw(!vp.pixelFaults && useVectorDraw())
     {
     }
 
@@ -337,6 +426,7 @@ struct RasterFrame::Impl {
     const Viewport vp;
     const DepthKeys keys;
     const double clearKey;
+    const bool vectorDraw;  // drawInTileAvx512 for the clean chain (useVectorDraw)
     LargeVector<StoredVertex> snapped;  // per vertex, set where inside every clip plane (outcode 0)
     LargeVector<unsigned char> outcode;
     std::vector<Chunk> chunks;
@@ -400,6 +490,9 @@ void RasterFrame::Impl::drawTile(int tile, double* windowDepth, std::uint32_t* p
     std::fill(std::begin(tileBuffer.key), std::end(tileBuffer.key), clearKey);
     std::fill(std::begin(tileBuffer.primitive), std::end(tileBuffer.primitive), kNoPrimitive);
     auto draw = [&](const TriangleSetup& setup) {
+#ifdef ZCHECK_RASTER_AVX512
+        if (vectorDraw) return drawInTileAvx512(camera.depth(), keys, setup, col0, row0, col1, row1, tileBuffer);
+#endif
         vp.pixelFaults ? drawInTile<true>(vp, keys, setup, col0, row0, col1, row1, tileBuffer)
                        : drawInTile<false>(vp, keys, setup, col0, row0, col1, row1, tileBuffer);
     };
