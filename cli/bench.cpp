@@ -6,6 +6,7 @@
 #include "zcheck/embree_reference.h"
 #include "zcheck/error.h"
 #include "zcheck/gl_reference.h"
+#include "zcheck/large_buffer.h"
 #include "zcheck/mesh_loader.h"
 
 #include <nlohmann/json.hpp>
@@ -128,6 +129,7 @@ WholeCheck wholeCheckInChild(const std::string& sceneName, const Camera& camera,
         getrusage(RUSAGE_SELF, &usage);
         w.peakMiB = maxResidentMiB(usage);
         {
+            releaseCachedLargeBuffers();  // the full-frame check's buffers new, as in a fresh process
             const CheckResult fullFrame = checker.check(camera);
             w.traceMs = fullFrame.report.timings.traceMs, w.rasterMs = fullFrame.report.timings.rasterMs;
             w.compareMs = fullFrame.report.timings.compareMs;

@@ -19,6 +19,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <random>
 #include <vector>
 
@@ -540,4 +541,36 @@ TEST_CASE("a LargeVector sits on 2 MiB boundaries and leaves elements made witho
     REQUIRE(filled.size() == kHugePage);
     REQUIRE(reinterpret_cast<std::uintptr_t>(filled.data()) % kHugePage == 0);
     REQUIRE(std::all_of(filled.begin(), filled.end(), [](float v) { return v == 1.5f; }));
+}
+
+TEST_CASE("a released large buffer is handed back, faulted in, to the next one of its size, and given up for any other",
+          "[core][large_buffer]")
+{
+    constexpr std::size_t kPixels = 1920 * 1080;  // 16,588,800 bytes of double: 8 huge pages
+    constexpr std::size_t kRounded = std::size_t(16) << 20;
+    releaseCachedLargeBuffers();
+    REQUIRE(cachedLargeBufferBytes() == 0);
+    const void* first = nullptr;
+    {
+        LargeVector<double> depth(kPixels, 0.75);
+        first = depth.data();
+    }
+    REQUIRE(cachedLargeBufferBytes() == kRounded);
+    // The next buffer of the same rounded size (another type) is the same memory, as it was left.
+    LargeVector<std::uint64_t> codes;
+    codes.resize(kPixels - 1000);
+    REQUIRE(static_cast<const void*>(codes.data()) == first);
+    REQUIRE(cachedLargeBufferBytes() == 0);
+    double value;
+    std::memcpy(&value, &codes[12345], sizeof value);
+    REQUIRE(value == 0.75);
+    LargeVector<std::uint64_t>().swap(codes);  // released
+    REQUIRE(cachedLargeBufferBytes() == kRounded);
+    // A buffer of another size finds nothing to reuse: everything kept is given back before
+    // new memory is mapped, so the cache never adds to the peak.
+    LargeVector<double> larger(2 * kPixels);
+    REQUIRE(cachedLargeBufferBytes() == 0);
+    // Small buffers are not kept.
+    { LargeVector<double> small(1000, 1.0); }
+    REQUIRE(cachedLargeBufferBytes() == 0);
 }

@@ -5,13 +5,86 @@
 
 #include <cstdint>
 #include <cstdlib>
+#include <mutex>
 #include <new>
+#include <vector>
 
 namespace zcheck {
 
 namespace {
+
 constexpr std::size_t kHugePage = std::size_t(2) << 20;
+constexpr std::size_t kCacheLimit = std::size_t(1) << 30;  // bytes the cache may hold at most
+
+// Blocks of 2 MiB and more that were released, kept faulted in for an allocation of the
+// same rounded size (the next frame's buffers). An allocation that finds none releases them
+// all before it maps new memory, so that the cache never adds to the peak: what it holds was
+// in use together before, and is given back before the process grows.
+class BlockCache {
+public:
+    void* take(std::size_t rounded)
+    {
+        const std::lock_guard<std::mutex> lock(mutex_);
+        for (std::size_t k = 0; k < blocks_.size(); ++k)
+            if (blocks_[k].bytes == rounded) {
+                void* data = blocks_[k].data;
+                held_ -= rounded;
+                blocks_[k] = blocks_.back();
+                blocks_.pop_back();
+                return data;
+            }
+        releaseAllLocked();
+        return nullptr;
+    }
+    void keep(void* data, std::size_t rounded) noexcept
+    {
+        const std::lock_guard<std::mutex> lock(mutex_);
+        if (held_ + rounded <= kCacheLimit && blocks_.size() < blocks_.capacity()) {
+            blocks_.push_back({data, rounded});
+            held_ += rounded;
+        } else {
+            std::free(data);
+        }
+    }
+    void releaseAll() noexcept
+    {
+        const std::lock_guard<std::mutex> lock(mutex_);
+        releaseAllLocked();
+    }
+    std::size_t held() noexcept
+    {
+        const std::lock_guard<std::mutex> lock(mutex_);
+        return held_;
+    }
+    BlockCache() { blocks_.reserve(64); }  // keep() never allocates
+
+private:
+    struct Block {
+        void* data;
+        std::size_t bytes;
+    };
+    void releaseAllLocked() noexcept
+    {
+        for (const Block& block : blocks_) std::free(block.data);
+        blocks_.clear();
+        held_ = 0;
+    }
+    std::mutex mutex_;
+    std::vector<Block> blocks_;
+    std::size_t held_ = 0;
+};
+
+// Never destroyed: buffers may be released by static destructors after this file's ones ran.
+BlockCache& blockCache()
+{
+    static BlockCache* cache = new BlockCache;
+    return *cache;
 }
+
+// A block's size: whole huge pages (wraps to less than `bytes` only for impossible sizes).
+std::size_t roundedToHugePages(std::size_t bytes) noexcept { return (bytes + kHugePage - 1) / kHugePage * kHugePage; }
+
+}  // namespace
 
 void adviseHugePages(void* data, std::size_t bytes)
 {
@@ -26,8 +99,9 @@ void adviseHugePages(void* data, std::size_t bytes)
 void* allocateLarge(std::size_t bytes)
 {
     if (bytes < kHugePage) return ::operator new(bytes);
-    const std::size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
+    const std::size_t rounded = roundedToHugePages(bytes);
     if (rounded < bytes) throw std::bad_alloc();
+    if (void* reused = blockCache().take(rounded)) return reused;
     void* data = std::aligned_alloc(kHugePage, rounded);
     if (!data) throw std::bad_alloc();
     adviseHugePages(data, rounded);
@@ -39,8 +113,12 @@ void releaseLarge(void* data, std::size_t bytes) noexcept
     if (bytes < kHugePage) {
         ::operator delete(data);
     } else {
-        std::free(data);
+        blockCache().keep(data, roundedToHugePages(bytes));
     }
 }
+
+void releaseCachedLargeBuffers() noexcept { blockCache().releaseAll(); }
+
+std::size_t cachedLargeBufferBytes() noexcept { return blockCache().held(); }
 
 }  // namespace zcheck

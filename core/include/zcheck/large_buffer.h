@@ -30,8 +30,20 @@ namespace zcheck {
 
 // Memory for `bytes`: from 2 MiB up on a 2 MiB boundary, advised huge pages; smaller from
 // operator new. Release with releaseLarge and the same byte count. Throws std::bad_alloc.
+//
+// Released blocks of 2 MiB and more are kept (up to 1 GiB), already faulted in, and handed
+// back to the next allocation of the same size rounded up to 2 MiB: a program that renders
+// frame after frame pays the page faults of its buffers once, not per frame (as a GPU
+// driver's reused framebuffer does). An allocation that finds no block of its size first
+// releases every kept one, so the cache never raises the peak resident set: it holds only
+// memory that was in use together, and gives it back before new memory is mapped.
+// Thread-safe. The contents of a reused block are whatever its last user left.
 void* allocateLarge(std::size_t bytes);
 void releaseLarge(void* data, std::size_t bytes) noexcept;
+// Gives every kept block back to the system (a first frame measured as a fresh process pays it).
+void releaseCachedLargeBuffers() noexcept;
+// The bytes the kept blocks hold.
+std::size_t cachedLargeBufferBytes() noexcept;
 
 // std::allocator's contract, with memory from allocateLarge and elements made with no value
 // default-initialised (an int or a double is then left as it was, not zeroed).
