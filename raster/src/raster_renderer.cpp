@@ -331,6 +331,14 @@ ZCHECK_TARGET_AVX512 inline __m512d clamp(__m512d v, __m512d lo, __m512d hi)
     return _mm512_mask_blend_pd(_mm512_cmp_pd_mask(hi, v, _CMP_LT_OQ), v, hi);
 }
 
+// Edge function k of t at pixels (col + j, row), j = 0..7, one per lane.
+ZCHECK_TARGET_AVX512 inline __m512i edgeAtLanes(const TriangleSetup& t, int k, int col, int row)
+{
+    const std::int64_t px = col * kSubpixel + kHalfPixel, py = row * kSubpixel + kHalfPixel;
+    return _mm512_add_epi64(_mm512_set1_epi64(t.A[k] * px + t.B[k] * py + t.C[k]),
+                            _mm512_mullo_epi64(_mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0), _mm512_set1_epi64(t.A[k] * kSubpixel)));
+}
+
 // drawInTile<false> with eight pixels of a row at a time: the same integer edge functions
 // and the same double operations in the same order per pixel (the build forbids contracting
 // them into fused multiply-adds), so its output is bit-identical to the scalar loop's. A
@@ -340,37 +348,36 @@ ZCHECK_TARGET_AVX512 void drawInTileAvx512(const DepthSettings& depth, const Dep
 {
     const int col0 = std::max(t.box.minCol, tileCol0), col1 = std::min(t.box.maxCol, tileCol1);
     const int row0 = std::max(t.box.minRow, tileRow0), row1 = std::min(t.box.maxRow, tileRow1);
-    const __m512i lane = _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0);
-    const __m256i laneColumn = _mm256_set_epi32(7, 6, 5, 4, 3, 2, 1, 0);
-    // Edge function k at lane j of a group: its value at the group's first pixel + j·A_k·256.
-    const __m512i laneStep0 = _mm512_mullo_epi64(lane, _mm512_set1_epi64(t.A[0] * kSubpixel));
-    const __m512i laneStep1 = _mm512_mullo_epi64(lane, _mm512_set1_epi64(t.A[1] * kSubpixel));
-    const __m512i laneStep2 = _mm512_mullo_epi64(lane, _mm512_set1_epi64(t.A[2] * kSubpixel));
-    const __m512d half = _mm512_set1_pd(0.5), x0 = _mm512_set1_pd(t.x0), dzdx = _mm512_set1_pd(t.dzdx);
+    // Edge function k at lane j of a group: its value at the group's first pixel + j·A_k·256;
+    // a group eight pixels on adds 8·A_k·256, a row down B_k·256 (exact: what the scalar loop
+    // computes as A_k·px + B_k·py + C_k).
+    __m512i rowE0 = edgeAtLanes(t, 0, col0, row0), rowE1 = edgeAtLanes(t, 1, col0, row0), rowE2 = edgeAtLanes(t, 2, col0, row0);
+    const __m512i down0 = _mm512_set1_epi64(t.B[0] * kSubpixel), across0 = _mm512_set1_epi64(t.A[0] * kSubpixel * 8);
+    const __m512i down1 = _mm512_set1_epi64(t.B[1] * kSubpixel), across1 = _mm512_set1_epi64(t.A[1] * kSubpixel * 8);
+    const __m512i down2 = _mm512_set1_epi64(t.B[2] * kSubpixel), across2 = _mm512_set1_epi64(t.A[2] * kSubpixel * 8);
+    // A lane's pixel centre col + 0.5 (exact in double, as are its steps of 8).
+    const __m512d firstCentres = _mm512_add_pd(_mm512_set1_pd(col0), _mm512_set_pd(7.5, 6.5, 5.5, 4.5, 3.5, 2.5, 1.5, 0.5));
+    const __m512d eight = _mm512_set1_pd(8.0), x0 = _mm512_set1_pd(t.x0), dzdx = _mm512_set1_pd(t.dzdx);
     const __m512d rangeMin = _mm512_set1_pd(depth.rangeMin), rangeMax = _mm512_set1_pd(depth.rangeMax);
     const __m512d maxCode = _mm512_set1_pd(keys.maxCode);
     const __m512d noFractionBits = _mm512_set1_pd(4503599627370496.0);  // nearbyintNonNegative's 2^52
     const __m256i primitive = _mm256_set1_epi32(int(t.primitive));
-    // The zero-masking forms with every lane on: the plain ones trip GCC 12's
+    // The zero-masking form with every lane on: the plain one trips GCC 12's
     // -Wmaybe-uninitialized inside its own headers (GCC bug 105593).
     const __mmask8 all = 0xFF;
+    // No branch on coverage: a group with no pixel covered stores nothing (its masks are
+    // empty), and a branch on it was mispredicted often enough to cost 5 %.
     for (int row = row0; row <= row1; ++row) {
-        const std::int64_t py = row * kSubpixel + kHalfPixel;
         const __m512d rowDepth = _mm512_set1_pd(t.z0 + t.dzdy * (row + 0.5 - t.y0));
         double* keyRow = out.key + (row - out.row0) * TileBuffer::kSide - out.col0;
         std::uint32_t* primitiveRow = out.primitive + (row - out.row0) * TileBuffer::kSide - out.col0;
+        __m512i e0 = rowE0, e1 = rowE1, e2 = rowE2;
+        __m512d centre = firstCentres;
         for (int col = col0; col <= col1; col += 8) {
-            const std::int64_t px = col * kSubpixel + kHalfPixel;
-            const __m512i e0 = _mm512_add_epi64(_mm512_set1_epi64(t.A[0] * px + t.B[0] * py + t.C[0]), laneStep0);
-            const __m512i e1 = _mm512_add_epi64(_mm512_set1_epi64(t.A[1] * px + t.B[1] * py + t.C[1]), laneStep1);
-            const __m512i e2 = _mm512_add_epi64(_mm512_set1_epi64(t.A[2] * px + t.B[2] * py + t.C[2]), laneStep2);
             const __mmask8 inBox = __mmask8((1u << std::min(8, col1 - col + 1)) - 1);
             const __mmask8 covered = _mm512_mask_cmpge_epi64_mask(
                 inBox, _mm512_or_si512(_mm512_or_si512(e0, e1), e2), _mm512_setzero_si512());
-            if (!covered) continue;
-            const __m512d column = _mm512_maskz_cvtepi32_pd(all, _mm256_add_epi32(_mm256_set1_epi32(col), laneColumn));
-            const __m512d interpolated =
-                _mm512_add_pd(rowDepth, _mm512_mul_pd(dzdx, _mm512_sub_pd(_mm512_add_pd(column, half), x0)));
+            const __m512d interpolated = _mm512_add_pd(rowDepth, _mm512_mul_pd(dzdx, _mm512_sub_pd(centre, x0)));
             const __m512d windowDepth = clamp(interpolated, rangeMin, rangeMax);
             // unormCode's own clamp to [0, 1] is left out: the camera holds 0 ≤ rangeMin < rangeMax ≤ 1,
             // so it returns every clamped value unchanged (NaN and −0 included).
@@ -382,7 +389,10 @@ ZCHECK_TARGET_AVX512 void drawInTileAvx512(const DepthSettings& depth, const Dep
                                                    : _mm512_mask_cmp_pd_mask(covered, key, stored, _CMP_LT_OQ);
             _mm512_mask_storeu_pd(keyRow + col, nearer, key);
             _mm256_mask_storeu_epi32(primitiveRow + col, nearer, primitive);
+            e0 = _mm512_add_epi64(e0, across0), e1 = _mm512_add_epi64(e1, across1), e2 = _mm512_add_epi64(e2, across2);
+            centre = _mm512_add_pd(centre, eight);
         }
+        rowE0 = _mm512_add_epi64(rowE0, down0), rowE1 = _mm512_add_epi64(rowE1, down1), rowE2 = _mm512_add_epi64(rowE2, down2);
     }
 }
 #endif
