@@ -222,11 +222,12 @@ namespace {
 RenderResult renderWithKernel(const RasterRenderer& raster, const Camera& camera, const char* kernel,
                               const RasterFaults& faults = {})
 {
+    struct Unset {  // also when render() throws: later tests in this process see no variable
+        ~Unset() { unsetenv("ZCHECK_RASTER_KERNEL"); }
+    } unsetAfter;
     if (kernel) setenv("ZCHECK_RASTER_KERNEL", kernel, 1);
     else unsetenv("ZCHECK_RASTER_KERNEL");
-    RenderResult result = raster.render(camera, faults);
-    unsetenv("ZCHECK_RASTER_KERNEL");
-    return result;
+    return raster.render(camera, faults);
 }
 
 }  // namespace
