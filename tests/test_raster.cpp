@@ -232,59 +232,71 @@ RenderResult renderWithKernel(const RasterRenderer& raster, const Camera& camera
 
 }  // namespace
 
-TEST_CASE("the vector drawing kernel is bit-identical to the scalar loop", "[raster][kernel]")
+TEST_CASE("the vector kernels are bit-identical to the scalar loops", "[raster][kernel]")
 {
-    // A soup of triangles from sub-pixel slivers to ones spanning several 64×64 tiles, some
-    // crossing the near or far plane (clipped, depths at the ends of the range), exact
-    // duplicates under other ids (equal keys: the first drawn keeps the pixel), both windings.
-    // Every convention, format, reversed-Z and a narrowed depth range, on an image the tiles
-    // cut on both edges; and with the fault "no near clipping", whose depths in front of the
-    // near plane leave the depth range (the clamp to it then decides). Compared bit for bit
-    // (memcmp), so a signed zero would show.
+    // Two soups of triangles from sub-pixel slivers to ones spanning several 64×64 tiles, with
+    // exact duplicates under other ids (equal keys: the first drawn keeps the pixel) and both
+    // windings. In the first, every triangle lies between the near and far planes, anywhere in
+    // the view and past its edges (boxes cut by the image): the vector set-up takes them eight
+    // at a time. In the second, most cross the near or far plane (clipped, depths at the ends
+    // of the range), so most runs of eight hold one that needs clipping and go to the scalar
+    // set-up. Every convention, format, reversed-Z and a narrowed depth range, on an image
+    // the tiles cut on both edges; and with the fault "no near clipping", whose depths in front
+    // of the near plane leave the depth range (the clamp to it then decides). Compared bit for
+    // bit (memcmp), so a signed zero would show.
     std::mt19937 random(20261126);
-    std::uniform_real_distribution<float> unit(-1.0f, 1.0f), depth(-12.0f, -0.2f);
-    std::vector<glm::vec3> positions;
-    std::vector<glm::uvec3> triangles;
-    for (int k = 0; k < 3000; ++k) {
-        const float size = std::pow(10.0f, unit(random) * 1.5f - 1.0f);  // 0.003 to 3 (image ≈ 2 wide)
-        const glm::vec3 centre(unit(random) * 1.2f, unit(random) * 1.2f, depth(random));
-        const std::uint32_t first = std::uint32_t(positions.size());
-        for (int v = 0; v < 3; ++v)
-            positions.push_back(centre + glm::vec3(unit(random) * size, unit(random) * size, unit(random) * 4.0f));
-        triangles.push_back({first, first + 1, first + 2});
-        if (k % 7 == 0) triangles.push_back({first, first + 1, first + 2});  // a duplicate
-        if (k % 11 == 0) triangles.push_back({first, first + 2, first + 1});  // the other winding
+    std::uniform_real_distribution<float> unit(-1.0f, 1.0f), depth(-12.0f, -0.2f), depthInside(-7.0f, -1.5f);
+    auto soupOf = [&](bool inside) {
+        std::vector<glm::vec3> positions;
+        std::vector<glm::uvec3> triangles;
+        for (int k = 0; k < 3000; ++k) {
+            const float size = std::pow(10.0f, unit(random) * 1.5f - 1.0f);  // 0.003 to 3 (image ≈ 2 wide at z = −1)
+            const float z = inside ? depthInside(random) : depth(random), spread = inside ? -z : 1.2f;
+            const glm::vec3 centre(unit(random) * spread, unit(random) * spread * 0.8f, z);
+            const std::uint32_t first = std::uint32_t(positions.size());
+            for (int v = 0; v < 3; ++v)
+                positions.push_back(centre + glm::vec3(unit(random) * size, unit(random) * size, unit(random) * (inside ? 0.5f : 4.0f)));
+            triangles.push_back({first, first + 1, first + 2});
+            if (k % 7 == 0) triangles.push_back({first, first + 1, first + 2});  // a duplicate
+            if (k % 11 == 0) triangles.push_back({first, first + 2, first + 1});  // the other winding
+        }
+        return sceneOf(positions, triangles);
+    };
+    const Scene soups[2] = {soupOf(true), soupOf(false)};
+    for (const Scene& soup : soups) {
+        const RasterRenderer raster(soup);
+        for (const char* convention : {"opengl", "direct3d", "vulkan", "metal", "opencv"})
+            for (DepthFormat format : {DepthFormat::Unorm16, DepthFormat::Unorm24, DepthFormat::Float32})
+                for (bool reversed : {false, true})
+                    for (int variant = 0; variant < 3; ++variant) {
+                        const bool narrowRange = variant == 1;
+                        RasterFaults faults;
+                        faults.noNearClip = variant == 2;
+                        CameraSpec spec;
+                        spec.convention = Convention::preset(convention);
+                        spec.width = 203, spec.height = 141;
+                        spec.projection.fovyDeg = 70, spec.projection.near = 0.5, spec.projection.far = 9;
+                        spec.view = View::lookAt({0, 0, 0}, {0, 0, -1}, {0, 1, 0});
+                        spec.depth.format = format, spec.depth.reversed = reversed;
+                        if (narrowRange) spec.depth.rangeMin = 0.25, spec.depth.rangeMax = 0.75;
+                        const Camera camera(spec);
+                        INFO((&soup == &soups[0] ? "inside" : "clipped") << " soup, " << convention << ' ' << toString(format)
+                                                                          << (reversed ? " reversed" : "")
+                                                                          << (narrowRange ? " range [0.25, 0.75]" : "")
+                                                                          << (faults.noNearClip ? " no near clipping" : ""));
+                        const RenderResult scalar = renderWithKernel(raster, camera, "scalar", faults);
+                        const RenderResult chosen = renderWithKernel(raster, camera, nullptr, faults);
+                        const std::size_t pixels = std::size_t(spec.width) * spec.height;
+                        REQUIRE(std::count_if(scalar.primitiveId.begin(), scalar.primitiveId.end(), [](std::uint32_t id) {
+                                    return id != kNoPrimitive;
+                                }) > std::ptrdiff_t(pixels / 2));
+                        REQUIRE(std::memcmp(scalar.primitiveId.data(), chosen.primitiveId.data(), pixels * sizeof(std::uint32_t)) == 0);
+                        REQUIRE(std::memcmp(scalar.windowDepth.value.data(), chosen.windowDepth.value.data(),
+                                            pixels * sizeof(double)) == 0);
+                    }
     }
-    const Scene soup = sceneOf(positions, triangles);
-    const RasterRenderer raster(soup);
-    for (const char* convention : {"opengl", "direct3d", "vulkan", "metal", "opencv"})
-        for (DepthFormat format : {DepthFormat::Unorm16, DepthFormat::Unorm24, DepthFormat::Float32})
-            for (bool reversed : {false, true})
-                for (int variant = 0; variant < 3; ++variant) {
-                    const bool narrowRange = variant == 1;
-                    RasterFaults faults;
-                    faults.noNearClip = variant == 2;
-                    CameraSpec spec;
-                    spec.convention = Convention::preset(convention);
-                    spec.width = 203, spec.height = 141;
-                    spec.projection.fovyDeg = 70, spec.projection.near = 0.5, spec.projection.far = 9;
-                    spec.view = View::lookAt({0, 0, 0}, {0, 0, -1}, {0, 1, 0});
-                    spec.depth.format = format, spec.depth.reversed = reversed;
-                    if (narrowRange) spec.depth.rangeMin = 0.25, spec.depth.rangeMax = 0.75;
-                    const Camera camera(spec);
-                    INFO(convention << ' ' << toString(format) << (reversed ? " reversed" : "")
-                                    << (narrowRange ? " range [0.25, 0.75]" : "") << (faults.noNearClip ? " no near clipping" : ""));
-                    const RenderResult scalar = renderWithKernel(raster, camera, "scalar", faults);
-                    const RenderResult chosen = renderWithKernel(raster, camera, nullptr, faults);
-                    const std::size_t pixels = std::size_t(spec.width) * spec.height;
-                    REQUIRE(std::count_if(scalar.primitiveId.begin(), scalar.primitiveId.end(),
-                                          [](std::uint32_t id) { return id != kNoPrimitive; }) > std::ptrdiff_t(pixels / 2));
-                    REQUIRE(std::memcmp(scalar.primitiveId.data(), chosen.primitiveId.data(), pixels * sizeof(std::uint32_t)) == 0);
-                    REQUIRE(std::memcmp(scalar.windowDepth.value.data(), chosen.windowDepth.value.data(),
-                                        pixels * sizeof(double)) == 0);
-                }
     if (!__builtin_cpu_supports("avx512f") || !__builtin_cpu_supports("avx512dq") || !__builtin_cpu_supports("avx512vl"))
-        WARN("this processor has no AVX-512 (F, DQ, VL): both renders used the scalar loop");
+        WARN("this processor has no AVX-512 (F, DQ, VL): both renders used the scalar loops");
 }
 
 TEST_CASE("ZCHECK_RASTER_KERNEL takes auto or scalar and nothing else", "[raster][kernel]")

@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstddef>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -56,7 +57,9 @@ struct SnappedVertex {
 // A snapped vertex as the per-vertex array stores it, in 16 bytes instead of 32 (a million
 // triangles' vertices are 8 MB less to fault in and to pull through the caches per tile).
 // A valid vertex lies within 2·kMaxImageCoordinate pixels, i.e. |X|, |Y| < 2^29: int32 holds
-// it exactly; an invalid one is marked by X = INT32_MIN.
+// it exactly. X = INT32_MIN marks a vertex not snapped: Y = 0 for one inside every clip plane
+// that cannot be snapped, Y = its outcode for one outside a clip plane (so that the vector
+// set-up reads a vertex's outcode with its position).
 static_assert(2 * kMaxImageCoordinate * kSubpixel < 2147483648.0, "a valid snapped vertex fits int32");
 struct StoredVertex {
     double z;
@@ -66,6 +69,7 @@ struct StoredVertex {
     {
         return v.valid ? StoredVertex{v.z, std::int32_t(v.X), std::int32_t(v.Y)} : StoredVertex{0.0, INT32_MIN, 0};
     }
+    static StoredVertex outside(unsigned outcode) { return {0.0, INT32_MIN, std::int32_t(outcode)}; }
     SnappedVertex snapped() const { return {X, Y, z, X != INT32_MIN}; }
 };
 
@@ -322,6 +326,11 @@ void drawInTile(const Viewport& vp, const DepthKeys& keys, const TriangleSetup& 
 }
 
 #ifdef ZCHECK_RASTER_AVX512
+// GCC 12's intrinsics headers start many conversions from an "undefined" vector, which its
+// -W(maybe-)uninitialized then reports inside the headers (GCC bug 105593).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#pragma GCC diagnostic ignored "-Wuninitialized"
 #define ZCHECK_TARGET_AVX512 __attribute__((target("avx512f,avx512dq,avx512vl")))
 
 // std::clamp(v, lo, hi) per lane: v < lo ? lo : hi < v ? hi : v, NaN and signed zeros included.
@@ -362,9 +371,6 @@ ZCHECK_TARGET_AVX512 void drawInTileAvx512(const DepthSettings& depth, const Dep
     const __m512d maxCode = _mm512_set1_pd(keys.maxCode);
     const __m512d noFractionBits = _mm512_set1_pd(4503599627370496.0);  // nearbyintNonNegative's 2^52
     const __m256i primitive = _mm256_set1_epi32(int(t.primitive));
-    // The zero-masking form with every lane on: the plain one trips GCC 12's
-    // -Wmaybe-uninitialized inside its own headers (GCC bug 105593).
-    const __mmask8 all = 0xFF;
     // No branch on coverage: a group with no pixel covered stores nothing (its masks are
     // empty), and a branch on it was mispredicted often enough to cost 5 %.
     for (int row = row0; row <= row1; ++row) {
@@ -383,7 +389,7 @@ ZCHECK_TARGET_AVX512 void drawInTileAvx512(const DepthSettings& depth, const Dep
             // so it returns every clamped value unchanged (NaN and −0 included).
             const __m512d key =
                 keys.unorm ? _mm512_sub_pd(_mm512_add_pd(_mm512_mul_pd(windowDepth, maxCode), noFractionBits), noFractionBits)
-                           : _mm512_maskz_cvtps_pd(all, _mm512_maskz_cvtpd_ps(all, windowDepth));
+                           : _mm512_cvtps_pd(_mm512_cvtpd_ps(windowDepth));
             const __m512d stored = _mm512_maskz_loadu_pd(covered, keyRow + col);
             const __mmask8 nearer = depth.reversed ? _mm512_mask_cmp_pd_mask(covered, stored, key, _CMP_LT_OQ)
                                                    : _mm512_mask_cmp_pd_mask(covered, key, stored, _CMP_LT_OQ);
@@ -395,12 +401,80 @@ ZCHECK_TARGET_AVX512 void drawInTileAvx512(const DepthSettings& depth, const Dep
         rowE0 = _mm512_add_epi64(rowE0, down0), rowE1 = _mm512_add_epi64(rowE1, down1), rowE2 = _mm512_add_epi64(rowE2, down2);
     }
 }
+
+// The prepare stage's loop body for triangles p .. p+7 at once: the bin items of those whose
+// vertices all lie inside every clip plane, appended in submission order with the boxes
+// coveredBox gives (the same int64 area, the same int32 box arithmetic); those wholly outside
+// one plane are skipped. Returns false, appending nothing, when one of the eight needs
+// clipping: the scalar loop then takes all eight, so that the order of items stays. Outcodes
+// come from the stored vertices (StoredVertex::outside), not from the outcode array.
+static_assert(sizeof(glm::uvec3) == 12 && sizeof(StoredVertex) == 16 && offsetof(StoredVertex, X) == 8 &&
+                  offsetof(StoredVertex, Y) == 12,
+              "the gathers' strides and offsets");
+ZCHECK_TARGET_AVX512 bool binItemsOfEight(const Viewport& vp, const glm::uvec3* triangles, std::uint32_t p,
+                                           const StoredVertex* snapped, std::vector<BinItem>& items)
+{
+    // The eight triangles' 24 vertex indices, loaded as they lie and dealt out by corner.
+    const int* corners = reinterpret_cast<const int*>(triangles + p);
+    const __m512i indices0to15 = _mm512_loadu_si512(corners);
+    const __m512i indices16to23 = _mm512_zextsi256_si512(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(corners + 16)));
+    // X and Y of each corner, one 64-bit gather (X in the low half); a vertex not snapped
+    // (X = INT32_MIN) holds its outcode in Y (StoredVertex).
+    const char* xyBase = reinterpret_cast<const char*>(snapped) + offsetof(StoredVertex, X);
+    const __m256i notSnapped = _mm256_set1_epi32(INT32_MIN);
+    __m256i X[3], Y[3];
+    __m256i orCodes = _mm256_setzero_si256(), andCodes = _mm256_set1_epi32(-1);
+    __mmask8 snappedAll = 0xFF;
+    for (int k = 0; k < 3; ++k) {
+        const __m512i corner = _mm512_add_epi32(_mm512_set_epi32(0, 0, 0, 0, 0, 0, 0, 0, 21, 18, 15, 12, 9, 6, 3, 0),
+                                                _mm512_set1_epi32(k));
+        const __m256i vertex = _mm512_castsi512_si256(_mm512_permutex2var_epi32(indices0to15, corner, indices16to23));
+        const __m512i xy = _mm512_i64gather_epi64(_mm512_slli_epi64(_mm512_cvtepu32_epi64(vertex), 1), xyBase, 8);
+        X[k] = _mm512_cvtepi64_epi32(xy), Y[k] = _mm512_cvtepi64_epi32(_mm512_srli_epi64(xy, 32));
+        const __mmask8 isSnapped = _mm256_cmpneq_epi32_mask(X[k], notSnapped);
+        const __m256i code = _mm256_maskz_mov_epi32(__mmask8(~isSnapped), Y[k]);
+        orCodes = _mm256_or_si256(orCodes, code), andCodes = _mm256_and_si256(andCodes, code);
+        snappedAll &= isSnapped;
+    }
+    const __mmask8 inside = _mm256_cmpeq_epi32_mask(orCodes, _mm256_setzero_si256());
+    const __mmask8 outsideOne = _mm256_test_epi32_mask(andCodes, andCodes);
+    if (__mmask8(~(inside | outsideOne))) return false;  // one needs clipping
+    __mmask8 keep = inside & snappedAll;
+    // coveredBox's twice signed area, in int64.
+    __m512i wide[3][2];  // [corner][X, Y]
+    for (int k = 0; k < 3; ++k) wide[k][0] = _mm512_cvtepi32_epi64(X[k]), wide[k][1] = _mm512_cvtepi32_epi64(Y[k]);
+    const __m512i area2 = _mm512_sub_epi64(
+        _mm512_mullo_epi64(_mm512_sub_epi64(wide[1][0], wide[0][0]), _mm512_sub_epi64(wide[2][1], wide[0][1])),
+        _mm512_mullo_epi64(_mm512_sub_epi64(wide[1][1], wide[0][1]), _mm512_sub_epi64(wide[2][0], wide[0][0])));
+    keep &= _mm512_test_epi64_mask(area2, area2);
+    // coveredBox's box: firstCentre (lo + 127) >> 8 and lastCentre (hi − 128) >> 8, inside the image.
+    const __m256i zero = _mm256_setzero_si256();
+    const __m256i firstOffset = _mm256_set1_epi32(int(kSubpixel - 1 - kHalfPixel)), lastOffset = _mm256_set1_epi32(int(kHalfPixel));
+    constexpr int kBits = RasterRenderer::kSubpixelBits;
+    const __m256i firstCol = _mm256_max_epi32(zero, _mm256_srai_epi32(_mm256_add_epi32(_mm256_min_epi32(_mm256_min_epi32(X[0], X[1]), X[2]), firstOffset), kBits));
+    const __m256i lastCol = _mm256_min_epi32(_mm256_set1_epi32(vp.width - 1), _mm256_srai_epi32(_mm256_sub_epi32(_mm256_max_epi32(_mm256_max_epi32(X[0], X[1]), X[2]), lastOffset), kBits));
+    const __m256i firstRow = _mm256_max_epi32(zero, _mm256_srai_epi32(_mm256_add_epi32(_mm256_min_epi32(_mm256_min_epi32(Y[0], Y[1]), Y[2]), firstOffset), kBits));
+    const __m256i lastRow = _mm256_min_epi32(_mm256_set1_epi32(vp.height - 1), _mm256_srai_epi32(_mm256_sub_epi32(_mm256_max_epi32(_mm256_max_epi32(Y[0], Y[1]), Y[2]), lastOffset), kBits));
+    alignas(32) int minCol[8], maxCol[8], minRow[8], maxRow[8];
+    _mm256_store_si256(reinterpret_cast<__m256i*>(minCol), firstCol);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(maxCol), lastCol);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(minRow), firstRow);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(maxRow), lastRow);
+    keep &= _mm256_cmple_epi32_mask(firstCol, lastCol) & _mm256_cmple_epi32_mask(firstRow, lastRow);
+    for (unsigned bits = keep; bits; bits &= bits - 1) {
+        const int k = __builtin_ctz(bits);
+        items.push_back({p + std::uint32_t(k), {minCol[k], maxCol[k], minRow[k], maxRow[k]}});
+    }
+    return true;
+}
+#pragma GCC diagnostic pop
 #endif
 
-// How the clean chain's pixels are drawn: eight at a time where the processor has AVX-512
-// (F, DQ, VL), one at a time otherwise. ZCHECK_RASTER_KERNEL=scalar forces the scalar loop
-// (tests compare the two bit for bit); any other value but "auto" is an error.
-bool useVectorDraw()
+// Whether the vector kernels run (the clean chain's pixels eight at a time, the set-up of
+// eight triangles at a time): where the processor has AVX-512 (F, DQ, VL). Elsewhere, or
+// with ZCHECK_RASTER_KERNEL=scalar, the scalar loops do (tests compare the two bit for bit);
+// any other value but "auto" is an error.
+bool useVectorKernels()
 {
     const char* requested = std::getenv("ZCHECK_RASTER_KERNEL");
     if (requested && std::strcmp(requested, "scalar") == 0) return false;
@@ -422,7 +496,8 @@ RasterRenderer::RasterRenderer(const Scene& scene) : scene_(scene) { validateSce
 struct RasterFrame::Impl {
     Impl(const Scene& s, const Camera& c, const RasterFaults& f)
         : scene(s), camera(c), faults(f), vp(camera, faults), keys(camera.depth().format),
-          clearKey(keys.keyOfStored(camera.clearDepth())), vectorDraw(!vp.pixelFaults && useVectorDraw())
+          clearKey(keys.keyOfStored(camera.clearDepth())), vectorKernels(useVectorKernels()),
+          vectorDraw(vectorKernels && !vp.pixelFaults)
     {
     }
 
@@ -436,7 +511,8 @@ struct RasterFrame::Impl {
     const Viewport vp;
     const DepthKeys keys;
     const double clearKey;
-    const bool vectorDraw;  // drawInTileAvx512 for the clean chain (useVectorDraw)
+    const bool vectorKernels;  // useVectorKernels: binItemsOfEight, and for the clean chain
+    const bool vectorDraw;     // drawInTileAvx512
     LargeVector<StoredVertex> snapped;  // per vertex, set where inside every clip plane (outcode 0)
     LargeVector<unsigned char> outcode;
     std::vector<Chunk> chunks;
@@ -446,15 +522,14 @@ void RasterFrame::Impl::prepare()
 {
     // Vertices to clip space in double, their outcodes, and those inside every clip plane
     // snapped once (a vertex outside one is snapped only where clipping made it).
-    // Uninitialised: the loop below writes every outcode, and every snapped vertex that is
-    // ever read (a triangle's vertices are read only when all three have outcode 0).
+    // Uninitialised: the loop below writes every outcode and every stored vertex.
     snapped.resize(scene.positions.size());
     outcode.resize(scene.positions.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, snapped.size(), 4096), [&](const auto& range) {
         for (std::size_t v = range.begin(); v != range.end(); ++v) {
             const glm::dvec4 pClip = clipOf(std::uint32_t(v));
             outcode[v] = static_cast<unsigned char>(vp.outcode(pClip));
-            if (outcode[v] == 0) snapped[v] = StoredVertex::from(snapVertex(vp, pClip));
+            snapped[v] = outcode[v] == 0 ? StoredVertex::from(snapVertex(vp, pClip)) : StoredVertex::outside(outcode[v]);
         }
     });
 
@@ -468,22 +543,31 @@ void RasterFrame::Impl::prepare()
         const std::size_t first = c * kChunkTriangles, last = std::min(triangleCount, first + kChunkTriangles);
         std::vector<BinItem> items;
         items.reserve(last - first);
-        PixelBox box;
-        std::int64_t area2;
-        for (std::size_t p = first; p < last; ++p) {
+        auto setUp = [&](std::size_t p) {
             const glm::uvec3& tri = scene.triangles[p];
             const unsigned codeA = outcode[tri[0]], codeB = outcode[tri[1]], codeC = outcode[tri[2]];
-            if (codeA & codeB & codeC) continue;  // wholly outside one plane
+            if (codeA & codeB & codeC) return;  // wholly outside one plane
             if ((codeA | codeB | codeC) == 0) {
+                PixelBox box;
+                std::int64_t area2;
                 if (coveredBox(vp, snapped[tri[0]].snapped(), snapped[tri[1]].snapped(), snapped[tri[2]].snapped(), box, area2))
                     items.push_back({std::uint32_t(p), box});
-                continue;
+                return;
             }
             const std::size_t before = chunk.clipped.size();
             setupClippedPrimitive(vp, clipOf(tri[0]), clipOf(tri[1]), clipOf(tri[2]), std::uint32_t(p), chunk.clipped);
             for (std::size_t k = before; k < chunk.clipped.size(); ++k)
                 items.push_back({kClippedBit | std::uint32_t(k), chunk.clipped[k].box});
-        }
+        };
+        std::size_t p = first;
+#ifdef ZCHECK_RASTER_AVX512
+        // Vertex indices are gathered as int32: below 2^31 vertices (a 24 GiB scene) only.
+        if (vectorKernels && scene.positions.size() < kClippedBit)
+            for (; p + 8 <= last; p += 8)
+                if (!binItemsOfEight(vp, scene.triangles.data(), std::uint32_t(p), snapped.data(), items))
+                    for (std::size_t q = p; q < p + 8; ++q) setUp(q);
+#endif
+        for (; p < last; ++p) setUp(p);
         binChunk(vp, items, chunk);
     });
 }
