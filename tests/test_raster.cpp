@@ -242,8 +242,8 @@ TEST_CASE("the vector kernels are bit-identical to the scalar loops", "[raster][
     // of the range), so most runs of eight hold one that needs clipping and go to the scalar
     // set-up. Every convention, format, reversed-Z and a narrowed depth range, on an image
     // the tiles cut on both edges; and with the fault "no near clipping", whose depths in front
-    // of the near plane leave the depth range (the clamp to it then decides). Compared bit for
-    // bit (memcmp), so a signed zero would show.
+    // of the near plane leave the depth range (the clamp to it then decides), and two other
+    // faults of the vertex stage. Compared bit for bit (memcmp), so a signed zero would show.
     std::mt19937 random(20261126);
     std::uniform_real_distribution<float> unit(-1.0f, 1.0f), depth(-12.0f, -0.2f), depthInside(-7.0f, -1.5f);
     auto soupOf = [&](bool inside) {
@@ -268,10 +268,12 @@ TEST_CASE("the vector kernels are bit-identical to the scalar loops", "[raster][
         for (const char* convention : {"opengl", "direct3d", "vulkan", "metal", "opencv"})
             for (DepthFormat format : {DepthFormat::Unorm16, DepthFormat::Unorm24, DepthFormat::Float32})
                 for (bool reversed : {false, true})
-                    for (int variant = 0; variant < 3; ++variant) {
+                    for (int variant = 0; variant < 5; ++variant) {
                         const bool narrowRange = variant == 1;
                         RasterFaults faults;
                         faults.noNearClip = variant == 2;
+                        faults.viewportMinusOne = variant == 3;
+                        faults.screenLinearEyeZ = variant == 4;  // the scalar loops only
                         CameraSpec spec;
                         spec.convention = Convention::preset(convention);
                         spec.width = 203, spec.height = 141;
@@ -283,7 +285,9 @@ TEST_CASE("the vector kernels are bit-identical to the scalar loops", "[raster][
                         INFO((&soup == &soups[0] ? "inside" : "clipped") << " soup, " << convention << ' ' << toString(format)
                                                                           << (reversed ? " reversed" : "")
                                                                           << (narrowRange ? " range [0.25, 0.75]" : "")
-                                                                          << (faults.noNearClip ? " no near clipping" : ""));
+                                                                          << (faults.noNearClip ? " no near clipping" : "")
+                                                                          << (faults.viewportMinusOne ? " viewport − 1" : "")
+                                                                          << (faults.screenLinearEyeZ ? " eye-z in screen space" : ""));
                         const RenderResult scalar = renderWithKernel(raster, camera, "scalar", faults);
                         const RenderResult chosen = renderWithKernel(raster, camera, nullptr, faults);
                         const std::size_t pixels = std::size_t(spec.width) * spec.height;

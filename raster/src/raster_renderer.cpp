@@ -402,6 +402,86 @@ ZCHECK_TARGET_AVX512 void drawInTileAvx512(const DepthSettings& depth, const Dep
     }
 }
 
+// Matrix column c, row r of a glm::dmat4 (m[c][r]) in every lane.
+ZCHECK_TARGET_AVX512 inline __m512d broadcast(const glm::dmat4& m, int c, int r) { return _mm512_set1_pd(m[c][r]); }
+
+// Row r of m · (x, y, z, 1) in glm's order: (m0·x + m1·y) + (m2·z + m3·1).
+ZCHECK_TARGET_AVX512 inline __m512d transformRow(const glm::dmat4& m, int r, __m512d x, __m512d y, __m512d z)
+{
+    return _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(broadcast(m, 0, r), x), _mm512_mul_pd(broadcast(m, 1, r), y)),
+                         _mm512_add_pd(_mm512_mul_pd(broadcast(m, 2, r), z), broadcast(m, 3, r)));
+}
+
+// roundHalfAwayFromZero per lane (|x| < 2^52): the truncation and the fraction are exact.
+ZCHECK_TARGET_AVX512 inline __m512i roundHalfAwayFromZero(__m512d x)
+{
+    const __m512i t = _mm512_cvttpd_epi64(x);
+    const __m512d fraction = _mm512_sub_pd(x, _mm512_cvtepi64_pd(t));
+    const __mmask8 up = _mm512_cmp_pd_mask(fraction, _mm512_set1_pd(0.5), _CMP_GE_OQ);
+    const __mmask8 down = _mm512_cmp_pd_mask(fraction, _mm512_set1_pd(-0.5), _CMP_LE_OQ);
+    const __m512i one = _mm512_set1_epi64(1);
+    const __m512i roundedUp = _mm512_mask_add_epi64(t, up, t, one);
+    return _mm512_mask_sub_epi64(roundedUp, down, roundedUp, one);
+}
+
+// The vertex stage for vertices v .. v+7 at once: clip space, outcodes and stored vertices
+// exactly as clipOf, Viewport::outcode, snapVertex and StoredVertex compute them one by one
+// (glm's order of operations for a matrix times a vector and for a dot product). Not for the
+// fault that interpolates eye-z (snapVertex's z is then another quantity).
+ZCHECK_TARGET_AVX512 void snapEight(const Viewport& vp, const glm::vec3* positions, std::size_t v, unsigned char* outcode,
+                                     StoredVertex* stored)
+{
+    static_assert(sizeof(glm::vec3) == 12, "positions are three packed floats");
+    const float* xyz = reinterpret_cast<const float*>(positions + v);
+    const __m512 first16 = _mm512_loadu_ps(xyz);
+    const __m512 last8 = _mm512_zextps256_ps512(_mm256_loadu_ps(xyz + 16));
+    __m512d p[3];
+    for (int k = 0; k < 3; ++k) {
+        const __m512i corner = _mm512_add_epi32(_mm512_set_epi32(0, 0, 0, 0, 0, 0, 0, 0, 21, 18, 15, 12, 9, 6, 3, 0),
+                                                _mm512_set1_epi32(k));
+        p[k] = _mm512_cvtps_pd(_mm512_castps512_ps256(_mm512_permutex2var_ps(first16, corner, last8)));
+    }
+    __m512d clip[4];
+    for (int r = 0; r < 4; ++r) clip[r] = transformRow(vp.clipFromWorld, r, p[0], p[1], p[2]);
+    // Outcodes: plane · pClip < 0, the dot product as glm's (t.x + t.y) + (t.z + t.w).
+    __m512i code = _mm512_setzero_si512();
+    for (int k = 0; k < vp.planes.size; ++k) {
+        const glm::dvec4& plane = vp.planes.plane[k];
+        const __m512d dot = _mm512_add_pd(
+            _mm512_add_pd(_mm512_mul_pd(_mm512_set1_pd(plane.x), clip[0]), _mm512_mul_pd(_mm512_set1_pd(plane.y), clip[1])),
+            _mm512_add_pd(_mm512_mul_pd(_mm512_set1_pd(plane.z), clip[2]), _mm512_mul_pd(_mm512_set1_pd(plane.w), clip[3])));
+        code = _mm512_mask_or_epi64(code, _mm512_cmp_pd_mask(dot, _mm512_setzero_pd(), _CMP_LT_OQ), code,
+                                    _mm512_set1_epi64(std::int64_t(1) << k));
+    }
+    _mm512_mask_cvtepi64_storeu_epi8(outcode + v, 0xFF, code);
+    // Divide, viewport, image rows top-down, snap (snapVertex); lanes outside a plane are
+    // computed too and then replaced (StoredVertex::outside).
+    __m512d ndc[3];
+    for (int k = 0; k < 3; ++k) ndc[k] = _mm512_div_pd(clip[k], clip[3]);
+    const __m512d windowX = transformRow(vp.windowFromNdc, 0, ndc[0], ndc[1], ndc[2]);
+    const __m512d windowY = transformRow(vp.windowFromNdc, 1, ndc[0], ndc[1], ndc[2]);
+    const __m512d windowZ = transformRow(vp.windowFromNdc, 2, ndc[0], ndc[1], ndc[2]);
+    const __m512d imageY = vp.camera.convention().windowOriginTop
+                               ? windowY
+                               : _mm512_sub_pd(_mm512_set1_pd(double(vp.camera.height())), windowY);
+    const __m512d limit = _mm512_set1_pd(2 * kMaxImageCoordinate);
+    const __mmask8 inside = _mm512_cmpeq_epi64_mask(code, _mm512_setzero_si512());
+    const __mmask8 valid = inside & _mm512_cmp_pd_mask(_mm512_abs_pd(windowX), limit, _CMP_LT_OQ) &
+                           _mm512_cmp_pd_mask(_mm512_abs_pd(imageY), limit, _CMP_LT_OQ);
+    const __m512d subpixel = _mm512_set1_pd(double(kSubpixel));
+    const __m512i X = roundHalfAwayFromZero(_mm512_mul_pd(windowX, subpixel));
+    const __m512i Y = roundHalfAwayFromZero(_mm512_mul_pd(imageY, subpixel));
+    // StoredVertex: snapped {z, X, Y}; not snappable {0, INT32_MIN, 0}; outside {0, INT32_MIN, outcode}.
+    const __m512i notSnapped = _mm512_set1_epi64(std::int64_t(std::uint32_t(INT32_MIN)));
+    const __m512i xy = _mm512_mask_or_epi64(_mm512_or_si512(notSnapped, _mm512_slli_epi64(code, 32)), valid,
+                                            _mm512_and_si512(X, _mm512_set1_epi64(0xFFFFFFFF)), _mm512_slli_epi64(Y, 32));
+    const __m512d z = _mm512_maskz_mov_pd(valid, windowZ);
+    const __m512d xyAsDouble = _mm512_castsi512_pd(xy);
+    double* out = reinterpret_cast<double*>(stored + v);
+    _mm512_storeu_pd(out, _mm512_permutex2var_pd(z, _mm512_set_epi64(11, 3, 10, 2, 9, 1, 8, 0), xyAsDouble));
+    _mm512_storeu_pd(out + 8, _mm512_permutex2var_pd(z, _mm512_set_epi64(15, 7, 14, 6, 13, 5, 12, 4), xyAsDouble));
+}
+
 // The prepare stage's loop body for triangles p .. p+7 at once: the bin items of those whose
 // vertices all lie inside every clip plane, appended in submission order with the boxes
 // coveredBox gives (the same int64 area, the same int32 box arithmetic); those wholly outside
@@ -525,8 +605,14 @@ void RasterFrame::Impl::prepare()
     // Uninitialised: the loop below writes every outcode and every stored vertex.
     snapped.resize(scene.positions.size());
     outcode.resize(scene.positions.size());
+    const bool vectorVertices = vectorKernels && !faults.screenLinearEyeZ;  // snapEight's condition
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, snapped.size(), 4096), [&](const auto& range) {
-        for (std::size_t v = range.begin(); v != range.end(); ++v) {
+        std::size_t v = range.begin();
+#ifdef ZCHECK_RASTER_AVX512
+        if (vectorVertices)
+            for (; v + 8 <= range.end(); v += 8) snapEight(vp, scene.positions.data(), v, outcode.data(), snapped.data());
+#endif
+        for (; v != range.end(); ++v) {
             const glm::dvec4 pClip = clipOf(std::uint32_t(v));
             outcode[v] = static_cast<unsigned char>(vp.outcode(pClip));
             snapped[v] = outcode[v] == 0 ? StoredVertex::from(snapVertex(vp, pClip)) : StoredVertex::outside(outcode[v]);
