@@ -3,6 +3,8 @@
 // binned into tiles as in Abrash's Larrabee rasterizer.
 #include "zcheck/raster_renderer.h"
 
+#include "raster_testing.h"
+
 #include "zcheck/clip.h"
 #include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
@@ -567,7 +569,49 @@ bool useVectorKernels()
 #endif
 }
 
+glm::dvec4 clipOf(const Viewport& vp, const glm::vec3& position)
+{
+    return vp.clipFromWorld * glm::dvec4(glm::dvec3(position), 1.0);
+}
+
+// The vertex stage: every vertex to clip space in double, its outcode, and its stored vertex
+// (snapped where inside every clip plane, StoredVertex::outside where not): eight at a time
+// with `vector` (snapEight; the caller checks its condition), one at a time otherwise. Writes
+// every element of both arrays, which are resized uninitialised.
+void vertexStage(const Viewport& vp, const std::vector<glm::vec3>& positions, bool vector,
+                 LargeVector<unsigned char>& outcode, LargeVector<StoredVertex>& stored)
+{
+    stored.resize(positions.size());
+    outcode.resize(positions.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, positions.size(), 4096), [&](const auto& range) {
+        std::size_t v = range.begin();
+#ifdef ZCHECK_RASTER_AVX512
+        if (vector)
+            for (; v + 8 <= range.end(); v += 8) snapEight(vp, positions.data(), v, outcode.data(), stored.data());
+#else
+        (void)vector;
+#endif
+        for (; v != range.end(); ++v) {
+            const glm::dvec4 pClip = clipOf(vp, positions[v]);
+            outcode[v] = static_cast<unsigned char>(vp.outcode(pClip));
+            stored[v] = outcode[v] == 0 ? StoredVertex::from(snapVertex(vp, pClip)) : StoredVertex::outside(outcode[v]);
+        }
+    });
+}
+
 }  // namespace
+
+std::vector<RasterVertexForTesting> rasterVertexStageForTesting(const Scene& scene, const Camera& camera,
+                                                                const RasterFaults& faults, bool vector)
+{
+    const Viewport vp(camera, faults);
+    LargeVector<unsigned char> outcode;
+    LargeVector<StoredVertex> stored;
+    vertexStage(vp, scene.positions, vector && useVectorKernels() && !faults.screenLinearEyeZ, outcode, stored);
+    std::vector<RasterVertexForTesting> out(stored.size());
+    for (std::size_t v = 0; v < stored.size(); ++v) out[v] = {outcode[v], stored[v].X, stored[v].Y, stored[v].z};
+    return out;
+}
 
 RasterRenderer::RasterRenderer(const Scene& scene) : scene_(scene) { validateScene(scene); }
 
@@ -581,7 +625,7 @@ struct RasterFrame::Impl {
     {
     }
 
-    glm::dvec4 clipOf(std::uint32_t v) const { return vp.clipFromWorld * glm::dvec4(glm::dvec3(scene.positions[v]), 1.0); }
+    glm::dvec4 clipOf(std::uint32_t v) const { return zcheck::clipOf(vp, scene.positions[v]); }
     void prepare();
     void drawTile(int tile, double* windowDepth, std::uint32_t* primitive, std::size_t stride) const;
 
@@ -602,22 +646,7 @@ void RasterFrame::Impl::prepare()
 {
     // Vertices to clip space in double, their outcodes, and those inside every clip plane
     // snapped once (a vertex outside one is snapped only where clipping made it).
-    // Uninitialised: the loop below writes every outcode and every stored vertex.
-    snapped.resize(scene.positions.size());
-    outcode.resize(scene.positions.size());
-    const bool vectorVertices = vectorKernels && !faults.screenLinearEyeZ;  // snapEight's condition
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, snapped.size(), 4096), [&](const auto& range) {
-        std::size_t v = range.begin();
-#ifdef ZCHECK_RASTER_AVX512
-        if (vectorVertices)
-            for (; v + 8 <= range.end(); v += 8) snapEight(vp, scene.positions.data(), v, outcode.data(), snapped.data());
-#endif
-        for (; v != range.end(); ++v) {
-            const glm::dvec4 pClip = clipOf(std::uint32_t(v));
-            outcode[v] = static_cast<unsigned char>(vp.outcode(pClip));
-            snapped[v] = outcode[v] == 0 ? StoredVertex::from(snapVertex(vp, pClip)) : StoredVertex::outside(outcode[v]);
-        }
-    });
+    vertexStage(vp, scene.positions, vectorKernels && !faults.screenLinearEyeZ, outcode, snapped);
 
     // Set-up and binning, one fixed-size chunk of triangles per task.
     const std::size_t triangleCount = scene.triangles.size();
