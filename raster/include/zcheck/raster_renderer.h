@@ -19,6 +19,12 @@
 // order; tiles are then drawn in parallel, each walking the chunks in order. The result is
 // bit-identical for any number of threads.
 //
+// Where the processor has AVX-512 (F, DQ, VL), the vertex stage, the set-up and the clean
+// chain's pixels run eight at a time, with the same integer and double operations in the same
+// order as the scalar loops (no FMA contraction), so the result is bit-identical to theirs;
+// the environment variable ZCHECK_RASTER_KERNEL=scalar forces the scalar loops, "auto" (or
+// unset) picks, and any other value makes render() and prepare() throw Error.
+//
 //   const zcheck::RasterRenderer raster(scene);
 //   const zcheck::RenderResult drawn = raster.render(camera);   // drawn.windowDepth: stored values
 #include "zcheck/render.h"
