@@ -12,7 +12,9 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <optional>
 #include <random>
+#include <string>
 
 using namespace zcheck;
 
@@ -220,13 +222,52 @@ TEST_CASE("the raster result is bit-identical for any number of threads", "[rast
 
 namespace {
 
+// 3000 triangles from sub-pixel slivers to ones spanning several 64×64 tiles of a 203×141
+// image through kernelCamera, with exact duplicates under other ids and both windings.
+// `inside`: all between its near and far planes, anywhere in the view and past its edges;
+// otherwise most cross the near or far plane.
+Scene triangleSoup(bool inside, std::uint32_t seed)
+{
+    std::mt19937 random(seed);
+    std::uniform_real_distribution<float> unit(-1.0f, 1.0f), depth(-12.0f, -0.2f), depthInside(-7.0f, -1.5f);
+    std::vector<glm::vec3> positions;
+    std::vector<glm::uvec3> triangles;
+    for (int k = 0; k < 3000; ++k) {
+        const float size = std::pow(10.0f, unit(random) * 1.5f - 1.0f);  // 0.003 to 3 (image ≈ 2 wide at z = −1)
+        const float z = inside ? depthInside(random) : depth(random), spread = inside ? -z : 1.2f;
+        const glm::vec3 centre(unit(random) * spread, unit(random) * spread * 0.8f, z);
+        const std::uint32_t first = std::uint32_t(positions.size());
+        for (int v = 0; v < 3; ++v)
+            positions.push_back(centre + glm::vec3(unit(random) * size, unit(random) * size, unit(random) * (inside ? 0.5f : 4.0f)));
+        triangles.push_back({first, first + 1, first + 2});
+        if (k % 7 == 0) triangles.push_back({first, first + 1, first + 2});  // a duplicate
+        if (k % 11 == 0) triangles.push_back({first, first + 2, first + 1});  // the other winding
+    }
+    return sceneOf(positions, triangles);
+}
+
+// The soups' camera: 203×141 (cut by the tiles on both edges), fovy 70°, near 0.5, far 9.
+CameraSpec kernelCamera(const char* convention, DepthFormat format, bool reversed, bool narrowRange)
+{
+    CameraSpec spec;
+    spec.convention = Convention::preset(convention);
+    spec.width = 203, spec.height = 141;
+    spec.projection.fovyDeg = 70, spec.projection.near = 0.5, spec.projection.far = 9;
+    spec.view = View::lookAt({0, 0, 0}, {0, 0, -1}, {0, 1, 0});
+    spec.depth.format = format, spec.depth.reversed = reversed;
+    if (narrowRange) spec.depth.rangeMin = 0.25, spec.depth.rangeMax = 0.75;
+    return spec;
+}
+
 // Renders with ZCHECK_RASTER_KERNEL set to `kernel` (nullptr: unset, the default choice).
 RenderResult renderWithKernel(const RasterRenderer& raster, const Camera& camera, const char* kernel,
                               const RasterFaults& faults = {})
 {
-    struct Unset {  // also when render() throws: later tests in this process see no variable
-        ~Unset() { unsetenv("ZCHECK_RASTER_KERNEL"); }
-    } unsetAfter;
+    struct Restore {  // also when render() throws: later tests see the variable as it was
+        std::optional<std::string> before;
+        ~Restore() { before ? setenv("ZCHECK_RASTER_KERNEL", before->c_str(), 1) : unsetenv("ZCHECK_RASTER_KERNEL"); }
+    } restore;
+    if (const char* value = std::getenv("ZCHECK_RASTER_KERNEL")) restore.before = value;
     if (kernel) setenv("ZCHECK_RASTER_KERNEL", kernel, 1);
     else unsetenv("ZCHECK_RASTER_KERNEL");
     return raster.render(camera, faults);
@@ -246,25 +287,7 @@ TEST_CASE("the vector kernels are bit-identical to the scalar loops", "[raster][
     // the tiles cut on both edges; and with the fault "no near clipping", whose depths in front
     // of the near plane leave the depth range (the clamp to it then decides), and two other
     // faults of the vertex stage. Compared bit for bit (memcmp), so a signed zero would show.
-    std::mt19937 random(20261126);
-    std::uniform_real_distribution<float> unit(-1.0f, 1.0f), depth(-12.0f, -0.2f), depthInside(-7.0f, -1.5f);
-    auto soupOf = [&](bool inside) {
-        std::vector<glm::vec3> positions;
-        std::vector<glm::uvec3> triangles;
-        for (int k = 0; k < 3000; ++k) {
-            const float size = std::pow(10.0f, unit(random) * 1.5f - 1.0f);  // 0.003 to 3 (image ≈ 2 wide at z = −1)
-            const float z = inside ? depthInside(random) : depth(random), spread = inside ? -z : 1.2f;
-            const glm::vec3 centre(unit(random) * spread, unit(random) * spread * 0.8f, z);
-            const std::uint32_t first = std::uint32_t(positions.size());
-            for (int v = 0; v < 3; ++v)
-                positions.push_back(centre + glm::vec3(unit(random) * size, unit(random) * size, unit(random) * (inside ? 0.5f : 4.0f)));
-            triangles.push_back({first, first + 1, first + 2});
-            if (k % 7 == 0) triangles.push_back({first, first + 1, first + 2});  // a duplicate
-            if (k % 11 == 0) triangles.push_back({first, first + 2, first + 1});  // the other winding
-        }
-        return sceneOf(positions, triangles);
-    };
-    const Scene soups[2] = {soupOf(true), soupOf(false)};
+    const Scene soups[2] = {triangleSoup(true, 20261126), triangleSoup(false, 20261127)};
     for (const Scene& soup : soups) {
         const RasterRenderer raster(soup);
         for (const char* convention : {"opengl", "direct3d", "vulkan", "metal", "opencv"})
@@ -276,13 +299,7 @@ TEST_CASE("the vector kernels are bit-identical to the scalar loops", "[raster][
                         faults.noNearClip = variant == 2;
                         faults.viewportMinusOne = variant == 3;
                         faults.screenLinearEyeZ = variant == 4;  // the scalar loops only
-                        CameraSpec spec;
-                        spec.convention = Convention::preset(convention);
-                        spec.width = 203, spec.height = 141;
-                        spec.projection.fovyDeg = 70, spec.projection.near = 0.5, spec.projection.far = 9;
-                        spec.view = View::lookAt({0, 0, 0}, {0, 0, -1}, {0, 1, 0});
-                        spec.depth.format = format, spec.depth.reversed = reversed;
-                        if (narrowRange) spec.depth.rangeMin = 0.25, spec.depth.rangeMax = 0.75;
+                        const CameraSpec spec = kernelCamera(convention, format, reversed, narrowRange);
                         const Camera camera(spec);
                         INFO((&soup == &soups[0] ? "inside" : "clipped") << " soup, " << convention << ' ' << toString(format)
                                                                           << (reversed ? " reversed" : "")
@@ -303,6 +320,40 @@ TEST_CASE("the vector kernels are bit-identical to the scalar loops", "[raster][
     }
     if (!__builtin_cpu_supports("avx512f") || !__builtin_cpu_supports("avx512dq") || !__builtin_cpu_supports("avx512vl"))
         WARN("this processor has no AVX-512 (F, DQ, VL): both renders used the scalar loops");
+}
+
+TEST_CASE("the vector draw kernel's depth arithmetic equals the scalar loop's to 2^-52", "[raster][kernel]")
+{
+    // White-box: a last-bit difference in a pixel's interpolated depth would almost never
+    // survive unorm or float32 quantization, so both kernels draw with depth keys of 2^52
+    // steps (rasterRenderWithFineKeysForTesting): such a difference then shows in about half
+    // the pixels it touches. The soup wholly inside the depth range, every convention,
+    // standard and reversed-Z, the full and a narrowed depth range.
+    const Scene soup = triangleSoup(true, 52);
+    auto withKernel = [](const char* kernel, const Scene& scene, const Camera& camera) {
+        setenv("ZCHECK_RASTER_KERNEL", kernel, 1);
+        RenderResult result = rasterRenderWithFineKeysForTesting(scene, camera);
+        unsetenv("ZCHECK_RASTER_KERNEL");
+        return result;
+    };
+    std::size_t distinct = 0;
+    for (const char* convention : {"opengl", "direct3d", "vulkan", "metal", "opencv"})
+        for (bool reversed : {false, true})
+            for (bool narrowRange : {false, true}) {
+                const Camera camera(kernelCamera(convention, DepthFormat::Unorm24, reversed, narrowRange));
+                INFO(convention << (reversed ? " reversed" : "") << (narrowRange ? " range [0.25, 0.75]" : ""));
+                const RenderResult scalar = withKernel("scalar", soup, camera);
+                const RenderResult vector = withKernel("auto", soup, camera);
+                const std::size_t pixels = scalar.windowDepth.value.size();
+                REQUIRE(std::memcmp(scalar.primitiveId.data(), vector.primitiveId.data(), pixels * sizeof(std::uint32_t)) == 0);
+                REQUIRE(std::memcmp(scalar.windowDepth.value.data(), vector.windowDepth.value.data(), pixels * sizeof(double)) == 0);
+                // The fine keys do resolve depth far below unorm24's quantum (the test can see a last bit).
+                for (std::size_t i = 0; i < pixels; ++i)
+                    if (scalar.primitiveId[i] != kNoPrimitive &&
+                        scalar.windowDepth.value[i] != quantizeDepth(DepthFormat::Unorm24, scalar.windowDepth.value[i]))
+                        ++distinct;
+            }
+    REQUIRE(distinct > 100000);
 }
 
 TEST_CASE("the vector vertex stage computes every vertex bit for bit as the scalar loop", "[raster][kernel]")

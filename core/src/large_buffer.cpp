@@ -18,22 +18,30 @@ constexpr std::size_t kCacheLimit = std::size_t(1) << 30;  // bytes the cache ma
 
 // Blocks of 2 MiB and more that were released, kept faulted in for an allocation of the
 // same rounded size (the next frame's buffers). An allocation that finds none releases them
-// all before it maps new memory, so that the cache never adds to the peak: what it holds was
-// in use together before, and is given back before the process grows.
+// all before it maps new memory, so that the cache never raises the peak of the memory
+// allocateLarge holds: what it keeps was in use together before, and is given back before
+// more is mapped. Blocks are freed outside the lock.
 class BlockCache {
 public:
     void* take(std::size_t rounded)
     {
-        const std::lock_guard<std::mutex> lock(mutex_);
-        for (std::size_t k = 0; k < blocks_.size(); ++k)
-            if (blocks_[k].bytes == rounded) {
-                void* data = blocks_[k].data;
-                held_ -= rounded;
-                blocks_[k] = blocks_.back();
-                blocks_.pop_back();
-                return data;
-            }
-        releaseAllLocked();
+        std::vector<Block> released;
+        {
+            const std::lock_guard<std::mutex> lock(mutex_);
+            for (std::size_t k = 0; k < blocks_.size(); ++k)
+                if (blocks_[k].bytes == rounded) {
+                    void* data = blocks_[k].data;
+                    held_ -= rounded;
+                    blocks_[k] = blocks_.back();
+                    blocks_.pop_back();
+                    return data;
+                }
+            if (blocks_.empty()) return nullptr;
+            released.swap(blocks_);
+            blocks_.reserve(released.capacity());  // keep() never allocates
+            held_ = 0;
+        }
+        for (const Block& block : released) std::free(block.data);
         return nullptr;
     }
     void keep(void* data, std::size_t rounded) noexcept

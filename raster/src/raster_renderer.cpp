@@ -258,8 +258,14 @@ struct DepthKeys {
     double maxCode;
 
     explicit DepthKeys(DepthFormat f) : unorm(f != DepthFormat::Float32), format(f), maxCode(unorm ? unormMax(f) : 1.0) {}
-    // The key of window depth d: value(key(d)) == quantizeDepth(format, d), bit for bit.
-    double key(double windowDepth) const { return unorm ? unormCode(format, windowDepth) : double(float(windowDepth)); }
+    // Integer codes of `codes` steps instead of the format's (RasterFrameTesting's fine keys).
+    DepthKeys(DepthFormat f, double codes) : unorm(true), format(f), maxCode(codes) {}
+    // The key of window depth d: value(key(d)) == quantizeDepth(format, d), bit for bit
+    // (unormCode's arithmetic, with maxCode = unormMax(format)).
+    double key(double windowDepth) const
+    {
+        return unorm ? nearbyintNonNegative(std::clamp(windowDepth, 0.0, 1.0) * maxCode) : double(float(windowDepth));
+    }
     double value(double key) const { return unorm ? key / maxCode : key; }
     // The key of a value the buffer can store (code / (2^N − 1) times 2^N − 1 is the code to
     // within 1e-9, so rounding recovers it exactly).
@@ -330,9 +336,11 @@ void drawInTile(const Viewport& vp, const DepthKeys& keys, const TriangleSetup& 
 #ifdef ZCHECK_RASTER_AVX512
 // GCC 12's intrinsics headers start many conversions from an "undefined" vector, which its
 // -W(maybe-)uninitialized then reports inside the headers (GCC bug 105593).
+#if !defined(__clang__)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #pragma GCC diagnostic ignored "-Wuninitialized"
+#endif
 #define ZCHECK_TARGET_AVX512 __attribute__((target("avx512f,avx512dq,avx512vl")))
 
 // std::clamp(v, lo, hi) per lane: v < lo ? lo : hi < v ? hi : v, NaN and signed zeros included.
@@ -549,7 +557,9 @@ ZCHECK_TARGET_AVX512 bool binItemsOfEight(const Viewport& vp, const glm::uvec3* 
     }
     return true;
 }
+#if !defined(__clang__)
 #pragma GCC diagnostic pop
+#endif
 #endif
 
 // Whether the vector kernels run (the clean chain's pixels eight at a time, the set-up of
@@ -618,8 +628,10 @@ RasterRenderer::RasterRenderer(const Scene& scene) : scene_(scene) { validateSce
 // One camera's set-up: vertices snapped, triangles set up and binned into tiles. The camera
 // and faults are the frame's own copies (the Viewport refers to them).
 struct RasterFrame::Impl {
-    Impl(const Scene& s, const Camera& c, const RasterFaults& f)
-        : scene(s), camera(c), faults(f), vp(camera, faults), keys(camera.depth().format),
+    // keyCodes > 0: depth keys of that many steps instead of the format's (tests only).
+    Impl(const Scene& s, const Camera& c, const RasterFaults& f, double keyCodes = 0)
+        : scene(s), camera(c), faults(f), vp(camera, faults),
+          keys(keyCodes > 0 ? DepthKeys(camera.depth().format, keyCodes) : DepthKeys(camera.depth().format)),
           clearKey(keys.keyOfStored(camera.clearDepth())), vectorKernels(useVectorKernels()),
           vectorDraw(vectorKernels && !vp.pixelFaults)
     {
@@ -676,8 +688,7 @@ void RasterFrame::Impl::prepare()
         };
         std::size_t p = first;
 #ifdef ZCHECK_RASTER_AVX512
-        // Vertex indices are gathered as int32: below 2^31 vertices (a 24 GiB scene) only.
-        if (vectorKernels && scene.positions.size() < kClippedBit)
+        if (vectorKernels)
             for (; p + 8 <= last; p += 8)
                 if (!binItemsOfEight(vp, scene.triangles.data(), std::uint32_t(p), snapped.data(), items))
                     for (std::size_t q = p; q < p + 8; ++q) setUp(q);
@@ -712,9 +723,10 @@ void RasterFrame::Impl::drawTile(int tile, double* windowDepth, std::uint32_t* p
                 draw(chunk.clipped[entry & ~kClippedBit]);
             } else {
                 const glm::uvec3& tri = scene.triangles[entry];
-                setupFromSnapped(vp, snapped[tri[0]].snapped(), snapped[tri[1]].snapped(), snapped[tri[2]].snapped(),
-                                 entry, t);
-                draw(t);
+                // Always true (binning took only triangles coveredBox accepted); never draw a stale set-up.
+                if (setupFromSnapped(vp, snapped[tri[0]].snapped(), snapped[tri[1]].snapped(), snapped[tri[2]].snapped(),
+                                     entry, t))
+                    draw(t);
             }
         }
     for (int row = row0; row <= row1; ++row) {
@@ -723,6 +735,29 @@ void RasterFrame::Impl::drawTile(int tile, double* windowDepth, std::uint32_t* p
         for (int k = 0; k < count; ++k) depthTo[k] = keys.value(tileBuffer.key[from + k]);
         std::copy_n(tileBuffer.primitive + from, count, primitive + std::size_t(row - row0) * stride);
     }
+}
+
+// The frame drawn with depth keys of 2^52 steps: window depth to within 2^-52 before the
+// format quantizes it, so that tests can compare the kernels' depth arithmetic where a
+// last-bit difference would almost never survive the format.
+struct RasterFrameTesting {
+    static RenderResult renderWithFineKeys(const Scene& scene, const Camera& camera)
+    {
+        RasterFrame::Impl frame(scene, camera, RasterFaults{}, 4503599627370496.0);
+        frame.prepare();
+        RenderResult result = RenderResult::allocated(camera.width(), camera.height());
+        for (int tile = 0; tile < frame.vp.tiles.count(); ++tile) {
+            const std::size_t first = frame.vp.tiles.firstPixel(tile);
+            frame.drawTile(tile, result.windowDepth.value.data() + first, result.primitiveId.data() + first,
+                           std::size_t(camera.width()));
+        }
+        return result;
+    }
+};
+
+RenderResult rasterRenderWithFineKeysForTesting(const Scene& scene, const Camera& camera)
+{
+    return RasterFrameTesting::renderWithFineKeys(scene, camera);
 }
 
 RasterFrame::RasterFrame(const Scene& scene, const Camera& camera, const RasterFaults& faults)

@@ -23,4 +23,10 @@ struct RasterVertexForTesting {
 std::vector<RasterVertexForTesting> rasterVertexStageForTesting(const Scene& scene, const Camera& camera,
                                                                 const RasterFaults& faults, bool vector);
 
+// The clean chain's render with depth keys of 2^52 steps instead of the format's: each
+// pixel's clamped window depth to within 2^-52 (the stored value is key / 2^52), so that a
+// last-bit difference between the kernels' depth arithmetic shows in about half the pixels
+// it touches, where the format would hide it. ZCHECK_RASTER_KERNEL applies.
+RenderResult rasterRenderWithFineKeysForTesting(const Scene& scene, const Camera& camera);
+
 }  // namespace zcheck

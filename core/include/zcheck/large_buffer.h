@@ -35,9 +35,12 @@ namespace zcheck {
 // back to the next allocation of the same size rounded up to 2 MiB: a program that renders
 // frame after frame pays the page faults of its buffers once, not per frame (as a GPU
 // driver's reused framebuffer does). An allocation that finds no block of its size first
-// releases every kept one, so the cache never raises the peak resident set: it holds only
-// memory that was in use together, and gives it back before new memory is mapped.
-// Thread-safe. The contents of a reused block are whatever its last user left.
+// releases every kept one, so the cache never raises the peak of the memory these functions
+// hold: it keeps only memory that was in use together, and gives it back before more is
+// mapped. It does keep that memory resident until then, while the rest of the process (a
+// mesh, a BVH, other allocations) may grow: a long-lived program that is done rendering
+// calls releaseCachedLargeBuffers. Thread-safe. The contents of a reused block are whatever
+// its last user left.
 void* allocateLarge(std::size_t bytes);
 void releaseLarge(void* data, std::size_t bytes) noexcept;
 // Gives every kept block back to the system (a first frame measured as a fresh process pays it).

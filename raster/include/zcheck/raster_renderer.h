@@ -67,6 +67,7 @@ public:
     void drawTile(int tile, double* windowDepth, std::uint32_t* primitive, std::size_t stride) const;
 
 private:
+    friend struct RasterFrameTesting;  // white-box tests (raster/src/raster_testing.h)
     struct Impl;
     std::unique_ptr<Impl> impl_;
 };
