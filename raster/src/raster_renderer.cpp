@@ -60,8 +60,8 @@ struct SnappedVertex {
 // triangles' vertices are 8 MB less to fault in and to pull through the caches per tile).
 // A valid vertex lies within 2·kMaxImageCoordinate pixels, i.e. |X|, |Y| < 2^29: int32 holds
 // it exactly. X = INT32_MIN marks a vertex not snapped: Y = 0 for one inside every clip plane
-// that cannot be snapped, Y = its outcode for one outside a clip plane (so that the vector
-// set-up reads a vertex's outcode with its position).
+// that cannot be snapped, Y = its outcode for one outside a clip plane (so that a vertex's
+// outcode is read with its position, and no array of outcodes is kept beside it).
 static_assert(2 * kMaxImageCoordinate * kSubpixel < 2147483648.0, "a valid snapped vertex fits int32");
 struct StoredVertex {
     double z;
@@ -73,6 +73,7 @@ struct StoredVertex {
     }
     static StoredVertex outside(unsigned outcode) { return {0.0, INT32_MIN, std::int32_t(outcode)}; }
     SnappedVertex snapped() const { return {X, Y, z, X != INT32_MIN}; }
+    unsigned outcode() const { return X == INT32_MIN ? unsigned(Y) : 0u; }  // bit k: outside clip plane k
 };
 
 // A bin entry names a triangle of the scene whose three vertices needed no clipping (its
@@ -438,8 +439,7 @@ ZCHECK_TARGET_AVX512 inline __m512i roundHalfAwayFromZero(__m512d x)
 // exactly as clipOf, Viewport::outcode, snapVertex and StoredVertex compute them one by one
 // (glm's order of operations for a matrix times a vector and for a dot product). Not for the
 // fault that interpolates eye-z (snapVertex's z is then another quantity).
-ZCHECK_TARGET_AVX512 void snapEight(const Viewport& vp, const glm::vec3* positions, std::size_t v, unsigned char* outcode,
-                                     StoredVertex* stored)
+ZCHECK_TARGET_AVX512 void snapEight(const Viewport& vp, const glm::vec3* positions, std::size_t v, StoredVertex* stored)
 {
     static_assert(sizeof(glm::vec3) == 12, "positions are three packed floats");
     const float* xyz = reinterpret_cast<const float*>(positions + v);
@@ -463,7 +463,6 @@ ZCHECK_TARGET_AVX512 void snapEight(const Viewport& vp, const glm::vec3* positio
         code = _mm512_mask_or_epi64(code, _mm512_cmp_pd_mask(dot, _mm512_setzero_pd(), _CMP_LT_OQ), code,
                                     _mm512_set1_epi64(std::int64_t(1) << k));
     }
-    _mm512_mask_cvtepi64_storeu_epi8(outcode + v, 0xFF, code);
     // Divide, viewport, image rows top-down, snap (snapVertex); lanes outside a plane are
     // computed too and then replaced (StoredVertex::outside).
     __m512d ndc[3];
@@ -497,7 +496,7 @@ ZCHECK_TARGET_AVX512 void snapEight(const Viewport& vp, const glm::vec3* positio
 // coveredBox gives (the same int64 area, the same int32 box arithmetic); those wholly outside
 // one plane are skipped. Returns false, appending nothing, when one of the eight needs
 // clipping: the scalar loop then takes all eight, so that the order of items stays. Outcodes
-// come from the stored vertices (StoredVertex::outside), not from the outcode array.
+// come from the stored vertices (StoredVertex::outside).
 static_assert(sizeof(glm::uvec3) == 12 && sizeof(StoredVertex) == 16 && offsetof(StoredVertex, X) == 8 &&
                   offsetof(StoredVertex, Y) == 12,
               "the gathers' strides and offsets");
@@ -584,27 +583,25 @@ glm::dvec4 clipOf(const Viewport& vp, const glm::vec3& position)
     return vp.clipFromWorld * glm::dvec4(glm::dvec3(position), 1.0);
 }
 
-// The vertex stage: every vertex to clip space in double, its outcode, and its stored vertex
-// (snapped where inside every clip plane, StoredVertex::outside where not): eight at a time
-// with `vector` (snapEight; the caller checks its condition), one at a time otherwise. Writes
-// every element of both arrays, which are resized uninitialised.
-void vertexStage(const Viewport& vp, const std::vector<glm::vec3>& positions, bool vector,
-                 LargeVector<unsigned char>& outcode, LargeVector<StoredVertex>& stored)
+// The vertex stage: every vertex to clip space in double and its stored vertex (snapped
+// where inside every clip plane, StoredVertex::outside with its outcode where not): eight at
+// a time with `vector` (snapEight; the caller checks its condition), one at a time
+// otherwise. Writes every element of `stored`, which is resized uninitialised.
+void vertexStage(const Viewport& vp, const std::vector<glm::vec3>& positions, bool vector, LargeVector<StoredVertex>& stored)
 {
     stored.resize(positions.size());
-    outcode.resize(positions.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, positions.size(), 4096), [&](const auto& range) {
         std::size_t v = range.begin();
 #ifdef ZCHECK_RASTER_AVX512
         if (vector)
-            for (; v + 8 <= range.end(); v += 8) snapEight(vp, positions.data(), v, outcode.data(), stored.data());
+            for (; v + 8 <= range.end(); v += 8) snapEight(vp, positions.data(), v, stored.data());
 #else
         (void)vector;
 #endif
         for (; v != range.end(); ++v) {
             const glm::dvec4 pClip = clipOf(vp, positions[v]);
-            outcode[v] = static_cast<unsigned char>(vp.outcode(pClip));
-            stored[v] = outcode[v] == 0 ? StoredVertex::from(snapVertex(vp, pClip)) : StoredVertex::outside(outcode[v]);
+            const unsigned code = vp.outcode(pClip);
+            stored[v] = code == 0 ? StoredVertex::from(snapVertex(vp, pClip)) : StoredVertex::outside(code);
         }
     });
 }
@@ -615,11 +612,10 @@ std::vector<RasterVertexForTesting> rasterVertexStageForTesting(const Scene& sce
                                                                 const RasterFaults& faults, bool vector)
 {
     const Viewport vp(camera, faults);
-    LargeVector<unsigned char> outcode;
     LargeVector<StoredVertex> stored;
-    vertexStage(vp, scene.positions, vector && useVectorKernels() && !faults.screenLinearEyeZ, outcode, stored);
+    vertexStage(vp, scene.positions, vector && useVectorKernels() && !faults.screenLinearEyeZ, stored);
     std::vector<RasterVertexForTesting> out(stored.size());
-    for (std::size_t v = 0; v < stored.size(); ++v) out[v] = {outcode[v], stored[v].X, stored[v].Y, stored[v].z};
+    for (std::size_t v = 0; v < stored.size(); ++v) out[v] = {stored[v].outcode(), stored[v].X, stored[v].Y, stored[v].z};
     return out;
 }
 
@@ -649,8 +645,7 @@ struct RasterFrame::Impl {
     const double clearKey;
     const bool vectorKernels;  // useVectorKernels: binItemsOfEight, and for the clean chain
     const bool vectorDraw;     // drawInTileAvx512
-    LargeVector<StoredVertex> snapped;  // per vertex, set where inside every clip plane (outcode 0)
-    LargeVector<unsigned char> outcode;
+    LargeVector<StoredVertex> snapped;  // per vertex: snapped, or its outcode (StoredVertex)
     std::vector<Chunk> chunks;
 };
 
@@ -658,7 +653,7 @@ void RasterFrame::Impl::prepare()
 {
     // Vertices to clip space in double, their outcodes, and those inside every clip plane
     // snapped once (a vertex outside one is snapped only where clipping made it).
-    vertexStage(vp, scene.positions, vectorKernels && !faults.screenLinearEyeZ, outcode, snapped);
+    vertexStage(vp, scene.positions, vectorKernels && !faults.screenLinearEyeZ, snapped);
 
     // Set-up and binning, one fixed-size chunk of triangles per task.
     const std::size_t triangleCount = scene.triangles.size();
@@ -672,12 +667,13 @@ void RasterFrame::Impl::prepare()
         items.reserve(last - first);
         auto setUp = [&](std::size_t p) {
             const glm::uvec3& tri = scene.triangles[p];
-            const unsigned codeA = outcode[tri[0]], codeB = outcode[tri[1]], codeC = outcode[tri[2]];
+            const StoredVertex &a = snapped[tri[0]], &b = snapped[tri[1]], &c = snapped[tri[2]];
+            const unsigned codeA = a.outcode(), codeB = b.outcode(), codeC = c.outcode();
             if (codeA & codeB & codeC) return;  // wholly outside one plane
             if ((codeA | codeB | codeC) == 0) {
                 PixelBox box;
                 std::int64_t area2;
-                if (coveredBox(vp, snapped[tri[0]].snapped(), snapped[tri[1]].snapped(), snapped[tri[2]].snapped(), box, area2))
+                if (coveredBox(vp, a.snapped(), b.snapped(), c.snapped(), box, area2))
                     items.push_back({std::uint32_t(p), box});
                 return;
             }
