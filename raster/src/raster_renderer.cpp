@@ -255,12 +255,16 @@ void binChunk(const Viewport& vp, const std::vector<BinItem>& items, Chunk& chun
 // key once, when the tile is copied into the frame: no division per drawn pixel.
 struct DepthKeys {
     bool unorm;
-    DepthFormat format;
     double maxCode;
 
-    explicit DepthKeys(DepthFormat f) : unorm(f != DepthFormat::Float32), format(f), maxCode(unorm ? unormMax(f) : 1.0) {}
-    // Integer codes of `codes` steps instead of the format's (RasterFrameTesting's fine keys).
-    DepthKeys(DepthFormat f, double codes) : unorm(true), format(f), maxCode(codes) {}
+    explicit DepthKeys(DepthFormat f) : unorm(f != DepthFormat::Float32), maxCode(unorm ? unormMax(f) : 1.0) {}
+    // Integer codes of `codes` steps whatever the format (RasterFrameTesting's fine keys).
+    static DepthKeys withCodes(double codes)
+    {
+        DepthKeys keys(DepthFormat::Unorm24);
+        keys.maxCode = codes;
+        return keys;
+    }
     // The key of window depth d: value(key(d)) == quantizeDepth(format, d), bit for bit
     // (unormCode's arithmetic, with maxCode = unormMax(format)).
     double key(double windowDepth) const
@@ -627,7 +631,7 @@ struct RasterFrame::Impl {
     // keyCodes > 0: depth keys of that many steps instead of the format's (tests only).
     Impl(const Scene& s, const Camera& c, const RasterFaults& f, double keyCodes = 0)
         : scene(s), camera(c), faults(f), vp(camera, faults),
-          keys(keyCodes > 0 ? DepthKeys(camera.depth().format, keyCodes) : DepthKeys(camera.depth().format)),
+          keys(keyCodes > 0 ? DepthKeys::withCodes(keyCodes) : DepthKeys(camera.depth().format)),
           clearKey(keys.keyOfStored(camera.clearDepth())), vectorKernels(useVectorKernels()),
           vectorDraw(vectorKernels && !vp.pixelFaults)
     {
@@ -733,34 +737,12 @@ void RasterFrame::Impl::drawTile(int tile, double* windowDepth, std::uint32_t* p
     }
 }
 
-// The frame drawn with depth keys of 2^52 steps: window depth to within 2^-52 before the
-// format quantizes it, so that tests can compare the kernels' depth arithmetic where a
-// last-bit difference would almost never survive the format.
-struct RasterFrameTesting {
-    static RenderResult renderWithFineKeys(const Scene& scene, const Camera& camera)
-    {
-        RasterFrame::Impl frame(scene, camera, RasterFaults{}, 4503599627370496.0);
-        frame.prepare();
-        RenderResult result = RenderResult::allocated(camera.width(), camera.height());
-        for (int tile = 0; tile < frame.vp.tiles.count(); ++tile) {
-            const std::size_t first = frame.vp.tiles.firstPixel(tile);
-            frame.drawTile(tile, result.windowDepth.value.data() + first, result.primitiveId.data() + first,
-                           std::size_t(camera.width()));
-        }
-        return result;
-    }
-};
-
-RenderResult rasterRenderWithFineKeysForTesting(const Scene& scene, const Camera& camera)
-{
-    return RasterFrameTesting::renderWithFineKeys(scene, camera);
-}
-
 RasterFrame::RasterFrame(const Scene& scene, const Camera& camera, const RasterFaults& faults)
-    : impl_(std::make_unique<Impl>(scene, camera, faults))
+    : RasterFrame(std::make_unique<Impl>(scene, camera, faults))
 {
-    impl_->prepare();
 }
+
+RasterFrame::RasterFrame(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) { impl_->prepare(); }
 
 RasterFrame::~RasterFrame() = default;
 
@@ -783,19 +765,44 @@ RasterFrame RasterRenderer::prepare(const Camera& camera, const RasterFaults& fa
     return RasterFrame(scene_, camera, faults);
 }
 
-RenderResult RasterRenderer::render(const Camera& camera, const RasterFaults& faults) const
+namespace {
+
+// Every tile of `frame`, drawn in parallel into a render of its camera's size.
+RenderResult drawnFrame(const RasterFrame& frame, int W, int H)
 {
-    const auto start = std::chrono::steady_clock::now();
-    const RasterFrame frame = prepare(camera, faults);
-    const int W = camera.width(), H = camera.height();
     RenderResult result = RenderResult::allocated(W, H);  // drawTile writes every pixel
     tbb::parallel_for(0, frame.tiles().count(), [&](int tile) {
         const std::size_t first = frame.tiles().firstPixel(tile);
         frame.drawTile(tile, result.windowDepth.value.data() + first, result.primitiveId.data() + first, std::size_t(W));
     });
+    return result;
+}
+
+}  // namespace
+
+RenderResult RasterRenderer::render(const Camera& camera, const RasterFaults& faults) const
+{
+    const auto start = std::chrono::steady_clock::now();
+    RenderResult result = drawnFrame(prepare(camera, faults), camera.width(), camera.height());
     result.renderMilliseconds =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return result;
+}
+
+// The frame drawn with depth keys of 2^52 steps: window depth to within 2^-52 before the
+// format quantizes it, so that tests can compare the kernels' depth arithmetic where a
+// last-bit difference would almost never survive the format.
+struct RasterFrameTesting {
+    static RenderResult renderWithFineKeys(const Scene& scene, const Camera& camera)
+    {
+        const RasterFrame frame(std::make_unique<RasterFrame::Impl>(scene, camera, RasterFaults{}, 4503599627370496.0));
+        return drawnFrame(frame, camera.width(), camera.height());
+    }
+};
+
+RenderResult rasterRenderWithFineKeysForTesting(const Scene& scene, const Camera& camera)
+{
+    return RasterFrameTesting::renderWithFineKeys(scene, camera);
 }
 
 }  // namespace zcheck

@@ -69,6 +69,7 @@ public:
 private:
     friend struct RasterFrameTesting;  // white-box tests (raster/src/raster_testing.h)
     struct Impl;
+    explicit RasterFrame(std::unique_ptr<Impl> impl);  // prepares it
     std::unique_ptr<Impl> impl_;
 };
 
