@@ -3,11 +3,11 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
+#include <array>
 #include <cstdint>
 #include <cstdlib>
 #include <mutex>
 #include <new>
-#include <vector>
 
 namespace zcheck {
 
@@ -25,30 +25,26 @@ class BlockCache {
 public:
     void* take(std::size_t rounded)
     {
-        std::vector<Block> released;
+        Blocks released;
         {
             const std::lock_guard<std::mutex> lock(mutex_);
-            for (std::size_t k = 0; k < blocks_.size(); ++k)
-                if (blocks_[k].bytes == rounded) {
-                    void* data = blocks_[k].data;
+            for (std::size_t k = 0; k < kept_.count; ++k)
+                if (kept_.block[k].bytes == rounded) {
+                    void* data = kept_.block[k].data;
                     held_ -= rounded;
-                    blocks_[k] = blocks_.back();
-                    blocks_.pop_back();
+                    kept_.block[k] = kept_.block[--kept_.count];
                     return data;
                 }
-            if (blocks_.empty()) return nullptr;
-            released.swap(blocks_);
-            blocks_.reserve(released.capacity());  // keep() never allocates
-            held_ = 0;
+            released = takeAllLocked();
         }
-        for (const Block& block : released) std::free(block.data);
+        freeAll(released);
         return nullptr;
     }
     void keep(void* data, std::size_t rounded) noexcept
     {
         const std::lock_guard<std::mutex> lock(mutex_);
-        if (held_ + rounded <= kCacheLimit && blocks_.size() < blocks_.capacity()) {
-            blocks_.push_back({data, rounded});
+        if (held_ + rounded <= kCacheLimit && kept_.count < kMaxBlocks) {
+            kept_.block[kept_.count++] = {data, rounded};
             held_ += rounded;
         } else {
             std::free(data);
@@ -56,29 +52,43 @@ public:
     }
     void releaseAll() noexcept
     {
-        const std::lock_guard<std::mutex> lock(mutex_);
-        releaseAllLocked();
+        Blocks released;
+        {
+            const std::lock_guard<std::mutex> lock(mutex_);
+            released = takeAllLocked();
+        }
+        freeAll(released);
     }
     std::size_t held() noexcept
     {
         const std::lock_guard<std::mutex> lock(mutex_);
         return held_;
     }
-    BlockCache() { blocks_.reserve(64); }  // keep() never allocates
 
 private:
+    static constexpr std::size_t kMaxBlocks = 64;
     struct Block {
         void* data;
         std::size_t bytes;
     };
-    void releaseAllLocked() noexcept
+    struct Blocks {  // a fixed array: keeping a block never allocates
+        std::array<Block, kMaxBlocks> block;
+        std::size_t count = 0;
+    };
+    // Every kept block, handed out to be freed outside the lock.
+    Blocks takeAllLocked() noexcept
     {
-        for (const Block& block : blocks_) std::free(block.data);
-        blocks_.clear();
+        const Blocks all = kept_;
+        kept_.count = 0;
         held_ = 0;
+        return all;
+    }
+    static void freeAll(const Blocks& blocks) noexcept
+    {
+        for (std::size_t k = 0; k < blocks.count; ++k) std::free(blocks.block[k].data);
     }
     std::mutex mutex_;
-    std::vector<Block> blocks_;
+    Blocks kept_;
     std::size_t held_ = 0;
 };
 
