@@ -259,9 +259,9 @@ CameraSpec kernelCamera(const char* convention, DepthFormat format, bool reverse
     return spec;
 }
 
-// Renders with ZCHECK_RASTER_KERNEL set to `kernel` (nullptr: unset, the default choice).
-RenderResult renderWithKernel(const RasterRenderer& raster, const Camera& camera, const char* kernel,
-                              const RasterFaults& faults = {})
+// render() with ZCHECK_RASTER_KERNEL set to `kernel` (nullptr: unset, the default choice).
+template <class Render>
+RenderResult withKernel(const char* kernel, Render render)
 {
     struct Restore {  // also when render() throws: later tests see the variable as it was
         std::optional<std::string> before;
@@ -270,7 +270,13 @@ RenderResult renderWithKernel(const RasterRenderer& raster, const Camera& camera
     if (const char* value = std::getenv("ZCHECK_RASTER_KERNEL")) restore.before = value;
     if (kernel) setenv("ZCHECK_RASTER_KERNEL", kernel, 1);
     else unsetenv("ZCHECK_RASTER_KERNEL");
-    return raster.render(camera, faults);
+    return render();
+}
+
+RenderResult renderWithKernel(const RasterRenderer& raster, const Camera& camera, const char* kernel,
+                              const RasterFaults& faults = {})
+{
+    return withKernel(kernel, [&] { return raster.render(camera, faults); });
 }
 
 }  // namespace
@@ -330,11 +336,8 @@ TEST_CASE("the vector draw kernel's depth arithmetic equals the scalar loop's to
     // the pixels it touches. The soup wholly inside the depth range, every convention,
     // standard and reversed-Z, the full and a narrowed depth range.
     const Scene soup = triangleSoup(true, 52);
-    auto withKernel = [](const char* kernel, const Scene& scene, const Camera& camera) {
-        setenv("ZCHECK_RASTER_KERNEL", kernel, 1);
-        RenderResult result = rasterRenderWithFineKeysForTesting(scene, camera);
-        unsetenv("ZCHECK_RASTER_KERNEL");
-        return result;
+    auto fineKeys = [&](const char* kernel, const Camera& camera) {
+        return withKernel(kernel, [&] { return rasterRenderWithFineKeysForTesting(soup, camera); });
     };
     std::size_t distinct = 0;
     for (const char* convention : {"opengl", "direct3d", "vulkan", "metal", "opencv"})
@@ -342,8 +345,8 @@ TEST_CASE("the vector draw kernel's depth arithmetic equals the scalar loop's to
             for (bool narrowRange : {false, true}) {
                 const Camera camera(kernelCamera(convention, DepthFormat::Unorm24, reversed, narrowRange));
                 INFO(convention << (reversed ? " reversed" : "") << (narrowRange ? " range [0.25, 0.75]" : ""));
-                const RenderResult scalar = withKernel("scalar", soup, camera);
-                const RenderResult vector = withKernel("auto", soup, camera);
+                const RenderResult scalar = fineKeys("scalar", camera);
+                const RenderResult vector = fineKeys("auto", camera);
                 const std::size_t pixels = scalar.windowDepth.value.size();
                 REQUIRE(std::memcmp(scalar.primitiveId.data(), vector.primitiveId.data(), pixels * sizeof(std::uint32_t)) == 0);
                 REQUIRE(std::memcmp(scalar.windowDepth.value.data(), vector.windowDepth.value.data(), pixels * sizeof(double)) == 0);
