@@ -5,10 +5,18 @@
 #include "zcheck/camera_file.h"
 #include "zcheck/camera_rays.h"
 #include "zcheck/inverse_projection.h"
+#include "zcheck/kernel_choice.h"
+#include "zcheck/ray_renderer.h"
+
+#include "kernel_testing.h"
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
 #include <string>
+#include <vector>
 
 using namespace zcheck;
 
@@ -80,4 +88,88 @@ TEST_CASE("the folded depth mapping is the inverse-projection module's, and its 
         }
         REQUIRE(rays.windowDepth(pImage, n) == Approx(camera.windowDepthNear()).margin(1e-14));
     });
+}
+
+namespace {
+// Whether two renders are the same bit for bit (memcmp: a signed zero or a NaN's bits would show).
+template <class Vector>
+bool sameBits(const Vector& a, const Vector& b)
+{
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(a[0])) == 0;
+}
+}  // namespace
+
+TEST_CASE("the trace compiled for AVX-512 is bit-identical to its baseline form", "[ray][kernel]")
+{
+    // RayRenderer::traceRect is one source compiled twice (kernel_choice.h): rays generated,
+    // traced, and every hit re-evaluated in double against its triangle's plane. Two soups of
+    // triangles (one wholly between the near and far planes, one mostly across them), through
+    // the soups' perspective camera in every convention, reversed or not, with a narrowed
+    // depth range, and through every example projection model (the raw matrix one takes
+    // per-pixel rays, not affine ones) looking at the soup; with no fault and with each of
+    // the ray route's faults; window depths, primitive ids and eye points compared bit for bit.
+    const bool avx512 = testing::withEnvironment("ZCHECK_RAY_KERNEL", nullptr,
+                                                 [] { return useAvx512Form("ZCHECK_RAY_KERNEL", "baseline"); });
+    if (!avx512) WARN("this processor has no AVX-512 (F, DQ, VL): both renders below are the baseline form");
+
+    std::vector<CameraSpec> cameras;
+    for (const char* convention : kConventions)
+        for (const bool reversed : {false, true})
+            for (const bool narrowRange : {false, true})
+                cameras.push_back(testing::kernelCamera(convention, DepthFormat::Float32, reversed, narrowRange));
+    for (const char* model : {"perspective", "lens", "pinhole", "frustum", "orthographic", "oblique-cabinet",
+                              "oblique-cavalier", "isometric", "dimetric", "trimetric", "infinite-far", "matrix-direct3d"}) {
+        CameraSpec spec = readCameraFile(std::string(ZCHECK_TESTS_DIR) + "/../examples/" + model + ".json");
+        spec.width = 203, spec.height = 141;
+        spec.view = View::lookAt({0.3, -0.2, 1.0}, {0, 0, -4}, {0, 1, 0});
+        cameras.push_back(spec);
+    }
+    RayFaults shifted, rowsFlipped, colsFlipped, distance;
+    shifted.shiftPixels = {0.5, -0.25};
+    rowsFlipped.flipRows = true;
+    colsFlipped.flipCols = true;
+    distance.distanceAsEyeZ = true;
+
+    std::int64_t misses = 0;  // over all renders: the misses' lanes are compared too
+    for (const bool inside : {true, false}) {
+        const Scene soup = testing::triangleSoup(inside, inside ? 31 : 32);
+        const RayRenderer ray(soup);
+        for (const CameraSpec& spec : cameras) {
+            const Camera camera(spec);
+            for (const RayFaults& faults : {RayFaults{}, shifted, rowsFlipped, colsFlipped, distance}) {
+                auto render = [&](const char* form) {
+                    return testing::withEnvironment("ZCHECK_RAY_KERNEL", form,
+                                                    [&] { return ray.render(camera, faults, EyePoints::Keep); });
+                };
+                const RenderResult baseline = render("baseline"), chosen = render("auto");
+                INFO((inside ? "soup inside, " : "soup across, ") << spec.convention.name << " " << spec.width << "x"
+                     << spec.height << (spec.depth.reversed ? " reversed" : "") << " fault shift/rows/cols/distance "
+                     << faults.shiftPixels.x << "/" << faults.flipRows << "/" << faults.flipCols << "/"
+                     << faults.distanceAsEyeZ);
+                const auto hits = std::count_if(baseline.primitiveId.begin(), baseline.primitiveId.end(),
+                                                [](std::uint32_t id) { return id != kNoPrimitive; });
+                REQUIRE(hits > 100);  // not an empty picture
+                misses += std::int64_t(baseline.primitiveId.size()) - hits;
+                REQUIRE(sameBits(chosen.primitiveId, baseline.primitiveId));
+                REQUIRE(sameBits(chosen.windowDepth.value, baseline.windowDepth.value));
+                REQUIRE(sameBits(chosen.pEye, baseline.pEye));
+            }
+        }
+    }
+    REQUIRE(misses > 10000);
+}
+
+TEST_CASE("ZCHECK_RAY_KERNEL takes auto or baseline and nothing else", "[ray][kernel]")
+{
+    const Scene soup = testing::triangleSoup(true, 33);
+    const RayRenderer ray(soup);
+    const Camera camera(testing::kernelCamera("opengl", DepthFormat::Unorm24, false, false));
+    auto renderWith = [&](const char* form) {
+        return testing::withEnvironment("ZCHECK_RAY_KERNEL", form, [&] { return ray.render(camera); });
+    };
+    REQUIRE_NOTHROW(renderWith("auto"));
+    REQUIRE_NOTHROW(renderWith(""));
+    REQUIRE_NOTHROW(renderWith("baseline"));
+    REQUIRE_THROWS_WITH(renderWith("avx2"),
+                        Catch::Contains("ZCHECK_RAY_KERNEL=avx2") && Catch::Contains("'auto' or 'baseline'"));
 }

@@ -3,6 +3,7 @@
 
 #include "zcheck/inverse_projection.h"
 
+#include "kernel_testing.h"
 #include "raster_testing.h"
 
 #include <catch2/catch.hpp>
@@ -222,55 +223,14 @@ TEST_CASE("the raster result is bit-identical for any number of threads", "[rast
 
 namespace {
 
-// 3000 triangles from sub-pixel slivers to ones spanning several 64×64 tiles of a 203×141
-// image through kernelCamera, with exact duplicates under other ids and both windings.
-// `inside`: all between its near and far planes, anywhere in the view and past its edges;
-// otherwise most cross the near or far plane.
-Scene triangleSoup(bool inside, std::uint32_t seed)
-{
-    std::mt19937 random(seed);
-    std::uniform_real_distribution<float> unit(-1.0f, 1.0f), depth(-12.0f, -0.2f), depthInside(-7.0f, -1.5f);
-    std::vector<glm::vec3> positions;
-    std::vector<glm::uvec3> triangles;
-    for (int k = 0; k < 3000; ++k) {
-        const float size = std::pow(10.0f, unit(random) * 1.5f - 1.0f);  // 0.003 to 3 (image ≈ 2 wide at z = −1)
-        const float z = inside ? depthInside(random) : depth(random), spread = inside ? -z : 1.2f;
-        const glm::vec3 centre(unit(random) * spread, unit(random) * spread * 0.8f, z);
-        const std::uint32_t first = std::uint32_t(positions.size());
-        for (int v = 0; v < 3; ++v)
-            positions.push_back(centre + glm::vec3(unit(random) * size, unit(random) * size, unit(random) * (inside ? 0.5f : 4.0f)));
-        triangles.push_back({first, first + 1, first + 2});
-        if (k % 7 == 0) triangles.push_back({first, first + 1, first + 2});  // a duplicate
-        if (k % 11 == 0) triangles.push_back({first, first + 2, first + 1});  // the other winding
-    }
-    return sceneOf(positions, triangles);
-}
-
-// The soups' camera: 203×141 (cut by the tiles on both edges), fovy 70°, near 0.5, far 9.
-CameraSpec kernelCamera(const char* convention, DepthFormat format, bool reversed, bool narrowRange)
-{
-    CameraSpec spec;
-    spec.convention = Convention::preset(convention);
-    spec.width = 203, spec.height = 141;
-    spec.projection.fovyDeg = 70, spec.projection.near = 0.5, spec.projection.far = 9;
-    spec.view = View::lookAt({0, 0, 0}, {0, 0, -1}, {0, 1, 0});
-    spec.depth.format = format, spec.depth.reversed = reversed;
-    if (narrowRange) spec.depth.rangeMin = 0.25, spec.depth.rangeMax = 0.75;
-    return spec;
-}
+using testing::kernelCamera;
+using testing::triangleSoup;
 
 // render() with ZCHECK_RASTER_KERNEL set to `kernel` (nullptr: unset, the default choice).
 template <class Render>
 RenderResult withKernel(const char* kernel, Render render)
 {
-    struct Restore {  // also when render() throws: later tests see the variable as it was
-        std::optional<std::string> before;
-        ~Restore() { before ? setenv("ZCHECK_RASTER_KERNEL", before->c_str(), 1) : unsetenv("ZCHECK_RASTER_KERNEL"); }
-    } restore;
-    if (const char* value = std::getenv("ZCHECK_RASTER_KERNEL")) restore.before = value;
-    if (kernel) setenv("ZCHECK_RASTER_KERNEL", kernel, 1);
-    else unsetenv("ZCHECK_RASTER_KERNEL");
-    return render();
+    return testing::withEnvironment("ZCHECK_RASTER_KERNEL", kernel, render);
 }
 
 RenderResult renderWithKernel(const RasterRenderer& raster, const Camera& camera, const char* kernel,

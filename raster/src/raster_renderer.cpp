@@ -8,6 +8,7 @@
 #include "zcheck/clip.h"
 #include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
+#include "zcheck/kernel_choice.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -16,11 +17,8 @@
 #include <chrono>
 #include <cstddef>
 #include <cmath>
-#include <cstdlib>
-#include <cstring>
 
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-#define ZCHECK_RASTER_AVX512 1
+#ifdef ZCHECK_X86_AVX512
 #include <immintrin.h>
 #endif
 
@@ -338,7 +336,7 @@ void drawInTile(const Viewport& vp, const DepthKeys& keys, const TriangleSetup& 
     }
 }
 
-#ifdef ZCHECK_RASTER_AVX512
+#ifdef ZCHECK_X86_AVX512
 // GCC 12's intrinsics headers start many conversions from an "undefined" vector, which its
 // -W(maybe-)uninitialized then reports inside the headers (GCC bug 105593).
 #if !defined(__clang__)
@@ -346,7 +344,6 @@ void drawInTile(const Viewport& vp, const DepthKeys& keys, const TriangleSetup& 
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #pragma GCC diagnostic ignored "-Wuninitialized"
 #endif
-#define ZCHECK_TARGET_AVX512 __attribute__((target("avx512f,avx512dq,avx512vl")))
 
 // std::clamp(v, lo, hi) per lane: v < lo ? lo : hi < v ? hi : v, NaN and signed zeros included.
 ZCHECK_TARGET_AVX512 inline __m512d clamp(__m512d v, __m512d lo, __m512d hi)
@@ -566,21 +563,8 @@ ZCHECK_TARGET_AVX512 bool binItemsOfEight(const Viewport& vp, const glm::uvec3* 
 #endif
 
 // Whether the vector kernels run (the clean chain's pixels eight at a time, the set-up of
-// eight triangles at a time): where the processor has AVX-512 (F, DQ, VL). Elsewhere, or
-// with ZCHECK_RASTER_KERNEL=scalar, the scalar loops do (tests compare the two bit for bit);
-// any other value but "auto" is an error.
-bool useVectorKernels()
-{
-    const char* requested = std::getenv("ZCHECK_RASTER_KERNEL");
-    if (requested && std::strcmp(requested, "scalar") == 0) return false;
-    if (requested && *requested && std::strcmp(requested, "auto") != 0)
-        throw Error(std::string("ZCHECK_RASTER_KERNEL=") + requested + ": must be 'auto' or 'scalar'");
-#ifdef ZCHECK_RASTER_AVX512
-    return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512vl");
-#else
-    return false;
-#endif
-}
+// eight triangles at a time): kernel_choice.h, ZCHECK_RASTER_KERNEL=scalar|auto.
+bool useVectorKernels() { return useAvx512Form("ZCHECK_RASTER_KERNEL", "scalar"); }
 
 glm::dvec4 clipOf(const Viewport& vp, const glm::vec3& position)
 {
@@ -596,7 +580,7 @@ void vertexStage(const Viewport& vp, const std::vector<glm::vec3>& positions, bo
     stored.resize(positions.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, positions.size(), 4096), [&](const auto& range) {
         std::size_t v = range.begin();
-#ifdef ZCHECK_RASTER_AVX512
+#ifdef ZCHECK_X86_AVX512
         if (vector)
             for (; v + 8 <= range.end(); v += 8) snapEight(vp, positions.data(), v, stored.data());
 #else
@@ -687,7 +671,7 @@ void RasterFrame::Impl::prepare()
                 items.push_back({kClippedBit | std::uint32_t(k), chunk.clipped[k].box});
         };
         std::size_t p = first;
-#ifdef ZCHECK_RASTER_AVX512
+#ifdef ZCHECK_X86_AVX512
         if (vectorKernels)
             for (; p + 8 <= last; p += 8)
                 if (!binItemsOfEight(vp, scene.triangles.data(), std::uint32_t(p), snapped.data(), items))
@@ -710,7 +694,7 @@ void RasterFrame::Impl::drawTile(int tile, double* windowDepth, std::uint32_t* p
     std::fill(std::begin(tileBuffer.key), std::end(tileBuffer.key), clearKey);
     std::fill(std::begin(tileBuffer.primitive), std::end(tileBuffer.primitive), kNoPrimitive);
     auto draw = [&](const TriangleSetup& setup) {
-#ifdef ZCHECK_RASTER_AVX512
+#ifdef ZCHECK_X86_AVX512
         if (vectorDraw) return drawInTileAvx512(camera.depth(), keys, setup, col0, row0, col1, row1, tileBuffer);
 #endif
         vp.pixelFaults ? drawInTile<true>(vp, keys, setup, col0, row0, col1, row1, tileBuffer)

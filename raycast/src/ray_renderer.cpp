@@ -3,6 +3,7 @@
 #include "zcheck/error.h"
 #include "zcheck/camera_rays.h"
 #include "zcheck/inverse_projection.h"
+#include "zcheck/kernel_choice.h"
 
 #include <embree3/rtcore.h>
 #include <tbb/blocked_range.h>
@@ -174,16 +175,24 @@ RenderResult RayRenderer::render(const Camera& camera, const RayFaults& fault, E
     return result;
 }
 
-void RayRenderer::traceRect(const Camera& camera, const PixelRect& rect, double* windowDepth, std::uint32_t* primitiveId,
-                            std::size_t stride, const RayFaults& fault, glm::dvec3* pEye) const
+namespace {
+
+// RayRenderer::traceRect's work, inlined into two functions: one compiled for the build's
+// baseline and one for AVX-512 (kernel_choice.h). Its per-packet steps are lambdas that must
+// be inlined too, or they would stay baseline code.
+#define ZCHECK_INLINE __attribute__((always_inline))
+ZCHECK_INLINE inline void traceRectBody(RTCScene rtcScene, const glm::dvec3& frameOrigin, const Scene& scene,
+                                        const Camera& camera, const PixelRect& rect, double* windowDepth,
+                                        std::uint32_t* primitiveId, std::size_t stride, const RayFaults& fault,
+                                        glm::dvec3* pEye)
 {
     const int col0 = rect.col0, row0 = rect.row0, col1 = rect.col1, row1 = rect.row1;
     const int W = camera.width(), H = camera.height();
-    RTCScene rtcScene = embree_->scene.get();
     const CameraRays cameraRays(camera);
     const std::optional<AffineRays> affine = cameraRays.affine();
     const double near = camera.nearDistance(), far = camera.farDistance(), clearDepth = camera.clearDepth();
-    const glm::dvec3 frameOrigin = embree_->frameOrigin;
+    const bool windowOriginTop = camera.imageYFromWindowY(0.0) == 0.0;  // else y_image = H − y_window
+    const double height = H;
 
     FlushDenormals flush;
     RTCIntersectContext context;
@@ -193,15 +202,19 @@ void RayRenderer::traceRect(const Camera& camera, const PixelRect& rect, double*
     // Rays made and traced: lanes as plain arrays, one quantity at a time, so that the
     // compiler can compute several lanes per instruction. Every field of every lane is
     // initialised, valid or not; an invalid lane (outside the rectangle) is a zero-length ray.
-    auto trace = [&](PacketInFlight& p, int px, int py) {
+    auto trace = [&](PacketInFlight& p, int px, int py) ZCHECK_INLINE {
         p.col0 = px, p.row0 = py;
+        // The image points: windowFromPixelCentre plus the shift, then imageYFromWindowY,
+        // spelt out so that this loop too computes several lanes per instruction.
         for (int k = 0; k < kPacketRays; ++k) {
             const int col = px + k % kPacketSide, row = py + k / kPacketSide;
             p.valid[k] = (col < col1 && row < row1) ? -1 : 0;
             const int sampleRow = fault.flipRows ? H - 1 - row : row;
             const int sampleCol = fault.flipCols ? W - 1 - col : col;
-            const glm::dvec2 pWindow = windowFromPixelCentre(camera, sampleCol, sampleRow) + fault.shiftPixels;
-            p.imageX[k] = pWindow.x, p.imageY[k] = camera.imageYFromWindowY(pWindow.y);
+            const double yImage = sampleRow + 0.5;
+            const double xWindow = (sampleCol + 0.5) + fault.shiftPixels.x;
+            const double yWindow = (windowOriginTop ? yImage : height - yImage) + fault.shiftPixels.y;
+            p.imageX[k] = xWindow, p.imageY[k] = windowOriginTop ? yWindow : height - yWindow;
         }
         RTCRay16& ray = p.packet.ray;
         if (affine) {  // t is eye-z: the near and far planes lie at t = near and far
@@ -244,30 +257,35 @@ void RayRenderer::traceRect(const Camera& camera, const PixelRect& rect, double*
         }
         rtcIntersect16(p.valid, rtcScene, &context, &p.packet);
         for (int k = 0; k < kPacketRays; ++k)
-            if (p.hit(k)) __builtin_prefetch(&scene_.triangles[p.packet.hit.primID[k]]);
+            if (p.hit(k)) __builtin_prefetch(&scene.triangles[p.packet.hit.primID[k]]);
     };
     // The hit triangles' vertices asked for (their indices were asked for one packet earlier).
-    auto fetchVertices = [&](const PacketInFlight& p) {
+    auto fetchVertices = [&](const PacketInFlight& p) ZCHECK_INLINE {
         for (int k = 0; k < kPacketRays; ++k)
             if (p.hit(k))
                 for (int corner = 0; corner < 3; ++corner)
-                    __builtin_prefetch(&scene_.positions[scene_.triangles[p.packet.hit.primID[k]][corner]]);
+                    __builtin_prefetch(&scene.positions[scene.triangles[p.packet.hit.primID[k]][corner]]);
     };
     // Each hit again, in double: the ray against the hit triangle's plane; then the pixels written.
-    auto finish = [&](const PacketInFlight& p) {
-        // The planes, lane by lane (neighbouring rays mostly hit the same triangle: its
-        // plane is kept); a miss keeps whatever plane came before, its result is not used.
-        alignas(64) double plane[6][kPacketRays];  // a vertex x, y, z and the normal x, y, z
-        std::uint32_t planeOf = RTC_INVALID_GEOMETRY_ID;
-        glm::dvec3 a(0.0), normal(0.0);
+    auto finish = [&](const PacketInFlight& p) ZCHECK_INLINE {
+        // The planes, every lane's own, without a branch: a vertex a and the normal
+        // cross(b − a, c − a), in double. (Keeping a plane while the next lanes hit the same
+        // triangle, as this did before, cost more in mispredicted branches than the arithmetic
+        // it saved.) A miss takes triangle 0's plane (a scene has one, RayRenderer checked), and
+        // its result is not used.
+        alignas(64) double corner[3][3][kPacketRays];  // corner, axis, lane
         for (int k = 0; k < kPacketRays; ++k) {
-            if (p.hit(k) && p.packet.hit.primID[k] != planeOf) {
-                planeOf = p.packet.hit.primID[k];
-                const glm::uvec3& tri = scene_.triangles[planeOf];
-                a = glm::dvec3(scene_.positions[tri[0]]);
-                normal = glm::cross(glm::dvec3(scene_.positions[tri[1]]) - a, glm::dvec3(scene_.positions[tri[2]]) - a);
-            }
-            for (int c = 0; c < 3; ++c) plane[c][k] = a[c], plane[3 + c][k] = normal[c];
+            const glm::uvec3& tri = scene.triangles[p.hit(k) ? p.packet.hit.primID[k] : 0];
+            for (int v = 0; v < 3; ++v)
+                for (int c = 0; c < 3; ++c) corner[v][c][k] = double(scene.positions[tri[v]][c]);
+        }
+        alignas(64) double plane[6][kPacketRays];  // a vertex x, y, z and the normal x, y, z
+        for (int k = 0; k < kPacketRays; ++k) {
+            const glm::dvec3 a(corner[0][0][k], corner[0][1][k], corner[0][2][k]);
+            const glm::dvec3 b(corner[1][0][k], corner[1][1][k], corner[1][2][k]);
+            const glm::dvec3 c(corner[2][0][k], corner[2][1][k], corner[2][2][k]);
+            const glm::dvec3 normal = glm::cross(b - a, c - a);
+            for (int axis = 0; axis < 3; ++axis) plane[axis][k] = a[axis], plane[3 + axis][k] = normal[axis];
         }
         // Lane by lane in plain arrays (several lanes per instruction): the ray parameter t
         // of the hit (Embree's, where the plane gives none) and its eye-z.
@@ -309,6 +327,36 @@ void RayRenderer::traceRect(const Camera& camera, const PixelRect& rect, double*
         if (i >= 1 && i - 1 < packets) fetchVertices(inFlight[(i - 1) % kInFlight]);
         if (i >= 2) finish(inFlight[(i - 2) % kInFlight]);
     }
+}
+
+
+void traceRectBaseline(RTCScene rtcScene, const glm::dvec3& frameOrigin, const Scene& scene, const Camera& camera,
+                       const PixelRect& rect, double* windowDepth, std::uint32_t* primitiveId, std::size_t stride,
+                       const RayFaults& fault, glm::dvec3* pEye)
+{
+    traceRectBody(rtcScene, frameOrigin, scene, camera, rect, windowDepth, primitiveId, stride, fault, pEye);
+}
+
+#ifdef ZCHECK_X86_AVX512
+ZCHECK_TARGET_AVX512 void traceRectAvx512(RTCScene rtcScene, const glm::dvec3& frameOrigin, const Scene& scene,
+                                          const Camera& camera, const PixelRect& rect, double* windowDepth,
+                                          std::uint32_t* primitiveId, std::size_t stride, const RayFaults& fault,
+                                          glm::dvec3* pEye)
+{
+    traceRectBody(rtcScene, frameOrigin, scene, camera, rect, windowDepth, primitiveId, stride, fault, pEye);
+}
+#endif
+
+}  // namespace
+
+void RayRenderer::traceRect(const Camera& camera, const PixelRect& rect, double* windowDepth, std::uint32_t* primitiveId,
+                            std::size_t stride, const RayFaults& fault, glm::dvec3* pEye) const
+{
+    auto* form = &traceRectBaseline;
+#ifdef ZCHECK_X86_AVX512
+    if (useAvx512Form("ZCHECK_RAY_KERNEL", "baseline")) form = &traceRectAvx512;
+#endif
+    form(embree_->scene.get(), embree_->frameOrigin, scene_, camera, rect, windowDepth, primitiveId, stride, fault, pEye);
 }
 
 }  // namespace zcheck

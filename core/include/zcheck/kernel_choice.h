@@ -1,0 +1,35 @@
+#pragma once
+// The choice, at run time, between a routine's AVX-512 form and its baseline form.
+//
+// The raster's vector kernels (hand-written, eight lanes at a time) and the trace (the same
+// source compiled twice, once for AVX-512) run their AVX-512 forms where the processor has
+// AVX-512 F, DQ and VL, and their baseline forms elsewhere. The two forms do the same IEEE
+// operations in the same order (the build has -ffp-contract=off, so no multiply and add are
+// fused into one rounding), so their outputs are bit-identical; the tests run both and
+// compare them bit for bit. An environment variable per route forces the baseline form:
+//
+//   ZCHECK_RASTER_KERNEL=scalar   the raster's scalar loops
+//   ZCHECK_RAY_KERNEL=baseline    the trace compiled for the build's baseline (x86-64: SSE2)
+//
+// Either variable unset, empty or `auto` lets the processor decide.
+//
+//   #ifdef ZCHECK_X86_AVX512
+//   ZCHECK_TARGET_AVX512 void drawAvx512(...);   // compiled for AVX-512, called only when chosen
+//   #endif
+//   if (useAvx512Form("ZCHECK_RASTER_KERNEL", "scalar")) drawAvx512(...); else draw(...);
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define ZCHECK_X86_AVX512 1
+// A function compiled for AVX-512 F, DQ and VL; its callers check useAvx512Form first.
+#define ZCHECK_TARGET_AVX512 __attribute__((target("avx512f,avx512dq,avx512vl")))
+#endif
+
+namespace zcheck {
+
+// Whether the AVX-512 form runs: the processor has AVX-512 F, DQ and VL (and the build
+// targets x86-64), and the environment variable `variable` is unset, empty or "auto", not
+// `baselineValue`. Any other value throws Error naming the variable, the value and the two
+// allowed. Reads the environment on every call (cheap next to a render).
+bool useAvx512Form(const char* variable, const char* baselineValue);
+
+}  // namespace zcheck
