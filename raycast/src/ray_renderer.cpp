@@ -10,8 +10,10 @@
 #include <tbb/parallel_for.h>
 #include <xmmintrin.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <mutex>
 
@@ -301,13 +303,30 @@ ZCHECK_INLINE inline void traceRectBody(RTCScene rtcScene, const glm::dvec3& fra
         } else {
             for (int k = 0; k < kPacketRays; ++k) eyeZ[k] = cameraRays.eyeZ(p.origin(k) + t[k] * p.direction(k));
         }
+        // The pixels, lane by lane into plain arrays, then a row of the packet at a time: four
+        // adjacent pixels, copied whole where all four lie in the rectangle.
+        alignas(64) double depthOf[kPacketRays];
+        alignas(64) std::uint32_t primitiveOf[kPacketRays];
         for (int k = 0; k < kPacketRays; ++k) {
-            if (!p.valid[k]) continue;
-            const std::size_t i = std::size_t(p.row0 + k / kPacketSide - row0) * stride + std::size_t(p.col0 + k % kPacketSide - col0);
             const bool hit = p.hit(k);
-            primitiveId[i] = hit ? p.packet.hit.primID[k] : kNoPrimitive;
-            windowDepth[i] = hit ? cameraRays.windowDepth(p.pImage(k), eyeZ[k]) : clearDepth;
-            if (pEye) pEye[i] = hit ? cameraRays.eyeFromWorld(p.origin(k) + t[k] * p.direction(k)) : glm::dvec3(NAN);
+            primitiveOf[k] = hit ? p.packet.hit.primID[k] : kNoPrimitive;
+            depthOf[k] = hit ? cameraRays.windowDepth(p.pImage(k), eyeZ[k]) : clearDepth;
+        }
+        const int cols = std::min(kPacketSide, col1 - p.col0), rows = std::min(kPacketSide, row1 - p.row0);
+        for (int r = 0; r < rows; ++r) {
+            const std::size_t i = std::size_t(p.row0 + r - row0) * stride + std::size_t(p.col0 - col0);
+            const int k = r * kPacketSide;
+            if (cols == kPacketSide) {
+                std::memcpy(windowDepth + i, depthOf + k, sizeof(double) * kPacketSide);
+                std::memcpy(primitiveId + i, primitiveOf + k, sizeof(std::uint32_t) * kPacketSide);
+            } else {
+                std::copy(depthOf + k, depthOf + k + cols, windowDepth + i);
+                std::copy(primitiveOf + k, primitiveOf + k + cols, primitiveId + i);
+            }
+            if (pEye)
+                for (int j = 0; j < cols; ++j)
+                    pEye[i + j] = p.hit(k + j) ? cameraRays.eyeFromWorld(p.origin(k + j) + t[k + j] * p.direction(k + j))
+                                               : glm::dvec3(NAN);
         }
     };
 
