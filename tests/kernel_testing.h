@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <optional>
 #include <random>
 #include <string>
@@ -50,6 +51,13 @@ inline CameraSpec kernelCamera(const char* convention, DepthFormat format, bool 
     spec.depth.format = format, spec.depth.reversed = reversed;
     if (narrowRange) spec.depth.rangeMin = 0.25, spec.depth.rangeMax = 0.75;
     return spec;
+}
+
+// Whether two arrays hold the same bits (memcmp: a signed zero or a NaN's payload would show).
+template <class Vector>
+bool sameBits(const Vector& a, const Vector& b)
+{
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(a[0])) == 0;
 }
 
 // run() with the environment variable `variable` set to `value` (nullptr: unset), and then

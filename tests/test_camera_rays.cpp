@@ -14,7 +14,6 @@
 
 #include <algorithm>
 #include <cstdint>
-#include <cstring>
 #include <string>
 #include <vector>
 
@@ -90,15 +89,6 @@ TEST_CASE("the folded depth mapping is the inverse-projection module's, and its 
     });
 }
 
-namespace {
-// Whether two renders are the same bit for bit (memcmp: a signed zero or a NaN's bits would show).
-template <class Vector>
-bool sameBits(const Vector& a, const Vector& b)
-{
-    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(a[0])) == 0;
-}
-}  // namespace
-
 TEST_CASE("the trace compiled for AVX-512 is bit-identical to its baseline form", "[ray][kernel]")
 {
     // RayRenderer::traceRect is one source compiled twice (kernel_choice.h): rays generated,
@@ -150,9 +140,9 @@ TEST_CASE("the trace compiled for AVX-512 is bit-identical to its baseline form"
                                                 [](std::uint32_t id) { return id != kNoPrimitive; });
                 REQUIRE(hits > 100);  // not an empty picture
                 misses += std::int64_t(baseline.primitiveId.size()) - hits;
-                REQUIRE(sameBits(chosen.primitiveId, baseline.primitiveId));
-                REQUIRE(sameBits(chosen.windowDepth.value, baseline.windowDepth.value));
-                REQUIRE(sameBits(chosen.pEye, baseline.pEye));
+                REQUIRE(testing::sameBits(chosen.primitiveId, baseline.primitiveId));
+                REQUIRE(testing::sameBits(chosen.windowDepth.value, baseline.windowDepth.value));
+                REQUIRE(testing::sameBits(chosen.pEye, baseline.pEye));
             }
         }
     }

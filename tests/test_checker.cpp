@@ -1,12 +1,15 @@
 // The Checker as a library: one object per scene, const and shareable between threads; faults
 // as arguments; one mistake catalogue for injection and diagnosis.
 #include "zcheck/checker.h"
+#include "zcheck/camera_file.h"
 #include "zcheck/error.h"
+#include "zcheck/kernel_choice.h"
 #include "zcheck/mistakes.h"
 #include "zcheck/percentile.h"
 #include "zcheck/report.h"
 
 #include "diagnosis_helpers.h"
+#include "kernel_testing.h"
 
 #include <catch2/catch.hpp>
 #include <tbb/global_control.h>
@@ -323,4 +326,110 @@ TEST_CASE("a map with no surface is explained by no hypothesis (a view that sees
     // ... and the diagnosis says that it is empty, first, not which hypothesis came closest.
     REQUIRE(diagnosis.front().name == "empty-map");
     REQUIRE(formatDiagnosis(diagnosis).find("holds no surface") != std::string::npos);
+}
+
+namespace {
+// A check's report as `zcheck check --json` gives it, without its timings.
+std::string reportWithoutTimings(CheckReport report)
+{
+    report.timings = Timings{};
+    return checkReportJson(report);
+}
+}  // namespace
+
+TEST_CASE("the comparison's AVX-512 form is bit-identical to its baseline form", "[compare][kernel]")
+{
+    // TileComparison's row loop is one source compiled twice (kernel_choice.h), and the slopes
+    // of a row's triangles are computed together, several per instruction. Both forms over
+    // three built-in scenes and a triangle soup (sliver to tile-sized triangles, duplicates
+    // under other ids), each through its camera at 203×131 (tiles cut on both edges) in two
+    // conventions, three formats, reversed or not, and through the orthographic and raw-matrix
+    // projections; clean, with rows flipped (unexplained pixels), with truncated unorm and a
+    // half-pixel shift (a depth bias), and with distance stored as eye-z. The whole report
+    // (every count, maximum, percentile, the worst pixel and the samples) and the per-pixel
+    // classes and ratios compared bit for bit; also compareRoutes given the ray's eye points
+    // and the raster's own per-pixel quanta (verify's inputs).
+    const bool avx512 = testing::withEnvironment("ZCHECK_COMPARE_KERNEL", nullptr,
+                                                 [] { return useAvx512Form("ZCHECK_COMPARE_KERNEL", "baseline"); });
+    if (!avx512) WARN("this processor has no AVX-512 (F, DQ, VL): both comparisons below are the baseline form");
+    auto inForm = [](const char* form, auto run) { return testing::withEnvironment("ZCHECK_COMPARE_KERNEL", form, run); };
+
+    std::vector<CheckOptions> runs(4);
+    runs[1].faults.ray.flipRows = true;
+    runs[2].faults.raster.truncateUnorm = true;
+    runs[2].faults.ray.shiftPixels = {0.5, 0.0};
+    runs[3].faults.ray.distanceAsEyeZ = true;
+    std::int64_t agree = 0, unexplained = 0, explained = 0, biased = 0;
+    for (const char* name : {"builtin:default", "builtin:near-crossing", "builtin:terrain?n=40", "soup"}) {
+        const bool soup = std::string(name) == "soup";
+        const Checker checker(soup ? testing::triangleSoup(false, 41) : builtinScene(name));
+        CameraSpec base = soup ? testing::kernelCamera("opengl", DepthFormat::Unorm24, false, false)
+                               : checker.scene().defaultCamera;
+        base.width = 203, base.height = 131;
+        std::vector<CameraSpec> cameras;
+        for (const char* convention : {"opengl", "opencv"})
+            for (const DepthFormat format : {DepthFormat::Unorm16, DepthFormat::Unorm24, DepthFormat::Float32})
+                for (const bool reversed : {false, true}) {
+                    CameraSpec spec = base;
+                    spec.convention = Convention::preset(convention);
+                    spec.depth.format = format, spec.depth.reversed = reversed;
+                    cameras.push_back(spec);
+                }
+        for (const char* model : {"orthographic", "matrix-direct3d"}) {
+            const CameraSpec example = readCameraFile(std::string(ZCHECK_TESTS_DIR) + "/../examples/" + model + ".json");
+            CameraSpec spec = base;  // the scene's view, the example's projection, convention and depth
+            spec.projection = example.projection, spec.convention = example.convention, spec.depth = example.depth;
+            cameras.push_back(spec);
+        }
+        for (const CameraSpec& spec : cameras) {
+            const Camera camera(spec);
+            for (std::size_t k = 0; k < runs.size(); ++k) {
+                INFO(name << ", " << spec.convention.name << ", " << toString(spec.depth.format)
+                          << (spec.depth.reversed ? " reversed" : "") << ", projection " << int(spec.projection.type)
+                          << ", run " << k);
+                const CheckResult baseline = inForm("baseline", [&] { return checker.check(camera, runs[k]); });
+                const CheckResult chosen = inForm("auto", [&] { return checker.check(camera, runs[k]); });
+                REQUIRE(reportWithoutTimings(chosen.report) == reportWithoutTimings(baseline.report));
+                REQUIRE(testing::sameBits(chosen.comparison.pixelClass, baseline.comparison.pixelClass));
+                REQUIRE(testing::sameBits(chosen.comparison.errorOverTolerance, baseline.comparison.errorOverTolerance));
+                const ComparisonReport& r = baseline.report.comparison;
+                agree += r.agree, unexplained += r.unexplained(), explained += r.coverageExplained + r.edgeSurface;
+                biased += r.depthBias ? 1 : 0;
+            }
+            // With the ray's eye points (the relative eye-z error from them) and the raster's
+            // own quanta, as verify passes them.
+            const RenderResult ray = checker.renderRay(camera, {}, EyePoints::Keep), raster = checker.renderRaster(camera);
+            std::vector<double> quanta(raster.windowDepth.value.size());
+            for (std::size_t i = 0; i < quanta.size(); ++i)
+                quanta[i] = storageQuantum(DepthFormat::Float32, raster.windowDepth.value[i]) * double(1 + i % 5);
+            const std::vector<double>* ownQuanta = &quanta;
+            for (const std::vector<double>* quantum : {ownQuanta, static_cast<const std::vector<double>*>(nullptr)}) {
+                const Comparison b = inForm("baseline", [&] { return compareRoutes(checker.scene(), camera, ray, raster, {}, quantum); });
+                const Comparison c = inForm("auto", [&] { return compareRoutes(checker.scene(), camera, ray, raster, {}, quantum); });
+                CheckReport byBaseline, byChosen;
+                byBaseline.comparison = b.report, byChosen.comparison = c.report;
+                REQUIRE(checkReportJson(byChosen) == checkReportJson(byBaseline));
+                REQUIRE(testing::sameBits(c.pixelClass, b.pixelClass));
+                REQUIRE(testing::sameBits(c.errorOverTolerance, b.errorOverTolerance));
+            }
+        }
+    }
+    // Every kind of pixel was there to compare.
+    REQUIRE(agree > 100000);
+    REQUIRE(unexplained > 1000);
+    REQUIRE(explained > 1000);
+    REQUIRE(biased > 0);
+}
+
+TEST_CASE("ZCHECK_COMPARE_KERNEL takes auto or baseline and nothing else", "[compare][kernel]")
+{
+    const Checker checker(builtinScene("builtin:default"));
+    const Camera camera(smallCamera(checker.scene()));
+    auto checkWith = [&](const char* form) {
+        return testing::withEnvironment("ZCHECK_COMPARE_KERNEL", form, [&] { return checker.check(camera); });
+    };
+    REQUIRE_NOTHROW(checkWith("auto"));
+    REQUIRE_NOTHROW(checkWith("baseline"));
+    REQUIRE_THROWS_WITH(checkWith("scalar"),
+                        Catch::Contains("ZCHECK_COMPARE_KERNEL=scalar") && Catch::Contains("'auto' or 'baseline'"));
 }

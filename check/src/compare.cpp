@@ -4,6 +4,7 @@
 #include "zcheck/drawn_polygon.h"
 #include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
+#include "zcheck/kernel_choice.h"
 #include "zcheck/large_buffer.h"
 #include "zcheck/percentile.h"
 
@@ -57,19 +58,34 @@ DepthSlopeFrame::DepthSlopeFrame(const Camera& camera, SlopeCredit credit)
 {
 }
 
-double DepthSlopeFrame::slope(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) const
+namespace {
+
+// DepthSlopeFrame::slope's arithmetic, inlined where it is called: one triangle at a time, and
+// over lane arrays in PixelJudge::slopes (several triangles per instruction there, so no
+// branch: a plane seen edge-on selects +inf after the division by its zero).
+__attribute__((always_inline)) inline double slopeOfTriangle(const DepthSlopeFrame& frame, const glm::dvec3& a,
+                                                             const glm::dvec3& b, const glm::dvec3& c)
 {
     const glm::dvec3 normal = glm::cross(b - a, c - a);
     const glm::dvec4 plane(normal, -glm::dot(normal, a));
     // The clip-space plane's x, y and z (its w is not needed): rows 0-2 of the product.
-    const glm::dmat4& m = clipPlaneFromWorldPlane;
-    auto row = [&](int k) { return m[0][k] * plane.x + m[1][k] * plane.y + m[2][k] * plane.z + m[3][k] * plane.w; };
-    const double x = row(0), y = row(1), z = row(2);
-    if (z == 0) return INFINITY;
-    const double dx = std::abs(x) * ndcPerPixelX, dy = std::abs(y) * ndcPerPixelY;
+    const glm::dmat4& m = frame.clipPlaneFromWorldPlane;
+    const double x = m[0][0] * plane.x + m[1][0] * plane.y + m[2][0] * plane.z + m[3][0] * plane.w;
+    const double y = m[0][1] * plane.x + m[1][1] * plane.y + m[2][1] * plane.z + m[3][1] * plane.w;
+    const double z = m[0][2] * plane.x + m[1][2] * plane.y + m[2][2] * plane.z + m[3][2] * plane.w;
+    const double dx = std::abs(x) * frame.ndcPerPixelX, dy = std::abs(y) * frame.ndcPerPixelY;
     // A sample up to S off in x and in y moves depth by up to S·(|∂d/∂x| + |∂d/∂y|); vertices
     // snapped by up to S/2 per axis by no more than S·max (compare.h).
-    return zWindowPerZNdc * (credit == SlopeCredit::SampleOffset ? dx + dy : std::max(dx, dy)) / std::abs(z);
+    const double slope =
+        frame.zWindowPerZNdc * (frame.credit == SlopeCredit::SampleOffset ? dx + dy : std::max(dx, dy)) / std::abs(z);
+    return z == 0 ? INFINITY : slope;
+}
+
+}  // namespace
+
+double DepthSlopeFrame::slope(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) const
+{
+    return slopeOfTriangle(*this, a, b, c);
 }
 
 double windowDepthSlope(const Camera& camera, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c)
@@ -104,7 +120,8 @@ PixelJudge::PixelJudge(const Scene& scene, const Camera& camera, const Tolerance
       S_(tolerance.snapPixels()),
       E_(16 * std::ldexp(1.0, -52) * std::max(std::abs(camera.depth().rangeMin), std::abs(camera.depth().rangeMax))),
       slopeFrame_(camera, tolerance.slopeCredit),
-      serial_(nextJudgeSerial.fetch_add(1, std::memory_order_relaxed))
+      serial_(nextJudgeSerial.fetch_add(1, std::memory_order_relaxed)),
+      avx512_(useAvx512Form("ZCHECK_COMPARE_KERNEL", "baseline"))
 {
 }
 
@@ -128,6 +145,68 @@ double PixelJudge::slope(std::uint32_t primitive) const
     if (memo.judge != serial_ || memo.primitive != primitive)
         memo = {serial_, primitive, computeSlope(primitive)};
     return memo.slope;
+}
+
+namespace {
+
+// Slopes of up to kSlopeLanes triangles together: their corners dealt into lane arrays, then
+// slopeOfTriangle lane by lane. Inlined into a baseline and an AVX-512 form (kernel_choice.h),
+// both bit-identical to slope() of each (the same IEEE operations in the same order).
+constexpr std::size_t kSlopeLanes = 64;
+__attribute__((always_inline)) inline void slopesTogether(const DepthSlopeFrame& frame, const Scene& scene,
+                                                          const std::uint32_t* primitive, std::size_t n, double* slope)
+{
+    alignas(64) double corner[3][3][kSlopeLanes];  // corner, axis, lane
+    for (std::size_t k = 0; k < n; ++k) {
+        const glm::uvec3& t = scene.triangles[primitive[k]];
+        for (int v = 0; v < 3; ++v)
+            for (int c = 0; c < 3; ++c) corner[v][c][k] = double(scene.positions[t[v]][c]);
+    }
+    for (std::size_t k = 0; k < n; ++k)
+        slope[k] = slopeOfTriangle(frame, glm::dvec3(corner[0][0][k], corner[0][1][k], corner[0][2][k]),
+                                   glm::dvec3(corner[1][0][k], corner[1][1][k], corner[1][2][k]),
+                                   glm::dvec3(corner[2][0][k], corner[2][1][k], corner[2][2][k]));
+}
+
+void slopesTogetherBaseline(const DepthSlopeFrame& frame, const Scene& scene, const std::uint32_t* primitive,
+                            std::size_t n, double* slope)
+{
+    slopesTogether(frame, scene, primitive, n, slope);
+}
+
+#ifdef ZCHECK_X86_AVX512
+ZCHECK_TARGET_AVX512 void slopesTogetherAvx512(const DepthSlopeFrame& frame, const Scene& scene,
+                                               const std::uint32_t* primitive, std::size_t n, double* slope)
+{
+    slopesTogether(frame, scene, primitive, n, slope);
+}
+#endif
+
+}  // namespace
+
+void PixelJudge::slopes(const std::uint32_t* primitive, std::size_t n, double* slope) const
+{
+    auto* together = &slopesTogetherBaseline;
+#ifdef ZCHECK_X86_AVX512
+    if (avx512_) together = &slopesTogetherAvx512;
+#endif
+    // Runs of lanes on one primitive (neighbouring pixels, mostly) take one slope: the runs'
+    // primitives listed without a branch (one not of the scene as triangle 0, its slope
+    // replaced by 0 afterwards), their slopes computed together, then dealt out to the lanes.
+    for (std::size_t j0 = 0; j0 < n; j0 += kSlopeLanes) {
+        const std::size_t lanes = std::min(kSlopeLanes, n - j0);
+        const std::uint32_t* p = primitive + j0;
+        std::uint32_t run[kSlopeLanes], runPrimitive[kSlopeLanes];
+        std::size_t runs = 0;
+        for (std::size_t j = 0; j < lanes; ++j) {
+            runs += std::size_t(j == 0 || p[j] != p[j - 1]);
+            run[j] = std::uint32_t(runs - 1);
+            runPrimitive[runs - 1] = known(p[j]) ? p[j] : 0;
+        }
+        alignas(64) double runSlope[kSlopeLanes];
+        together(slopeFrame_, scene_, runPrimitive, runs, runSlope);
+        for (std::size_t j = 0; j < lanes; ++j) slope[j0 + j] = known(p[j]) ? runSlope[run[j]] : 0.0;
+    }
 }
 
 double PixelJudge::surfaceTolerance(std::uint32_t primitive, double q) const { return toleranceForSlope(slope(primitive), q); }
@@ -272,6 +351,29 @@ struct PixelMeasures {
     {
         return (raster.windowDepth[b] - ray.windowDepth[a]) / q;
     }
+    // quantum() of n pixels of a row, entries a0.. and b0.., into q: several per instruction
+    // where the format's quantum is one constant or comes from the raster's own array.
+    void quanta(const RoutePixels& ray, const RoutePixels& raster, std::size_t a0, std::size_t b0, std::size_t n,
+                double* q) const
+    {
+        if (raster.quantum) {
+            std::copy(raster.quantum + b0, raster.quantum + b0 + n, q);
+        } else if (format != DepthFormat::Float32) {
+            std::fill(q, q + n, storageQuantum(format, 0.0));  // 1/(2^N − 1) at every depth
+        } else {
+            for (std::size_t j = 0; j < n; ++j) q[j] = storageQuantum(format, ray.windowDepth[a0 + j]);
+        }
+    }
+    // relativeEyeZError of n pixels of a row from (col0, row), entries a0.. and b0.., into
+    // `relative`: several per instruction where the closed form applies.
+    void relativeEyeZErrors(const RoutePixels& ray, const RoutePixels& raster, std::size_t a0, std::size_t b0, int col0,
+                            int row, std::size_t n, double* relative) const
+    {
+        if (!ray.pEye && cameraRays.relativeEyeZDifferences(ray.windowDepth + a0, raster.windowDepth + b0, n, relative))
+            return;
+        for (std::size_t j = 0; j < n; ++j)
+            relative[j] = relativeEyeZError(ray, raster, a0 + j, b0 + j, col0 + int(j), row);
+    }
     // The relative eye-z error of a pixel compared on depth.
     double relativeEyeZError(const RoutePixels& ray, const RoutePixels& raster, std::size_t a, std::size_t b, int col,
                              int row) const
@@ -320,6 +422,11 @@ struct TileComparison::Impl {
     }
 
     void compare(int tile, const RoutePixels& ray, const RoutePixels& raster);
+    void compareBody(int tile, const RoutePixels& ray, const RoutePixels& raster);
+    void compareBaseline(int tile, const RoutePixels& ray, const RoutePixels& raster);
+#ifdef ZCHECK_X86_AVX512
+    ZCHECK_TARGET_AVX512 void compareAvx512(int tile, const RoutePixels& ray, const RoutePixels& raster);
+#endif
 
     const Camera& camera;
     Comparison* perPixel;
@@ -332,7 +439,13 @@ struct TileComparison::Impl {
     tbb::enumerable_thread_specific<StatisticCounts> statisticCounts;
 };
 
-void TileComparison::Impl::compare(int tile, const RoutePixels& ray, const RoutePixels& raster)
+// Impl::compare's work, inlined into a baseline and an AVX-512 form (compareBaseline,
+// compareAvx512; kernel_choice.h), bit-identical to each other: the same IEEE operations in
+// the same order, and every sum, count and keeper fed in scan order. Row by row: first the
+// common case's measures for the whole row, lane by lane (several pixels per instruction),
+// then the pixels tallied in scan order, the common case from those measures.
+#define ZCHECK_INLINE __attribute__((always_inline))
+ZCHECK_INLINE inline void TileComparison::Impl::compareBody(int tile, const RoutePixels& ray, const RoutePixels& raster)
 {
     TileTally& tally = tallies[std::size_t(tile)];
     ComparisonReport& r = tally.report;
@@ -341,19 +454,24 @@ void TileComparison::Impl::compare(int tile, const RoutePixels& ray, const Route
     const int col0 = rect.col0, row0 = rect.row0, col1 = rect.col1, row1 = rect.row1;
 
     // Pixel (col, row): a in the ray's arrays, b in the raster's, i in the image.
-    auto quantumAt = [&](std::size_t a, std::size_t b) { return measures.quantum(ray, raster, a, b); };
-    auto signedErrorQuantaAt = [&](std::size_t a, std::size_t b, double q) {
+    auto quantumAt = [&](std::size_t a, std::size_t b) ZCHECK_INLINE { return measures.quantum(ray, raster, a, b); };
+    auto signedErrorQuantaAt = [&](std::size_t a, std::size_t b, double q) ZCHECK_INLINE {
         return PixelMeasures::signedErrorQuanta(ray, raster, a, b, q);
     };
     // |Δ| / tolerance, as the report and the heatmap give it.
-    auto ratioOf = [](double error, double bound) { return bound > 0 ? error / bound : (error > 0 ? INFINITY : 0.0); };
+    // (The division and both comparisons are made whatever the bound, so that a loop of these
+    // needs no branch: a compiler may not make a trapping operation the code skipped.)
+    auto ratioOf = [](double error, double bound) ZCHECK_INLINE {
+        const double quotient = error / bound;
+        const bool boundPositive = bound > 0, errorPositive = error > 0;
+        const double unbounded = errorPositive ? INFINITY : 0.0;
+        return boundPositive ? quotient : unbounded;
+    };
     // A pixel compared on depth (agree or depth error), whichever path judged it: its count, its
     // ratio, the statistics. Returns whether it is the worst so far (its finding is then r.worst).
-    auto noteCompared = [&](std::size_t a, std::size_t b, std::size_t i, int col, int row, bool agree, double ratio,
-                            double errorQuanta) {
+    auto noteCompared = [&](std::size_t i, bool agree, double ratio, double errorQuanta, double relative) ZCHECK_INLINE {
         agree ? ++r.agree : ++r.depthErrors;
         if (perPixel) perPixel->errorOverTolerance[i] = static_cast<float>(ratio);
-        const double relative = measures.relativeEyeZError(ray, raster, a, b, col, row);
         counts.errorQuanta.add(float(errorQuanta));
         counts.relativeEyeZ.add(float(relative));
         r.maxRelativeEyeZError = std::max(r.maxRelativeEyeZError, relative);
@@ -362,49 +480,77 @@ void TileComparison::Impl::compare(int tile, const RoutePixels& ray, const Route
         if (worst) r.maxErrorOverTolerance = std::max(r.maxErrorOverTolerance, ratio);
         return worst;
     };
-    auto setClass = [&](std::size_t i, PixelClass c) {
+    auto setClass = [&](std::size_t i, PixelClass c) ZCHECK_INLINE {
         if (perPixel) perPixel->pixelClass[i] = c;
     };
 
+    // A row's measures of the common case, both routes on one triangle (PixelJudge::bothHit's
+    // rule for a single surface: one slope, no edge or clip-plane question). Lanes where it is
+    // not the case are computed too, and not used.
+    constexpr int kLanes = kTileSize;
+    alignas(64) std::uint32_t surface[kLanes];  // the triangle both routes hit, else kNoPrimitive
+    alignas(64) bool common[kLanes];
+    alignas(64) double slope[kLanes], quantum[kLanes], bound[kLanes], signedErrorQuanta[kLanes], ratio[kLanes];
+    alignas(64) double relative[kLanes], position[kLanes];
+    alignas(64) bool agree[kLanes], biasSample[kLanes];
+
     for (int row = row0; row < row1; ++row) {
-        for (int col = col0; col < col1; ++col) {
-            const std::size_t a = ray.at(col, row), b = raster.at(col, row), i = std::size_t(row) * W + col;
-            const std::uint32_t rayPrimitive = ray.primitive[a], rasterPrimitive = raster.primitive[b];
+        const std::size_t a0 = ray.at(col0, row), b0 = raster.at(col0, row);
+        const int n = col1 - col0;
+        const std::uint32_t* rayPrimitives = ray.primitive + a0;
+        const std::uint32_t* rasterPrimitives = raster.primitive + b0;
+        const double* rayDepths = ray.windowDepth + a0;
+        const double* rasterDepths = raster.windowDepth + b0;
+        for (int j = 0; j < n; ++j) {
+            common[j] = rayPrimitives[j] != kNoPrimitive && rayPrimitives[j] == rasterPrimitives[j];
+            surface[j] = common[j] ? rayPrimitives[j] : kNoPrimitive;
+        }
+        judge.slopes(surface, std::size_t(n), slope);
+        measures.quanta(ray, raster, a0, b0, std::size_t(n), quantum);
+        for (int j = 0; j < n; ++j) {
+            const double q = quantum[j], m = slope[j], rayDepth = rayDepths[j];
+            bound[j] = judge.toleranceForSlope(m, q);
+            const double error = std::abs(rasterDepths[j] - rayDepth);
+            signedErrorQuanta[j] = signedErrorQuantaAt(a0 + j, b0 + j, q);
+            ratio[j] = ratioOf(error, bound[j]);
+            agree[j] = error <= bound[j];
+            // Where quantization dominates, the pixel feeds the bias test: its signed error and
+            // where its exact depth falls in the quantum (position: d/q).
+            biasSample[j] = S * m <= 0.1 * q;
+            position[j] = rayDepth / q;
+        }
+        measures.relativeEyeZErrors(ray, raster, a0, b0, col0, row, std::size_t(n), relative);
+
+        for (int j = 0; j < n; ++j) {
+            const int col = col0 + j;
+            const std::size_t a = a0 + std::size_t(j), b = b0 + std::size_t(j), i = std::size_t(row) * W + col;
+            const std::uint32_t rayPrimitive = rayPrimitives[j], rasterPrimitive = rasterPrimitives[j];
             const bool rayHit = rayPrimitive != kNoPrimitive, rasterHit = rasterPrimitive != kNoPrimitive;
             if (!rayHit && !rasterHit) {
                 ++r.bothMiss;  // pixelClass is BothMiss already
                 continue;
             }
-            if (rayHit && rasterHit && rayPrimitive == rasterPrimitive) {
-                // The common case, kept lean: one surface, so one slope, and no edge or
-                // clip-plane question (PixelJudge::bothHit's rule for a single surface).
+            if (common[j]) {
                 ++r.bothHit;
-                const double rayDepth = ray.windowDepth[a], rasterDepth = raster.windowDepth[b];
-                const double q = quantumAt(a, b), m = judge.slope(rayPrimitive);
-                const double bound = judge.toleranceForSlope(m, q);
-                const double error = std::abs(rasterDepth - rayDepth);
-                const double signedErrorQuanta = signedErrorQuantaAt(a, b, q), errorQuanta = std::abs(signedErrorQuanta);
-                const double ratio = ratioOf(error, bound);
-                const bool agree = error <= bound;
-                if (S * m <= 0.1 * q) {
-                    // Quantization dominates here: feed the bias test.
-                    tally.signedErrorSum += signedErrorQuanta;
-                    const double position = rayDepth / q;
-                    ++tally.quarterCounts[std::clamp(int(4 * (position - std::floor(position))), 0, 3)];
+                if (biasSample[j]) {
+                    tally.signedErrorSum += signedErrorQuanta[j];
+                    ++tally.quarterCounts[std::clamp(int(4 * (position[j] - std::floor(position[j]))), 0, 3)];
                     ++r.biasSamples;
                 }
-                setClass(i, agree ? PixelClass::Agree : PixelClass::DepthError);
-                const bool worst = noteCompared(a, b, i, col, row, agree, ratio, errorQuanta);
-                if (agree && !worst) continue;  // nothing to note: no finding is built
+                const PixelClass c = agree[j] ? PixelClass::Agree : PixelClass::DepthError;
+                setClass(i, c);
+                const double errorQuanta = std::abs(signedErrorQuanta[j]);
+                const bool worst = noteCompared(i, agree[j], ratio[j], errorQuanta, relative[j]);
+                if (agree[j] && !worst) continue;  // nothing to note: no finding is built
                 PixelFinding f;
                 f.col = col, f.row = row;
-                f.rayWindowDepth = rayDepth, f.rasterWindowDepth = rasterDepth;
+                f.rayWindowDepth = rayDepths[j], f.rasterWindowDepth = rasterDepths[j];
                 f.rayPrimitive = f.rasterPrimitive = rayPrimitive;
-                f.pixelClass = agree ? PixelClass::Agree : PixelClass::DepthError;
+                f.pixelClass = c;
                 f.errorQuanta = errorQuanta;
-                f.toleranceQuanta = bound / q;
+                f.toleranceQuanta = bound[j] / quantum[j];
                 if (worst) r.worst = f;
-                if (!agree) noteUnexplained(r, f);
+                if (!agree[j]) noteUnexplained(r, f);
                 continue;
             }
             const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
@@ -431,7 +577,8 @@ void TileComparison::Impl::compare(int tile, const RoutePixels& ray, const Route
                 };
                 if (f.pixelClass == PixelClass::EdgeSurface) {
                     ++r.edgeSurface;
-                } else if (noteCompared(a, b, i, col, row, f.pixelClass == PixelClass::Agree, ratio, f.errorQuanta)) {
+                } else if (noteCompared(i, f.pixelClass == PixelClass::Agree, ratio, f.errorQuanta,
+                                        measures.relativeEyeZError(ray, raster, a, b, col, row))) {
                     r.worst = withTolerance(f);
                 }
                 if (f.pixelClass == PixelClass::DepthError) withTolerance(f);
@@ -448,6 +595,26 @@ void TileComparison::Impl::compare(int tile, const RoutePixels& ray, const Route
             if (isUnexplained(f.pixelClass)) noteUnexplained(r, f);
         }
     }
+}
+
+void TileComparison::Impl::compareBaseline(int tile, const RoutePixels& ray, const RoutePixels& raster)
+{
+    compareBody(tile, ray, raster);
+}
+
+#ifdef ZCHECK_X86_AVX512
+ZCHECK_TARGET_AVX512 void TileComparison::Impl::compareAvx512(int tile, const RoutePixels& ray, const RoutePixels& raster)
+{
+    compareBody(tile, ray, raster);
+}
+#endif
+
+void TileComparison::Impl::compare(int tile, const RoutePixels& ray, const RoutePixels& raster)
+{
+#ifdef ZCHECK_X86_AVX512
+    if (judge.avx512Form()) return compareAvx512(tile, ray, raster);
+#endif
+    compareBaseline(tile, ray, raster);
 }
 
 TileComparison::TileComparison(const Scene& scene, const Camera& camera, const ToleranceModel& tolerance,

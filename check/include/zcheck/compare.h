@@ -175,6 +175,15 @@ public:
     // Whether the primitive's plane meets the pixel's ray on the near or far plane.
     bool atClipPlane(std::uint32_t primitive, const glm::dvec2& pWindow) const;
     double slope(std::uint32_t primitive) const;
+    // slope() of n primitives at once into `slope` (0 for one not of the scene, such as
+    // kNoPrimitive), bit-identical to slope() of each: one per run of equal primitives, the
+    // runs' slopes computed together, several per instruction where the processor allows
+    // (ZCHECK_COMPARE_KERNEL=baseline|auto, kernel_choice.h). Not memoised: a row of a tile
+    // computes them faster than it looks them up.
+    void slopes(const std::uint32_t* primitive, std::size_t n, double* slope) const;
+    // Whether the comparison's AVX-512 forms run (ZCHECK_COMPARE_KERNEL, read when the judge
+    // was made).
+    bool avx512Form() const { return avx512_; }
     double snapPixels() const { return S_; }
 
 private:
@@ -187,6 +196,7 @@ private:
     double C_, S_, E_;
     DepthSlopeFrame slopeFrame_;
     std::uint64_t serial_;  // this judge's key in the per-thread slope memo
+    bool avx512_;           // ZCHECK_COMPARE_KERNEL: the AVX-512 forms (avx512Form())
 };
 
 // One route's results over a rectangle of the image, as the comparison reads them: pixel

@@ -27,6 +27,7 @@
 #include "zcheck/inverse_projection.h"
 
 #include <cmath>
+#include <cstddef>
 #include <optional>
 
 namespace zcheck {
@@ -81,12 +82,35 @@ public:
             const double zReference = eyeZFromWindowDepth(pImage, reference);
             return std::abs(eyeZFromWindowDepth(pImage, other) - zReference) / std::abs(zReference);
         }
-        // Parallel: z = (w − A)/B, so (z_o − z_r)/z_r = (w_o − w_r)/(w_r − A).
-        return parallel_ ? std::abs((other - reference) / (reference - depthA_))
-                         : std::abs((reference - other) / (other - depthA_));
+        return parallel_ ? parallelRelative(depthA_, reference, other) : perspectiveRelative(depthA_, reference, other);
+    }
+
+    // relativeEyeZDifference of n pairs (reference[j], other[j]) into out[j], several per
+    // instruction; false (nothing written) for a raw-matrix camera, whose pixels differ.
+    bool relativeEyeZDifferences(const double* reference, const double* other, std::size_t n, double* out) const
+    {
+        if (fromMatrix_) return false;
+        const double A = depthA_;
+        if (parallel_) {
+            for (std::size_t j = 0; j < n; ++j) out[j] = parallelRelative(A, reference[j], other[j]);
+        } else {
+            for (std::size_t j = 0; j < n; ++j) out[j] = perspectiveRelative(A, reference[j], other[j]);
+        }
+        return true;
     }
 
 private:
+    // The closed forms of relativeEyeZDifference. Perspective: z = B/(w − A), so
+    // (z_o − z_r)/z_r = (w_r − w_o)/(w_o − A); parallel: z = (w − A)/B, so (w_o − w_r)/(w_r − A).
+    static double perspectiveRelative(double A, double reference, double other)
+    {
+        return std::abs((reference - other) / (other - A));
+    }
+    static double parallelRelative(double A, double reference, double other)
+    {
+        return std::abs((other - reference) / (reference - A));
+    }
+
     // A raw-matrix camera's depth mapping, through the inverse-projection module.
     double matrixWindowDepth(const glm::dvec2& pImage, double eyeZ) const;
     double matrixEyeZFromWindowDepth(const glm::dvec2& pImage, double windowDepth) const;
