@@ -433,3 +433,55 @@ TEST_CASE("ZCHECK_COMPARE_KERNEL takes auto or baseline and nothing else", "[com
     REQUIRE_THROWS_WITH(checkWith("scalar"),
                         Catch::Contains("ZCHECK_COMPARE_KERNEL=scalar") && Catch::Contains("'auto' or 'baseline'"));
 }
+
+TEST_CASE("the comparison writes every pixel's class and ratio, whose arrays are not cleared first", "[compare][allocated]")
+{
+    // TileComparison sizes the per-pixel arrays without clearing them and each tile writes all
+    // of its pixels: a pixel it failed to write would show what the memory held. Arrays of the
+    // same sizes are filled with garbage and freed first, so that they may be handed back. On
+    // an image the 64×64 tiles cut on both edges, clean and with rows flipped (depth errors and
+    // coverage mismatches), every class's pixels must number what the report counts, and only
+    // the pixels compared on depth may carry a ratio.
+    const Checker checker(builtinScene("builtin:near-crossing"));
+    CameraSpec spec = checker.scene().defaultCamera;
+    spec.width = 131, spec.height = 70;
+    const Camera camera(spec);
+    const std::size_t pixels = std::size_t(spec.width) * spec.height;
+    for (const bool flipRows : {false, true}) {
+        RayFaults faults;
+        faults.flipRows = flipRows;
+        const RenderResult ray = checker.renderRay(camera, faults), raster = checker.renderRaster(camera);
+        {
+            LargeVector<PixelClass> classGarbage(pixels, PixelClass::RayOnly);
+            LargeVector<float> ratioGarbage(pixels, -5.0f);
+        }
+        const Comparison c = compareRoutes(checker.scene(), camera, ray, raster);
+        const ComparisonReport& r = c.report;
+        INFO((flipRows ? "rows flipped" : "clean"));
+        std::int64_t count[10] = {};
+        float maxRatio = 0;
+        for (std::size_t i = 0; i < pixels; ++i) {
+            const PixelClass k = c.pixelClass[i];
+            REQUIRE(int(k) < 10);
+            ++count[int(k)];
+            if (k == PixelClass::Agree || k == PixelClass::DepthError) {
+                REQUIRE(c.errorOverTolerance[i] >= 0.0f);
+                maxRatio = std::max(maxRatio, c.errorOverTolerance[i]);
+            } else {
+                REQUIRE(c.errorOverTolerance[i] == 0.0f);
+            }
+        }
+        REQUIRE(count[int(PixelClass::BothMiss)] == r.bothMiss);
+        REQUIRE(count[int(PixelClass::Agree)] == r.agree);
+        REQUIRE(count[int(PixelClass::DepthError)] == r.depthErrors);
+        REQUIRE(count[int(PixelClass::EdgeSurface)] == r.edgeSurface);
+        REQUIRE(count[int(PixelClass::RayOnly)] + count[int(PixelClass::RasterOnly)] == r.coverageUnexplained);
+        REQUIRE(count[int(PixelClass::RayOnlyEdge)] + count[int(PixelClass::RasterOnlyEdge)] +
+                    count[int(PixelClass::RayOnlyAtClear)] + count[int(PixelClass::AtClipPlane)] ==
+                r.coverageExplained);
+        REQUIRE(maxRatio == float(r.maxErrorOverTolerance));
+        REQUIRE(r.bothMiss > 0);
+        REQUIRE(r.agree > 1000);
+        if (flipRows) REQUIRE(r.unexplained() > 100);
+    }
+}

@@ -469,9 +469,8 @@ ZCHECK_INLINE inline void TileComparison::Impl::compareBody(int tile, const Rout
     };
     // A pixel compared on depth (agree or depth error), whichever path judged it: its count, its
     // ratio, the statistics. Returns whether it is the worst so far (its finding is then r.worst).
-    auto noteCompared = [&](std::size_t i, bool agree, double ratio, double errorQuanta, double relative) ZCHECK_INLINE {
+    auto noteCompared = [&](bool agree, double ratio, double errorQuanta, double relative) ZCHECK_INLINE {
         agree ? ++r.agree : ++r.depthErrors;
-        if (perPixel) perPixel->errorOverTolerance[i] = static_cast<float>(ratio);
         counts.errorQuanta.add(float(errorQuanta));
         counts.relativeEyeZ.add(float(relative));
         r.maxRelativeEyeZError = std::max(r.maxRelativeEyeZError, relative);
@@ -520,6 +519,14 @@ ZCHECK_INLINE inline void TileComparison::Impl::compareBody(int tile, const Rout
             position[j] = rayDepth / q;
         }
         measures.relativeEyeZErrors(ray, raster, a0, b0, col0, row, std::size_t(n), relative);
+        if (perPixel) {  // every pixel of the row, as the common case or a miss would have it
+            PixelClass* classes = perPixel->pixelClass.data() + std::size_t(row) * W + col0;
+            float* ratios = perPixel->errorOverTolerance.data() + std::size_t(row) * W + col0;
+            for (int j = 0; j < n; ++j) {
+                classes[j] = common[j] ? (agree[j] ? PixelClass::Agree : PixelClass::DepthError) : PixelClass::BothMiss;
+                ratios[j] = common[j] ? static_cast<float>(ratio[j]) : 0.0f;
+            }
+        }
 
         for (int j = 0; j < n; ++j) {
             const int col = col0 + j;
@@ -527,7 +534,7 @@ ZCHECK_INLINE inline void TileComparison::Impl::compareBody(int tile, const Rout
             const std::uint32_t rayPrimitive = rayPrimitives[j], rasterPrimitive = rasterPrimitives[j];
             const bool rayHit = rayPrimitive != kNoPrimitive, rasterHit = rasterPrimitive != kNoPrimitive;
             if (!rayHit && !rasterHit) {
-                ++r.bothMiss;  // pixelClass is BothMiss already
+                ++r.bothMiss;  // its class and ratio are written already
                 continue;
             }
             if (common[j]) {
@@ -537,10 +544,9 @@ ZCHECK_INLINE inline void TileComparison::Impl::compareBody(int tile, const Rout
                     ++tally.quarterCounts[std::clamp(int(4 * (position[j] - std::floor(position[j]))), 0, 3)];
                     ++r.biasSamples;
                 }
-                const PixelClass c = agree[j] ? PixelClass::Agree : PixelClass::DepthError;
-                setClass(i, c);
+                const PixelClass c = agree[j] ? PixelClass::Agree : PixelClass::DepthError;  // written already
                 const double errorQuanta = std::abs(signedErrorQuanta[j]);
-                const bool worst = noteCompared(i, agree[j], ratio[j], errorQuanta, relative[j]);
+                const bool worst = noteCompared(agree[j], ratio[j], errorQuanta, relative[j]);
                 if (agree[j] && !worst) continue;  // nothing to note: no finding is built
                 PixelFinding f;
                 f.col = col, f.row = row;
@@ -577,9 +583,11 @@ ZCHECK_INLINE inline void TileComparison::Impl::compareBody(int tile, const Rout
                 };
                 if (f.pixelClass == PixelClass::EdgeSurface) {
                     ++r.edgeSurface;
-                } else if (noteCompared(i, f.pixelClass == PixelClass::Agree, ratio, f.errorQuanta,
-                                        measures.relativeEyeZError(ray, raster, a, b, col, row))) {
-                    r.worst = withTolerance(f);
+                } else {
+                    if (perPixel) perPixel->errorOverTolerance[i] = static_cast<float>(ratio);
+                    if (noteCompared(f.pixelClass == PixelClass::Agree, ratio, f.errorQuanta,
+                                     measures.relativeEyeZError(ray, raster, a, b, col, row)))
+                        r.worst = withTolerance(f);
                 }
                 if (f.pixelClass == PixelClass::DepthError) withTolerance(f);
             } else {
@@ -623,8 +631,8 @@ TileComparison::TileComparison(const Scene& scene, const Camera& camera, const T
 {
     if (perPixel) {
         const std::size_t pixels = std::size_t(camera.width()) * std::size_t(camera.height());
-        perPixel->pixelClass.assign(pixels, PixelClass::BothMiss);
-        perPixel->errorOverTolerance.assign(pixels, 0.0f);
+        perPixel->pixelClass.resize(pixels);  // uninitialised: compareTile writes every pixel of its tile
+        perPixel->errorOverTolerance.resize(pixels);
     }
 }
 

@@ -219,7 +219,8 @@ struct RoutePixels {
 // Tiles are merged in tile order and what depends on scan order is restored (the first
 // unexplained pixels, the worst pixel among equals), so the report is the same for any
 // order and thread count, and the same as compareRoutes'. `perPixel`, when given, receives
-// the classes and ratios (sized here); without it nothing per pixel is kept. Keepers' floors:
+// the classes and ratios (sized here, not cleared: each compareTile writes every pixel of its
+// tile, so they are whole once every tile is compared); without it nothing per pixel is kept. Keepers' floors:
 // see percentile.h; finish() returns nullopt when one was too high (compare again without).
 class TileComparison {
 public:
