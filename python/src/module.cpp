@@ -14,6 +14,7 @@
 #include "zcheck/convention.h"
 #include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
+#include "zcheck/large_buffer.h"
 #include "zcheck/mesh_loader.h"
 #include "zcheck/mistakes.h"
 #include "zcheck/quantity.h"
@@ -1050,6 +1051,14 @@ Returns (points, pixels): points (N, 3) float64, pixels (N, 2) int64 as (col, ro
 the top, one per non-miss pixel, in scan order.)doc");
 
 
+    m.def(
+        "release_cached_buffers", [] { releaseCachedLargeBuffers(); },
+        R"doc(Gives back to the system the per-frame buffers zcheck keeps for the next render of the same
+size (renders and comparisons of 2 MiB and more, up to 1 GiB in all; see cached_buffer_bytes).
+A loop over many cameras or maps pays their page faults once because of them; a long-lived
+program that is done checking calls this. Safe at any time: buffers in use are not touched.)doc");
+    m.def("cached_buffer_bytes", [] { return cachedLargeBufferBytes(); },
+          "The bytes zcheck's kept per-frame buffers hold (see release_cached_buffers).");
 
     m.attr("__name__") = "zcheck._zcheck";
 }

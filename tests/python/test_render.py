@@ -150,3 +150,20 @@ def test_render_routes_agree_on_the_default_scene(default_checker, small_camera)
     assert np.median(np.abs(ray[both] - raster[both]) / ray[both]) < 1e-5
     world = default_checker.render(small_camera, "position-world")
     assert world.shape == (H, W, 3) and np.all(np.isnan(world[~np.isfinite(ray)]))
+
+
+def test_release_cached_buffers_gives_the_kept_frames_back(default_scene, default_checker):
+    # A 1024x768 check with its pixels keeps buffers of 2 MiB and more; once the report is
+    # dropped they are kept for the next check of that size, until released.
+    camera = default_scene.default_camera.replace(width=1024, height=768)
+    zcheck.release_cached_buffers()
+    assert zcheck.cached_buffer_bytes() == 0
+    report = default_checker.check(camera)
+    assert report.consistent
+    del report
+    kept = zcheck.cached_buffer_bytes()
+    assert kept >= 2 << 20
+    zcheck.release_cached_buffers()
+    assert zcheck.cached_buffer_bytes() == 0
+    # The next check of that size maps fresh buffers and gives the same answer.
+    assert default_checker.check(camera).consistent
