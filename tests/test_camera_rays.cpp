@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -123,15 +124,16 @@ TEST_CASE("the trace compiled for AVX-512 is bit-identical to its baseline form"
     std::int64_t misses = 0;  // over all renders: the misses' lanes are compared too
     for (const bool inside : {true, false}) {
         const Scene soup = testing::triangleSoup(inside, inside ? 31 : 32);
-        const RayRenderer ray(soup);
+        // The form is chosen when a renderer is made.
+        auto rendererIn = [&](const char* form) {
+            return testing::withEnvironment("ZCHECK_RAY_KERNEL", form, [&] { return std::make_unique<RayRenderer>(soup); });
+        };
+        const std::unique_ptr<RayRenderer> baselineForm = rendererIn("baseline"), chosenForm = rendererIn("auto");
         for (const CameraSpec& spec : cameras) {
             const Camera camera(spec);
             for (const RayFaults& faults : {RayFaults{}, shifted, rowsFlipped, colsFlipped, distance}) {
-                auto render = [&](const char* form) {
-                    return testing::withEnvironment("ZCHECK_RAY_KERNEL", form,
-                                                    [&] { return ray.render(camera, faults, EyePoints::Keep); });
-                };
-                const RenderResult baseline = render("baseline"), chosen = render("auto");
+                const RenderResult baseline = baselineForm->render(camera, faults, EyePoints::Keep);
+                const RenderResult chosen = chosenForm->render(camera, faults, EyePoints::Keep);
                 INFO((inside ? "soup inside, " : "soup across, ") << spec.convention.name << " " << spec.width << "x"
                      << spec.height << (spec.depth.reversed ? " reversed" : "") << " fault shift/rows/cols/distance "
                      << faults.shiftPixels.x << "/" << faults.flipRows << "/" << faults.flipCols << "/"
@@ -152,10 +154,9 @@ TEST_CASE("the trace compiled for AVX-512 is bit-identical to its baseline form"
 TEST_CASE("ZCHECK_RAY_KERNEL takes auto or baseline and nothing else", "[ray][kernel]")
 {
     const Scene soup = testing::triangleSoup(true, 33);
-    const RayRenderer ray(soup);
     const Camera camera(testing::kernelCamera("opengl", DepthFormat::Unorm24, false, false));
-    auto renderWith = [&](const char* form) {
-        return testing::withEnvironment("ZCHECK_RAY_KERNEL", form, [&] { return ray.render(camera); });
+    auto renderWith = [&](const char* form) {  // read when the renderer is made
+        return testing::withEnvironment("ZCHECK_RAY_KERNEL", form, [&] { return RayRenderer(soup).render(camera); });
     };
     REQUIRE_NOTHROW(renderWith("auto"));
     REQUIRE_NOTHROW(renderWith(""));

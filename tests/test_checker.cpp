@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <random>
 
 #include <set>
@@ -437,8 +438,8 @@ TEST_CASE("ZCHECK_COMPARE_KERNEL takes auto or baseline and nothing else", "[com
 TEST_CASE("the comparison writes every pixel's class and ratio, whose arrays are not cleared first", "[compare][allocated]")
 {
     // TileComparison sizes the per-pixel arrays without clearing them and each tile writes all
-    // of its pixels: a pixel it failed to write would show what the memory held. Arrays of the
-    // same sizes are filled with garbage and freed first, so that they may be handed back. On
+    // of its pixels: a pixel it failed to write would show what the arrays held. They are
+    // handed to it full of garbage already at their size (resizing keeps it). On
     // an image the 64×64 tiles cut on both edges, clean and with rows flipped (depth errors and
     // coverage mismatches), every class's pixels must number what the report counts, and only
     // the pixels compared on depth may carry a ratio.
@@ -451,12 +452,15 @@ TEST_CASE("the comparison writes every pixel's class and ratio, whose arrays are
         RayFaults faults;
         faults.flipRows = flipRows;
         const RenderResult ray = checker.renderRay(camera, faults), raster = checker.renderRaster(camera);
-        {
-            LargeVector<PixelClass> classGarbage(pixels, PixelClass::RayOnly);
-            LargeVector<float> ratioGarbage(pixels, -5.0f);
-        }
-        const Comparison c = compareRoutes(checker.scene(), camera, ray, raster);
-        const ComparisonReport& r = c.report;
+        Comparison c;
+        c.pixelClass.assign(pixels, PixelClass::RayOnly);
+        c.errorOverTolerance.assign(pixels, -5.0f);
+        TileComparison tiles(checker.scene(), camera, {}, &c);
+        for (int tile = 0; tile < tiles.tiles().count(); ++tile)
+            tiles.compareTile(tile, RoutePixels::of(ray), RoutePixels::of(raster));
+        const std::optional<ComparisonReport> report = tiles.finish();
+        REQUIRE(report.has_value());
+        const ComparisonReport& r = *report;
         INFO((flipRows ? "rows flipped" : "clean"));
         std::int64_t count[10] = {};
         float maxRatio = 0;

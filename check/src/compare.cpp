@@ -63,7 +63,7 @@ namespace {
 // DepthSlopeFrame::slope's arithmetic, inlined where it is called: one triangle at a time, and
 // over lane arrays in PixelJudge::slopes (several triangles per instruction there, so no
 // branch: a plane seen edge-on selects +inf after the division by its zero).
-__attribute__((always_inline)) inline double slopeOfTriangle(const DepthSlopeFrame& frame, const glm::dvec3& a,
+ZCHECK_ALWAYS_INLINE inline double slopeOfTriangle(const DepthSlopeFrame& frame, const glm::dvec3& a,
                                                              const glm::dvec3& b, const glm::dvec3& c)
 {
     const glm::dvec3 normal = glm::cross(b - a, c - a);
@@ -153,7 +153,7 @@ namespace {
 // slopeOfTriangle lane by lane. Inlined into a baseline and an AVX-512 form (kernel_choice.h),
 // both bit-identical to slope() of each (the same IEEE operations in the same order).
 constexpr std::size_t kSlopeLanes = 64;
-__attribute__((always_inline)) inline void slopesTogether(const DepthSlopeFrame& frame, const Scene& scene,
+ZCHECK_ALWAYS_INLINE inline void slopesTogether(const DepthSlopeFrame& frame, const Scene& scene,
                                                           const std::uint32_t* primitive, std::size_t n, double* slope)
 {
     alignas(64) double corner[3][3][kSlopeLanes];  // corner, axis, lane
@@ -193,6 +193,7 @@ void PixelJudge::slopes(const std::uint32_t* primitive, std::size_t n, double* s
     // Runs of lanes on one primitive (neighbouring pixels, mostly) take one slope: the runs'
     // primitives listed without a branch (one not of the scene as triangle 0, its slope
     // replaced by 0 afterwards), their slopes computed together, then dealt out to the lanes.
+    if (scene_.triangles.empty()) return void(std::fill(slope, slope + n, 0.0));  // nothing is known
     for (std::size_t j0 = 0; j0 < n; j0 += kSlopeLanes) {
         const std::size_t lanes = std::min(kSlopeLanes, n - j0);
         const std::uint32_t* p = primitive + j0;
@@ -444,8 +445,7 @@ struct TileComparison::Impl {
 // the same order, and every sum, count and keeper fed in scan order. Row by row: first the
 // common case's measures for the whole row, lane by lane (several pixels per instruction),
 // then the pixels tallied in scan order, the common case from those measures.
-#define ZCHECK_INLINE __attribute__((always_inline))
-ZCHECK_INLINE inline void TileComparison::Impl::compareBody(int tile, const RoutePixels& ray, const RoutePixels& raster)
+ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tile, const RoutePixels& ray, const RoutePixels& raster)
 {
     TileTally& tally = tallies[std::size_t(tile)];
     ComparisonReport& r = tally.report;
@@ -454,14 +454,14 @@ ZCHECK_INLINE inline void TileComparison::Impl::compareBody(int tile, const Rout
     const int col0 = rect.col0, row0 = rect.row0, col1 = rect.col1, row1 = rect.row1;
 
     // Pixel (col, row): a in the ray's arrays, b in the raster's, i in the image.
-    auto quantumAt = [&](std::size_t a, std::size_t b) ZCHECK_INLINE { return measures.quantum(ray, raster, a, b); };
-    auto signedErrorQuantaAt = [&](std::size_t a, std::size_t b, double q) ZCHECK_INLINE {
+    auto quantumAt = [&](std::size_t a, std::size_t b) ZCHECK_ALWAYS_INLINE { return measures.quantum(ray, raster, a, b); };
+    auto signedErrorQuantaAt = [&](std::size_t a, std::size_t b, double q) ZCHECK_ALWAYS_INLINE {
         return PixelMeasures::signedErrorQuanta(ray, raster, a, b, q);
     };
     // |Δ| / tolerance, as the report and the heatmap give it.
     // (The division and both comparisons are made whatever the bound, so that a loop of these
     // needs no branch: a compiler may not make a trapping operation the code skipped.)
-    auto ratioOf = [](double error, double bound) ZCHECK_INLINE {
+    auto ratioOf = [](double error, double bound) ZCHECK_ALWAYS_INLINE {
         const double quotient = error / bound;
         const bool boundPositive = bound > 0, errorPositive = error > 0;
         const double unbounded = errorPositive ? INFINITY : 0.0;
@@ -469,7 +469,7 @@ ZCHECK_INLINE inline void TileComparison::Impl::compareBody(int tile, const Rout
     };
     // A pixel compared on depth (agree or depth error), whichever path judged it: its count, its
     // ratio, the statistics. Returns whether it is the worst so far (its finding is then r.worst).
-    auto noteCompared = [&](bool agree, double ratio, double errorQuanta, double relative) ZCHECK_INLINE {
+    auto noteCompared = [&](bool agree, double ratio, double errorQuanta, double relative) ZCHECK_ALWAYS_INLINE {
         agree ? ++r.agree : ++r.depthErrors;
         counts.errorQuanta.add(float(errorQuanta));
         counts.relativeEyeZ.add(float(relative));
@@ -479,7 +479,7 @@ ZCHECK_INLINE inline void TileComparison::Impl::compareBody(int tile, const Rout
         if (worst) r.maxErrorOverTolerance = std::max(r.maxErrorOverTolerance, ratio);
         return worst;
     };
-    auto setClass = [&](std::size_t i, PixelClass c) ZCHECK_INLINE {
+    auto setClass = [&](std::size_t i, PixelClass c) ZCHECK_ALWAYS_INLINE {
         if (perPixel) perPixel->pixelClass[i] = c;
     };
 

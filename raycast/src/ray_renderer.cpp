@@ -101,7 +101,8 @@ struct RayRenderer::Embree {
     }
 };
 
-RayRenderer::RayRenderer(const Scene& scene) : embree_(std::make_unique<Embree>()), scene_(scene)
+RayRenderer::RayRenderer(const Scene& scene)
+    : embree_(std::make_unique<Embree>()), scene_(scene), avx512_(useAvx512Form("ZCHECK_RAY_KERNEL", "baseline"))
 {
     validateScene(scene);
     const auto start = Clock::now();
@@ -182,8 +183,7 @@ namespace {
 // RayRenderer::traceRect's work, inlined into two functions: one compiled for the build's
 // baseline and one for AVX-512 (kernel_choice.h). Its per-packet steps are lambdas that must
 // be inlined too, or they would stay baseline code.
-#define ZCHECK_INLINE __attribute__((always_inline))
-ZCHECK_INLINE inline void traceRectBody(RTCScene rtcScene, const glm::dvec3& frameOrigin, const Scene& scene,
+ZCHECK_ALWAYS_INLINE inline void traceRectBody(RTCScene rtcScene, const glm::dvec3& frameOrigin, const Scene& scene,
                                         const Camera& camera, const PixelRect& rect, double* windowDepth,
                                         std::uint32_t* primitiveId, std::size_t stride, const RayFaults& fault,
                                         glm::dvec3* pEye)
@@ -193,7 +193,7 @@ ZCHECK_INLINE inline void traceRectBody(RTCScene rtcScene, const glm::dvec3& fra
     const CameraRays cameraRays(camera);
     const std::optional<AffineRays> affine = cameraRays.affine();
     const double near = camera.nearDistance(), far = camera.farDistance(), clearDepth = camera.clearDepth();
-    const bool windowOriginTop = camera.imageYFromWindowY(0.0) == 0.0;  // else y_image = H − y_window
+    const bool windowOriginTop = camera.convention().windowOriginTop;  // else y_image = H − y_window
     const double height = H;
 
     FlushDenormals flush;
@@ -204,7 +204,7 @@ ZCHECK_INLINE inline void traceRectBody(RTCScene rtcScene, const glm::dvec3& fra
     // Rays made and traced: lanes as plain arrays, one quantity at a time, so that the
     // compiler can compute several lanes per instruction. Every field of every lane is
     // initialised, valid or not; an invalid lane (outside the rectangle) is a zero-length ray.
-    auto trace = [&](PacketInFlight& p, int px, int py) ZCHECK_INLINE {
+    auto trace = [&](PacketInFlight& p, int px, int py) ZCHECK_ALWAYS_INLINE {
         p.col0 = px, p.row0 = py;
         // The image points: windowFromPixelCentre plus the shift, then imageYFromWindowY,
         // spelt out so that this loop too computes several lanes per instruction.
@@ -262,14 +262,14 @@ ZCHECK_INLINE inline void traceRectBody(RTCScene rtcScene, const glm::dvec3& fra
             if (p.hit(k)) __builtin_prefetch(&scene.triangles[p.packet.hit.primID[k]]);
     };
     // The hit triangles' vertices asked for (their indices were asked for one packet earlier).
-    auto fetchVertices = [&](const PacketInFlight& p) ZCHECK_INLINE {
+    auto fetchVertices = [&](const PacketInFlight& p) ZCHECK_ALWAYS_INLINE {
         for (int k = 0; k < kPacketRays; ++k)
             if (p.hit(k))
                 for (int corner = 0; corner < 3; ++corner)
                     __builtin_prefetch(&scene.positions[scene.triangles[p.packet.hit.primID[k]][corner]]);
     };
     // Each hit again, in double: the ray against the hit triangle's plane; then the pixels written.
-    auto finish = [&](const PacketInFlight& p) ZCHECK_INLINE {
+    auto finish = [&](const PacketInFlight& p) ZCHECK_ALWAYS_INLINE {
         // The planes, every lane's own, without a branch: a vertex a and the normal
         // cross(b − a, c − a), in double. (Keeping a plane while the next lanes hit the same
         // triangle, as this did before, cost more in mispredicted branches than the arithmetic
@@ -373,7 +373,7 @@ void RayRenderer::traceRect(const Camera& camera, const PixelRect& rect, double*
 {
     auto* form = &traceRectBaseline;
 #ifdef ZCHECK_X86_AVX512
-    if (useAvx512Form("ZCHECK_RAY_KERNEL", "baseline")) form = &traceRectAvx512;
+    if (avx512_) form = &traceRectAvx512;
 #endif
     form(embree_->scene.get(), embree_->frameOrigin, scene_, camera, rect, windowDepth, primitiveId, stride, fault, pEye);
 }

@@ -156,6 +156,8 @@ struct DepthSlopeFrame {
 // never changes a result); a judge allocates nothing per triangle.
 class PixelJudge {
 public:
+    // Reads ZCHECK_COMPARE_KERNEL (kernel_choice.h) and throws Error for a value but
+    // `baseline`, `auto` or empty; so do compareRoutes and TileComparison, which make one.
     PixelJudge(const Scene& scene, const Camera& camera, const ToleranceModel& tolerance = {});
 
     // One surface's tolerance at depth-storage quantum q, in window-depth units:

@@ -15,10 +15,22 @@
 //
 // A variable unset, empty or `auto` lets the processor decide.
 //
+//   ZCHECK_ALWAYS_INLINE inline void drawBody(...) { ... }       // one source ...
+//   void drawBaseline(...) { drawBody(...); }
 //   #ifdef ZCHECK_X86_AVX512
-//   ZCHECK_TARGET_AVX512 void drawAvx512(...);   // compiled for AVX-512, called only when chosen
+//   ZCHECK_TARGET_AVX512 void drawAvx512(...) { drawBody(...); } // ... compiled twice
 //   #endif
-//   if (useAvx512Form("ZCHECK_RASTER_KERNEL", "scalar")) drawAvx512(...); else draw(...);
+//   auto* draw = &drawBaseline;
+//   #ifdef ZCHECK_X86_AVX512
+//   if (useAvx512Form("ZCHECK_RAY_KERNEL", "baseline")) draw = &drawAvx512;
+//   #endif
+//
+// Read the choice once per render or frame, on the calling thread (not per tile on the
+// workers: a program may change its environment meanwhile).
+
+// A function inlined wherever it is called, also into a function compiled for other
+// instructions (a body shared by two forms, and the lambdas inside it, must be).
+#define ZCHECK_ALWAYS_INLINE __attribute__((always_inline))
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #define ZCHECK_X86_AVX512 1

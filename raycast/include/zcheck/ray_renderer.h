@@ -45,7 +45,10 @@ enum class EyePoints { Omit, Keep };
 class RayRenderer {
 public:
     // Builds the BVH (timed); throws Error. `scene` must outlive it: Embree reads its index
-    // buffer in place.
+    // buffer in place. Where the processor has AVX-512 (F, DQ, VL) the trace runs a form of
+    // itself compiled for it, bit-identical to the baseline form (kernel_choice.h); the
+    // environment variable ZCHECK_RAY_KERNEL=baseline, read here, forces the baseline form,
+    // and any value but that, `auto` or empty throws Error.
     explicit RayRenderer(const Scene& scene);
     ~RayRenderer();
     RayRenderer(const RayRenderer&) = delete;
@@ -73,6 +76,7 @@ private:
     struct Embree;
     std::unique_ptr<Embree> embree_;
     const Scene& scene_;
+    bool avx512_;  // the trace's AVX-512 form (ZCHECK_RAY_KERNEL, read when this was made)
     double buildMilliseconds_ = 0;
 };
 
