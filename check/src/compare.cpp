@@ -157,11 +157,7 @@ ZCHECK_ALWAYS_INLINE inline void slopesTogether(const DepthSlopeFrame& frame, co
                                                           const std::uint32_t* primitive, std::size_t n, double* slope)
 {
     alignas(64) double corner[3][3][kSlopeLanes];  // corner, axis, lane
-    for (std::size_t k = 0; k < n; ++k) {
-        const glm::uvec3& t = scene.triangles[primitive[k]];
-        for (int v = 0; v < 3; ++v)
-            for (int c = 0; c < 3; ++c) corner[v][c][k] = double(scene.positions[t[v]][c]);
-    }
+    cornersInLanes(scene, primitive, n, corner);
     for (std::size_t k = 0; k < n; ++k)
         slope[k] = slopeOfTriangle(frame, glm::dvec3(corner[0][0][k], corner[0][1][k], corner[0][2][k]),
                                    glm::dvec3(corner[1][0][k], corner[1][1][k], corner[1][2][k]),

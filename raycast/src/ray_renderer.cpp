@@ -275,12 +275,10 @@ ZCHECK_ALWAYS_INLINE inline void traceRectBody(RTCScene rtcScene, const glm::dve
         // triangle, as this did before, cost more in mispredicted branches than the arithmetic
         // it saved.) A miss takes triangle 0's plane (a scene has one, RayRenderer checked), and
         // its result is not used.
+        std::uint32_t triangle[kPacketRays];
+        for (int k = 0; k < kPacketRays; ++k) triangle[k] = p.hit(k) ? p.packet.hit.primID[k] : 0;
         alignas(64) double corner[3][3][kPacketRays];  // corner, axis, lane
-        for (int k = 0; k < kPacketRays; ++k) {
-            const glm::uvec3& tri = scene.triangles[p.hit(k) ? p.packet.hit.primID[k] : 0];
-            for (int v = 0; v < 3; ++v)
-                for (int c = 0; c < 3; ++c) corner[v][c][k] = double(scene.positions[tri[v]][c]);
-        }
+        cornersInLanes(scene, triangle, kPacketRays, corner);
         alignas(64) double plane[6][kPacketRays];  // a vertex x, y, z and the normal x, y, z
         for (int k = 0; k < kPacketRays; ++k) {
             const glm::dvec3 a(corner[0][0][k], corner[0][1][k], corner[0][2][k]);
