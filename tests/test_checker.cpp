@@ -234,6 +234,31 @@ TEST_CASE("the 99th percentile from the largest values kept is the sorted one, i
                 for (const LargestValues& keeper : keepers) all.push_back(&keeper);
                 INFO("n " << n << ", " << parts << " keepers");
                 REQUIRE(LargestValues::percentile99(all) == expected);
+                // Given a row at a time with a mask, as the comparison gives them, among larger
+                // values masked out: the same, with and without a floor.
+                for (const float floor : {0.0f, float(expected)}) {
+                    std::vector<LargestValues> byRow(static_cast<std::size_t>(parts), LargestValues(keep, floor));
+                    for (std::size_t part = 0; part < std::size_t(parts); ++part) {
+                        std::vector<float> row;
+                        std::vector<std::uint8_t> use;
+                        auto flush = [&] {
+                            byRow[part].add(row.data(), use.data(), row.size());
+                            row.clear(), use.clear();
+                        };
+                        for (std::size_t k = 0; k < order.size(); ++k) {
+                            if (k * std::size_t(parts) / order.size() != part) continue;
+                            row.push_back(order[k]), use.push_back(1);
+                            row.push_back(1e30f), use.push_back(0);
+                            if (row.size() == 64) flush();
+                        }
+                        flush();
+                    }
+                    std::vector<const LargestValues*> allByRow;
+                    std::size_t counted = 0;
+                    for (const LargestValues& keeper : byRow) allByRow.push_back(&keeper), counted += keeper.count();
+                    REQUIRE(counted == std::size_t(n));
+                    REQUIRE(LargestValues::percentile99(allByRow) == expected);
+                }
                 // With a floor at or below the percentile, the same; above it, no answer.
                 for (const float floor : {float(expected), float(expected) + 0.125f}) {
                     std::vector<LargestValues> floored(static_cast<std::size_t>(parts), LargestValues(keep, floor));
@@ -487,5 +512,79 @@ TEST_CASE("the comparison writes every pixel's class and ratio, whose arrays are
         REQUIRE(r.bothMiss > 0);
         REQUIRE(r.agree > 1000);
         if (flipRows) REQUIRE(r.unexplained() > 100);
+    }
+}
+
+// The comparison tallies the common case (both routes on one triangle) lane by lane and visits
+// in scan order only the pixels that may change the worst one (compare.cpp, noteWorst): the
+// worst must still be the first pixel in scan order with the largest ratio, in a row, across
+// rows and across tiles. On a quad, the raster's depths set to the ray's wherever both hit (no
+// error), then the same exact error planted at pixels on it (ties in double: the depths with and
+// without it lie in one binade), then a larger one; beyond the tolerance and within it.
+TEST_CASE("the worst pixel is the first in scan order with the largest ratio, in a row, across rows and tiles",
+          "[compare][worst]")
+{
+    Scene quad;
+    quad.name = "quad";
+    quad.positions = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
+    quad.triangles = {{0, 1, 2}, {0, 2, 3}};
+    const Checker checker(frameScene(quad, "the test quad"));
+    CameraSpec spec = checker.scene().defaultCamera;
+    spec.width = 200, spec.height = 150;  // tiles cut at both edges
+    spec.depth.format = DepthFormat::Unorm24;
+    const Camera camera(spec);
+    const RenderResult ray = checker.renderRay(camera, {});
+    const std::uint32_t triangle = ray.primitiveId[std::size_t(75) * 200 + 100];
+    REQUIRE(triangle != kNoPrimitive);
+    for (const auto& [form, error] : {std::pair{"baseline", 0x1p-12}, {"auto", 0x1p-12}, {"baseline", 0x1p-26}, {"auto", 0x1p-26}}) {
+        // 2^-12 ≈ 4000 q of unorm24, a depth error; 2^-26 ≈ q/4, within the tolerance (agree)
+        INFO(form << ", error " << error);
+        const PixelClass expectedClass = error > 0x1p-20 ? PixelClass::DepthError : PixelClass::Agree;
+        testing::withEnvironment("ZCHECK_COMPARE_KERNEL", form, [&] {
+            RenderResult raster = checker.renderRaster(camera);
+            std::vector<std::size_t> onTriangle;  // in scan order
+            for (std::size_t i = 0; i < ray.primitiveId.size(); ++i) {
+                const double d = ray.windowDepth.value[i];
+                if (ray.hit(i) && raster.hit(i)) raster.windowDepth.value[i] = d;
+                if (ray.primitiveId[i] != triangle || raster.primitiveId[i] != triangle) continue;
+                if (d >= 0.5 && d + 2 * error < 1.0) onTriangle.push_back(i);
+            }
+            REQUIRE(onTriangle.size() > 2000);
+            auto col = [](std::size_t i) { return int(i % 200); };
+            auto row = [](std::size_t i) { return int(i / 200); };
+            // a, then b later in a's row, c in a later row and tile, d left of a in the next row
+            const std::size_t a = onTriangle[onTriangle.size() / 8];
+            std::size_t b = a, c = a, d = a;
+            for (std::size_t i : onTriangle) {
+                if (row(i) == row(a) && col(i) > col(a) + 3 && b == a) b = i;
+                if (row(i) / 64 > row(a) / 64 && c == a) c = i;  // a tile below a's
+                if (row(i) == row(a) + 1 && col(i) < col(a) && d == a) d = i;
+            }
+            REQUIRE((b != a && c != a && d != a));
+            auto worstOf = [&](const std::vector<std::pair<std::size_t, double>>& planted) {
+                RenderResult withErrors = raster;
+                for (auto [i, e] : planted) withErrors.windowDepth.value[i] = ray.windowDepth.value[i] + e;
+                return compareRoutes(checker.scene(), camera, ray, withErrors).report.worst;
+            };
+            // With no error anywhere, every ratio is 0: the first pixel both routes hit.
+            std::size_t firstBothHit = 0;
+            while (!(ray.hit(firstBothHit) && raster.hit(firstBothHit))) ++firstBothHit;
+            const PixelFinding none = worstOf({});
+            CHECK(none.col == col(firstBothHit));
+            CHECK(none.row == row(firstBothHit));
+            for (const auto& [planted, expected] :
+                 std::vector<std::pair<std::vector<std::pair<std::size_t, double>>, std::size_t>>{
+                     {{{c, error}, {d, error}, {b, error}, {a, error}}, a},
+                     {{{c, error}, {d, error}, {b, error}}, b},
+                     {{{c, error}, {d, error}}, d},
+                     {{{a, error}, {b, 2 * error}, {c, error}}, b},
+                     {{{a, error}, {c, 2 * error}, {d, error}}, c},
+                 }) {
+                const PixelFinding worst = worstOf(planted);
+                CHECK(worst.col == col(expected));
+                CHECK(worst.row == row(expected));
+                CHECK(worst.pixelClass == expectedClass);
+            }
+        });
     }
 }

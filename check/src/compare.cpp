@@ -270,6 +270,11 @@ struct TileTally {
     std::int64_t quarterCounts[4] = {0, 0, 0, 0};
 };
 
+// A float's or a double's bits, read through a pointer to it (the lane loops below stay SIMD
+// where std::memcpy would not).
+typedef std::uint32_t __attribute__((may_alias)) AliasedBits32;
+typedef std::int64_t __attribute__((may_alias)) AliasedBits64;
+
 constexpr std::size_t kUnexplainedSamples = 20;  // the first ones in scan order (compare.h)
 
 bool beforeInScanOrder(const PixelFinding& a, const PixelFinding& b)
@@ -437,10 +442,12 @@ struct TileComparison::Impl {
 };
 
 // Impl::compare's work, inlined into a baseline and an AVX-512 form (compareBaseline,
-// compareAvx512; kernel_choice.h), bit-identical to each other: the same IEEE operations in
-// the same order, and every sum, count and keeper fed in scan order. Row by row: first the
-// common case's measures for the whole row, lane by lane (several pixels per instruction),
-// then the pixels tallied in scan order, the common case from those measures.
+// compareAvx512; kernel_choice.h), bit-identical to each other and to the pixel-by-pixel
+// tally they replaced: the same IEEE operations in the same order wherever the order can change
+// a result. Row by row: first the common case's measures for the whole row, lane by lane
+// (several pixels per instruction); then its tally, lane by lane where the order cannot matter
+// (counts, maxima, the keepers), in scan order for the bias sum; then, in scan order, the pixels
+// off the common case and those of it that may be the worst (noteWorst).
 ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tile, const RoutePixels& ray, const RoutePixels& raster)
 {
     TileTally& tally = tallies[std::size_t(tile)];
@@ -463,17 +470,26 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tile, con
         const double unbounded = errorPositive ? INFINITY : 0.0;
         return boundPositive ? quotient : unbounded;
     };
-    // A pixel compared on depth (agree or depth error), whichever path judged it: its count, its
-    // ratio, the statistics. Returns whether it is the worst so far (its finding is then r.worst).
+    // A pixel compared on depth (agree or depth error), in scan order: whether it is the worst so
+    // far (its finding is then r.worst): the first compared, or a ratio above every one before.
+    // So the worst is the first pixel in scan order with the largest ratio (NaN ratios aside), and
+    // a row's common-case pixels that are neither its first compared one nor the first with its
+    // largest ratio can be left out without changing it.
+    bool comparedBefore = r.agree + r.depthErrors > 0;
+    auto noteWorst = [&](double ratio) ZCHECK_ALWAYS_INLINE {
+        const bool worst = ratio > r.maxErrorOverTolerance || !comparedBefore;
+        comparedBefore = true;
+        if (worst) r.maxErrorOverTolerance = std::max(r.maxErrorOverTolerance, ratio);
+        return worst;
+    };
+    // A pixel compared on depth off the common case: its count, the statistics, noteWorst.
     auto noteCompared = [&](bool agree, double ratio, double errorQuanta, double relative) ZCHECK_ALWAYS_INLINE {
         agree ? ++r.agree : ++r.depthErrors;
         counts.errorQuanta.add(float(errorQuanta));
         counts.relativeEyeZ.add(float(relative));
         r.maxRelativeEyeZError = std::max(r.maxRelativeEyeZError, relative);
         r.maxErrorQuanta = std::max(r.maxErrorQuanta, errorQuanta);
-        const bool worst = ratio > r.maxErrorOverTolerance || r.agree + r.depthErrors == 1;
-        if (worst) r.maxErrorOverTolerance = std::max(r.maxErrorOverTolerance, ratio);
-        return worst;
+        return noteWorst(ratio);
     };
     auto setClass = [&](std::size_t i, PixelClass c) ZCHECK_ALWAYS_INLINE {
         if (perPixel) perPixel->pixelClass[i] = c;
@@ -483,15 +499,29 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tile, con
     // rule for a single surface: one slope, no edge or clip-plane question). Lanes where it is
     // not the case are computed too, and not used.
     constexpr int kLanes = kTileSize;
+    constexpr int kRowsAhead = 2;
     alignas(64) std::uint32_t surface[kLanes];  // the triangle both routes hit, else kNoPrimitive
-    alignas(64) bool common[kLanes];
+    alignas(64) std::uint8_t common[kLanes];  // 0 or 1 (bytes, not bool: GCC vectorises their loops)
     alignas(64) double slope[kLanes], quantum[kLanes], bound[kLanes], signedErrorQuanta[kLanes], ratio[kLanes];
     alignas(64) double relative[kLanes], position[kLanes];
-    alignas(64) bool agree[kLanes], biasSample[kLanes];
+    alignas(64) std::uint8_t agree[kLanes], biasSample[kLanes], visit[kLanes];
+    alignas(64) double errorQuanta[kLanes];
+    alignas(64) float errorQuantaOfLane[kLanes], relativeOfLane[kLanes];
 
     for (int row = row0; row < row1; ++row) {
         const std::size_t a0 = ray.at(col0, row), b0 = raster.at(col0, row);
         const int n = col1 - col0;
+        // A later row's pixels asked for now: a tile's row of a full-frame image is a few cache
+        // lines, too short for the hardware to see a stream, and each row began with misses.
+        if (row + kRowsAhead < row1) {
+            const std::size_t aAhead = ray.at(col0, row + kRowsAhead), bAhead = raster.at(col0, row + kRowsAhead);
+            for (int j = 0; j < n; j += 16) {
+                __builtin_prefetch(ray.primitive + aAhead + j), __builtin_prefetch(raster.primitive + bAhead + j);
+                __builtin_prefetch(ray.windowDepth + aAhead + j), __builtin_prefetch(ray.windowDepth + aAhead + j + 8);
+                __builtin_prefetch(raster.windowDepth + bAhead + j);
+                __builtin_prefetch(raster.windowDepth + bAhead + j + 8);
+            }
+        }
         const std::uint32_t* rayPrimitives = ray.primitive + a0;
         const std::uint32_t* rasterPrimitives = raster.primitive + b0;
         const double* rayDepths = ray.windowDepth + a0;
@@ -518,38 +548,98 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tile, con
         if (perPixel) {  // every pixel of the row, as the common case or a miss would have it
             PixelClass* classes = perPixel->pixelClass.data() + std::size_t(row) * W + col0;
             float* ratios = perPixel->errorOverTolerance.data() + std::size_t(row) * W + col0;
+            // Without a branch, so that the loop stays SIMD: the class as arithmetic, the ratio's
+            // bits masked (0.0f where not common).
+            static_assert(int(PixelClass::BothMiss) == 0 && int(PixelClass::Agree) == 1 &&
+                              int(PixelClass::DepthError) == 3,
+                          "the class arithmetic below");
+            std::uint8_t* classBytes = reinterpret_cast<std::uint8_t*>(classes);
+            AliasedBits32* ratioBits = reinterpret_cast<AliasedBits32*>(ratios);
             for (int j = 0; j < n; ++j) {
-                classes[j] = common[j] ? (agree[j] ? PixelClass::Agree : PixelClass::DepthError) : PixelClass::BothMiss;
-                ratios[j] = common[j] ? static_cast<float>(ratio[j]) : 0.0f;
+                classBytes[j] = std::uint8_t(common[j] + 2 * (common[j] & (agree[j] ^ 1)));
+                const float ratioOfLane = static_cast<float>(ratio[j]);
+                ratioBits[j] = *reinterpret_cast<const AliasedBits32*>(&ratioOfLane) & (0u - std::uint32_t(common[j]));
             }
         }
 
+        // The common case's tally, in any order where the result cannot depend on it: counts,
+        // maxima (std::max's: a NaN never replaces), the percentiles' keepers, and the row's
+        // largest ratio; several pixels per instruction.
+        // std::max(start, x[j]) over the row's common lanes in turn, for values ≥ +0 or NaN
+        // (which std::max skips): as the order of their bits, several lanes per instruction.
+        auto maxOfCommon = [&](double start, const double* x) ZCHECK_ALWAYS_INLINE {
+            const AliasedBits64* bits = reinterpret_cast<const AliasedBits64*>(x);
+            std::int64_t largest = -1;
+            for (int j = 0; j < n; ++j) {
+                const std::int64_t b = common[j] & (x[j] == x[j]) ? bits[j] : -1;
+                largest = largest < b ? b : largest;
+            }
+            double largestValue;
+            std::memcpy(&largestValue, &largest, sizeof largestValue);
+            return largest < 0 ? start : std::max(start, largestValue);
+        };
+        int commons = 0, agreeing = 0, hits = 0;
         for (int j = 0; j < n; ++j) {
+            commons += common[j];
+            agreeing += common[j] & agree[j];
+            hits += (rayPrimitives[j] != kNoPrimitive) | (rasterPrimitives[j] != kNoPrimitive);
+        }
+        for (int j = 0; j < n; ++j) {
+            errorQuanta[j] = std::abs(signedErrorQuanta[j]);
+            errorQuantaOfLane[j] = float(errorQuanta[j]);
+            relativeOfLane[j] = float(relative[j]);
+        }
+        r.bothMiss += n - hits;  // their class and ratio are written already
+        r.bothHit += commons, r.agree += agreeing, r.depthErrors += commons - agreeing;
+        r.maxErrorQuanta = maxOfCommon(r.maxErrorQuanta, errorQuanta);
+        r.maxRelativeEyeZError = maxOfCommon(r.maxRelativeEyeZError, relative);
+        const double rowMaxRatio = maxOfCommon(-1.0, ratio);
+        counts.errorQuanta.add(errorQuantaOfLane, common, std::size_t(n));
+        counts.relativeEyeZ.add(relativeOfLane, common, std::size_t(n));
+        // The bias test's sum in scan order (its rounding depends on the order).
+        double signedErrorSum = tally.signedErrorSum;
+        std::int64_t quarters[4] = {0, 0, 0, 0}, biasSamples = 0;
+        for (int j = 0; j < n; ++j)
+            if (common[j] && biasSample[j]) {
+                signedErrorSum += signedErrorQuanta[j];
+                ++quarters[std::clamp(int(4 * (position[j] - std::floor(position[j]))), 0, 3)];
+                ++biasSamples;
+            }
+        tally.signedErrorSum = signedErrorSum;
+        for (int k = 0; k < 4; ++k) tally.quarterCounts[k] += quarters[k];
+        r.biasSamples += biasSamples;
+
+        // What is left in scan order (noteWorst): the pixels off the common case, the common
+        // case's depth errors (a NaN ratio is one), its first pixel when nothing was compared
+        // before, and its first with the row's largest ratio when that may be the worst.
+        for (int j = 0; j < n; ++j) {
+            const int hit = (rayPrimitives[j] != kNoPrimitive) | (rasterPrimitives[j] != kNoPrimitive);
+            visit[j] = std::uint8_t((common[j] & (agree[j] ^ 1)) | ((common[j] ^ 1) & hit));
+        }
+        if (commons > 0 && !comparedBefore) visit[std::find(common, common + n, true) - common] = true;
+        if (commons > 0 && rowMaxRatio > r.maxErrorOverTolerance)
+            for (int j = 0; j < n; ++j)
+                if (common[j] && ratio[j] == rowMaxRatio) {
+                    visit[j] = true;
+                    break;
+                }
+
+        for (int j = 0; j < n; ++j) {
+            if (!visit[j]) continue;
             const int col = col0 + j;
             const std::size_t a = a0 + std::size_t(j), b = b0 + std::size_t(j), i = std::size_t(row) * W + col;
             const std::uint32_t rayPrimitive = rayPrimitives[j], rasterPrimitive = rasterPrimitives[j];
             const bool rayHit = rayPrimitive != kNoPrimitive, rasterHit = rasterPrimitive != kNoPrimitive;
-            if (!rayHit && !rasterHit) {
-                ++r.bothMiss;  // its class and ratio are written already
-                continue;
-            }
-            if (common[j]) {
-                ++r.bothHit;
-                if (biasSample[j]) {
-                    tally.signedErrorSum += signedErrorQuanta[j];
-                    ++tally.quarterCounts[std::clamp(int(4 * (position[j] - std::floor(position[j]))), 0, 3)];
-                    ++r.biasSamples;
-                }
+            if (common[j]) {  // tallied already
                 const PixelClass c = agree[j] ? PixelClass::Agree : PixelClass::DepthError;  // written already
-                const double errorQuanta = std::abs(signedErrorQuanta[j]);
-                const bool worst = noteCompared(agree[j], ratio[j], errorQuanta, relative[j]);
+                const bool worst = noteWorst(ratio[j]);
                 if (agree[j] && !worst) continue;  // nothing to note: no finding is built
                 PixelFinding f;
                 f.col = col, f.row = row;
                 f.rayWindowDepth = rayDepths[j], f.rasterWindowDepth = rasterDepths[j];
                 f.rayPrimitive = f.rasterPrimitive = rayPrimitive;
                 f.pixelClass = c;
-                f.errorQuanta = errorQuanta;
+                f.errorQuanta = errorQuanta[j];
                 f.toleranceQuanta = bound[j] / quantum[j];
                 if (worst) r.worst = f;
                 if (!agree[j]) noteUnexplained(r, f);

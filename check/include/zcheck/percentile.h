@@ -15,6 +15,8 @@
 //   LargestValues mine(width * height / 100 + 2);                // one per thread
 //   mine.add(float(errorQuanta));                                // each value
 //   std::optional<double> p99 = LargestValues::percentile99({&mine, &other});
+#include "zcheck/kernel_choice.h"
+
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -30,10 +32,25 @@ public:
     void add(float value)
     {
         ++count_;
-        const std::uint32_t bits = floatBits(value);
-        if (bits < floor_ || (kept_.size() >= keep_ && bits <= threshold_)) return;  // not among the largest
-        kept_.push_back(bits);
-        if (kept_.size() == 2 * keep_) shrink();
+        keepIfLargest(floatBits(value));
+    }
+    // add() of each values[k] with use[k] = 1 (0 or 1), k < n: the same keepers (whatever the order, see
+    // above). Which values might be kept is found for all n first, several per instruction;
+    // inlined, so that each form of a kernel (kernel_choice.h) compiles its own.
+    ZCHECK_ALWAYS_INLINE void add(const float* values, const std::uint8_t* use, std::size_t n)
+    {
+        typedef std::uint32_t __attribute__((may_alias)) AliasedBits;  // (memcpy would not vectorise)
+        const AliasedBits* bits = reinterpret_cast<const AliasedBits*>(values);
+        int used = 0, mayKeep = 0;
+        const int full = kept_.size() >= keep_;
+        for (std::size_t k = 0; k < n; ++k) {
+            used += use[k];
+            mayKeep |= use[k] & (bits[k] >= floor_) & ((full ^ 1) | (bits[k] > threshold_));
+        }
+        count_ += std::size_t(used);
+        if (mayKeep)
+            for (std::size_t k = 0; k < n; ++k)
+                if (use[k] & (bits[k] >= floor_)) keepIfLargest(bits[k]);
     }
     std::size_t count() const { return count_; }  // values added
 
@@ -50,6 +67,12 @@ private:
         std::uint32_t bits;
         std::memcpy(&bits, &value, sizeof bits);
         return bits;
+    }
+    void keepIfLargest(std::uint32_t bits)
+    {
+        if (bits < floor_ || (kept_.size() >= keep_ && bits <= threshold_)) return;  // not among the largest
+        kept_.push_back(bits);
+        if (kept_.size() == 2 * keep_) shrink();
     }
     void shrink();
 
