@@ -515,25 +515,50 @@ TEST_CASE("the comparison writes every pixel's class and ratio, whose arrays are
     }
 }
 
+// A quad of two triangles seen by a 200×150 unorm24 camera (64×64 tiles cut at both edges),
+// with the raster's depths set to the ray's wherever both routes hit: a comparison without
+// any error, for tests to plant their own.
+struct ErrorFreeQuad {
+    static Scene quad()
+    {
+        Scene s;
+        s.name = "quad";
+        s.positions = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
+        s.triangles = {{0, 1, 2}, {0, 2, 3}};
+        return frameScene(s, "the test quad");
+    }
+    static Camera camera200x150(const Scene& scene)
+    {
+        CameraSpec spec = scene.defaultCamera;
+        spec.width = 200, spec.height = 150;
+        spec.depth.format = DepthFormat::Unorm24;
+        return Camera(spec);
+    }
+    ErrorFreeQuad() : checker(quad()), camera(camera200x150(checker.scene())), ray(checker.renderRay(camera, {}))
+    {
+        raster = checker.renderRaster(camera);
+        for (std::size_t i = 0; i < ray.primitiveId.size(); ++i)
+            if (ray.hit(i) && raster.hit(i)) raster.windowDepth.value[i] = ray.windowDepth.value[i];
+    }
+    const Checker checker;
+    const Camera camera;
+    const RenderResult ray;
+    RenderResult raster;
+};
+
 // The comparison tallies the common case (both routes on one triangle) lane by lane and visits
 // in scan order only the pixels that may change the worst one (compare.cpp, noteWorst): the
 // worst must still be the first pixel in scan order with the largest ratio, in a row, across
-// rows and across tiles. On a quad, the raster's depths set to the ray's wherever both hit (no
-// error), then the same exact error planted at pixels on it (ties in double: the depths with and
-// without it lie in one binade), then a larger one; beyond the tolerance and within it.
+// rows and across tiles. On a quad without error (ErrorFreeQuad), the same exact error planted
+// at pixels of one triangle (ties in double: the depths with and without it lie in one
+// binade), then a larger one; beyond the tolerance and within it.
 TEST_CASE("the worst pixel is the first in scan order with the largest ratio, in a row, across rows and tiles",
           "[compare][worst]")
 {
-    Scene quad;
-    quad.name = "quad";
-    quad.positions = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
-    quad.triangles = {{0, 1, 2}, {0, 2, 3}};
-    const Checker checker(frameScene(quad, "the test quad"));
-    CameraSpec spec = checker.scene().defaultCamera;
-    spec.width = 200, spec.height = 150;  // tiles cut at both edges
-    spec.depth.format = DepthFormat::Unorm24;
-    const Camera camera(spec);
-    const RenderResult ray = checker.renderRay(camera, {});
+    const ErrorFreeQuad quad;
+    const Checker& checker = quad.checker;
+    const Camera& camera = quad.camera;
+    const RenderResult& ray = quad.ray;
     const std::uint32_t triangle = ray.primitiveId[std::size_t(75) * 200 + 100];
     REQUIRE(triangle != kNoPrimitive);
     for (const auto& [form, error] : {std::pair{"baseline", 0x1p-12}, {"auto", 0x1p-12}, {"baseline", 0x1p-26}, {"auto", 0x1p-26}}) {
@@ -541,11 +566,10 @@ TEST_CASE("the worst pixel is the first in scan order with the largest ratio, in
         INFO(form << ", error " << error);
         const PixelClass expectedClass = error > 0x1p-20 ? PixelClass::DepthError : PixelClass::Agree;
         testing::withEnvironment("ZCHECK_COMPARE_KERNEL", form, [&] {
-            RenderResult raster = checker.renderRaster(camera);
+            const RenderResult& raster = quad.raster;
             std::vector<std::size_t> onTriangle;  // in scan order
             for (std::size_t i = 0; i < ray.primitiveId.size(); ++i) {
                 const double d = ray.windowDepth.value[i];
-                if (ray.hit(i) && raster.hit(i)) raster.windowDepth.value[i] = d;
                 if (ray.primitiveId[i] != triangle || raster.primitiveId[i] != triangle) continue;
                 if (d >= 0.5 && d + 2 * error < 1.0) onTriangle.push_back(i);
             }
@@ -585,6 +609,42 @@ TEST_CASE("the worst pixel is the first in scan order with the largest ratio, in
                 CHECK(worst.row == row(expected));
                 CHECK(worst.pixelClass == expectedClass);
             }
+        });
+    }
+}
+
+// A NaN depth (a map's, in verify) is compared and fails, as std::max and the keepers take it:
+// a depth error, sampled as unexplained in scan order, never a maximum nor, once a pixel was
+// compared before it, the worst.
+TEST_CASE("a NaN depth is a depth error and never the largest error", "[compare][worst]")
+{
+    const ErrorFreeQuad quad;
+    const std::size_t row = 75, width = 200;
+    // both on one triangle, both routes: the common case
+    const std::size_t a = row * width + 100, b = a + 5;
+    for (const std::size_t i : {a, b}) {
+        REQUIRE(quad.ray.hit(i));
+        REQUIRE(quad.ray.primitiveId[i] == quad.raster.primitiveId[i]);
+    }
+    for (const char* form : {"baseline", "auto"}) {
+        INFO(form);
+        testing::withEnvironment("ZCHECK_COMPARE_KERNEL", form, [&] {
+            RenderResult raster = quad.raster;
+            raster.windowDepth.value[a] = NAN;
+            raster.windowDepth.value[b] = quad.ray.windowDepth.value[b] + 0x1p-12;
+            const ComparisonReport r = compareRoutes(quad.checker.scene(), quad.camera, quad.ray, raster).report;
+            const double q = storageQuantum(DepthFormat::Unorm24, quad.ray.windowDepth.value[b]);
+            CHECK(r.depthErrors == 2);
+            REQUIRE(r.unexplainedSamples.size() == 2);
+            CHECK(r.unexplainedSamples[0].col == int(a % width));
+            CHECK(r.unexplainedSamples[1].col == int(b % width));
+            CHECK(r.maxErrorQuanta == std::abs((raster.windowDepth.value[b] - quad.ray.windowDepth.value[b]) / q));
+            CHECK(std::isfinite(r.maxRelativeEyeZError));
+            CHECK(r.maxRelativeEyeZError > 0);
+            CHECK(std::isfinite(r.maxErrorOverTolerance));
+            CHECK(r.worst.col == int(b % width));
+            CHECK(r.worst.row == int(row));
+            CHECK(r.p99ErrorQuanta == 0.0);
         });
     }
 }
