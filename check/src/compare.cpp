@@ -562,11 +562,10 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tile, con
             }
         }
 
-        // The common case's tally, in any order where the result cannot depend on it: counts,
-        // maxima (std::max's: a NaN never replaces), the percentiles' keepers, and the row's
-        // largest ratio; several pixels per instruction.
-        // std::max(start, x[j]) over the row's common lanes in turn, for values ≥ +0 or NaN
-        // (which std::max skips): as the order of their bits, several lanes per instruction.
+        // The common case's tally, in any order where the result cannot depend on it (counts,
+        // maxima, the percentiles' keepers, and the row's largest ratio), several pixels per
+        // instruction. maxOfCommon is std::max(start, x[j]) over the row's common lanes in turn,
+        // for values ≥ +0 or NaN (which std::max skips): as the order of their bits.
         auto maxOfCommon = [&](double start, const double* x) ZCHECK_ALWAYS_INLINE {
             const AliasedBits64* bits = reinterpret_cast<const AliasedBits64*>(x);
             std::int64_t largest = -1;
@@ -616,11 +615,11 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tile, con
             const int hit = (rayPrimitives[j] != kNoPrimitive) | (rasterPrimitives[j] != kNoPrimitive);
             visit[j] = std::uint8_t((common[j] & (agree[j] ^ 1)) | ((common[j] ^ 1) & hit));
         }
-        if (commons > 0 && !comparedBefore) visit[std::find(common, common + n, true) - common] = true;
+        if (commons > 0 && !comparedBefore) visit[std::find(common, common + n, std::uint8_t(1)) - common] = 1;
         if (commons > 0 && rowMaxRatio > r.maxErrorOverTolerance)
             for (int j = 0; j < n; ++j)
                 if (common[j] && ratio[j] == rowMaxRatio) {
-                    visit[j] = true;
+                    visit[j] = 1;
                     break;
                 }
 
