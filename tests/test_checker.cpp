@@ -235,21 +235,24 @@ TEST_CASE("the 99th percentile from the largest values kept is the sorted one, i
                 INFO("n " << n << ", " << parts << " keepers");
                 REQUIRE(LargestValues::percentile99(all) == expected);
                 // Given a row at a time with a mask, as the comparison gives them, among larger
-                // values masked out: the same, with and without a floor.
+                // values masked out: the same, with and without a floor. Rows of a tile's 64
+                // pixels, of more (taken 64 at a time) and of a few (less than eight bytes).
                 for (const float floor : {0.0f, float(expected)}) {
                     std::vector<LargestValues> byRow(static_cast<std::size_t>(parts), LargestValues(keep, floor));
                     for (std::size_t part = 0; part < std::size_t(parts); ++part) {
                         std::vector<float> row;
                         std::vector<std::uint8_t> use;
+                        std::size_t rows = 0;
                         auto flush = [&] {
                             byRow[part].add(row.data(), use.data(), row.size());
-                            row.clear(), use.clear();
+                            row.clear(), use.clear(), ++rows;
                         };
                         for (std::size_t k = 0; k < order.size(); ++k) {
                             if (k * std::size_t(parts) / order.size() != part) continue;
                             row.push_back(order[k]), use.push_back(1);
                             row.push_back(1e30f), use.push_back(0);
-                            if (row.size() == 64) flush();
+                            const std::size_t rowLength[] = {64, 150, 6};
+                            if (row.size() == rowLength[rows % 3]) flush();
                         }
                         flush();
                     }

@@ -17,6 +17,7 @@
 //   std::optional<double> p99 = LargestValues::percentile99({&mine, &other});
 #include "zcheck/kernel_choice.h"
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -41,16 +42,30 @@ public:
     {
         typedef std::uint32_t __attribute__((may_alias)) AliasedBits;  // (memcpy would not vectorise)
         const AliasedBits* bits = reinterpret_cast<const AliasedBits*>(values);
-        int used = 0, mayKeep = 0;
-        const int full = kept_.size() >= keep_;
-        for (std::size_t k = 0; k < n; ++k) {
-            used += use[k];
-            mayKeep |= use[k] & (bits[k] >= floor_) & ((full ^ 1) | (bits[k] > threshold_));
+        constexpr std::size_t kChunk = 64;
+        for (std::size_t first = 0; first < n; first += kChunk) {
+            const std::size_t m = std::min(kChunk, n - first);
+            // Which values might be kept, one byte each (a superset: keepIfLargest decides, and
+            // what it would refuse now it refuses later too, as the threshold only rises).
+            alignas(8) std::uint8_t candidate[kChunk] = {};
+            int used = 0;
+            const std::uint32_t full = kept_.size() >= keep_;
+            for (std::size_t k = 0; k < m; ++k) {
+                const std::uint32_t b = bits[first + k];
+                used += use[first + k];
+                candidate[k] = std::uint8_t(use[first + k] & (b >= floor_) & ((full ^ 1) | (b > threshold_)));
+            }
+            count_ += std::size_t(used);
+            // The candidates (a few per row of a tile) found eight bytes at a time, without a
+            // branch per value: byte k of the little-endian word is candidate[w + k].
+            static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "candidate bytes read as a little-endian word");
+            for (std::size_t w = 0; w < m; w += 8) {
+                std::uint64_t word;
+                std::memcpy(&word, candidate + w, sizeof word);
+                for (; word != 0; word &= word - 1)
+                    keepIfLargest(bits[first + w + std::size_t(__builtin_ctzll(word) >> 3)]);
+            }
         }
-        count_ += std::size_t(used);
-        if (mayKeep)
-            for (std::size_t k = 0; k < n; ++k)
-                if (use[k] & (bits[k] >= floor_)) keepIfLargest(bits[k]);
     }
     std::size_t count() const { return count_; }  // values added
 
