@@ -503,7 +503,7 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tile, con
     alignas(64) std::uint32_t surface[kLanes];  // the triangle both routes hit, else kNoPrimitive
     alignas(64) std::uint8_t common[kLanes];  // 0 or 1 (bytes, not bool: GCC vectorises their loops)
     alignas(64) double slope[kLanes], quantum[kLanes], bound[kLanes], signedErrorQuanta[kLanes], ratio[kLanes];
-    alignas(64) double relative[kLanes], position[kLanes];
+    alignas(64) double relative[kLanes];
     alignas(64) std::uint8_t agree[kLanes], biasSample[kLanes], visit[kLanes];
     alignas(64) double errorQuanta[kLanes];
     alignas(64) float errorQuantaOfLane[kLanes], relativeOfLane[kLanes];
@@ -539,10 +539,9 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tile, con
             signedErrorQuanta[j] = signedErrorQuantaAt(a0 + j, b0 + j, q);
             ratio[j] = ratioOf(error, bound[j]);
             agree[j] = error <= bound[j];
-            // Where quantization dominates, the pixel feeds the bias test: its signed error and
-            // where its exact depth falls in the quantum (position: d/q).
+            // Where quantization dominates, the pixel feeds the bias test (its signed error, and
+            // where its exact depth falls in the quantum, computed there: a division per pixel).
             biasSample[j] = S * m <= 0.1 * q;
-            position[j] = rayDepth / q;
         }
         measures.relativeEyeZErrors(ray, raster, a0, b0, col0, row, std::size_t(n), relative);
         if (perPixel) {  // every pixel of the row, as the common case or a miss would have it
@@ -601,7 +600,8 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tile, con
         for (int j = 0; j < n; ++j)
             if (common[j] && biasSample[j]) {
                 signedErrorSum += signedErrorQuanta[j];
-                ++quarters[std::clamp(int(4 * (position[j] - std::floor(position[j]))), 0, 3)];
+                const double position = rayDepths[j] / quantum[j];  // d/q
+                ++quarters[std::clamp(int(4 * (position - std::floor(position))), 0, 3)];
                 ++biasSamples;
             }
         tally.signedErrorSum = signedErrorSum;
