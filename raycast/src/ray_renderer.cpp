@@ -167,12 +167,29 @@ RenderResult RayRenderer::render(const Camera& camera, const RayFaults& fault, E
     const int W = camera.width(), H = camera.height();
     RenderResult result = RenderResult::allocated(W, H);  // traceRect writes every pixel, hit or not
     if (eyePoints == EyePoints::Keep) result.pEye.assign(std::size_t(W) * H, glm::dvec3(NAN));
-    // 64×64 regions in parallel (a region's set-up, the camera's rays, is made once).
+    // 64×64 regions in parallel (a region's set-up, the camera's rays, is made once). Each is
+    // traced into a buffer of the worker's own and then copied into the image a row at a time:
+    // written straight into the image, a packet's four rows went to eight cache lines far apart
+    // that were not in the cache, and the stores waiting on them stalled the packets behind
+    // (the trace 88–92 → 70–79 ms for the speed workload). Eye points, rarely asked for, are
+    // written straight.
     const TileGrid regions(W, H, kRegion);
     tbb::parallel_for(0, regions.count(), [&](int region) {
+        const PixelRect rect = regions.rect(region);
         const std::size_t first = regions.firstPixel(region);
-        traceRect(camera, regions.rect(region), result.windowDepth.value.data() + first, result.primitiveId.data() + first,
-                  std::size_t(W), fault, eyePoints == EyePoints::Keep ? result.pEye.data() + first : nullptr);
+        if (eyePoints == EyePoints::Keep) {
+            traceRect(camera, rect, result.windowDepth.value.data() + first, result.primitiveId.data() + first,
+                      std::size_t(W), fault, result.pEye.data() + first);
+            return;
+        }
+        alignas(64) thread_local double depth[kRegion * kRegion];
+        alignas(64) thread_local std::uint32_t primitive[kRegion * kRegion];
+        traceRect(camera, rect, depth, primitive, kRegion, fault, nullptr);
+        for (int r = 0; r < rect.height(); ++r) {
+            const std::size_t to = first + std::size_t(r) * std::size_t(W), from = std::size_t(r) * kRegion;
+            std::memcpy(result.windowDepth.value.data() + to, depth + from, sizeof(double) * std::size_t(rect.width()));
+            std::memcpy(result.primitiveId.data() + to, primitive + from, sizeof(std::uint32_t) * std::size_t(rect.width()));
+        }
     });
     result.renderMilliseconds = millisecondsSince(start);
     return result;

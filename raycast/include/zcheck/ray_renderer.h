@@ -5,7 +5,8 @@
 // binary32 from the eye plane with [tNear, tFar] spanning near to far plane (for every model
 // but a raw matrix the direction gains one unit of eye-z per unit of t: AffineRays), traced
 // as coherent 4×4 packets (rtcIntersect16), row by row of packets over 64×64 regions, the
-// regions in parallel with TBB (traceRect traces one rectangle). Each hit is then recomputed
+// regions in parallel with TBB (traceRect traces one rectangle), each into a buffer of its
+// worker's own, copied into the image when the region is done. Each hit is then recomputed
 // in double against the hit triangle's plane (two packets later, once the triangle's indices
 // and vertices have been fetched while Embree traced), and its eye-z turned into the exact
 // window depth the depth buffer should hold by the convention's depth mapping in closed
