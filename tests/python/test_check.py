@@ -149,7 +149,8 @@ def test_gil_is_released_during_check():
     """While another thread is inside check(), this thread keeps running: the longest pause between
     two of its loop iterations stays far below the duration of one check."""
     checker = zcheck.Checker(zcheck.Scene.from_file("builtin:terrain?n=200"))
-    camera = checker.scene.default_camera.replace(width=800, height=600)
+    # (800x600 became too quick to tell, at 0.045 s, once the comparison got faster)
+    camera = checker.scene.default_camera.replace(width=1600, height=1200)
     start = time.perf_counter()
     checker.check(camera, threads=1)
     duration = time.perf_counter() - start
