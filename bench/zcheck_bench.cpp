@@ -13,9 +13,12 @@
 #include <CLI/CLI.hpp>
 #include <sys/resource.h>
 #include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <memory>
 
@@ -45,6 +48,7 @@ Stats timeRepeated(int repeats, F&& run)
 
 // `phase` other than "all" times one phase alone, for A/B comparisons of its code: "raster"
 // (no BVH is built), "trace", "compare" (both routes rendered once, the comparison repeated),
+// "floor" (what the comparison costs at least: its arrays read and written, nothing computed),
 // or "tiles" (the whole check drawn, traced and compared tile by tile, as `zcheck check` runs).
 void runPhase(const std::string& phase, const Scene& scene, const Camera& camera, int repeats)
 {
@@ -91,6 +95,43 @@ void runPhase(const std::string& phase, const Scene& scene, const Camera& camera
             });
             std::printf("trace %7.1f ms (best %7.1f) %6.2f Mrays/s", ms.median, ms.best,
                         double(camera.width()) * camera.height() / ms.median / 1e3);
+        } else if (phase == "floor") {
+            // What any comparison of these renders costs at least: the same four arrays read and
+            // two per-pixel arrays written (as Comparison's, fresh for the first repeat, kept
+            // after), one subtraction per pixel and nothing else; by 64×64 tiles in parallel, as
+            // the comparison goes, and by whole rows, a stream the processor prefetches.
+            const RenderResult drawn = raster.render(camera);
+            const std::size_t W = std::size_t(camera.width());
+            auto pass = [&](int parts, auto rectOf) {
+                double first = 0;
+                const Stats ms = timeRepeated(repeats, [&] {
+                    const auto start = std::chrono::steady_clock::now();
+                    LargeVector<std::uint8_t> classes;
+                    LargeVector<float> ratios;
+                    classes.resize(ray.primitiveId.size()), ratios.resize(ray.primitiveId.size());
+                    tbb::parallel_for(0, parts, [&](int part) {
+                        const PixelRect rect = rectOf(part);
+                        for (int row = rect.row0; row < rect.row1; ++row)
+                            for (std::size_t i = row * W + std::size_t(rect.col0); i < row * W + std::size_t(rect.col1); ++i) {
+                                classes[i] = std::uint8_t(ray.primitiveId[i] == drawn.primitiveId[i]);
+                                ratios[i] = float(std::abs(drawn.windowDepth.value[i] - ray.windowDepth.value[i]));
+                            }
+                    });
+                    const double elapsed =
+                        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+                    if (first == 0) first = elapsed;
+                    return elapsed;
+                });
+                std::printf(" %7.1f ms (best %7.1f, first %7.1f)", ms.median, ms.best, first);
+            };
+            const TileGrid tiles(camera.width(), camera.height(), TileComparison::kTileSize);
+            std::printf("compare floor: by tiles");
+            pass(tiles.count(), [&](int tile) { return tiles.rect(tile); });
+            constexpr int kRows = 16;  // blocks of whole rows
+            std::printf(", by rows");
+            pass((camera.height() + kRows - 1) / kRows, [&](int block) {
+                return PixelRect{0, block * kRows, camera.width(), std::min(camera.height(), (block + 1) * kRows)};
+            });
         } else {
             const RenderResult drawn = raster.render(camera);
             const Stats ms = timeRepeated(repeats, [&] {
@@ -156,9 +197,9 @@ int main(int argc, char** argv)
     app.add_option("--only", only, "run only workloads whose label contains this text");
     app.add_option("--scene", sceneName, "one workload: this scene (a built-in name or a mesh file) instead of the named ones");
     app.add_option("--camera", cameraFile, "with --scene: a camera file (its size overrides --width/--height)");
-    app.add_option("--phase", phase, "all, or one phase alone: raster (no BVH built), trace, compare, tiles (a check tile by tile), "
+    app.add_option("--phase", phase, "all, or one phase alone: raster (no BVH built), trace, compare, floor (what any comparison costs at least: its arrays read and written, nothing computed), tiles (a check tile by tile), "
                    "or embree (the trace's yardstick: Embree's own best packet trace)")
-        ->check(CLI::IsMember({"all", "raster", "trace", "compare", "tiles", "embree"}))
+        ->check(CLI::IsMember({"all", "raster", "trace", "compare", "floor", "tiles", "embree"}))
         ->capture_default_str();
     CLI11_PARSE(app, argc, argv);
 

@@ -651,3 +651,58 @@ TEST_CASE("a NaN depth is a depth error and never the largest error", "[compare]
         });
     }
 }
+
+TEST_CASE("a tile compared a few rows at a time, tiles interleaved, reports what whole tiles report", "[compare][rows]")
+{
+    // compareRoutes compares a band of tiles image row by image row (compareTileRows); a tile's
+    // rows then arrive in several calls, between other tiles' calls. Whole tiles in reverse
+    // order against pieces of 1 to 9 rows, the next piece taken from a random unfinished tile:
+    // the same report (counts, maxima, percentiles, bias, the worst pixel and the unexplained
+    // samples in scan order) and the same per-pixel classes and ratios, clean and with rows
+    // flipped (thousands of unexplained pixels) or a depth bias, on tiles cut by both edges.
+    const Checker checker(builtinScene("builtin:default"));
+    CameraSpec spec = smallCamera(checker.scene());
+    spec.width = 203, spec.height = 131;
+    const Camera camera(spec);
+    std::vector<CheckOptions> runs(3);
+    runs[1].faults.ray.flipRows = true;
+    runs[2].faults.raster.truncateUnorm = true;
+    std::mt19937 random(5);
+    for (const CheckOptions& options : runs) {
+        const RenderResult ray = checker.renderRay(camera, options.faults.ray);
+        const RenderResult raster = checker.renderRaster(camera, options.faults.raster);
+        auto reportOf = [&](Comparison& c, bool inPieces) {
+            TileComparison tiles(checker.scene(), camera, {}, &c);
+            const TileGrid& grid = tiles.tiles();
+            if (!inPieces) {
+                for (int tile = grid.count() - 1; tile >= 0; --tile)
+                    tiles.compareTile(tile, RoutePixels::of(ray), RoutePixels::of(raster));
+            } else {
+                std::vector<int> nextRow(std::size_t(grid.count()));
+                for (int tile = 0; tile < grid.count(); ++tile) nextRow[std::size_t(tile)] = grid.rect(tile).row0;
+                for (;;) {
+                    std::vector<int> open;
+                    for (int tile = 0; tile < grid.count(); ++tile)
+                        if (nextRow[std::size_t(tile)] < grid.rect(tile).row1) open.push_back(tile);
+                    if (open.empty()) break;
+                    const int tile = open[random() % open.size()];
+                    const int from = nextRow[std::size_t(tile)], to = from + 1 + int(random() % 9);
+                    tiles.compareTileRows(tile, from, to, RoutePixels::of(ray), RoutePixels::of(raster));
+                    nextRow[std::size_t(tile)] = std::min(to, grid.rect(tile).row1);
+                }
+            }
+            CheckReport report;
+            report.describeInputs(checker.scene(), camera, {});
+            report.comparison = tiles.finish().value();
+            return report;
+        };
+        Comparison whole, pieces;
+        const CheckReport byTiles = reportOf(whole, false), byPieces = reportOf(pieces, true);
+        INFO("faults: rows flipped " << options.faults.ray.flipRows << ", truncated " << options.faults.raster.truncateUnorm);
+        REQUIRE(byTiles.comparison.bothHit > 1000);
+        if (options.faults.ray.flipRows) REQUIRE(byTiles.comparison.unexplainedSamples.size() == 20);
+        REQUIRE(checkReportJson(byPieces) == checkReportJson(byTiles));
+        REQUIRE(testing::sameBits(pieces.pixelClass, whole.pixelClass));
+        REQUIRE(testing::sameBits(pieces.errorOverTolerance, whole.errorOverTolerance));
+    }
+}

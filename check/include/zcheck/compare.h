@@ -237,6 +237,11 @@ public:
     const TileGrid& tiles() const;  // kTileSize squares over the camera's image
     // `ray` and `raster` must cover the tile (they may cover more).
     void compareTile(int tile, const RoutePixels& ray, const RoutePixels& raster);
+    // The tile's rows in [rowBegin, rowEnd) only (image rows; cut to the tile). A tile may be
+    // compared in several such calls, each of its rows once and in order (top to bottom, each
+    // call after the one before it returned), interleaved with other tiles' calls in any way:
+    // the report is the same as compareTile's.
+    void compareTileRows(int tile, int rowBegin, int rowEnd, const RoutePixels& ray, const RoutePixels& raster);
     std::optional<ComparisonReport> finish();
 
 private:
