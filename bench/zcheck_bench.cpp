@@ -97,9 +97,11 @@ void runPhase(const std::string& phase, const Scene& scene, const Camera& camera
                         double(camera.width()) * camera.height() / ms.median / 1e3);
         } else if (phase == "floor") {
             // What any comparison of these renders costs at least: the same four arrays read and
-            // two per-pixel arrays written (as Comparison's, fresh for the first repeat, kept
-            // after), one subtraction per pixel and nothing else; by 64×64 tiles in parallel, as
-            // the comparison goes, and by whole rows, a stream the processor prefetches.
+            // two per-pixel arrays written (LargeVectors, as Comparison's: fresh memory only for
+            // the first repeat of the tiles pass, whose `first` figure shows it; every later
+            // repeat, and the rows pass, reuses the buffers kept from it), one subtraction per
+            // pixel and nothing else; by 64×64 tiles in parallel, as the comparison's tile-by-tile
+            // form goes, and by whole rows, a stream the processor prefetches.
             const RenderResult drawn = raster.render(camera);
             const std::size_t W = std::size_t(camera.width());
             auto pass = [&](int parts, auto rectOf) {
