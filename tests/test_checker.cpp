@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <optional>
 #include <random>
 
@@ -225,54 +226,57 @@ TEST_CASE("the 99th percentile from the largest values kept is the sorted one, i
         const double expected = sorted[std::size_t(std::ceil(0.99 * n)) - 1];
         std::vector<std::vector<float>> orders = {values, sorted, std::vector<float>(sorted.rbegin(), sorted.rend())};
         for (const std::vector<float>& order : orders)
-            for (const int parts : {1, 3}) {
-                const std::size_t keep = std::size_t(n) / 100 + 2;  // n is the most the keepers see
-                std::vector<LargestValues> keepers(static_cast<std::size_t>(parts), LargestValues(keep));
-                // Contiguous runs per keeper, as threads take runs of tiles.
-                for (std::size_t k = 0; k < order.size(); ++k) keepers[k * std::size_t(parts) / order.size()].add(order[k]);
-                std::vector<const LargestValues*> all;
-                for (const LargestValues& keeper : keepers) all.push_back(&keeper);
-                INFO("n " << n << ", " << parts << " keepers");
-                REQUIRE(LargestValues::percentile99(all) == expected);
-                // Given a row at a time with a mask, as the comparison gives them, among larger
-                // values masked out: the same, with and without a floor. Rows of a tile's 64
-                // pixels, of more (taken 64 at a time) and of a few (less than eight bytes).
-                for (const float floor : {0.0f, float(expected)}) {
-                    std::vector<LargestValues> byRow(static_cast<std::size_t>(parts), LargestValues(keep, floor));
-                    for (std::size_t part = 0; part < std::size_t(parts); ++part) {
-                        std::vector<float> row;
-                        std::vector<std::uint8_t> use;
-                        std::size_t rows = 0;
-                        auto flush = [&] {
-                            byRow[part].add(row.data(), use.data(), row.size());
-                            row.clear(), use.clear(), ++rows;
-                        };
-                        for (std::size_t k = 0; k < order.size(); ++k) {
-                            if (k * std::size_t(parts) / order.size() != part) continue;
-                            row.push_back(order[k]), use.push_back(1);
-                            row.push_back(1e30f), use.push_back(0);
-                            const std::size_t rowLength[] = {64, 150, 6};
-                            if (row.size() == rowLength[rows % 3]) flush();
+            for (const int parts : {1, 3})
+                for (const std::size_t slack : {1, 2}) {
+                    // n is the most the keepers see; n/100 + 1 the fewest they may keep (every
+                    // value a keeper's shrinking drops wrongly is then missed)
+                    const std::size_t keep = std::size_t(n) / 100 + slack;
+                    std::vector<LargestValues> keepers(static_cast<std::size_t>(parts), LargestValues(keep));
+                    // Contiguous runs per keeper, as threads take runs of tiles.
+                    for (std::size_t k = 0; k < order.size(); ++k) keepers[k * std::size_t(parts) / order.size()].add(order[k]);
+                    std::vector<const LargestValues*> all;
+                    for (const LargestValues& keeper : keepers) all.push_back(&keeper);
+                    INFO("n " << n << ", " << parts << " keepers of " << keep);
+                    REQUIRE(LargestValues::percentile99(all) == expected);
+                    // Given a row at a time with a mask, as the comparison gives them, among larger
+                    // values masked out: the same, with and without a floor. Rows of a tile's 64
+                    // pixels, of more (taken 64 at a time) and of a few (less than eight bytes).
+                    for (const float floor : {0.0f, float(expected)}) {
+                        std::vector<LargestValues> byRow(static_cast<std::size_t>(parts), LargestValues(keep, floor));
+                        for (std::size_t part = 0; part < std::size_t(parts); ++part) {
+                            std::vector<float> row;
+                            std::vector<std::uint8_t> use;
+                            std::size_t rows = 0;
+                            auto flush = [&] {
+                                byRow[part].add(row.data(), use.data(), row.size());
+                                row.clear(), use.clear(), ++rows;
+                            };
+                            for (std::size_t k = 0; k < order.size(); ++k) {
+                                if (k * std::size_t(parts) / order.size() != part) continue;
+                                row.push_back(order[k]), use.push_back(1);
+                                row.push_back(1e30f), use.push_back(0);
+                                const std::size_t rowLength[] = {64, 150, 6};
+                                if (row.size() == rowLength[rows % 3]) flush();
+                            }
+                            flush();
                         }
-                        flush();
+                        std::vector<const LargestValues*> allByRow;
+                        std::size_t counted = 0;
+                        for (const LargestValues& keeper : byRow) allByRow.push_back(&keeper), counted += keeper.count();
+                        REQUIRE(counted == std::size_t(n));
+                        REQUIRE(LargestValues::percentile99(allByRow) == expected);
                     }
-                    std::vector<const LargestValues*> allByRow;
-                    std::size_t counted = 0;
-                    for (const LargestValues& keeper : byRow) allByRow.push_back(&keeper), counted += keeper.count();
-                    REQUIRE(counted == std::size_t(n));
-                    REQUIRE(LargestValues::percentile99(allByRow) == expected);
+                    // With a floor at or below the percentile, the same; above it, no answer.
+                    for (const float floor : {float(expected), float(expected) + 0.125f}) {
+                        std::vector<LargestValues> floored(static_cast<std::size_t>(parts), LargestValues(keep, floor));
+                        for (std::size_t k = 0; k < order.size(); ++k) floored[k * std::size_t(parts) / order.size()].add(order[k]);
+                        std::vector<const LargestValues*> allFloored;
+                        for (const LargestValues& keeper : floored) allFloored.push_back(&keeper);
+                        const std::optional<double> p99 = LargestValues::percentile99(allFloored);
+                        if (floor == float(expected)) REQUIRE(p99 == expected);
+                        else if (sorted.back() > expected) REQUIRE_FALSE(p99.has_value());
+                    }
                 }
-                // With a floor at or below the percentile, the same; above it, no answer.
-                for (const float floor : {float(expected), float(expected) + 0.125f}) {
-                    std::vector<LargestValues> floored(static_cast<std::size_t>(parts), LargestValues(keep, floor));
-                    for (std::size_t k = 0; k < order.size(); ++k) floored[k * std::size_t(parts) / order.size()].add(order[k]);
-                    std::vector<const LargestValues*> allFloored;
-                    for (const LargestValues& keeper : floored) allFloored.push_back(&keeper);
-                    const std::optional<double> p99 = LargestValues::percentile99(allFloored);
-                    if (floor == float(expected)) REQUIRE(p99 == expected);
-                    else if (sorted.back() > expected) REQUIRE_FALSE(p99.has_value());
-                }
-            }
     }
     REQUIRE(LargestValues::percentile99({}) == 0.0);
     // Kept too few for the rank: no answer, not a wrong one.
@@ -285,6 +289,32 @@ TEST_CASE("the 99th percentile from the largest values kept is the sorted one, i
     REQUIRE(LargestValues::floorBelowPercentile99(sample) == 1941.0f);
     std::vector<float> small(999, 5.0f);
     REQUIRE(LargestValues::floorBelowPercentile99(small) == 0.0f);
+}
+
+// The keepers select by counting bit patterns (kthSmallestBits); std::nth_element is the
+// independent expectation, over patterns that differ only in their lowest bits, only in their
+// highest, everywhere, and in a few values repeated.
+TEST_CASE("the k-th smallest by counting bits is nth_element's", "[compare]")
+{
+    std::mt19937 random(5);
+    auto uniformBits = [&](std::uint32_t mask, std::uint32_t base) { return base | (std::uint32_t(random()) & mask); };
+    const std::vector<std::function<std::uint32_t()>> kinds = {
+        [&] { return uniformBits(0x3FFu, 0x40490000u); },   // the last level's bits alone
+        [&] { return uniformBits(0xFFE00000u, 0x5u); },     // the first level's alone, sign bit included
+        [&] { return uniformBits(0xFFFFFFFFu, 0); },        // everywhere
+        [&] { return std::uint32_t(random() % 3) * 0x00200401u; },  // three values, one in each level
+    };
+    for (const auto& kind : kinds)
+        for (const std::size_t n : {std::size_t(1), std::size_t(2), std::size_t(37), std::size_t(5000)}) {
+            std::vector<std::uint32_t> bits(n);
+            for (std::uint32_t& b : bits) b = kind();
+            for (const std::size_t k : {std::size_t(0), n / 3, n * 97 / 100, n - 1}) {
+                std::vector<std::uint32_t> sorted = bits;
+                std::nth_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(k), sorted.end());
+                INFO("n " << n << ", k " << k);
+                REQUIRE(kthSmallestBits(bits.data(), n, k) == sorted[k]);
+            }
+        }
 }
 
 TEST_CASE("judges of different cameras on one thread never share a slope", "[checker][compare]")

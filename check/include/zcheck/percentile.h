@@ -26,6 +26,12 @@
 
 namespace zcheck {
 
+// The k-th smallest (from 0, k < n) of n 32-bit patterns as unsigned integers: counted by
+// their top 11 bits, then those in the bucket holding rank k by their next 11, then by the
+// last 10. Exact, linear in n, and the values are not reordered (what std::nth_element would
+// select, in a few passes of counting).
+std::uint32_t kthSmallestBits(const std::uint32_t* bits, std::size_t n, std::size_t k);
+
 class LargestValues {
 public:
     explicit LargestValues(std::size_t keep, float floor = 0.0f);
@@ -72,9 +78,9 @@ public:
     // The 99th percentile of every value the keepers were given (0 when there were none), or
     // nullopt when they kept too few values to hold it: a floor above it, or keep below n/100 + 1.
     static std::optional<double> percentile99(const std::vector<const LargestValues*>& keepers);
-    // A floor for keepers from a sample of the values (reordered): its 97th percentile, or 0 for
-    // a sample under 1000 values.
-    static float floorBelowPercentile99(std::vector<float>& sample);
+    // A floor for keepers from a sample of the values: its 97th percentile, or 0 for a sample
+    // under 1000 values.
+    static float floorBelowPercentile99(const std::vector<float>& sample);
 
 private:
     static std::uint32_t floatBits(float value)
