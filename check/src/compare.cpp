@@ -10,6 +10,7 @@
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include <algorithm>
 #include <atomic>
@@ -754,8 +755,9 @@ std::optional<ComparisonReport> TileComparison::finish()
         errorQuantaParts.push_back(&counts.errorQuanta);
         relativeEyeZParts.push_back(&counts.relativeEyeZ);
     }
-    const std::optional<double> p99ErrorQuanta = LargestValues::percentile99(errorQuantaParts);
-    const std::optional<double> p99RelativeEyeZ = LargestValues::percentile99(relativeEyeZParts);
+    std::optional<double> p99ErrorQuanta, p99RelativeEyeZ;
+    tbb::parallel_invoke([&] { p99ErrorQuanta = LargestValues::percentile99(errorQuantaParts); },
+                         [&] { p99RelativeEyeZ = LargestValues::percentile99(relativeEyeZParts); });
     if (!p99ErrorQuanta || !p99RelativeEyeZ) return std::nullopt;
 
     ComparisonReport r = std::move(total.report);
@@ -784,18 +786,37 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
     // 97th percentile lie below the 99th of all with overwhelming probability, and a keeper then
     // holds ~3 % of its values instead of rebuilding its running largest as values grow down the
     // image. A floor too high is found out at the end, and the comparison run again without.
+    // One task per statistic, each a row's measures at a time, lane by lane as the comparison
+    // takes them.
     const PixelMeasures measures(camera);
-    std::vector<float> errorQuantaSample, relativeEyeZSample;
-    for (int row = 0; row < H; row += 32)
-        for (int col = 0; col < W; ++col) {
-            const std::size_t i = std::size_t(row) * W + col;
-            if (!ray.hit(i) || ray.primitiveId[i] != raster.primitiveId[i]) continue;
-            const double q = measures.quantum(rayPixels, rasterPixels, i, i);
-            errorQuantaSample.push_back(float(std::abs(PixelMeasures::signedErrorQuanta(rayPixels, rasterPixels, i, i, q))));
-            relativeEyeZSample.push_back(float(measures.relativeEyeZError(rayPixels, rasterPixels, i, i, col, row)));
+    auto floorFromSample = [&](auto measureRow) {
+        std::vector<float> sample;
+        std::vector<double> value(static_cast<std::size_t>(W));
+        for (int row = 0; row < H; row += 32) {
+            const std::size_t i0 = std::size_t(row) * W;
+            measureRow(i0, row, value.data());
+            for (int col = 0; col < W; ++col) {
+                const std::size_t i = i0 + std::size_t(col);
+                if (ray.hit(i) && ray.primitiveId[i] == raster.primitiveId[i]) sample.push_back(float(value[col]));
+            }
         }
-    const float errorQuantaFloor = LargestValues::floorBelowPercentile99(errorQuantaSample);
-    const float relativeEyeZFloor = LargestValues::floorBelowPercentile99(relativeEyeZSample);
+        return LargestValues::floorBelowPercentile99(sample);
+    };
+    float errorQuantaFloor = 0, relativeEyeZFloor = 0;
+    tbb::parallel_invoke(
+        [&] {
+            errorQuantaFloor = floorFromSample([&](std::size_t i0, int, double* errorQuanta) {
+                measures.quanta(rayPixels, rasterPixels, i0, i0, std::size_t(W), errorQuanta);  // q, then |Δ|/q
+                for (std::size_t j = 0; j < std::size_t(W); ++j)
+                    errorQuanta[j] =
+                        std::abs(PixelMeasures::signedErrorQuanta(rayPixels, rasterPixels, i0 + j, i0 + j, errorQuanta[j]));
+            });
+        },
+        [&] {
+            relativeEyeZFloor = floorFromSample([&](std::size_t i0, int row, double* relative) {
+                measures.relativeEyeZErrors(rayPixels, rasterPixels, i0, i0, 0, row, std::size_t(W), relative);
+            });
+        });
 
     Comparison out;
     for (const bool floors : {true, false}) {
