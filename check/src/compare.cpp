@@ -630,8 +630,7 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tile, int
                     break;
                 }
 
-        for (int j = 0; j < n; ++j) {
-            if (!visit[j]) continue;
+        auto visitPixel = [&](int j) ZCHECK_ALWAYS_INLINE {
             const int col = col0 + j;
             const std::size_t a = a0 + std::size_t(j), b = b0 + std::size_t(j), i = std::size_t(row) * W + col;
             const std::uint32_t rayPrimitive = rayPrimitives[j], rasterPrimitive = rasterPrimitives[j];
@@ -639,7 +638,7 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tile, int
             if (common[j]) {  // tallied already
                 const PixelClass c = agree[j] ? PixelClass::Agree : PixelClass::DepthError;  // written already
                 const bool worst = noteWorst(ratio[j]);
-                if (agree[j] && !worst) continue;  // nothing to note: no finding is built
+                if (agree[j] && !worst) return;  // nothing to note: no finding is built
                 PixelFinding f;
                 f.col = col, f.row = row;
                 f.rayWindowDepth = rayDepths[j], f.rasterWindowDepth = rasterDepths[j];
@@ -649,7 +648,7 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tile, int
                 f.toleranceQuanta = bound[j] / quantum[j];
                 if (worst) r.worst = f;
                 if (!agree[j]) noteUnexplained(r, f);
-                continue;
+                return;
             }
             const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
             PixelFinding f;
@@ -693,6 +692,15 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tile, int
             }
             setClass(i, f.pixelClass);
             if (isUnexplained(f.pixelClass)) noteUnexplained(r, f);
+        };
+        // The pixels to visit (a few per row, mostly none) found eight at a time, in scan order:
+        // byte k of the little-endian word is visit[w + k].
+        static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "visit bytes read as a little-endian word");
+        std::fill(visit + n, visit + ((n + 7) & ~7), std::uint8_t(0));
+        for (int w = 0; w < n; w += 8) {
+            std::uint64_t word;
+            std::memcpy(&word, visit + w, sizeof word);
+            for (; word != 0; word &= word - 1) visitPixel(w + (__builtin_ctzll(word) >> 3));
         }
     }
 }
