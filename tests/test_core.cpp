@@ -6,6 +6,7 @@
 #include "zcheck/clip.h"
 #include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
+#include "zcheck/lane_mask.h"
 #include "zcheck/large_buffer.h"
 #include "zcheck/tile_grid.h"
 
@@ -573,4 +574,23 @@ TEST_CASE("a released large buffer is handed back, faulted in, to the next one o
     // Small buffers are not kept.
     { LargeVector<double> small(1000, 1.0); }
     REQUIRE(cachedLargeBufferBytes() == 0);
+}
+
+// The lane loops' sparse walks (forEachSetLane) must visit exactly the set lanes below n, in
+// order: against a plain loop, over masks dense and sparse, lengths not a multiple of eight,
+// and set bytes past n that must be ignored.
+TEST_CASE("forEachSetLane visits the set lanes below n in order", "[core]")
+{
+    std::mt19937 random(3);
+    for (const int percentSet : {0, 3, 50, 100})
+        for (std::size_t n = 0; n <= 64; ++n) {
+            alignas(64) std::uint8_t mask[64];
+            for (std::size_t j = 0; j < 64; ++j) mask[j] = std::uint8_t(j >= n || int(random() % 100) < percentSet);
+            std::vector<std::size_t> expected, visited;
+            for (std::size_t j = 0; j < n; ++j)
+                if (mask[j]) expected.push_back(j);
+            forEachSetLane(mask, n, [&](std::size_t j) { visited.push_back(j); });
+            INFO(percentSet << " % set, n " << n);
+            REQUIRE(visited == expected);
+        }
 }

@@ -5,6 +5,7 @@
 #include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
 #include "zcheck/kernel_choice.h"
+#include "zcheck/lane_mask.h"
 #include "zcheck/large_buffer.h"
 #include "zcheck/percentile.h"
 
@@ -546,9 +547,9 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tile, int
             signedErrorQuanta[j] = signedErrorQuantaAt(a0 + j, b0 + j, q);
             ratio[j] = ratioOf(error, bound[j]);
             agree[j] = error <= bound[j];
-            // Where quantization dominates, the pixel feeds the bias test (its signed error, and
+            // Where quantization dominates, a common-case pixel feeds the bias test (its signed error, and
             // where its exact depth falls in the quantum, computed there: a division per pixel).
-            biasSample[j] = S * m <= 0.1 * q;
+            biasSample[j] = common[j] & (S * m <= 0.1 * q);
         }
         measures.relativeEyeZErrors(ray, raster, a0, b0, col0, row, std::size_t(n), relative);
         if (perPixel) {  // every pixel of the row, as the common case or a miss would have it
@@ -604,13 +605,12 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tile, int
         // The bias test's sum in scan order (its rounding depends on the order).
         double signedErrorSum = tally.signedErrorSum;
         std::int64_t quarters[4] = {0, 0, 0, 0}, biasSamples = 0;
-        for (int j = 0; j < n; ++j)
-            if (common[j] && biasSample[j]) {
-                signedErrorSum += signedErrorQuanta[j];
-                const double position = rayDepths[j] / quantum[j];  // d/q
-                ++quarters[std::clamp(int(4 * (position - std::floor(position))), 0, 3)];
-                ++biasSamples;
-            }
+        forEachSetLane(biasSample, std::size_t(n), [&](std::size_t j) ZCHECK_ALWAYS_INLINE {
+            signedErrorSum += signedErrorQuanta[j];
+            const double position = rayDepths[j] / quantum[j];  // d/q
+            ++quarters[std::clamp(int(4 * (position - std::floor(position))), 0, 3)];
+            ++biasSamples;
+        });
         tally.signedErrorSum = signedErrorSum;
         for (int k = 0; k < 4; ++k) tally.quarterCounts[k] += quarters[k];
         r.biasSamples += biasSamples;
@@ -693,15 +693,8 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tile, int
             setClass(i, f.pixelClass);
             if (isUnexplained(f.pixelClass)) noteUnexplained(r, f);
         };
-        // The pixels to visit (a few per row, mostly none) found eight at a time, in scan order:
-        // byte k of the little-endian word is visit[w + k].
-        static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "visit bytes read as a little-endian word");
-        std::fill(visit + n, visit + ((n + 7) & ~7), std::uint8_t(0));
-        for (int w = 0; w < n; w += 8) {
-            std::uint64_t word;
-            std::memcpy(&word, visit + w, sizeof word);
-            for (; word != 0; word &= word - 1) visitPixel(w + (__builtin_ctzll(word) >> 3));
-        }
+        // The pixels to visit (a few per row, mostly none), in scan order.
+        forEachSetLane(visit, std::size_t(n), [&](std::size_t j) ZCHECK_ALWAYS_INLINE { visitPixel(int(j)); });
     }
 }
 

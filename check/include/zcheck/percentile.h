@@ -16,6 +16,7 @@
 //   mine.add(float(errorQuanta));                                // each value
 //   std::optional<double> p99 = LargestValues::percentile99({&mine, &other});
 #include "zcheck/kernel_choice.h"
+#include "zcheck/lane_mask.h"
 
 #include <algorithm>
 #include <cstddef>
@@ -62,15 +63,8 @@ public:
                 candidate[k] = std::uint8_t(use[first + k] & (b >= floor_) & ((full ^ 1) | (b > threshold_)));
             }
             count_ += std::size_t(used);
-            // The candidates (a few per row of a tile) found eight bytes at a time, without a
-            // branch per value: byte k of the little-endian word is candidate[w + k].
-            static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "candidate bytes read as a little-endian word");
-            for (std::size_t w = 0; w < m; w += 8) {
-                std::uint64_t word;
-                std::memcpy(&word, candidate + w, sizeof word);
-                for (; word != 0; word &= word - 1)
-                    keepIfLargest(bits[first + w + std::size_t(__builtin_ctzll(word) >> 3)]);
-            }
+            // The candidates (a few per row of a tile), without a branch per value.
+            forEachSetLane(candidate, m, [&](std::size_t k) ZCHECK_ALWAYS_INLINE { keepIfLargest(bits[first + k]); });
         }
     }
     std::size_t count() const { return count_; }  // values added
