@@ -190,8 +190,11 @@ void PixelJudge::slopes(const std::uint32_t* primitive, std::size_t n, double* s
 #endif
     // Runs of lanes on one primitive (neighbouring pixels, mostly) take one slope: the runs'
     // primitives listed without a branch (one not of the scene as triangle 0, its slope
-    // replaced by 0 afterwards), their slopes computed together, then dealt out to the lanes.
+    // replaced by 0 afterwards); each looked up in the thread's memo (a triangle two pixels
+    // tall is met again in the next row: two runs in three, on the speed workload); the
+    // missing ones computed together and remembered; then dealt out to the lanes.
     if (scene_.triangles.empty()) return void(std::fill(slope, slope + n, 0.0));  // nothing is known
+    SlopeMemo& memoOfThread = slopeMemo;
     for (std::size_t j0 = 0; j0 < n; j0 += kSlopeLanes) {
         const std::size_t lanes = std::min(kSlopeLanes, n - j0);
         const std::uint32_t* p = primitive + j0;
@@ -202,8 +205,20 @@ void PixelJudge::slopes(const std::uint32_t* primitive, std::size_t n, double* s
             run[j] = std::uint32_t(runs - 1);
             runPrimitive[runs - 1] = known(p[j]) ? p[j] : 0;
         }
-        alignas(64) double runSlope[kSlopeLanes];
-        together(slopeFrame_, scene_, runPrimitive, runs, runSlope);
+        alignas(64) double runSlope[kSlopeLanes], missingSlope[kSlopeLanes];
+        std::uint32_t missing[kSlopeLanes], missingPrimitive[kSlopeLanes];  // runs not in the memo
+        std::size_t misses = 0;
+        for (std::size_t k = 0; k < runs; ++k) {
+            const SlopeMemo::Entry& memo = memoOfThread.entries[runPrimitive[k] % SlopeMemo::kEntries];
+            runSlope[k] = memo.slope;  // replaced below where it is another's
+            missing[misses] = std::uint32_t(k), missingPrimitive[misses] = runPrimitive[k];
+            misses += std::size_t(memo.judge != serial_ || memo.primitive != runPrimitive[k]);
+        }
+        together(slopeFrame_, scene_, missingPrimitive, misses, missingSlope);
+        for (std::size_t m = 0; m < misses; ++m) {
+            runSlope[missing[m]] = missingSlope[m];
+            memoOfThread.entries[missingPrimitive[m] % SlopeMemo::kEntries] = {serial_, missingPrimitive[m], missingSlope[m]};
+        }
         for (std::size_t j = 0; j < lanes; ++j) slope[j0 + j] = known(p[j]) ? runSlope[run[j]] : 0.0;
     }
 }

@@ -178,10 +178,10 @@ public:
     bool atClipPlane(std::uint32_t primitive, const glm::dvec2& pWindow) const;
     double slope(std::uint32_t primitive) const;
     // slope() of n primitives at once into `slope` (0 for one not of the scene, such as
-    // kNoPrimitive), bit-identical to slope() of each: one per run of equal primitives, the
-    // runs' slopes computed together, several per instruction where the processor allows
-    // (ZCHECK_COMPARE_KERNEL=baseline|auto, kernel_choice.h). Not memoised: a row of a tile
-    // computes them faster than it looks them up.
+    // kNoPrimitive), bit-identical to slope() of each: one per run of equal primitives, taken
+    // from the thread's memo that slope() also uses where the triangle was met lately (in the
+    // row above, mostly), the others computed together, several per instruction where the
+    // processor allows (ZCHECK_COMPARE_KERNEL=baseline|auto, kernel_choice.h), and remembered.
     void slopes(const std::uint32_t* primitive, std::size_t n, double* slope) const;
     // Whether the comparison's AVX-512 forms run (ZCHECK_COMPARE_KERNEL, read when the judge
     // was made).
