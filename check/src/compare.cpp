@@ -562,8 +562,9 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tile, int
             signedErrorQuanta[j] = signedErrorQuantaAt(a0 + j, b0 + j, q);
             ratio[j] = ratioOf(error, bound[j]);
             agree[j] = error <= bound[j];
-            // Where quantization dominates, a common-case pixel feeds the bias test (its signed error, and
-            // where its exact depth falls in the quantum, computed there: a division per pixel).
+            // Where quantization dominates, a common-case pixel feeds the bias test (its signed
+            // error, and where its exact depth falls in the quantum, computed there: a division
+            // per pixel).
             biasSample[j] = common[j] & (S * m <= 0.1 * q);
         }
         measures.relativeEyeZErrors(ray, raster, a0, b0, col0, row, std::size_t(n), relative);
