@@ -107,7 +107,12 @@ struct SlopeMemo {
         std::uint64_t judge;
         std::uint32_t primitive;
         double slope;
+
+        // Whether this is judge's slope of primitive (as a value, not a branch: lane loops use it).
+        bool holds(std::uint64_t judgeSerial, std::uint32_t p) const { return (judge == judgeSerial) & (primitive == p); }
     };
+    Entry& entryOf(std::uint32_t primitive) { return entries[primitive % kEntries]; }
+
     Entry entries[kEntries];  // zero-initialised: no judge has serial 0
 };
 thread_local SlopeMemo slopeMemo;
@@ -143,9 +148,8 @@ double PixelJudge::computeSlope(std::uint32_t primitive) const
 double PixelJudge::slope(std::uint32_t primitive) const
 {
     if (!known(primitive)) return 0.0;
-    SlopeMemo::Entry& memo = slopeMemo.entries[primitive % SlopeMemo::kEntries];
-    if (memo.judge != serial_ || memo.primitive != primitive)
-        memo = {serial_, primitive, computeSlope(primitive)};
+    SlopeMemo::Entry& memo = slopeMemo.entryOf(primitive);
+    if (!memo.holds(serial_, primitive)) memo = {serial_, primitive, computeSlope(primitive)};
     return memo.slope;
 }
 
@@ -209,15 +213,15 @@ void PixelJudge::slopes(const std::uint32_t* primitive, std::size_t n, double* s
         std::uint32_t missing[kSlopeLanes], missingPrimitive[kSlopeLanes];  // runs not in the memo
         std::size_t misses = 0;
         for (std::size_t k = 0; k < runs; ++k) {
-            const SlopeMemo::Entry& memo = memoOfThread.entries[runPrimitive[k] % SlopeMemo::kEntries];
+            const SlopeMemo::Entry& memo = memoOfThread.entryOf(runPrimitive[k]);
             runSlope[k] = memo.slope;  // replaced below where it is another's
             missing[misses] = std::uint32_t(k), missingPrimitive[misses] = runPrimitive[k];
-            misses += std::size_t(memo.judge != serial_ || memo.primitive != runPrimitive[k]);
+            misses += std::size_t(!memo.holds(serial_, runPrimitive[k]));
         }
         together(slopeFrame_, scene_, missingPrimitive, misses, missingSlope);
         for (std::size_t m = 0; m < misses; ++m) {
             runSlope[missing[m]] = missingSlope[m];
-            memoOfThread.entries[missingPrimitive[m] % SlopeMemo::kEntries] = {serial_, missingPrimitive[m], missingSlope[m]};
+            memoOfThread.entryOf(missingPrimitive[m]) = {serial_, missingPrimitive[m], missingSlope[m]};
         }
         for (std::size_t j = 0; j < lanes; ++j) slope[j0 + j] = known(p[j]) ? runSlope[run[j]] : 0.0;
     }
