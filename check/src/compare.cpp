@@ -9,12 +9,12 @@
 #include "zcheck/large_buffer.h"
 #include "zcheck/percentile.h"
 
+#include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <optional>
@@ -97,26 +97,56 @@ double windowDepthSlope(const Camera& camera, const glm::dvec3& a, const glm::dv
 
 namespace {
 
-// The slopes of the triangles a thread saw last, for any judge: direct-mapped on the
-// primitive, keyed by the judge's serial (0: empty). A triangle covering many pixels costs
-// one slope; a million-triangle scene costs no per-triangle cache (that was 8 MB to fault in
-// for every comparison).
-struct SlopeMemo {
-    static constexpr std::size_t kEntries = 4096;
-    struct Entry {
-        std::uint64_t judge;
-        std::uint32_t primitive;
-        double slope;
+// Slopes of up to kSlopeLanes consecutive triangles together: their corners dealt into lane
+// arrays, then slopeOfTriangle lane by lane. Inlined into a baseline and an AVX-512 form
+// (kernel_choice.h), both bit-identical to DepthSlopeFrame::slope of each (the same IEEE
+// operations in the same order).
+constexpr std::size_t kSlopeLanes = 64;
+ZCHECK_ALWAYS_INLINE inline void slopesTogether(const DepthSlopeFrame& frame, const Scene& scene, std::uint32_t first,
+                                                std::size_t n, double* slope)
+{
+    std::uint32_t triangle[kSlopeLanes];
+    for (std::size_t k = 0; k < n; ++k) triangle[k] = first + std::uint32_t(k);
+    alignas(64) double corner[3][3][kSlopeLanes];  // corner, axis, lane
+    cornersInLanes(scene, triangle, n, corner);
+    for (std::size_t k = 0; k < n; ++k)
+        slope[k] = slopeOfTriangle(frame, glm::dvec3(corner[0][0][k], corner[0][1][k], corner[0][2][k]),
+                                   glm::dvec3(corner[1][0][k], corner[1][1][k], corner[1][2][k]),
+                                   glm::dvec3(corner[2][0][k], corner[2][1][k], corner[2][2][k]));
+}
 
-        // Whether this is judge's slope of primitive (as a value, not a branch: lane loops use it).
-        bool holds(std::uint64_t judgeSerial, std::uint32_t p) const { return (judge == judgeSerial) & (primitive == p); }
-    };
-    Entry& entryOf(std::uint32_t primitive) { return entries[primitive % kEntries]; }
+void slopesTogetherBaseline(const DepthSlopeFrame& frame, const Scene& scene, std::uint32_t first, std::size_t n,
+                            double* slope)
+{
+    slopesTogether(frame, scene, first, n, slope);
+}
 
-    Entry entries[kEntries];  // zero-initialised: no judge has serial 0
-};
-thread_local SlopeMemo slopeMemo;
-std::atomic<std::uint64_t> nextJudgeSerial{1};
+#ifdef ZCHECK_X86_AVX512
+ZCHECK_TARGET_AVX512 void slopesTogetherAvx512(const DepthSlopeFrame& frame, const Scene& scene, std::uint32_t first,
+                                               std::size_t n, double* slope)
+{
+    slopesTogether(frame, scene, first, n, slope);
+}
+#endif
+
+// DepthSlopeFrame::slope of every triangle of the scene, in parallel.
+LargeVector<double> slopesOfAllTriangles(const Scene& scene, const DepthSlopeFrame& frame, bool avx512)
+{
+    auto* together = &slopesTogetherBaseline;
+#ifdef ZCHECK_X86_AVX512
+    if (avx512) together = &slopesTogetherAvx512;
+#endif
+    const std::size_t n = scene.triangles.size();
+    LargeVector<double> slope(n);  // uninitialised: every entry is written below
+    const std::size_t blocks = (n + kSlopeLanes - 1) / kSlopeLanes;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks, 16), [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t block = range.begin(); block != range.end(); ++block) {
+            const std::size_t first = block * kSlopeLanes;
+            together(frame, scene, std::uint32_t(first), std::min(kSlopeLanes, n - first), slope.data() + first);
+        }
+    });
+    return slope;
+}
 
 }  // namespace
 
@@ -126,105 +156,14 @@ PixelJudge::PixelJudge(const Scene& scene, const Camera& camera, const Tolerance
       C_(ToleranceModel::constantQuanta(camera.depth())),
       S_(tolerance.snapPixels()),
       E_(16 * std::ldexp(1.0, -52) * std::max(std::abs(camera.depth().rangeMin), std::abs(camera.depth().rangeMax))),
-      slopeFrame_(camera, tolerance.slopeCredit),
-      serial_(nextJudgeSerial.fetch_add(1, std::memory_order_relaxed)),
-      avx512_(useAvx512Form("ZCHECK_COMPARE_KERNEL", "baseline"))
+      avx512_(useAvx512Form("ZCHECK_COMPARE_KERNEL", "baseline")),
+      slopeOfTriangle_(slopesOfAllTriangles(scene, DepthSlopeFrame(camera, tolerance.slopeCredit), avx512_))
 {
 }
 
 glm::dvec3 PixelJudge::vertex(std::uint32_t primitive, int corner) const
 {
     return glm::dvec3(scene_.positions[scene_.triangles[primitive][corner]]);
-}
-
-double PixelJudge::computeSlope(std::uint32_t primitive) const
-{
-    const glm::uvec3& t = scene_.triangles[primitive];
-    return slopeFrame_.slope(glm::dvec3(scene_.positions[t[0]]), glm::dvec3(scene_.positions[t[1]]),
-                             glm::dvec3(scene_.positions[t[2]]));
-}
-
-// m is a property of the triangle's plane, the same at every pixel.
-double PixelJudge::slope(std::uint32_t primitive) const
-{
-    if (!known(primitive)) return 0.0;
-    SlopeMemo::Entry& memo = slopeMemo.entryOf(primitive);
-    if (!memo.holds(serial_, primitive)) memo = {serial_, primitive, computeSlope(primitive)};
-    return memo.slope;
-}
-
-namespace {
-
-// Slopes of up to kSlopeLanes triangles together: their corners dealt into lane arrays, then
-// slopeOfTriangle lane by lane. Inlined into a baseline and an AVX-512 form (kernel_choice.h),
-// both bit-identical to slope() of each (the same IEEE operations in the same order).
-constexpr std::size_t kSlopeLanes = 64;
-ZCHECK_ALWAYS_INLINE inline void slopesTogether(const DepthSlopeFrame& frame, const Scene& scene,
-                                                          const std::uint32_t* primitive, std::size_t n, double* slope)
-{
-    alignas(64) double corner[3][3][kSlopeLanes];  // corner, axis, lane
-    cornersInLanes(scene, primitive, n, corner);
-    for (std::size_t k = 0; k < n; ++k)
-        slope[k] = slopeOfTriangle(frame, glm::dvec3(corner[0][0][k], corner[0][1][k], corner[0][2][k]),
-                                   glm::dvec3(corner[1][0][k], corner[1][1][k], corner[1][2][k]),
-                                   glm::dvec3(corner[2][0][k], corner[2][1][k], corner[2][2][k]));
-}
-
-void slopesTogetherBaseline(const DepthSlopeFrame& frame, const Scene& scene, const std::uint32_t* primitive,
-                            std::size_t n, double* slope)
-{
-    slopesTogether(frame, scene, primitive, n, slope);
-}
-
-#ifdef ZCHECK_X86_AVX512
-ZCHECK_TARGET_AVX512 void slopesTogetherAvx512(const DepthSlopeFrame& frame, const Scene& scene,
-                                               const std::uint32_t* primitive, std::size_t n, double* slope)
-{
-    slopesTogether(frame, scene, primitive, n, slope);
-}
-#endif
-
-}  // namespace
-
-void PixelJudge::slopes(const std::uint32_t* primitive, std::size_t n, double* slope) const
-{
-    auto* together = &slopesTogetherBaseline;
-#ifdef ZCHECK_X86_AVX512
-    if (avx512_) together = &slopesTogetherAvx512;
-#endif
-    // Runs of lanes on one primitive (neighbouring pixels, mostly) take one slope: the runs'
-    // primitives listed without a branch (one not of the scene as triangle 0, its slope
-    // replaced by 0 afterwards); each looked up in the thread's memo (a triangle two pixels
-    // tall is met again in the next row: two runs in three, on the speed workload); the
-    // missing ones computed together and remembered; then dealt out to the lanes.
-    if (scene_.triangles.empty()) return void(std::fill(slope, slope + n, 0.0));  // nothing is known
-    SlopeMemo& memoOfThread = slopeMemo;
-    for (std::size_t j0 = 0; j0 < n; j0 += kSlopeLanes) {
-        const std::size_t lanes = std::min(kSlopeLanes, n - j0);
-        const std::uint32_t* p = primitive + j0;
-        std::uint32_t run[kSlopeLanes], runPrimitive[kSlopeLanes];
-        std::size_t runs = 0;
-        for (std::size_t j = 0; j < lanes; ++j) {
-            runs += std::size_t(j == 0 || p[j] != p[j - 1]);
-            run[j] = std::uint32_t(runs - 1);
-            runPrimitive[runs - 1] = known(p[j]) ? p[j] : 0;
-        }
-        alignas(64) double runSlope[kSlopeLanes], missingSlope[kSlopeLanes];
-        std::uint32_t missing[kSlopeLanes], missingPrimitive[kSlopeLanes];  // runs not in the memo
-        std::size_t misses = 0;
-        for (std::size_t k = 0; k < runs; ++k) {
-            const SlopeMemo::Entry& memo = memoOfThread.entryOf(runPrimitive[k]);
-            runSlope[k] = memo.slope;  // replaced below where it is another's
-            missing[misses] = std::uint32_t(k), missingPrimitive[misses] = runPrimitive[k];
-            misses += std::size_t(!memo.holds(serial_, runPrimitive[k]));
-        }
-        together(slopeFrame_, scene_, missingPrimitive, misses, missingSlope);
-        for (std::size_t m = 0; m < misses; ++m) {
-            runSlope[missing[m]] = missingSlope[m];
-            memoOfThread.entryOf(missingPrimitive[m]) = {serial_, missingPrimitive[m], missingSlope[m]};
-        }
-        for (std::size_t j = 0; j < lanes; ++j) slope[j0 + j] = known(p[j]) ? runSlope[run[j]] : 0.0;
-    }
 }
 
 double PixelJudge::surfaceTolerance(std::uint32_t primitive, double q) const { return toleranceForSlope(slope(primitive), q); }

@@ -48,8 +48,9 @@ struct Timings {
     double rasterMs = 0;     // transform, clip, bin, rasterize, wall time
     double compareMs = 0;    // per-pixel comparison and classification, wall time
     // Drawn and compared tile by tile (CheckOptions::keepPixels false): the three phases ran
-    // interleaved, so their wall time is the pass's (with the raster's set-up before it)
-    // shared out in proportion to the threads' time in each; they still add up to the total.
+    // interleaved, so their wall time is the pass's shared out in proportion to the threads'
+    // time in each, plus the raster's set-up and the comparison's (its slopes of all triangles)
+    // before it; they still add up to the total.
     bool tileByTile = false;
 };
 

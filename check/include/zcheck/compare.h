@@ -35,11 +35,13 @@
 //
 // Verdict: consistent ⇔ no unexplained coverage mismatch, no depth error and no bias.
 #include "zcheck/camera.h"
+#include "zcheck/kernel_choice.h"
 #include "zcheck/large_buffer.h"
 #include "zcheck/render.h"
 #include "zcheck/scene.h"
 #include "zcheck/tile_grid.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -151,9 +153,13 @@ struct DepthSlopeFrame {
 // The per-pixel rule above, in one place: the comparison applies it to the raster's surface,
 // and `verify` (which must guess the surface a map saw) applies it to every candidate surface,
 // so that which surfaces a pixel may show and whether its depth agrees are one decision.
-// Thread-safe: const calls may run from several threads at once. Slopes are memoised per
-// thread for the triangles seen last (a pure function of triangle and camera, so the memo
-// never changes a result); a judge allocates nothing per triangle.
+// Thread-safe: const calls may run from several threads at once.
+// Cost: making a judge computes the slope m of every triangle of the scene, in parallel and
+// several per instruction, into a table of 8 bytes per triangle (the scene's triangles in
+// order, so their corners are read as a stream: ~2 ms per million triangles on two threads);
+// a pixel's slope is then one load. (Slopes computed for the triangles seen, remembered per
+// thread, cost the comparison more: a million-triangle scene at 1080p shows ~600,000
+// triangles, each met in ~3 runs of pixels to look up, with its corners gathered at random.)
 class PixelJudge {
 public:
     // Reads ZCHECK_COMPARE_KERNEL (kernel_choice.h) and throws Error for a value but
@@ -176,13 +182,18 @@ public:
     bool nearEdge(std::uint32_t primitive, const glm::dvec2& pWindow) const;
     // Whether the primitive's plane meets the pixel's ray on the near or far plane.
     bool atClipPlane(std::uint32_t primitive, const glm::dvec2& pWindow) const;
-    double slope(std::uint32_t primitive) const;
-    // slope() of n primitives at once into `slope` (0 for one not of the scene, such as
-    // kNoPrimitive), bit-identical to slope() of each: one per run of equal primitives, taken
-    // from the thread's memo that slope() also uses where the triangle was met lately (in the
-    // row above, mostly), the others computed together, several per instruction where the
-    // processor allows (ZCHECK_COMPARE_KERNEL=baseline|auto, kernel_choice.h), and remembered.
-    void slopes(const std::uint32_t* primitive, std::size_t n, double* slope) const;
+    // m of the primitive's plane (DepthSlopeFrame::slope), 0 for one not of the scene.
+    double slope(std::uint32_t primitive) const { return known(primitive) ? slopeOfTriangle_[primitive] : 0.0; }
+    // slope() of n primitives into `slope`. Inlined, so that a lane loop of each form of a
+    // kernel (kernel_choice.h) loads several per instruction.
+    ZCHECK_ALWAYS_INLINE void slopes(const std::uint32_t* primitive, std::size_t n, double* slope) const
+    {
+        if (slopeOfTriangle_.empty()) return void(std::fill(slope, slope + n, 0.0));  // nothing is known
+        for (std::size_t j = 0; j < n; ++j) {
+            const double m = slopeOfTriangle_[known(primitive[j]) ? primitive[j] : 0];  // a load in any case
+            slope[j] = known(primitive[j]) ? m : 0.0;
+        }
+    }
     // Whether the comparison's AVX-512 forms run (ZCHECK_COMPARE_KERNEL, read when the judge
     // was made).
     bool avx512Form() const { return avx512_; }
@@ -191,14 +202,12 @@ public:
 private:
     bool known(std::uint32_t primitive) const { return primitive < scene_.triangles.size(); }
     glm::dvec3 vertex(std::uint32_t primitive, int corner) const;
-    double computeSlope(std::uint32_t primitive) const;  // slope() without the memo
 
     const Scene& scene_;
     const Camera& camera_;
     double C_, S_, E_;
-    DepthSlopeFrame slopeFrame_;
-    std::uint64_t serial_;  // this judge's key in the per-thread slope memo
-    bool avx512_;           // ZCHECK_COMPARE_KERNEL: the AVX-512 forms (avx512Form())
+    bool avx512_;  // ZCHECK_COMPARE_KERNEL: the AVX-512 forms (avx512Form())
+    LargeVector<double> slopeOfTriangle_;  // m of triangle t, for every t of the scene
 };
 
 // One route's results over a rectangle of the image, as the comparison reads them: pixel
