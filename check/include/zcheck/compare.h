@@ -156,10 +156,11 @@ struct DepthSlopeFrame {
 // Thread-safe: const calls may run from several threads at once.
 // Cost: making a judge computes the slope m of every triangle of the scene, in parallel and
 // several per instruction, into a table of 8 bytes per triangle (the scene's triangles in
-// order, so their corners are read as a stream: ~2 ms per million triangles on two threads);
-// a pixel's slope is then one load. (Slopes computed for the triangles seen, remembered per
-// thread, cost the comparison more: a million-triangle scene at 1080p shows ~600,000
-// triangles, each met in ~3 runs of pixels to look up, with its corners gathered at random.)
+// order, so their corners are read as a stream: 3-4.5 ms per million triangles on two
+// threads, 9.5 on one, on the speed workload's machine); a pixel's slope is then one load.
+// (Slopes computed only for the triangles seen and remembered per thread cost the comparison
+// more: a million-triangle scene at 1080p shows ~600,000 triangles, met in ~1.8 million runs
+// of pixels to look up, with their corners gathered at random.)
 class PixelJudge {
 public:
     // Reads ZCHECK_COMPARE_KERNEL (kernel_choice.h) and throws Error for a value but
