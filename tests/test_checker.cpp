@@ -319,10 +319,11 @@ TEST_CASE("the k-th smallest by counting bits is nth_element's", "[compare]")
 
 TEST_CASE("a judge's slopes are each triangle's own, for its camera, one at a time and a row at a time", "[checker][compare]")
 {
-    // The judge computes every triangle's slope up front, several per instruction in blocks
-    // of consecutive triangles (the last block partial here): each must equal windowDepthSlope
-    // of that triangle alone, for the judge's own camera (two judges alive at once), in both
-    // kernel forms, and a row of primitives must get them lane by lane (0 for no triangle).
+    // A judge with a table computes every triangle's slope up front, several per instruction
+    // in blocks of consecutive triangles (the last block partial here); one without computes
+    // each when asked. Each slope must equal windowDepthSlope of that triangle alone, for the
+    // judge's own camera (judges of two cameras alive at once), in both kernel forms, and a row
+    // of primitives must get them lane by lane (0 for no triangle).
     const Scene scene = builtinScene("builtin:terrain?n=60");
     REQUIRE(scene.triangleCount() % 64 != 0);
     CameraSpec wide = smallCamera(scene), narrow = wide;
@@ -338,24 +339,28 @@ TEST_CASE("a judge's slopes are each triangle's own, for its camera, one at a ti
                                             std::uint32_t(scene.triangleCount() - 1), kUnknownPrimitive,
                                             std::uint32_t(scene.triangleCount())};
     for (const char* form : {"baseline", "auto"}) {
-        auto judge = [&](const Camera& camera) {
-            return testing::withEnvironment("ZCHECK_COMPARE_KERNEL", form,
-                                            [&] { return std::make_unique<PixelJudge>(scene, camera); });
-        };
-        const std::unique_ptr<PixelJudge> aMade = judge(wideCamera), bMade = judge(narrowCamera);
-        const PixelJudge &a = *aMade, &b = *bMade;
-        for (std::uint32_t t = 0; t < scene.triangleCount(); ++t) {
-            INFO(form << ": triangle " << t);
-            REQUIRE(expected(wideCamera, t) != expected(narrowCamera, t));
-            REQUIRE(a.slope(t) == expected(wideCamera, t));
-            REQUIRE(b.slope(t) == expected(narrowCamera, t));
-        }
-        for (const auto& [judge, camera] : {std::pair{&a, &wideCamera}, std::pair{&b, &narrowCamera}}) {
-            std::vector<double> slope(row.size(), -1.0);
-            judge->slopes(row.data(), row.size(), slope.data());
-            for (std::size_t j = 0; j < row.size(); ++j) {
-                INFO(form << ": lane " << j << ", primitive " << row[j]);
-                REQUIRE(slope[j] == (row[j] < scene.triangleCount() ? expected(*camera, row[j]) : 0.0));
+        for (const SlopeSource source : {SlopeSource::TableOfAll, SlopeSource::EachCall}) {
+            const char* sourceName = source == SlopeSource::TableOfAll ? "table" : "each call";
+            auto judge = [&](const Camera& camera) {
+                return testing::withEnvironment("ZCHECK_COMPARE_KERNEL", form, [&] {
+                    return std::make_unique<PixelJudge>(scene, camera, ToleranceModel{}, source);
+                });
+            };
+            const std::unique_ptr<PixelJudge> aMade = judge(wideCamera), bMade = judge(narrowCamera);
+            const PixelJudge &a = *aMade, &b = *bMade;
+            for (std::uint32_t t = 0; t < scene.triangleCount(); ++t) {
+                INFO(form << ", " << sourceName << ": triangle " << t);
+                REQUIRE(expected(wideCamera, t) != expected(narrowCamera, t));
+                REQUIRE(a.slope(t) == expected(wideCamera, t));
+                REQUIRE(b.slope(t) == expected(narrowCamera, t));
+            }
+            for (const auto& [judge, camera] : {std::pair{&a, &wideCamera}, std::pair{&b, &narrowCamera}}) {
+                std::vector<double> slope(row.size(), -1.0);
+                judge->slopes(row.data(), row.size(), slope.data());
+                for (std::size_t j = 0; j < row.size(); ++j) {
+                    INFO(form << ", " << sourceName << ": lane " << j << ", primitive " << row[j]);
+                    REQUIRE(slope[j] == (row[j] < scene.triangleCount() ? expected(*camera, row[j]) : 0.0));
+                }
             }
         }
     }

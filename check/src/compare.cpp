@@ -150,20 +150,27 @@ LargeVector<double> slopesOfAllTriangles(const Scene& scene, const DepthSlopeFra
 
 }  // namespace
 
-PixelJudge::PixelJudge(const Scene& scene, const Camera& camera, const ToleranceModel& tolerance)
+PixelJudge::PixelJudge(const Scene& scene, const Camera& camera, const ToleranceModel& tolerance, SlopeSource slopes)
     : scene_(scene),
       camera_(camera),
       C_(ToleranceModel::constantQuanta(camera.depth())),
       S_(tolerance.snapPixels()),
       E_(16 * std::ldexp(1.0, -52) * std::max(std::abs(camera.depth().rangeMin), std::abs(camera.depth().rangeMax))),
       avx512_(useAvx512Form("ZCHECK_COMPARE_KERNEL", "baseline")),
-      slopeOfTriangle_(slopesOfAllTriangles(scene, DepthSlopeFrame(camera, tolerance.slopeCredit), avx512_))
+      slopeFrame_(camera, tolerance.slopeCredit),
+      source_(slopes)
 {
+    if (source_ == SlopeSource::TableOfAll) slopeOfTriangle_ = slopesOfAllTriangles(scene, slopeFrame_, avx512_);
 }
 
 glm::dvec3 PixelJudge::vertex(std::uint32_t primitive, int corner) const
 {
     return glm::dvec3(scene_.positions[scene_.triangles[primitive][corner]]);
+}
+
+double PixelJudge::computeSlope(std::uint32_t primitive) const
+{
+    return slopeFrame_.slope(vertex(primitive, 0), vertex(primitive, 1), vertex(primitive, 2));
 }
 
 double PixelJudge::surfaceTolerance(std::uint32_t primitive, double q) const { return toleranceForSlope(slope(primitive), q); }

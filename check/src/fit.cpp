@@ -390,7 +390,7 @@ std::vector<Sample> withTolerances(const Scene& scene, const Camera& declared, c
                                    std::vector<Sample> samples)
 {
     const Camera departed(departedCameraSpec(declared, d));
-    const PixelJudge judge(scene, departed, mapTolerance());
+    const PixelJudge judge(scene, departed, mapTolerance(), SlopeSource::EachCall);  // ~16,000 samples
     const double valueQuantum = map.valueQuantum / std::abs(d.valueScale);
     tbb::parallel_for(std::size_t(0), samples.size(), [&](std::size_t k) {
         Sample& s = samples[k];

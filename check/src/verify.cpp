@@ -93,9 +93,9 @@ VertexNeighbours::VertexNeighbours(const Scene& scene, const RayRenderer* rays) 
 std::string VertexNeighbours::key(const glm::vec3& p) { return std::string(reinterpret_cast<const char*>(&p), sizeof p); }
 
 MapReader::MapReader(const Scene& scene, const Camera& camera, const DepthMap& map, const RenderResult& truth,
-                     const VertexNeighbours& neighbours)
+                     const VertexNeighbours& neighbours, SlopeSource slopes)
     : scene_(scene), camera_(camera), map_(map), truth_(truth), neighbours_(neighbours),
-      judge_(scene, camera, mapTolerance())
+      judge_(scene, camera, mapTolerance(), slopes)
 {
 }
 
@@ -225,7 +225,7 @@ RenderResult renderResultFromMap(const Scene& scene, const Camera& camera, const
     const int W = camera.width(), H = camera.height();
     RenderResult out = RenderResult::cleared(W, H, camera.clearDepth());
     quantum.assign(std::size_t(W) * H, 0.0);
-    const MapReader reader(scene, camera, map, truth, neighbours);
+    const MapReader reader(scene, camera, map, truth, neighbours, SlopeSource::TableOfAll);
     // Rows in parallel: each pixel's choice reads only the truth and the map.
     tbb::parallel_for(0, H, [&](int row) {
         for (int col = 0; col < W; ++col) {
@@ -259,7 +259,7 @@ std::optional<std::int64_t> screenUnexplained(const Scene& scene, const Camera& 
     constexpr std::int64_t kEnough = 64;
     constexpr int kStride = 4;
     const int W = camera.width(), H = camera.height();
-    const MapReader reader(scene, camera, map, truth, neighbours);
+    const MapReader reader(scene, camera, map, truth, neighbours, SlopeSource::EachCall);  // a sixteenth of the pixels
     std::vector<std::vector<std::uint32_t>> suspectsOfRow(static_cast<std::size_t>(H));
     tbb::parallel_for(0, H, [&](int row) {
         if (row % kStride != 0) return;
@@ -300,7 +300,7 @@ Probe probeAgreement(const Scene& scene, const RayRenderer& rays, const Camera& 
 {
     constexpr int kGrid = 16;
     const int W = camera.width(), H = camera.height();
-    const PixelJudge judge(scene, camera, mapTolerance());
+    const PixelJudge judge(scene, camera, mapTolerance(), SlopeSource::EachCall);  // 256 pixels
     std::atomic<int> agree{0}, seen{0};
     tbb::parallel_for(0, kGrid * kGrid, [&](int k) {
         const int col = (2 * (k % kGrid) + 1) * W / (2 * kGrid), row = (2 * (k / kGrid) + 1) * H / (2 * kGrid);

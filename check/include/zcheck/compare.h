@@ -154,18 +154,26 @@ struct DepthSlopeFrame {
 // and `verify` (which must guess the surface a map saw) applies it to every candidate surface,
 // so that which surfaces a pixel may show and whether its depth agrees are one decision.
 // Thread-safe: const calls may run from several threads at once.
-// Cost: making a judge computes the slope m of every triangle of the scene, in parallel and
-// several per instruction, into a table of 8 bytes per triangle (the scene's triangles in
-// order, so their corners are read as a stream: 3-4.5 ms per million triangles on two
-// threads, 9.5 on one, on the speed workload's machine); a pixel's slope is then one load.
-// (Slopes computed only for the triangles seen and remembered per thread cost the comparison
-// more: a million-triangle scene at 1080p shows ~600,000 triangles, met in ~1.8 million runs
-// of pixels to look up, with their corners gathered at random.)
+//
+// Where a judge finds a triangle's slope m (SlopeSource), the same value either way:
+// - TableOfAll, for judging whole images: making the judge computes every triangle's m, in
+//   parallel and several per instruction, into a table of 8 bytes per triangle (the scene's
+//   triangles in order, their corners read as a stream: 3-4.5 ms per million triangles on two
+//   threads, 9.5 on one, on the speed workload's machine); a pixel's m is then one load.
+//   (Slopes computed only for the triangles seen and remembered per thread cost the comparison
+//   more: a million-triangle scene at 1080p shows ~600,000 triangles, met in ~1.8 million
+//   runs of pixels to look up, with their corners gathered at random.)
+// - EachCall, for a judge asked about a few thousand pixels or fewer (verify's probes of a
+//   camera, a fit's samples): m computed from the triangle at every call; making it costs
+//   nothing per triangle.
+enum class SlopeSource { TableOfAll, EachCall };
+
 class PixelJudge {
 public:
     // Reads ZCHECK_COMPARE_KERNEL (kernel_choice.h) and throws Error for a value but
     // `baseline`, `auto` or empty; so do compareRoutes and TileComparison, which make one.
-    PixelJudge(const Scene& scene, const Camera& camera, const ToleranceModel& tolerance = {});
+    PixelJudge(const Scene& scene, const Camera& camera, const ToleranceModel& tolerance = {},
+               SlopeSource slopes = SlopeSource::TableOfAll);
 
     // One surface's tolerance at depth-storage quantum q, in window-depth units:
     // C·q + S·m + E (m = 0 for kUnknownPrimitive, which earns no slope credit).
@@ -184,12 +192,19 @@ public:
     // Whether the primitive's plane meets the pixel's ray on the near or far plane.
     bool atClipPlane(std::uint32_t primitive, const glm::dvec2& pWindow) const;
     // m of the primitive's plane (DepthSlopeFrame::slope), 0 for one not of the scene.
-    double slope(std::uint32_t primitive) const { return known(primitive) ? slopeOfTriangle_[primitive] : 0.0; }
+    double slope(std::uint32_t primitive) const
+    {
+        if (!known(primitive)) return 0.0;
+        return source_ == SlopeSource::TableOfAll ? slopeOfTriangle_[primitive] : computeSlope(primitive);
+    }
     // slope() of n primitives into `slope`. Inlined, so that a lane loop of each form of a
-    // kernel (kernel_choice.h) loads several per instruction.
+    // kernel (kernel_choice.h) loads several per instruction from the table.
     ZCHECK_ALWAYS_INLINE void slopes(const std::uint32_t* primitive, std::size_t n, double* slope) const
     {
-        if (slopeOfTriangle_.empty()) return void(std::fill(slope, slope + n, 0.0));  // nothing is known
+        if (source_ == SlopeSource::EachCall || slopeOfTriangle_.empty()) {  // (empty: nothing is known)
+            for (std::size_t j = 0; j < n; ++j) slope[j] = this->slope(primitive[j]);
+            return;
+        }
         for (std::size_t j = 0; j < n; ++j) {
             const double m = slopeOfTriangle_[known(primitive[j]) ? primitive[j] : 0];  // a load in any case
             slope[j] = known(primitive[j]) ? m : 0.0;
@@ -203,12 +218,15 @@ public:
 private:
     bool known(std::uint32_t primitive) const { return primitive < scene_.triangles.size(); }
     glm::dvec3 vertex(std::uint32_t primitive, int corner) const;
+    double computeSlope(std::uint32_t primitive) const;  // DepthSlopeFrame::slope of its corners
 
     const Scene& scene_;
     const Camera& camera_;
     double C_, S_, E_;
     bool avx512_;  // ZCHECK_COMPARE_KERNEL: the AVX-512 forms (avx512Form())
-    LargeVector<double> slopeOfTriangle_;  // m of triangle t, for every t of the scene
+    DepthSlopeFrame slopeFrame_;
+    SlopeSource source_;
+    LargeVector<double> slopeOfTriangle_;  // TableOfAll: m of triangle t, for every t of the scene
 };
 
 // One route's results over a rectangle of the image, as the comparison reads them: pixel
