@@ -161,8 +161,8 @@ struct DepthSlopeFrame {
 //   triangles in order, their corners read as a stream: 3-4.5 ms per million triangles on two
 //   threads, 9.5 on one, on the speed workload's machine); a pixel's m is then one load.
 //   (Slopes computed only for the triangles seen and remembered per thread cost the comparison
-//   more: a million-triangle scene at 1080p shows ~600,000 triangles, met in ~1.8 million
-//   runs of pixels to look up, with their corners gathered at random.)
+//   more: the million-triangle speed workload shows under 300,000 of its triangles at 1080p,
+//   but in ~922,000 runs of pixels to look up, with their corners gathered at random.)
 // - EachCall, for a judge asked about a few thousand pixels or fewer (verify's probes of a
 //   camera, a fit's samples): m computed from the triangle at every call; making it costs
 //   nothing per triangle.
