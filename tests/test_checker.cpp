@@ -354,9 +354,9 @@ TEST_CASE("a judge's slopes are each triangle's own, for its camera, one at a ti
                 REQUIRE(a.slope(t) == expected(wideCamera, t));
                 REQUIRE(b.slope(t) == expected(narrowCamera, t));
             }
-            for (const auto& [judge, camera] : {std::pair{&a, &wideCamera}, std::pair{&b, &narrowCamera}}) {
+            for (const auto& [rowJudge, camera] : {std::pair{&a, &wideCamera}, std::pair{&b, &narrowCamera}}) {
                 std::vector<double> slope(row.size(), -1.0);
-                judge->slopes(row.data(), row.size(), slope.data());
+                rowJudge->slopes(row.data(), row.size(), slope.data());
                 for (std::size_t j = 0; j < row.size(); ++j) {
                     INFO(form << ", " << sourceName << ": lane " << j << ", primitive " << row[j]);
                     REQUIRE(slope[j] == (row[j] < scene.triangleCount() ? expected(*camera, row[j]) : 0.0));

@@ -41,7 +41,6 @@
 #include "zcheck/scene.h"
 #include "zcheck/tile_grid.h"
 
-#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <optional>
