@@ -13,8 +13,10 @@
 
 #include <catch2/catch.hpp>
 #include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <functional>
 #include <optional>
@@ -319,11 +321,12 @@ TEST_CASE("the k-th smallest by counting bits is nth_element's", "[compare]")
 
 TEST_CASE("a judge's slopes are each triangle's own, for its camera, one at a time and a row at a time", "[checker][compare]")
 {
-    // A judge with a table computes every triangle's slope up front, several per instruction
-    // in blocks of consecutive triangles (the last block partial here); one without computes
-    // each when asked. Each slope must equal windowDepthSlope of that triangle alone, for the
-    // judge's own camera (judges of two cameras alive at once), in both kernel forms, and a row
-    // of primitives must get them lane by lane (0 for no triangle).
+    // A judge with a table computes a block of 64 consecutive triangles' slopes the first time
+    // one of them is asked for, several per instruction (the last block partial here); one
+    // without computes each when asked. Each slope must equal windowDepthSlope of that triangle
+    // alone, for the judge's own camera (judges of two cameras alive at once), in both kernel
+    // forms, and a row of primitives must get them lane by lane (0 for no triangle): asked of a
+    // fresh judge (its blocks not computed yet), and again once every block is.
     const Scene scene = builtinScene("builtin:terrain?n=60");
     REQUIRE(scene.triangleCount() % 64 != 0);
     CameraSpec wide = smallCamera(scene), narrow = wide;
@@ -335,12 +338,12 @@ TEST_CASE("a judge's slopes are each triangle's own, for its camera, one at a ti
         return windowDepthSlope(camera, glm::dvec3(scene.positions[tri[0]]), glm::dvec3(scene.positions[tri[1]]),
                                 glm::dvec3(scene.positions[tri[2]]));
     };
+    const std::uint32_t last = std::uint32_t(scene.triangleCount() - 1);
     const std::vector<std::uint32_t> row = {4096, 4096, 0, 1, 1, kNoPrimitive, 4097, 1, 0, 5120, 1024,
-                                            std::uint32_t(scene.triangleCount() - 1), kUnknownPrimitive,
-                                            std::uint32_t(scene.triangleCount())};
+                                            last, kUnknownPrimitive, last + 1, last - 64};
     for (const char* form : {"baseline", "auto"}) {
-        for (const SlopeSource source : {SlopeSource::TableOfAll, SlopeSource::EachCall}) {
-            const char* sourceName = source == SlopeSource::TableOfAll ? "table" : "each call";
+        for (const SlopeSource source : {SlopeSource::TableOfSeen, SlopeSource::EachCall}) {
+            const char* sourceName = source == SlopeSource::TableOfSeen ? "table" : "each call";
             auto judge = [&](const Camera& camera) {
                 return testing::withEnvironment("ZCHECK_COMPARE_KERNEL", form, [&] {
                     return std::make_unique<PixelJudge>(scene, camera, ToleranceModel{}, source);
@@ -348,22 +351,71 @@ TEST_CASE("a judge's slopes are each triangle's own, for its camera, one at a ti
             };
             const std::unique_ptr<PixelJudge> aMade = judge(wideCamera), bMade = judge(narrowCamera);
             const PixelJudge &a = *aMade, &b = *bMade;
+            auto requireRow = [&](const char* when) {
+                for (const auto& [rowJudge, camera] : {std::pair{&a, &wideCamera}, std::pair{&b, &narrowCamera}}) {
+                    std::vector<double> slope(row.size(), -1.0);
+                    rowJudge->slopes(row.data(), row.size(), slope.data());
+                    for (std::size_t j = 0; j < row.size(); ++j) {
+                        INFO(form << ", " << sourceName << ", " << when << ": lane " << j << ", primitive " << row[j]);
+                        REQUIRE(slope[j] == (row[j] < scene.triangleCount() ? expected(*camera, row[j]) : 0.0));
+                    }
+                }
+            };
+            requireRow("asked first");
             for (std::uint32_t t = 0; t < scene.triangleCount(); ++t) {
                 INFO(form << ", " << sourceName << ": triangle " << t);
                 REQUIRE(expected(wideCamera, t) != expected(narrowCamera, t));
                 REQUIRE(a.slope(t) == expected(wideCamera, t));
                 REQUIRE(b.slope(t) == expected(narrowCamera, t));
             }
-            for (const auto& [rowJudge, camera] : {std::pair{&a, &wideCamera}, std::pair{&b, &narrowCamera}}) {
-                std::vector<double> slope(row.size(), -1.0);
-                rowJudge->slopes(row.data(), row.size(), slope.data());
-                for (std::size_t j = 0; j < row.size(); ++j) {
-                    INFO(form << ", " << sourceName << ": lane " << j << ", primitive " << row[j]);
-                    REQUIRE(slope[j] == (row[j] < scene.triangleCount() ? expected(*camera, row[j]) : 0.0));
-                }
-            }
+            requireRow("every block computed");
         }
     }
+}
+
+TEST_CASE("a judge's table of slopes filled from several threads at once holds each triangle's own", "[checker][compare]")
+{
+    // Rows of a frame's kind (runs of neighbouring triangles, some lanes with none), asked in a
+    // random order from every worker of fresh judges, so that threads meet blocks another one is
+    // computing: every answer must still be the triangle's own slope.
+    const Scene scene = builtinScene("builtin:terrain?n=60");
+    const Camera camera(smallCamera(scene));
+    const std::uint32_t n = std::uint32_t(scene.triangleCount());
+    std::vector<double> expected(n);
+    for (std::uint32_t t = 0; t < n; ++t) {
+        const auto& tri = scene.triangles[t];
+        expected[t] = windowDepthSlope(camera, glm::dvec3(scene.positions[tri[0]]), glm::dvec3(scene.positions[tri[1]]),
+                                       glm::dvec3(scene.positions[tri[2]]));
+    }
+    std::mt19937 random(7);
+    std::vector<std::vector<std::uint32_t>> rows(4000, std::vector<std::uint32_t>(64));
+    for (auto& r : rows) {
+        std::uint32_t t = std::uint32_t(random() % n);
+        for (std::uint32_t& p : r) {
+            if (random() % 4 == 0) t = std::uint32_t(random() % n);
+            p = random() % 16 == 0 ? kNoPrimitive : t;
+        }
+    }
+    const tbb::global_control threads(tbb::global_control::max_allowed_parallelism, 4);
+    for (const char* form : {"baseline", "auto"})
+        for (int round = 0; round < 20; ++round) {
+            const std::unique_ptr<PixelJudge> judge = testing::withEnvironment(
+                "ZCHECK_COMPARE_KERNEL", form, [&] { return std::make_unique<PixelJudge>(scene, camera); });
+            std::atomic<std::size_t> wrong{0};
+            tbb::parallel_for(std::size_t(0), rows.size(), [&](std::size_t k) {
+                const std::vector<std::uint32_t>& r = rows[(k * 2654435761u + std::size_t(round)) % rows.size()];
+                double slope[64];
+                if (k % 3 == 0) {
+                    for (std::size_t j = 0; j < r.size(); ++j) slope[j] = judge->slope(r[j]);
+                } else {
+                    judge->slopes(r.data(), r.size(), slope);
+                }
+                for (std::size_t j = 0; j < r.size(); ++j)
+                    if (slope[j] != (r[j] < n ? expected[r[j]] : 0.0)) ++wrong;
+            });
+            INFO(form << ", round " << round);
+            REQUIRE(wrong == 0);
+        }
 }
 
 TEST_CASE("camera-pose mistakes: an inverted extrinsic and OpenCV axes used as OpenGL's are diagnosed by name", "[checker][mistakes][diagnose]")

@@ -129,25 +129,6 @@ ZCHECK_TARGET_AVX512 void slopesTogetherAvx512(const DepthSlopeFrame& frame, con
 }
 #endif
 
-// DepthSlopeFrame::slope of every triangle of the scene, in parallel.
-LargeVector<double> slopesOfAllTriangles(const Scene& scene, const DepthSlopeFrame& frame, bool avx512)
-{
-    auto* together = &slopesTogetherBaseline;
-#ifdef ZCHECK_X86_AVX512
-    if (avx512) together = &slopesTogetherAvx512;
-#endif
-    const std::size_t n = scene.triangles.size();
-    LargeVector<double> slope(n);  // uninitialised: every entry is written below
-    const std::size_t blocks = (n + kSlopeLanes - 1) / kSlopeLanes;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks, 16), [&](const tbb::blocked_range<std::size_t>& range) {
-        for (std::size_t block = range.begin(); block != range.end(); ++block) {
-            const std::size_t first = block * kSlopeLanes;
-            together(frame, scene, std::uint32_t(first), std::min(kSlopeLanes, n - first), slope.data() + first);
-        }
-    });
-    return slope;
-}
-
 }  // namespace
 
 PixelJudge::PixelJudge(const Scene& scene, const Camera& camera, const ToleranceModel& tolerance, SlopeSource slopes)
@@ -160,7 +141,30 @@ PixelJudge::PixelJudge(const Scene& scene, const Camera& camera, const Tolerance
       slopeFrame_(camera, tolerance.slopeCredit),
       source_(slopes)
 {
-    if (source_ == SlopeSource::TableOfAll) slopeOfTriangle_ = slopesOfAllTriangles(scene, slopeFrame_, avx512_);
+    if (source_ != SlopeSource::TableOfSeen) return;
+    const std::size_t n = scene.triangles.size();
+    slopeOfTriangle_.resize(n + 1);  // uninitialised: an entry is read only once its block is ready
+    slopeOfTriangle_[n] = 0.0;
+    blockCount_ = std::uint32_t((n + kSlopeBlock - 1) / kSlopeBlock);
+    blockState_ = std::make_unique<std::atomic<std::uint8_t>[]>(blockCount_);
+}
+
+bool PixelJudge::makeBlockReady(std::uint32_t block) const
+{
+    std::atomic<std::uint8_t>& state = blockReady(block);
+    std::uint8_t notComputed = 0;
+    if (!state.compare_exchange_strong(notComputed, 1, std::memory_order_acquire))
+        return notComputed == kBlockReady;  // false: another thread is computing it
+    static_assert(kSlopeBlock == kSlopeLanes, "a block's slopes are computed together");
+    auto* together = &slopesTogetherBaseline;
+#ifdef ZCHECK_X86_AVX512
+    if (avx512_) together = &slopesTogetherAvx512;
+#endif
+    const std::size_t first = std::size_t(block) * kSlopeBlock;
+    together(slopeFrame_, scene_, std::uint32_t(first), std::min<std::size_t>(kSlopeBlock, scene_.triangles.size() - first),
+             slopeOfTriangle_.data() + first);
+    state.store(kBlockReady, std::memory_order_release);
+    return true;
 }
 
 glm::dvec3 PixelJudge::vertex(std::uint32_t primitive, int corner) const

@@ -225,7 +225,7 @@ RenderResult renderResultFromMap(const Scene& scene, const Camera& camera, const
     const int W = camera.width(), H = camera.height();
     RenderResult out = RenderResult::cleared(W, H, camera.clearDepth());
     quantum.assign(std::size_t(W) * H, 0.0);
-    const MapReader reader(scene, camera, map, truth, neighbours, SlopeSource::TableOfAll);
+    const MapReader reader(scene, camera, map, truth, neighbours, SlopeSource::TableOfSeen);
     // Rows in parallel: each pixel's choice reads only the truth and the map.
     tbb::parallel_for(0, H, [&](int row) {
         for (int col = 0; col < W; ++col) {

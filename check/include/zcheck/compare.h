@@ -36,11 +36,14 @@
 // Verdict: consistent ⇔ no unexplained coverage mismatch, no depth error and no bias.
 #include "zcheck/camera.h"
 #include "zcheck/kernel_choice.h"
+#include "zcheck/lane_mask.h"
 #include "zcheck/large_buffer.h"
 #include "zcheck/render.h"
 #include "zcheck/scene.h"
 #include "zcheck/tile_grid.h"
 
+#include <algorithm>
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -155,24 +158,26 @@ struct DepthSlopeFrame {
 // Thread-safe: const calls may run from several threads at once.
 //
 // Where a judge finds a triangle's slope m (SlopeSource), the same value either way:
-// - TableOfAll, for judging whole images: making the judge computes every triangle's m, in
-//   parallel and several per instruction, into a table of 8 bytes per triangle (the scene's
-//   triangles in order, their corners read as a stream: 3-4.5 ms per million triangles on two
-//   threads, 9.5 on one, on the speed workload's machine); a pixel's m is then one load.
-//   (Slopes computed only for the triangles seen and remembered per thread cost the comparison
-//   more: the million-triangle speed workload shows under 300,000 of its triangles at 1080p,
-//   but in ~922,000 runs of pixels to look up, with their corners gathered at random.)
+// - TableOfSeen, for judging whole images: the first time any triangle of a block of 64
+//   consecutive ones is asked for, the whole block's m is computed (several per instruction,
+//   its corners read as a stream) into a table of 8 bytes per triangle, where every later
+//   question finds it with one load. Only the blocks of triangles the judge is asked about are
+//   computed: the million-triangle speed workload shows under 300,000 of its triangles at
+//   1080p, and a table of all of them computed up front cost 3-4.5 ms on two threads (9.5 on
+//   one) against a comparison of 11-18 ms. (Slopes remembered per thread instead, triangle by
+//   triangle, cost the comparison more: ~922,000 runs of pixels to look up per frame, with
+//   their corners gathered at random.)
 // - EachCall, for a judge asked about a few thousand pixels or fewer (verify's probes of a
 //   camera, a fit's samples): m computed from the triangle at every call; making it costs
 //   nothing per triangle.
-enum class SlopeSource { TableOfAll, EachCall };
+enum class SlopeSource { TableOfSeen, EachCall };
 
 class PixelJudge {
 public:
     // Reads ZCHECK_COMPARE_KERNEL (kernel_choice.h) and throws Error for a value but
     // `baseline`, `auto` or empty; so do compareRoutes and TileComparison, which make one.
     PixelJudge(const Scene& scene, const Camera& camera, const ToleranceModel& tolerance = {},
-               SlopeSource slopes = SlopeSource::TableOfAll);
+               SlopeSource slopes = SlopeSource::TableOfSeen);
 
     // One surface's tolerance at depth-storage quantum q, in window-depth units:
     // C·q + S·m + E (m = 0 for kUnknownPrimitive, which earns no slope credit).
@@ -194,20 +199,39 @@ public:
     double slope(std::uint32_t primitive) const
     {
         if (!known(primitive)) return 0.0;
-        return source_ == SlopeSource::TableOfAll ? slopeOfTriangle_[primitive] : computeSlope(primitive);
+        if (source_ == SlopeSource::TableOfSeen &&
+            (blockReady(primitive / kSlopeBlock).load(std::memory_order_acquire) == kBlockReady ||
+             makeBlockReady(primitive / kSlopeBlock)))
+            return slopeOfTriangle_[primitive];
+        return computeSlope(primitive);
     }
     // slope() of n primitives into `slope`. Inlined, so that a lane loop of each form of a
-    // kernel (kernel_choice.h) loads several per instruction from the table.
+    // kernel (kernel_choice.h) loads several per instruction from the table once it finds every
+    // block asked about ready (most rows of a frame after its first few).
     ZCHECK_ALWAYS_INLINE void slopes(const std::uint32_t* primitive, std::size_t n, double* slope) const
     {
-        if (source_ == SlopeSource::EachCall || slopeOfTriangle_.empty()) {  // (empty: nothing is known)
+        bool ready = source_ == SlopeSource::TableOfSeen;
+        // Each block asked about once per run of lanes in it (a row of a frame crosses few),
+        // found 64 lanes at a time without a branch per lane; none for a primitive not of the scene.
+        const std::uint32_t blocks = blockCount_;
+        for (std::size_t j0 = 0; j0 < n && ready; j0 += kSlopeBlock) {
+            const std::uint32_t* p = primitive + j0;
+            const std::size_t lanes = std::min<std::size_t>(kSlopeBlock, n - j0);
+            alignas(64) std::uint8_t runStart[kSlopeBlock];
+            runStart[0] = p[0] / kSlopeBlock < blocks && (j0 == 0 || p[0] / kSlopeBlock != p[-1] / kSlopeBlock);
+            for (std::size_t j = 1; j < lanes; ++j)
+                runStart[j] = (p[j] / kSlopeBlock < blocks) & (p[j] / kSlopeBlock != p[j - 1] / kSlopeBlock);
+            forEachSetLane(runStart, lanes, [&](std::size_t j) ZCHECK_ALWAYS_INLINE {
+                ready &= blockReady(p[j] / kSlopeBlock).load(std::memory_order_relaxed) == kBlockReady;
+            });
+        }
+        if (!ready) {
             for (std::size_t j = 0; j < n; ++j) slope[j] = this->slope(primitive[j]);
             return;
         }
-        for (std::size_t j = 0; j < n; ++j) {
-            const double m = slopeOfTriangle_[known(primitive[j]) ? primitive[j] : 0];  // a load in any case
-            slope[j] = known(primitive[j]) ? m : 0.0;
-        }
+        std::atomic_thread_fence(std::memory_order_acquire);  // the relaxed loads above saw each block's release
+        const std::uint32_t none = std::uint32_t(scene_.triangles.size());  // its entry: 0, and always there
+        for (std::size_t j = 0; j < n; ++j) slope[j] = slopeOfTriangle_[std::min(primitive[j], none)];
     }
     // Whether the comparison's AVX-512 forms run (ZCHECK_COMPARE_KERNEL, read when the judge
     // was made).
@@ -219,13 +243,27 @@ private:
     glm::dvec3 vertex(std::uint32_t primitive, int corner) const;
     double computeSlope(std::uint32_t primitive) const;  // DepthSlopeFrame::slope of its corners
 
+    // TableOfSeen: triangles [b·kSlopeBlock, (b+1)·kSlopeBlock) are block b, whose byte in
+    // blockState_ goes 0 (not computed) → 1 (being computed, by the thread that made it so) →
+    // kBlockReady (its slopes in the table, stored with release: read them after an acquire).
+    static constexpr std::uint32_t kSlopeBlock = 64;
+    static constexpr std::uint8_t kBlockReady = 2;
+    std::atomic<std::uint8_t>& blockReady(std::uint32_t block) const { return blockState_[block]; }
+    // Computes block b into the table unless another thread is computing it; whether it is ready.
+    bool makeBlockReady(std::uint32_t block) const;
+
     const Scene& scene_;
     const Camera& camera_;
     double C_, S_, E_;
     bool avx512_;  // ZCHECK_COMPARE_KERNEL: the AVX-512 forms (avx512Form())
     DepthSlopeFrame slopeFrame_;
     SlopeSource source_;
-    LargeVector<double> slopeOfTriangle_;  // TableOfAll: m of triangle t, for every t of the scene
+    // TableOfSeen: m of triangle t once its block is ready; written by const calls only under
+    // the block's state above, each entry once. One entry more, 0, for any primitive not of the
+    // scene.
+    mutable LargeVector<double> slopeOfTriangle_;
+    std::unique_ptr<std::atomic<std::uint8_t>[]> blockState_;  // zeroed: no block computed
+    std::uint32_t blockCount_ = 0;
 };
 
 // One route's results over a rectangle of the image, as the comparison reads them: pixel

@@ -79,7 +79,7 @@ MapPixel mapPixelDepth(const Camera& camera, DepthQuantity quantity, double valu
 // Reads a map pixel by pixel against an already rendered truth: the per-pixel rule of
 // renderResultFromMap, and the comparison's class for one pixel, so that a diagnosis can
 // judge a sample of pixels without reading the whole map. Holds references; thread-safe.
-// `slopes`: TableOfAll for reading every pixel, EachCall for a sample (PixelJudge).
+// `slopes`: TableOfSeen for reading every pixel, EachCall for a sample (PixelJudge).
 class MapReader {
 public:
     MapReader(const Scene& scene, const Camera& camera, const DepthMap& map, const RenderResult& truth,
