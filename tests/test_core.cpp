@@ -577,15 +577,15 @@ TEST_CASE("a released large buffer is handed back, faulted in, to the next one o
 }
 
 // The lane loops' sparse walks (forEachSetLane) must visit exactly the set lanes below n, in
-// order: against a plain loop, over masks dense and sparse, lengths not a multiple of eight,
-// and set bytes past n that must be ignored.
+// order: against a plain loop, over masks dense and sparse, lengths not a multiple of eight
+// and longer than the 64 lanes packed at a time, and set bytes past n that must be ignored.
 TEST_CASE("forEachSetLane visits the set lanes below n in order", "[core]")
 {
     std::mt19937 random(3);
     for (const int percentSet : {0, 3, 50, 100})
-        for (std::size_t n = 0; n <= 64; ++n) {
-            alignas(64) std::uint8_t mask[64];
-            for (std::size_t j = 0; j < 64; ++j) mask[j] = std::uint8_t(j >= n || int(random() % 100) < percentSet);
+        for (std::size_t n = 0; n <= 200; ++n) {
+            alignas(64) std::uint8_t mask[208];
+            for (std::size_t j = 0; j < 208; ++j) mask[j] = std::uint8_t(j >= n || int(random() % 100) < percentSet);
             std::vector<std::size_t> expected, visited;
             for (std::size_t j = 0; j < n; ++j)
                 if (mask[j]) expected.push_back(j);
