@@ -7,6 +7,7 @@
 #include "zcheck/mistakes.h"
 #include "zcheck/percentile.h"
 #include "zcheck/report.h"
+#include "zcheck/verify.h"
 
 #include "diagnosis_helpers.h"
 #include "kernel_testing.h"
@@ -753,6 +754,52 @@ TEST_CASE("a NaN depth is a depth error and never the largest error", "[compare]
             CHECK(r.p99ErrorQuanta == 0.0);
         });
     }
+}
+
+TEST_CASE("a comparison through a judge of the caller's, asked before, reports what one through its own does", "[compare]")
+{
+    // verify reads a map with a judge and compares through the same judge, so that the slopes
+    // computed while reading serve the comparison. A judge used for one comparison (and so
+    // holding that one's slopes) must give the next, of other renders, the report and pixels
+    // a judge of its own gives: clean, with rows flipped (the rows' surfaces then differ), and
+    // with a depth bias; with both slope credits (on a terrain, where they differ).
+    const Checker checker(builtinScene("builtin:terrain?n=60"));
+    CameraSpec spec = smallCamera(checker.scene());
+    spec.width = 203, spec.height = 131;
+    const Camera camera(spec);
+    std::vector<CheckOptions> runs(3);
+    runs[1].faults.ray.flipRows = true;
+    runs[2].faults.raster.truncateUnorm = true;
+    auto json = [&](const Comparison& c, const ToleranceModel& tolerance) {
+        CheckReport report;
+        report.describeInputs(checker.scene(), camera, tolerance);
+        report.comparison = c.report;
+        return checkReportJson(report);
+    };
+    for (const ToleranceModel& tolerance : {ToleranceModel{}, mapTolerance()}) {
+        const PixelJudge shared(checker.scene(), camera, tolerance);
+        for (const CheckOptions& options : runs) {
+            const RenderResult ray = checker.renderRay(camera, options.faults.ray);
+            const RenderResult raster = checker.renderRaster(camera, options.faults.raster);
+            const Comparison own = compareRoutes(checker.scene(), camera, ray, raster, tolerance);
+            const Comparison borrowed = compareRoutes(shared, ray, raster);
+            INFO("slope credit " << int(tolerance.slopeCredit) << ", rows flipped " << options.faults.ray.flipRows
+                                 << ", truncated " << options.faults.raster.truncateUnorm);
+            REQUIRE(own.report.bothHit > 1000);
+            if (tolerance.slopeCredit == SlopeCredit::SampleOffset)  // the credits differ here
+                REQUIRE(compareRoutes(checker.scene(), camera, ray, raster).report.maxErrorOverTolerance !=
+                        own.report.maxErrorOverTolerance);
+            REQUIRE(json(borrowed, tolerance) == json(own, tolerance));
+            REQUIRE(testing::sameBits(borrowed.pixelClass, own.pixelClass));
+            REQUIRE(testing::sameBits(borrowed.errorOverTolerance, own.errorOverTolerance));
+        }
+    }
+    // A map is read only with map tolerances.
+    const PixelJudge rasterJudge(checker.scene(), camera);
+    const RenderResult truth = checker.renderRay(camera);
+    const DepthMap map = testing::windowMapOf(camera, truth);
+    const VertexNeighbours neighbours(checker.scene(), nullptr);
+    REQUIRE_THROWS_AS(MapReader(rasterJudge, map, truth, neighbours), std::logic_error);
 }
 
 TEST_CASE("a tile compared a few rows at a time, tiles interleaved, reports what whole tiles report", "[compare][rows]")

@@ -56,7 +56,7 @@ CheckResult Checker::checkTileByTile(const Camera& camera, const CheckOptions& o
     const RasterFrame frame = raster_.prepare(camera, options.faults.raster);
     const double setUpMs = millisecondsSince(start);
     const auto comparisonStart = Clock::now();
-    TileComparison tiles(scene_, camera, options.tolerance, nullptr);  // the judge's slopes of all triangles
+    TileComparison tiles(scene_, camera, options.tolerance, nullptr);  // (its slopes are computed as the tiles ask)
     const double comparisonSetUpMs = millisecondsSince(comparisonStart);
 
     struct Worker {

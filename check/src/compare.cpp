@@ -134,6 +134,7 @@ ZCHECK_TARGET_AVX512 void slopesTogetherAvx512(const DepthSlopeFrame& frame, con
 PixelJudge::PixelJudge(const Scene& scene, const Camera& camera, const ToleranceModel& tolerance, SlopeSource slopes)
     : scene_(scene),
       camera_(camera),
+      tolerance_(tolerance),
       C_(ToleranceModel::constantQuanta(camera.depth())),
       S_(tolerance.snapPixels()),
       E_(16 * std::ldexp(1.0, -52) * std::max(std::abs(camera.depth().rangeMin), std::abs(camera.depth().rangeMax))),
@@ -376,13 +377,15 @@ RoutePixels RoutePixels::of(const RenderResult& render)
 }
 
 struct TileComparison::Impl {
-    Impl(const Scene& scene, const Camera& camera, const ToleranceModel& tolerance, Comparison* perPixel,
+    // `ownJudge` empty: `judge` is the caller's.
+    Impl(std::optional<PixelJudge> ownJudge, const PixelJudge* callersJudge, Comparison* perPixel,
          float errorQuantaFloor, float relativeEyeZFloor)
-        : camera(camera),
+        : ownJudge(std::move(ownJudge)),
+          judge(callersJudge ? *callersJudge : *this->ownJudge),
+          camera(judge.camera()),
           perPixel(perPixel),
-          judge(scene, camera, tolerance),
           measures(camera),
-          S(tolerance.snapPixels()),
+          S(judge.snapPixels()),
           W(camera.width()),
           H(camera.height()),
           grid(W, H, kTileSize),
@@ -403,9 +406,10 @@ struct TileComparison::Impl {
                                             const RoutePixels& raster);
 #endif
 
+    const std::optional<PixelJudge> ownJudge;
+    const PixelJudge& judge;
     const Camera& camera;
     Comparison* perPixel;
-    const PixelJudge judge;
     const PixelMeasures measures;
     const double S;
     const int W, H;
@@ -692,10 +696,23 @@ void TileComparison::Impl::compare(int tile, int rowBegin, int rowEnd, const Rou
 
 TileComparison::TileComparison(const Scene& scene, const Camera& camera, const ToleranceModel& tolerance,
                                Comparison* perPixel, float errorQuantaFloor, float relativeEyeZFloor)
-    : impl_(std::make_unique<Impl>(scene, camera, tolerance, perPixel, errorQuantaFloor, relativeEyeZFloor))
+    : impl_(std::make_unique<Impl>(std::optional<PixelJudge>(std::in_place, scene, camera, tolerance), nullptr, perPixel,
+                                   errorQuantaFloor, relativeEyeZFloor))
 {
-    if (perPixel) {
-        const std::size_t pixels = std::size_t(camera.width()) * std::size_t(camera.height());
+    sizePerPixel();
+}
+
+TileComparison::TileComparison(const PixelJudge& judge, Comparison* perPixel, float errorQuantaFloor,
+                               float relativeEyeZFloor)
+    : impl_(std::make_unique<Impl>(std::nullopt, &judge, perPixel, errorQuantaFloor, relativeEyeZFloor))
+{
+    sizePerPixel();
+}
+
+void TileComparison::sizePerPixel()
+{
+    if (Comparison* perPixel = impl_->perPixel) {
+        const std::size_t pixels = std::size_t(impl_->W) * std::size_t(impl_->H);
         perPixel->pixelClass.resize(pixels);  // uninitialised: compareTile writes every pixel of its tile
         perPixel->errorOverTolerance.resize(pixels);
     }
@@ -749,6 +766,13 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
                          const RenderResult& raster, const ToleranceModel& tolerance,
                          const std::vector<double>* rasterQuantum)
 {
+    return compareRoutes(PixelJudge(scene, camera, tolerance), ray, raster, rasterQuantum);
+}
+
+Comparison compareRoutes(const PixelJudge& judge, const RenderResult& ray, const RenderResult& raster,
+                         const std::vector<double>* rasterQuantum)
+{
+    const Camera& camera = judge.camera();
     const int W = camera.width(), H = camera.height();
     RoutePixels rayPixels = RoutePixels::of(ray), rasterPixels = RoutePixels::of(raster);
     if (rasterQuantum) rasterPixels.quantum = rasterQuantum->data();
@@ -791,8 +815,7 @@ Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderR
 
     Comparison out;
     for (const bool floors : {true, false}) {
-        TileComparison tiles(scene, camera, tolerance, &out, floors ? errorQuantaFloor : 0.0f,
-                             floors ? relativeEyeZFloor : 0.0f);
+        TileComparison tiles(judge, &out, floors ? errorQuantaFloor : 0.0f, floors ? relativeEyeZFloor : 0.0f);
         // A band of tiles at a time, image row by image row across the band: each row of the
         // four arrays is then read as one stream, where tile by tile it was read in 64-pixel
         // pieces 15 KB apart (a pass that only reads and writes the arrays takes ~3× as long

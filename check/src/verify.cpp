@@ -16,6 +16,7 @@
 #include <cmath>
 #include <functional>
 #include <optional>
+#include <stdexcept>
 
 namespace zcheck {
 
@@ -92,11 +93,13 @@ VertexNeighbours::VertexNeighbours(const Scene& scene, const RayRenderer* rays) 
 
 std::string VertexNeighbours::key(const glm::vec3& p) { return std::string(reinterpret_cast<const char*>(&p), sizeof p); }
 
-MapReader::MapReader(const Scene& scene, const Camera& camera, const DepthMap& map, const RenderResult& truth,
-                     const VertexNeighbours& neighbours, SlopeSource slopes)
-    : scene_(scene), camera_(camera), map_(map), truth_(truth), neighbours_(neighbours),
-      judge_(scene, camera, mapTolerance(), slopes)
+MapReader::MapReader(const PixelJudge& judge, const DepthMap& map, const RenderResult& truth,
+                     const VertexNeighbours& neighbours)
+    : scene_(judge.scene()), camera_(judge.camera()), map_(map), truth_(truth), neighbours_(neighbours), judge_(judge)
 {
+    const ToleranceModel tolerance = judge.tolerance(), wanted = mapTolerance();
+    if (tolerance.subpixelBits != wanted.subpixelBits || tolerance.slopeCredit != wanted.slopeCredit)
+        throw std::logic_error("MapReader: the judge was not made with mapTolerance()");
 }
 
 MapPixel mapPixelDepth(const Camera& camera, const DepthMap& map, int col, int row, double truthDepth)
@@ -218,14 +221,14 @@ PixelClass MapReader::classify(int col, int row, const MapPixel& pixel) const
                     : judge_.oneHit(false, pixel.depth, pixel.primitive, pixel.quantum, pWindow);
 }
 
-RenderResult renderResultFromMap(const Scene& scene, const Camera& camera, const DepthMap& map,
-                                 const RenderResult& truth, const VertexNeighbours& neighbours,
-                                 std::vector<double>& quantum)
+RenderResult renderResultFromMap(const PixelJudge& judge, const DepthMap& map, const RenderResult& truth,
+                                 const VertexNeighbours& neighbours, std::vector<double>& quantum)
 {
+    const Camera& camera = judge.camera();
     const int W = camera.width(), H = camera.height();
     RenderResult out = RenderResult::cleared(W, H, camera.clearDepth());
     quantum.assign(std::size_t(W) * H, 0.0);
-    const MapReader reader(scene, camera, map, truth, neighbours, SlopeSource::TableOfSeen);
+    const MapReader reader(judge, map, truth, neighbours);
     // Rows in parallel: each pixel's choice reads only the truth and the map.
     tbb::parallel_for(0, H, [&](int row) {
         for (int col = 0; col < W; ++col) {
@@ -259,7 +262,8 @@ std::optional<std::int64_t> screenUnexplained(const Scene& scene, const Camera& 
     constexpr std::int64_t kEnough = 64;
     constexpr int kStride = 4;
     const int W = camera.width(), H = camera.height();
-    const MapReader reader(scene, camera, map, truth, neighbours, SlopeSource::EachCall);  // a sixteenth of the pixels
+    const PixelJudge judge(scene, camera, mapTolerance(), SlopeSource::EachCall);  // a sixteenth of the pixels
+    const MapReader reader(judge, map, truth, neighbours);
     std::vector<std::vector<std::uint32_t>> suspectsOfRow(static_cast<std::size_t>(H));
     tbb::parallel_for(0, H, [&](int row) {
         if (row % kStride != 0) return;
@@ -327,9 +331,10 @@ VerifyResult verifyAgainst(const Scene& scene, const Camera& camera, const Depth
     VerifyResult run;
     run.truth = std::move(truth);
     std::vector<double> quantum;
-    run.map = renderResultFromMap(scene, camera, map, run.truth, neighbours, quantum);
+    const PixelJudge judge(scene, camera, mapTolerance());  // reads the map, then compares with the slopes it found
+    run.map = renderResultFromMap(judge, map, run.truth, neighbours, quantum);
     const auto start = std::chrono::steady_clock::now();
-    run.comparison = compareRoutes(scene, camera, run.truth, run.map, mapTolerance(), &quantum);
+    run.comparison = compareRoutes(judge, run.truth, run.map, &quantum);
     run.report.timings.compareMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     run.report.timings.traceMs = run.truth.renderMilliseconds;
     run.report.describeInputs(scene, camera, mapTolerance());

@@ -237,6 +237,10 @@ public:
     // was made).
     bool avx512Form() const { return avx512_; }
     double snapPixels() const { return S_; }
+    // What it was made for.
+    const Scene& scene() const { return scene_; }
+    const Camera& camera() const { return camera_; }
+    const ToleranceModel& tolerance() const { return tolerance_; }
 
 private:
     bool known(std::uint32_t primitive) const { return primitive < scene_.triangles.size(); }
@@ -254,6 +258,7 @@ private:
 
     const Scene& scene_;
     const Camera& camera_;
+    ToleranceModel tolerance_;
     double C_, S_, E_;
     bool avx512_;  // ZCHECK_COMPARE_KERNEL: the AVX-512 forms (avx512Form())
     DepthSlopeFrame slopeFrame_;
@@ -295,6 +300,10 @@ public:
 
     TileComparison(const Scene& scene, const Camera& camera, const ToleranceModel& tolerance, Comparison* perPixel,
                    float errorQuantaFloor = 0.0f, float relativeEyeZFloor = 0.0f);
+    // The same with a judge of the caller's (the judge's scene, camera and tolerance), which
+    // must outlive this: the slopes it computed for one comparison serve the next.
+    TileComparison(const PixelJudge& judge, Comparison* perPixel, float errorQuantaFloor = 0.0f,
+                   float relativeEyeZFloor = 0.0f);
     ~TileComparison();
     TileComparison(const TileComparison&) = delete;
     TileComparison& operator=(const TileComparison&) = delete;
@@ -310,6 +319,7 @@ public:
     std::optional<ComparisonReport> finish();
 
 private:
+    void sizePerPixel();  // perPixel's arrays, for the camera's pixels
     struct Impl;
     std::unique_ptr<Impl> impl_;
 };
@@ -324,6 +334,10 @@ private:
 constexpr std::uint32_t kUnknownPrimitive = 0xFFFFFFFEu;
 Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderResult& ray,
                          const RenderResult& raster, const ToleranceModel& tolerance = {},
+                         const std::vector<double>* rasterQuantum = nullptr);
+// The same through a judge of the caller's (its scene, camera and tolerance; TableOfSeen, or
+// every slope is computed per pixel): `verify` reads a map with the judge it then compares with.
+Comparison compareRoutes(const PixelJudge& judge, const RenderResult& ray, const RenderResult& raster,
                          const std::vector<double>* rasterQuantum = nullptr);
 
 // The same for one triangle (DepthSlopeFrame::slope).

@@ -79,11 +79,12 @@ MapPixel mapPixelDepth(const Camera& camera, DepthQuantity quantity, double valu
 // Reads a map pixel by pixel against an already rendered truth: the per-pixel rule of
 // renderResultFromMap, and the comparison's class for one pixel, so that a diagnosis can
 // judge a sample of pixels without reading the whole map. Holds references; thread-safe.
-// `slopes`: TableOfSeen for reading every pixel, EachCall for a sample (PixelJudge).
+// `judge`: made for the scene and camera with mapTolerance() (std::logic_error otherwise);
+// SlopeSource::TableOfSeen for reading every pixel, EachCall for a sample.
 class MapReader {
 public:
-    MapReader(const Scene& scene, const Camera& camera, const DepthMap& map, const RenderResult& truth,
-              const VertexNeighbours& neighbours, SlopeSource slopes);
+    MapReader(const PixelJudge& judge, const DepthMap& map, const RenderResult& truth,
+              const VertexNeighbours& neighbours);
     // `search` false: a hit that does not agree with the truth's own surface is left as
     // kUnknownPrimitive unsearched (a cheap test of whether the pixel needs the search).
     MapPixel read(int col, int row, bool search = true) const;
@@ -96,15 +97,15 @@ private:
     const DepthMap& map_;
     const RenderResult& truth_;
     const VertexNeighbours& neighbours_;
-    PixelJudge judge_;
+    const PixelJudge& judge_;
 };
 
 // The map as the raster side of a comparison (window depth per pixel, a hit where the value is
 // not a miss, the surface chosen as above). `quantum` receives each pixel's storage step in
-// window units.
-RenderResult renderResultFromMap(const Scene& scene, const Camera& camera, const DepthMap& map,
-                                 const RenderResult& truth, const VertexNeighbours& neighbours,
-                                 std::vector<double>& quantum);
+// window units. `judge` as MapReader's; the comparison of the result may then use it too
+// (compareRoutes), finding the slopes it computed.
+RenderResult renderResultFromMap(const PixelJudge& judge, const DepthMap& map, const RenderResult& truth,
+                                 const VertexNeighbours& neighbours, std::vector<double>& quantum);
 
 // Throws Error unless `map` is camera.width() × camera.height() with a value per pixel.
 void requireMapFits(const Camera& camera, const DepthMap& map);
