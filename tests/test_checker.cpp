@@ -35,6 +35,24 @@ CameraSpec smallCamera(const Scene& scene)
     spec.width = 160, spec.height = 120;
     return spec;
 }
+
+// smallCamera at a size the 64×64 tiles cut on both edges.
+CameraSpec tileCutCamera(const Scene& scene)
+{
+    CameraSpec spec = smallCamera(scene);
+    spec.width = 203, spec.height = 131;
+    return spec;
+}
+
+// A check clean, with the ray's rows flipped (thousands of unexplained pixels), and with the
+// raster's unorm depths truncated (a depth bias).
+std::vector<CheckOptions> cleanFlippedAndBiased()
+{
+    std::vector<CheckOptions> runs(3);
+    runs[1].faults.ray.flipRows = true;
+    runs[2].faults.raster.truncateUnorm = true;
+    return runs;
+}
 }  // namespace
 
 TEST_CASE("one Checker used from several threads at once gives each the same answer", "[checker][threads]")
@@ -187,14 +205,11 @@ TEST_CASE("a check tile by tile reports what the full-frame check reports", "[ch
 {
     for (const char* name : {"builtin:default", "builtin:near-crossing", "builtin:terrain?n=40"}) {
         const Checker checker(builtinScene(name));
-        CameraSpec spec = smallCamera(checker.scene());
-        spec.width = 203, spec.height = 131;  // tiles cut by both edges
+        CameraSpec spec = tileCutCamera(checker.scene());
         for (const DepthFormat format : {DepthFormat::Unorm16, DepthFormat::Float32}) {
             spec.depth.format = format;
             const Camera camera(spec);
-            std::vector<CheckOptions> runs(3);
-            runs[1].faults.ray.flipRows = true;                // thousands of unexplained pixels
-            runs[2].faults.raster.truncateUnorm = true;        // a depth bias
+            std::vector<CheckOptions> runs = cleanFlippedAndBiased();
             runs[2].faults.ray.shiftPixels = {0.5, 0.0};
             for (CheckOptions& options : runs) {
                 CheckResult full = checker.check(camera, options);
@@ -764,12 +779,7 @@ TEST_CASE("a comparison through a judge of the caller's, asked before, reports w
     // a judge of its own gives: clean, with rows flipped (the rows' surfaces then differ), and
     // with a depth bias; with both slope credits (on a terrain, where they differ).
     const Checker checker(builtinScene("builtin:terrain?n=60"));
-    CameraSpec spec = smallCamera(checker.scene());
-    spec.width = 203, spec.height = 131;
-    const Camera camera(spec);
-    std::vector<CheckOptions> runs(3);
-    runs[1].faults.ray.flipRows = true;
-    runs[2].faults.raster.truncateUnorm = true;
+    const Camera camera(tileCutCamera(checker.scene()));
     auto json = [&](const Comparison& c, const ToleranceModel& tolerance) {
         CheckReport report;
         report.describeInputs(checker.scene(), camera, tolerance);
@@ -778,7 +788,7 @@ TEST_CASE("a comparison through a judge of the caller's, asked before, reports w
     };
     for (const ToleranceModel& tolerance : {ToleranceModel{}, mapTolerance()}) {
         const PixelJudge shared(checker.scene(), camera, tolerance);
-        for (const CheckOptions& options : runs) {
+        for (const CheckOptions& options : cleanFlippedAndBiased()) {
             const RenderResult ray = checker.renderRay(camera, options.faults.ray);
             const RenderResult raster = checker.renderRaster(camera, options.faults.raster);
             const Comparison own = compareRoutes(checker.scene(), camera, ray, raster, tolerance);
@@ -811,14 +821,9 @@ TEST_CASE("a tile compared a few rows at a time, tiles interleaved, reports what
     // samples in scan order) and the same per-pixel classes and ratios, clean and with rows
     // flipped (thousands of unexplained pixels) or a depth bias, on tiles cut by both edges.
     const Checker checker(builtinScene("builtin:default"));
-    CameraSpec spec = smallCamera(checker.scene());
-    spec.width = 203, spec.height = 131;
-    const Camera camera(spec);
-    std::vector<CheckOptions> runs(3);
-    runs[1].faults.ray.flipRows = true;
-    runs[2].faults.raster.truncateUnorm = true;
+    const Camera camera(tileCutCamera(checker.scene()));
     std::mt19937 random(5);
-    for (const CheckOptions& options : runs) {
+    for (const CheckOptions& options : cleanFlippedAndBiased()) {
         const RenderResult ray = checker.renderRay(camera, options.faults.ray);
         const RenderResult raster = checker.renderRaster(camera, options.faults.raster);
         auto reportOf = [&](Comparison& c, bool inPieces) {
