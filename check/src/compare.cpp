@@ -9,7 +9,6 @@
 #include "zcheck/large_buffer.h"
 #include "zcheck/percentile.h"
 
-#include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>

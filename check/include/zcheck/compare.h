@@ -162,11 +162,12 @@ struct DepthSlopeFrame {
 //   consecutive ones is asked for, the whole block's m is computed (several per instruction,
 //   its corners read as a stream) into a table of 8 bytes per triangle, where every later
 //   question finds it with one load. Only the blocks of triangles the judge is asked about are
-//   computed: the million-triangle speed workload shows under 300,000 of its triangles at
-//   1080p, and a table of all of them computed up front cost 3-4.5 ms on two threads (9.5 on
-//   one) against a comparison of 11-18 ms. (Slopes remembered per thread instead, triangle by
-//   triangle, cost the comparison more: ~922,000 runs of pixels to look up per frame, with
-//   their corners gathered at random.)
+//   computed: the million-triangle speed workload shows 246,522 of its triangles at 1080p, in
+//   4,237 of its 15,665 blocks, and a table of all of them computed up front cost 3-4.5 ms on
+//   two threads (9.5 on one) against a comparison of 11-18 ms; at four million triangles the
+//   comparison took ~7 ms less. (Slopes remembered per thread instead, triangle by triangle,
+//   cost the comparison more: ~922,000 runs of pixels to look up per frame, with their
+//   corners gathered at random.)
 // - EachCall, for a judge asked about a few thousand pixels or fewer (verify's probes of a
 //   camera, a fit's samples): m computed from the triangle at every call; making it costs
 //   nothing per triangle.
