@@ -151,7 +151,7 @@ PixelJudge::PixelJudge(const Scene& scene, const Camera& camera, const Tolerance
 
 bool PixelJudge::makeBlockReady(std::uint32_t block) const
 {
-    std::atomic<std::uint8_t>& state = blockReady(block);
+    std::atomic<std::uint8_t>& state = blockState(block);
     std::uint8_t notComputed = 0;
     if (!state.compare_exchange_strong(notComputed, 1, std::memory_order_acquire))
         return notComputed == kBlockReady;  // false: another thread is computing it

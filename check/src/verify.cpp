@@ -97,8 +97,7 @@ MapReader::MapReader(const PixelJudge& judge, const DepthMap& map, const RenderR
                      const VertexNeighbours& neighbours)
     : scene_(judge.scene()), camera_(judge.camera()), map_(map), truth_(truth), neighbours_(neighbours), judge_(judge)
 {
-    const ToleranceModel tolerance = judge.tolerance(), wanted = mapTolerance();
-    if (tolerance.subpixelBits != wanted.subpixelBits || tolerance.slopeCredit != wanted.slopeCredit)
+    if (judge.tolerance() != mapTolerance())
         throw std::logic_error("MapReader: the judge was not made with mapTolerance()");
 }
 

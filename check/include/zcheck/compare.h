@@ -84,6 +84,12 @@ struct ToleranceModel {
     double snapPixels() const { return 1.0 / double(1 << subpixelBits); }
     // C, in storage quanta.
     static double constantQuanta(const DepthSettings& depth);
+
+    bool operator==(const ToleranceModel& other) const
+    {
+        return subpixelBits == other.subpixelBits && slopeCredit == other.slopeCredit;
+    }
+    bool operator!=(const ToleranceModel& other) const { return !(*this == other); }
 };
 
 // One pixel as the report shows it.
@@ -201,7 +207,7 @@ public:
     {
         if (!known(primitive)) return 0.0;
         if (source_ == SlopeSource::TableOfSeen &&
-            (blockReady(primitive / kSlopeBlock).load(std::memory_order_acquire) == kBlockReady ||
+            (blockState(primitive / kSlopeBlock).load(std::memory_order_acquire) == kBlockReady ||
              makeBlockReady(primitive / kSlopeBlock)))
             return slopeOfTriangle_[primitive];
         return computeSlope(primitive);
@@ -223,7 +229,7 @@ public:
             for (std::size_t j = 1; j < lanes; ++j)
                 runStart[j] = (p[j] / kSlopeBlock < blocks) & (p[j] / kSlopeBlock != p[j - 1] / kSlopeBlock);
             forEachSetLane(runStart, lanes, [&](std::size_t j) ZCHECK_ALWAYS_INLINE {
-                ready &= blockReady(p[j] / kSlopeBlock).load(std::memory_order_relaxed) == kBlockReady;
+                ready &= blockState(p[j] / kSlopeBlock).load(std::memory_order_relaxed) == kBlockReady;
             });
         }
         if (!ready) {
@@ -253,7 +259,7 @@ private:
     // kBlockReady (its slopes in the table, stored with release: read them after an acquire).
     static constexpr std::uint32_t kSlopeBlock = 64;
     static constexpr std::uint8_t kBlockReady = 2;
-    std::atomic<std::uint8_t>& blockReady(std::uint32_t block) const { return blockState_[block]; }
+    std::atomic<std::uint8_t>& blockState(std::uint32_t block) const { return blockState_[block]; }
     // Computes block b into the table unless another thread is computing it; whether it is ready.
     bool makeBlockReady(std::uint32_t block) const;
 
