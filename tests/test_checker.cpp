@@ -36,6 +36,14 @@ CameraSpec smallCamera(const Scene& scene)
     return spec;
 }
 
+// windowDepthSlope of triangle t of the scene, through the camera.
+double slopeOfTriangle(const Scene& scene, const Camera& camera, std::uint32_t t)
+{
+    const auto& tri = scene.triangles[t];
+    return windowDepthSlope(camera, glm::dvec3(scene.positions[tri[0]]), glm::dvec3(scene.positions[tri[1]]),
+                            glm::dvec3(scene.positions[tri[2]]));
+}
+
 // smallCamera at a size the 64×64 tiles cut on both edges.
 CameraSpec tileCutCamera(const Scene& scene)
 {
@@ -349,11 +357,7 @@ TEST_CASE("a judge's slopes are each triangle's own, for its camera, one at a ti
     wide.projection = Projection::perspective(90.0, 0.1, 100.0);
     narrow.projection = Projection::perspective(20.0, 0.1, 100.0);
     const Camera wideCamera(wide), narrowCamera(narrow);
-    auto expected = [&](const Camera& camera, std::uint32_t t) {
-        const auto& tri = scene.triangles[t];
-        return windowDepthSlope(camera, glm::dvec3(scene.positions[tri[0]]), glm::dvec3(scene.positions[tri[1]]),
-                                glm::dvec3(scene.positions[tri[2]]));
-    };
+    auto expected = [&](const Camera& camera, std::uint32_t t) { return slopeOfTriangle(scene, camera, t); };
     const std::uint32_t last = std::uint32_t(scene.triangleCount() - 1);
     const std::vector<std::uint32_t> row = {4096, 4096, 0, 1, 1, kNoPrimitive, 4097, 1, 0, 5120, 1024,
                                             last, kUnknownPrimitive, last + 1, last - 64};
@@ -398,11 +402,7 @@ TEST_CASE("a judge's table of slopes filled from several threads at once holds e
     const Camera camera(smallCamera(scene));
     const std::uint32_t n = std::uint32_t(scene.triangleCount());
     std::vector<double> expected(n);
-    for (std::uint32_t t = 0; t < n; ++t) {
-        const auto& tri = scene.triangles[t];
-        expected[t] = windowDepthSlope(camera, glm::dvec3(scene.positions[tri[0]]), glm::dvec3(scene.positions[tri[1]]),
-                                       glm::dvec3(scene.positions[tri[2]]));
-    }
+    for (std::uint32_t t = 0; t < n; ++t) expected[t] = slopeOfTriangle(scene, camera, t);
     std::mt19937 random(7);
     std::vector<std::vector<std::uint32_t>> rows(4000, std::vector<std::uint32_t>(64));
     for (auto& r : rows) {
