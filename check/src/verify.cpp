@@ -1,22 +1,21 @@
 #include "zcheck/verify.h"
 
-#include "zcheck/error.h"
 #include "zcheck/drawn_polygon.h"
+#include "zcheck/error.h"
 #include "zcheck/fit.h"
-#include "zcheck/mistakes.h"
-
 #include "zcheck/inverse_projection.h"
+#include "zcheck/mistakes.h"
 
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <unordered_map>
 #include <cmath>
 #include <functional>
 #include <optional>
 #include <stdexcept>
+#include <unordered_map>
 
 namespace zcheck {
 
