@@ -20,6 +20,7 @@
 #include <atomic>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <random>
 
@@ -567,6 +568,188 @@ TEST_CASE("the comparison's AVX-512 form is bit-identical to its baseline form",
     REQUIRE(unexplained > 1000);
     REQUIRE(explained > 1000);
     REQUIRE(biased > 0);
+}
+
+namespace {
+// Two routes' results made up by a test, with the raster's own quanta (as verify passes them).
+struct MadeUpRoutes {
+    MadeUpRoutes(const Camera& camera)
+        : ray(RenderResult::cleared(camera.width(), camera.height(), camera.clearDepth())),
+          raster(RenderResult::cleared(camera.width(), camera.height(), camera.clearDepth())),
+          quantum(ray.primitiveId.size(), storageQuantum(camera.depth().format, 0.0))
+    {
+    }
+    // Pixel i: both routes on `primitive` at these depths, quantum q.
+    void setCommon(std::size_t i, std::uint32_t primitive, double rayDepth, double rasterDepth, double q)
+    {
+        ray.primitiveId[i] = raster.primitiveId[i] = primitive;
+        ray.windowDepth.value[i] = rayDepth, raster.windowDepth.value[i] = rasterDepth, quantum[i] = q;
+    }
+    RenderResult ray, raster;
+    std::vector<double> quantum;
+};
+
+// The routes compared tile by tile in both kernel forms, with the keepers' floors given: the
+// reports (both there or both not) and the per-pixel results must be the same bit for bit.
+// Returns the baseline form's report.
+std::optional<ComparisonReport> requireFormsAgree(const Scene& scene, const Camera& camera, const MadeUpRoutes& routes,
+                                                  float errorQuantaFloor = 0.0f, float relativeEyeZFloor = 0.0f)
+{
+    RoutePixels ray = RoutePixels::of(routes.ray), raster = RoutePixels::of(routes.raster);
+    raster.quantum = routes.quantum.data();
+    auto compare = [&](const char* form, Comparison& perPixel) {
+        return testing::withEnvironment("ZCHECK_COMPARE_KERNEL", form, [&] {
+            const PixelJudge judge(scene, camera);
+            TileComparison tiles(judge, &perPixel, errorQuantaFloor, relativeEyeZFloor);
+            for (int tile = 0; tile < tiles.tiles().count(); ++tile) tiles.compareTile(tile, ray, raster);
+            return tiles.finish();
+        });
+    };
+    auto json = [](const ComparisonReport& comparison) {
+        CheckReport report;
+        report.comparison = comparison;
+        return checkReportJson(report);
+    };
+    Comparison byBaseline, byChosen;
+    const std::optional<ComparisonReport> baseline = compare("baseline", byBaseline);
+    const std::optional<ComparisonReport> chosen = compare("auto", byChosen);
+    REQUIRE(bool(chosen) == bool(baseline));
+    if (baseline) REQUIRE(json(*chosen) == json(*baseline));
+    REQUIRE(testing::sameBits(byChosen.pixelClass, byBaseline.pixelClass));
+    REQUIRE(testing::sameBits(byChosen.errorOverTolerance, byBaseline.errorOverTolerance));
+    return baseline;
+}
+}  // namespace
+
+TEST_CASE("the comparison's AVX-512 form is bit-identical to its baseline form on edge values too", "[compare][kernel]")
+{
+    // The AVX-512 form's lane pass is written out by hand (compare.cpp), so renders alone,
+    // which hold few of the values where two ways of computing a lane part, do not pin it.
+    // Here the routes' arrays are made up: rows of 5, 67 and 203 pixels (every tile's row ends in a
+    // part of eight lanes), hits on one side, on neither and on two triangles, and in the common
+    // case |Δ| exactly at its bound, one step above and below it, NaN and infinite depths, and
+    // quanta that are zero, negative, NaN or large (the bound's sum, C·q + S·m + E, then rounds
+    // differently in another order). Then again with the keepers' floors exactly at the two
+    // 99th percentiles: a value equal to a floor must be kept.
+    const Scene scene = builtinScene("builtin:terrain?n=8");
+    const std::uint32_t triangles = std::uint32_t(scene.triangleCount());
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    std::size_t ties = 0, orderMatters = 0;
+    for (const int width : {5, 67, 203}) {
+        INFO("width " << width);
+        CameraSpec spec = scene.defaultCamera;
+        spec.width = width, spec.height = 70;
+        const Camera camera(spec);
+        const PixelJudge judge(scene, camera);
+        const PixelJudge::ToleranceTerms terms = judge.toleranceTerms();
+        MadeUpRoutes routes(camera);
+        std::mt19937 random{std::uint32_t(width)};
+        auto uniform = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(random); };
+        for (std::size_t i = 0; i < routes.quantum.size(); ++i) {
+            const std::uint32_t t = random() % triangles, u = (t + 1 + random() % (triangles - 1)) % triangles;
+            // Mostly a format's kind of quantum; some zero, negative or NaN; some large enough
+            // that E falls below a unit in the last place of C·q + S·m.
+            const double edgeQuanta[] = {0.0, -std::ldexp(1.0, -20), nan};
+            const int kind = int(random() % 128);
+            const double q = kind == 0 ? edgeQuanta[random() % 3]
+                             : kind < 48 ? std::ldexp(1.0 + random() % 7, 2 + int(random() % 8))
+                                         : std::ldexp(1.0 + random() % 7, -24 + int(random() % 12));
+            const double bound = terms.of(judge.slope(t), q);
+            double rayDepth = uniform(0.0, 1.0), rasterDepth = rayDepth + uniform(-3.0, 3.0) * bound;
+            switch (random() % 8) {
+            case 0: rayDepth = 0.0, rasterDepth = bound; break;  // |Δ| is the bound
+            case 1: rayDepth = 0.0, rasterDepth = std::nextafter(bound, INFINITY); break;
+            case 2: rayDepth = 0.0, rasterDepth = std::nextafter(bound, 0.0); break;
+            case 3: rasterDepth = rayDepth; break;
+            case 4:
+                if (random() % 64 == 0) (random() % 2 ? rayDepth : rasterDepth) = random() % 2 ? nan : INFINITY;
+                break;
+            default: break;
+            }
+            routes.setCommon(i, t, rayDepth, rasterDepth, q);
+            switch (random() % 8) {
+            case 0: routes.raster.primitiveId[i] = kNoPrimitive; break;
+            case 1: routes.ray.primitiveId[i] = kNoPrimitive; break;
+            case 2: routes.ray.primitiveId[i] = routes.raster.primitiveId[i] = kNoPrimitive; break;
+            case 3: routes.raster.primitiveId[i] = u; break;
+            default:
+                if (rayDepth == 0.0 && rasterDepth == bound && bound > 0) {
+                    ++ties;
+                    // The bound's sum in another order rounds below it here: that form would call it a depth error.
+                    orderMatters += terms.C * q + (terms.S * judge.slope(t) + terms.E) < bound;
+                }
+            }
+        }
+        const std::optional<ComparisonReport> report = requireFormsAgree(scene, camera, routes);
+        REQUIRE(report);
+        REQUIRE(report->agree > 0);
+        REQUIRE(report->depthErrors > 0);
+        REQUIRE(report->unexplained() > 0);
+        const float errorQuantaFloor = float(report->p99ErrorQuanta), relativeEyeZFloor = float(report->p99RelativeEyeZError);
+        REQUIRE(errorQuantaFloor > 0);
+        REQUIRE(relativeEyeZFloor > 0);
+        const std::optional<ComparisonReport> atFloors =
+            requireFormsAgree(scene, camera, routes, errorQuantaFloor, relativeEyeZFloor);
+        REQUIRE(atFloors);
+        REQUIRE(atFloors->p99ErrorQuanta == report->p99ErrorQuanta);
+        REQUIRE(atFloors->p99RelativeEyeZError == report->p99RelativeEyeZError);
+    }
+    REQUIRE(ties > 500);
+    REQUIRE(orderMatters > 0);
+}
+
+TEST_CASE("the comparison's AVX-512 form on rows of NaN, a zero bound and the bias rule's edge",
+          "[compare][kernel]")
+{
+    // Rows of eleven pixels, every one on one triangle in both routes. First: a NaN depth in its
+    // first pixel (compared first, so visited whatever its ratio), then pixel 1 with the row's
+    // largest |Δ|/q, relative error and ratio (0.9: it agrees, so only the row's maxima can make
+    // it the worst pixel), then small errors. Second: with the quantum for which the bound is
+    // exactly 0 (C·q = −S·m − E): equal depths have ratio 0, others +inf. Third: the bias
+    // test's rule met with equality.
+    const Scene scene = builtinScene("builtin:terrain?n=8");
+    CameraSpec spec = scene.defaultCamera;
+    spec.width = 11, spec.height = 1;
+    const Camera camera(spec);
+    const PixelJudge judge(scene, camera);
+    const PixelJudge::ToleranceTerms terms = judge.toleranceTerms();
+    const std::uint32_t t = 0;
+    const double m = judge.slope(t);
+    REQUIRE(m > 0);
+
+    const double q = std::ldexp(1.0, -24), bound = terms.of(m, q);
+    MadeUpRoutes withNaN(camera);
+    withNaN.setCommon(0, t, std::numeric_limits<double>::quiet_NaN(), 0.5, q);
+    withNaN.setCommon(1, t, 0.5, 0.5 + 0.9 * bound, q);
+    for (std::size_t i = 2; i < 11; ++i) withNaN.setCommon(i, t, 0.5, 0.5 + 0.1 * bound, q);
+    const std::optional<ComparisonReport> report = requireFormsAgree(scene, camera, withNaN);
+    REQUIRE(report);
+    REQUIRE(report->worst.col == 1);
+    REQUIRE(report->maxErrorOverTolerance == ((0.5 + 0.9 * bound) - 0.5) / bound);
+    REQUIRE(report->maxErrorQuanta == ((0.5 + 0.9 * bound) - 0.5) / q);
+    REQUIRE(report->maxRelativeEyeZError > 0);
+
+    const double zeroBoundQ = (-(terms.S * m) - terms.E) / terms.C;
+    REQUIRE(terms.of(m, zeroBoundQ) == 0.0);
+    MadeUpRoutes zeroBound(camera);
+    for (std::size_t i = 0; i < 11; ++i) zeroBound.setCommon(i, t, 0.5, i % 2 ? 0.5 : std::nextafter(0.5, 1.0), zeroBoundQ);
+    const std::optional<ComparisonReport> zeroReport = requireFormsAgree(scene, camera, zeroBound);
+    REQUIRE(zeroReport);
+    REQUIRE(zeroReport->agree == 5);
+    REQUIRE(zeroReport->depthErrors == 6);
+    REQUIRE(zeroReport->maxErrorOverTolerance == INFINITY);
+
+    // A quantum at which the bias test's rule, S·m <= 0.1·q, holds with equality: every pixel
+    // of the row is a bias sample.
+    double tieQ = terms.S * m / 0.1;
+    for (int step = 0; step < 64 && 0.1 * tieQ != terms.S * m; ++step)
+        tieQ = std::nextafter(tieQ, 0.1 * tieQ < terms.S * m ? INFINITY : 0.0);
+    REQUIRE(0.1 * tieQ == terms.S * m);
+    MadeUpRoutes atBiasRule(camera);
+    for (std::size_t i = 0; i < 11; ++i) atBiasRule.setCommon(i, t, 0.5, 0.5 + tieQ * double(i % 3), tieQ);
+    const std::optional<ComparisonReport> biasReport = requireFormsAgree(scene, camera, atBiasRule);
+    REQUIRE(biasReport);
+    REQUIRE(biasReport->biasSamples == 11);
 }
 
 TEST_CASE("ZCHECK_COMPARE_KERNEL takes auto or baseline and nothing else", "[compare][kernel]")

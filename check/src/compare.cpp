@@ -9,6 +9,9 @@
 #include "zcheck/large_buffer.h"
 #include "zcheck/percentile.h"
 
+#ifdef ZCHECK_X86_AVX512
+#include <immintrin.h>
+#endif
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
@@ -134,9 +137,8 @@ PixelJudge::PixelJudge(const Scene& scene, const Camera& camera, const Tolerance
     : scene_(scene),
       camera_(camera),
       tolerance_(tolerance),
-      C_(ToleranceModel::constantQuanta(camera.depth())),
-      S_(tolerance.snapPixels()),
-      E_(16 * std::ldexp(1.0, -52) * std::max(std::abs(camera.depth().rangeMin), std::abs(camera.depth().rangeMax))),
+      terms_{ToleranceModel::constantQuanta(camera.depth()), tolerance.snapPixels(),
+             16 * std::ldexp(1.0, -52) * std::max(std::abs(camera.depth().rangeMin), std::abs(camera.depth().rangeMax))},
       avx512_(useAvx512Form("ZCHECK_COMPARE_KERNEL", "baseline")),
       slopeFrame_(camera, tolerance.slopeCredit),
       source_(slopes)
@@ -197,7 +199,7 @@ bool PixelJudge::atClipPlane(std::uint32_t primitive, const glm::dvec2& pWindow)
 bool PixelJudge::nearEdge(std::uint32_t primitive, const glm::dvec2& pWindow) const
 {
     if (!known(primitive)) return false;
-    return distanceToDrawnEdge(camera_, vertex(primitive, 0), vertex(primitive, 1), vertex(primitive, 2), pWindow) <= S_;
+    return distanceToDrawnEdge(camera_, vertex(primitive, 0), vertex(primitive, 1), vertex(primitive, 2), pWindow) <= terms_.S;
 }
 
 PixelClass PixelJudge::bothHit(double rayDepth, std::uint32_t rayPrimitive, double rasterDepth,
@@ -320,10 +322,7 @@ struct PixelMeasures {
         return raster.quantum ? raster.quantum[b] : storageQuantum(format, ray.windowDepth[a]);
     }
     // (d_raster − d_ray)/q, of which the statistics take the absolute value.
-    static double signedErrorQuanta(const RoutePixels& ray, const RoutePixels& raster, std::size_t a, std::size_t b, double q)
-    {
-        return (raster.windowDepth[b] - ray.windowDepth[a]) / q;
-    }
+    static double signedErrorQuanta(double rayDepth, double rasterDepth, double q) { return (rasterDepth - rayDepth) / q; }
     // quantum() of n pixels of a row, entries a0.. and b0.., into q: several per instruction
     // where the format's quantum is one constant or comes from the raster's own array.
     void quanta(const RoutePixels& ray, const RoutePixels& raster, std::size_t a0, std::size_t b0, std::size_t n,
@@ -331,11 +330,23 @@ struct PixelMeasures {
     {
         if (raster.quantum) {
             std::copy(raster.quantum + b0, raster.quantum + b0 + n, q);
-        } else if (format != DepthFormat::Float32) {
-            std::fill(q, q + n, storageQuantum(format, 0.0));  // 1/(2^N − 1) at every depth
+        } else if (const std::optional<double> constant = constantQuantum(raster)) {
+            std::fill(q, q + n, *constant);
         } else {
             for (std::size_t j = 0; j < n; ++j) q[j] = storageQuantum(format, ray.windowDepth[a0 + j]);
         }
+    }
+    // The quantum of every pixel, where the format gives one for all and the raster no own ones.
+    std::optional<double> constantQuantum(const RoutePixels& raster) const
+    {
+        if (raster.quantum || format == DepthFormat::Float32) return std::nullopt;
+        return storageQuantum(format, 0.0);  // 1/(2^N − 1) at every depth
+    }
+    // The closed form relativeEyeZErrors takes, where it takes one (no eye points, not a raw matrix).
+    std::optional<CameraRays::RelativeForm> relativeForm(const RoutePixels& ray) const
+    {
+        if (ray.pEye) return std::nullopt;
+        return cameraRays.relativeForm();
     }
     // relativeEyeZError of n pixels of a row from (col0, row), entries a0.. and b0.., into
     // `relative`: several per instruction where the closed form applies.
@@ -362,6 +373,218 @@ struct PixelMeasures {
     const CameraRays cameraRays;  // eye-z of a window depth in closed form
     const DepthFormat format;
 };
+
+// A tile's row, as its lane pass (rowLanesBaseline, rowLanesAvx512) reads it: n ≤ kLanes
+// pixels, pixel j at entry j of each array.
+constexpr int kLanes = TileComparison::kTileSize;
+struct RowInputs {
+    const std::uint32_t* rayPrimitive = nullptr;
+    const std::uint32_t* rasterPrimitive = nullptr;
+    const double* rayDepth = nullptr;
+    const double* rasterDepth = nullptr;
+    const double* slope = nullptr;     // of the triangle both routes hit (where they hit one)
+    const double* quantum = nullptr;   // q
+    const double* relative = nullptr;  // the relative eye-z error
+    int n = 0;
+    // rowLanesAvx512 only: where these are given, it computes the three arrays above itself
+    // (which are then not read): the slopes from PixelJudge::slopeTableFor, the quantum one for
+    // all, the relative error in closed form.
+    const double* slopeTable = nullptr;
+    std::uint32_t slopeTableNone = 0;
+    std::optional<double> constantQuantum;
+    std::optional<CameraRays::RelativeForm> relativeForm;
+    PixelClass* pixelClass = nullptr;  // the row's per-pixel results, or null (none kept)
+    float* errorOverTolerance = nullptr;
+};
+
+// What a row's lane pass gives the rest of its tally: the common case's measures (both routes
+// on one triangle: PixelJudge::bothHit's rule for a single surface, one slope, no edge or
+// clip-plane question), computed for every lane and used for the common ones, and the lanes'
+// masks as bits (lane j: bit j).
+struct RowLanes {
+    alignas(64) double bound[kLanes], signedErrorQuanta[kLanes], errorQuanta[kLanes], ratio[kLanes];
+    std::uint64_t common;  // both routes hit one triangle
+    std::uint64_t agree;   // |Δ| <= bound
+    std::uint64_t hit;     // either route hit
+    std::uint64_t bias;    // common, and quantization dominates: it feeds the bias test
+    // The largest |Δ|/q, relative error and ratio of the common lanes, as the bits of a double:
+    // for values ≥ +0 or NaN (NaN left out, as std::max leaves it), the largest bit pattern is
+    // the largest value; -1 where no lane counts.
+    std::int64_t largest[3];
+};
+
+// |Δ| / tolerance, as the report and the heatmap give it.
+// (The division and both comparisons are made whatever the bound, so that a loop of these
+// needs no branch: a compiler may not make a trapping operation the code skipped.)
+ZCHECK_ALWAYS_INLINE inline double ratioOf(double error, double bound)
+{
+    const double quotient = error / bound;
+    const bool boundPositive = bound > 0, errorPositive = error > 0;
+    const double unbounded = errorPositive ? INFINITY : 0.0;
+    return boundPositive ? quotient : unbounded;
+}
+
+// A row's lane pass, lane by lane: the measures and masks above; each pixel's class and ratio
+// as the common case or a miss has them (the scan-order pass rewrites the others); the common
+// lanes' |Δ|/q and relative errors given to the keepers. Auto-vectorised where it is compiled
+// for (several pixels per instruction with AVX-512).
+ZCHECK_ALWAYS_INLINE inline void rowLanesBaseline(const RowInputs& in, const PixelJudge::ToleranceTerms& terms,
+                                                  StatisticCounts& counts, RowLanes& out)
+{
+    const int n = in.n;
+    alignas(64) std::uint8_t common[kLanes], agree[kLanes], hit[kLanes], bias[kLanes];
+    alignas(64) float errorQuantaOfLane[kLanes], relativeOfLane[kLanes];
+    for (int j = 0; j < n; ++j) {
+        const std::uint32_t rayPrimitive = in.rayPrimitive[j], rasterPrimitive = in.rasterPrimitive[j];
+        common[j] = rayPrimitive != kNoPrimitive && rayPrimitive == rasterPrimitive;
+        hit[j] = (rayPrimitive != kNoPrimitive) | (rasterPrimitive != kNoPrimitive);
+    }
+    for (int j = 0; j < n; ++j) {
+        const double q = in.quantum[j], m = in.slope[j];
+        out.bound[j] = terms.of(m, q);
+        const double error = std::abs(in.rasterDepth[j] - in.rayDepth[j]);
+        out.signedErrorQuanta[j] = PixelMeasures::signedErrorQuanta(in.rayDepth[j], in.rasterDepth[j], q);
+        out.ratio[j] = ratioOf(error, out.bound[j]);
+        agree[j] = error <= out.bound[j];
+        bias[j] = common[j] & (terms.S * m <= 0.1 * q);
+    }
+    if (in.pixelClass) {
+        // Without a branch, so that the loop stays SIMD: the class as arithmetic, the ratio's
+        // bits masked (0.0f where not common).
+        static_assert(int(PixelClass::BothMiss) == 0 && int(PixelClass::Agree) == 1 && int(PixelClass::DepthError) == 3,
+                      "the class arithmetic below");
+        std::uint8_t* classBytes = reinterpret_cast<std::uint8_t*>(in.pixelClass);
+        AliasedBits32* ratioBits = reinterpret_cast<AliasedBits32*>(in.errorOverTolerance);
+        for (int j = 0; j < n; ++j) {
+            classBytes[j] = std::uint8_t(common[j] + 2 * (common[j] & (agree[j] ^ 1)));
+            const float ratioOfLane = static_cast<float>(out.ratio[j]);
+            ratioBits[j] = *reinterpret_cast<const AliasedBits32*>(&ratioOfLane) & (0u - std::uint32_t(common[j]));
+        }
+    }
+    for (int j = 0; j < n; ++j) {
+        out.errorQuanta[j] = std::abs(out.signedErrorQuanta[j]);
+        errorQuantaOfLane[j] = float(out.errorQuanta[j]);
+        relativeOfLane[j] = float(in.relative[j]);
+    }
+    // The three maxima in one loop (its mask widened once: three loops measured slower).
+    {
+        const AliasedBits64* bitsQ = reinterpret_cast<const AliasedBits64*>(out.errorQuanta);
+        const AliasedBits64* bitsE = reinterpret_cast<const AliasedBits64*>(in.relative);
+        const AliasedBits64* bitsR = reinterpret_cast<const AliasedBits64*>(out.ratio);
+        std::int64_t lq = -1, le = -1, lr = -1;
+        for (int j = 0; j < n; ++j) {
+            const std::int64_t keep = -std::int64_t(common[j]);  // all ones where common
+            const std::int64_t q = (out.errorQuanta[j] == out.errorQuanta[j]) ? (bitsQ[j] & keep) | ~keep : -1;
+            const std::int64_t e = (in.relative[j] == in.relative[j]) ? (bitsE[j] & keep) | ~keep : -1;
+            const std::int64_t t = (out.ratio[j] == out.ratio[j]) ? (bitsR[j] & keep) | ~keep : -1;
+            lq = lq < q ? q : lq;
+            le = le < e ? e : le;
+            lr = lr < t ? t : lr;
+        }
+        out.largest[0] = lq, out.largest[1] = le, out.largest[2] = lr;
+    }
+    counts.errorQuanta.add(errorQuantaOfLane, common, std::size_t(n));
+    counts.relativeEyeZ.add(relativeOfLane, common, std::size_t(n));
+    out.common = laneBits(common, std::size_t(n)), out.agree = laneBits(agree, std::size_t(n));
+    out.hit = laneBits(hit, std::size_t(n)), out.bias = laneBits(bias, std::size_t(n));
+}
+
+#ifdef ZCHECK_X86_AVX512
+ZCHECK_INTRINSICS_BEGIN
+// rowLanesBaseline's results, written out eight lanes at a time for AVX-512: the same IEEE
+// operations lane for lane (bit-identical), its masks in mask registers and the keepers'
+// candidates found among them, a row in one pass. (The lane loops above compiled for AVX-512,
+// each through arrays of bytes, made the whole comparison ~1.25× as long; bench/speed-log.md.)
+ZCHECK_TARGET_AVX512 void rowLanesAvx512(const RowInputs& in, const PixelJudge::ToleranceTerms& terms,
+                                         StatisticCounts& counts, RowLanes& out)
+{
+    alignas(64) float errorQuantaOfLane[kLanes], relativeOfLane[kLanes];
+    const __m256i none = _mm256_set1_epi32(int(kNoPrimitive));
+    const __m512d C = _mm512_set1_pd(terms.C), S = _mm512_set1_pd(terms.S), E = _mm512_set1_pd(terms.E);
+    const __m512d tenth = _mm512_set1_pd(0.1), zero = _mm512_setzero_pd(), infinity = _mm512_set1_pd(INFINITY);
+    const __m512i magnitude = _mm512_set1_epi64(0x7fffffffffffffff);  // std::abs: the sign bit cleared
+    // A keeper's candidates: the common lanes at or above its leastKeepable() (none at 2^32).
+    const std::uint64_t leastQ = counts.errorQuanta.leastKeepable(), leastE = counts.relativeEyeZ.leastKeepable();
+    const __mmask8 keepsQ = leastQ >> 32 ? 0 : 0xFF, keepsE = leastE >> 32 ? 0 : 0xFF;
+    const __m256i leastQBits = _mm256_set1_epi32(int(std::uint32_t(leastQ)));
+    const __m256i leastEBits = _mm256_set1_epi32(int(std::uint32_t(leastE)));
+    const __m256i slopeTableNone = _mm256_set1_epi32(int(in.slopeTableNone));
+    const __m512d constantQuantum = _mm512_set1_pd(in.constantQuantum.value_or(0.0));
+    const __m512d relativeA = _mm512_set1_pd(in.relativeForm ? in.relativeForm->A : 0.0);
+    const bool parallel = in.relativeForm && in.relativeForm->parallel;
+    __m512i largestQ = _mm512_set1_epi64(-1), largestE = largestQ, largestR = largestQ;
+    std::uint64_t common = 0, agree = 0, hit = 0, bias = 0, candidateQ = 0, candidateE = 0;
+    for (int j = 0; j < in.n; j += 8) {
+        const __mmask8 lanes = in.n - j >= 8 ? __mmask8(0xFF) : __mmask8((1u << (in.n - j)) - 1);
+        const __m256i rayPrimitive = _mm256_maskz_loadu_epi32(lanes, in.rayPrimitive + j);
+        const __m256i rasterPrimitive = _mm256_maskz_loadu_epi32(lanes, in.rasterPrimitive + j);
+        const __mmask8 rayHit = _mm256_mask_cmpneq_epu32_mask(lanes, rayPrimitive, none);
+        const __mmask8 c = _mm256_mask_cmpeq_epu32_mask(rayHit, rayPrimitive, rasterPrimitive);
+        const __mmask8 h = rayHit | _mm256_mask_cmpneq_epu32_mask(lanes, rasterPrimitive, none);
+        const __m512d rayDepth = _mm512_maskz_loadu_pd(lanes, in.rayDepth + j);
+        const __m512d rasterDepth = _mm512_maskz_loadu_pd(lanes, in.rasterDepth + j);
+        // The slope of a common lane's triangle (0 elsewhere, as table[slopeTableNone] is).
+        const __m512d m = in.slopeTable ? _mm512_mask_i32gather_pd(zero, c, _mm256_min_epu32(rayPrimitive, slopeTableNone),
+                                                                   in.slopeTable, sizeof(double))
+                                        : _mm512_maskz_loadu_pd(lanes, in.slope + j);
+        const __m512d q = in.constantQuantum ? constantQuantum : _mm512_maskz_loadu_pd(lanes, in.quantum + j);
+        // CameraRays::relativeEyeZDifferences (reference: the ray's depth, other: the raster's).
+        __m512d relative;
+        if (!in.relativeForm)
+            relative = _mm512_maskz_loadu_pd(lanes, in.relative + j);
+        else if (parallel)
+            relative = _mm512_div_pd(_mm512_sub_pd(rasterDepth, rayDepth), _mm512_sub_pd(rayDepth, relativeA));
+        else
+            relative = _mm512_div_pd(_mm512_sub_pd(rayDepth, rasterDepth), _mm512_sub_pd(rasterDepth, relativeA));
+        if (in.relativeForm) relative = _mm512_castsi512_pd(_mm512_and_si512(_mm512_castpd_si512(relative), magnitude));
+        // terms.of(m, q) = C·q + S·m + E, in that order.
+        const __m512d slopeTerm = _mm512_mul_pd(S, m);
+        const __m512d bound = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(C, q), slopeTerm), E);
+        const __m512d difference = _mm512_sub_pd(rasterDepth, rayDepth);
+        const __m512d error = _mm512_castsi512_pd(_mm512_and_si512(_mm512_castpd_si512(difference), magnitude));
+        const __m512d signedErrorQuanta = _mm512_div_pd(difference, q);
+        const __m512d errorQuanta =
+            _mm512_castsi512_pd(_mm512_and_si512(_mm512_castpd_si512(signedErrorQuanta), magnitude));
+        // ratioOf(error, bound).
+        const __m512d unbounded = _mm512_maskz_mov_pd(_mm512_cmp_pd_mask(error, zero, _CMP_GT_OQ), infinity);
+        const __m512d ratio =
+            _mm512_mask_blend_pd(_mm512_cmp_pd_mask(bound, zero, _CMP_GT_OQ), unbounded, _mm512_div_pd(error, bound));
+        const __mmask8 a = _mm512_mask_cmp_pd_mask(lanes, error, bound, _CMP_LE_OQ);
+        const __mmask8 b = _mm512_mask_cmp_pd_mask(c, slopeTerm, _mm512_mul_pd(tenth, q), _CMP_LE_OQ);
+        _mm512_store_pd(out.bound + j, bound);
+        _mm512_store_pd(out.signedErrorQuanta + j, signedErrorQuanta);
+        _mm512_store_pd(out.errorQuanta + j, errorQuanta);
+        _mm512_store_pd(out.ratio + j, ratio);
+        const __m256 errorQuantaOfLanes = _mm512_cvtpd_ps(errorQuanta), relativeOfLanes = _mm512_cvtpd_ps(relative);
+        if (in.pixelClass) {
+            const __m256i pixelClass = _mm256_mask_set1_epi32(
+                _mm256_maskz_set1_epi32(__mmask8(c & a), int(PixelClass::Agree)), __mmask8(c & ~a), int(PixelClass::DepthError));
+            _mm256_mask_cvtepi32_storeu_epi8(reinterpret_cast<std::uint8_t*>(in.pixelClass) + j, lanes, pixelClass);
+            _mm256_mask_storeu_ps(in.errorOverTolerance + j, lanes, _mm256_maskz_mov_ps(c, _mm512_cvtpd_ps(ratio)));
+        }
+        largestQ = _mm512_mask_max_epi64(largestQ, _mm512_mask_cmp_pd_mask(c, errorQuanta, errorQuanta, _CMP_ORD_Q),
+                                         largestQ, _mm512_castpd_si512(errorQuanta));
+        largestE = _mm512_mask_max_epi64(largestE, _mm512_mask_cmp_pd_mask(c, relative, relative, _CMP_ORD_Q), largestE,
+                                         _mm512_castpd_si512(relative));
+        largestR = _mm512_mask_max_epi64(largestR, _mm512_mask_cmp_pd_mask(c, ratio, ratio, _CMP_ORD_Q), largestR,
+                                         _mm512_castpd_si512(ratio));
+        _mm256_store_ps(errorQuantaOfLane + j, errorQuantaOfLanes);
+        _mm256_store_ps(relativeOfLane + j, relativeOfLanes);
+        const __mmask8 keptQ = _mm256_mask_cmpge_epu32_mask(__mmask8(c & keepsQ), _mm256_castps_si256(errorQuantaOfLanes), leastQBits);
+        const __mmask8 keptE = _mm256_mask_cmpge_epu32_mask(__mmask8(c & keepsE), _mm256_castps_si256(relativeOfLanes), leastEBits);
+        common |= std::uint64_t(c) << j, agree |= std::uint64_t(a) << j, hit |= std::uint64_t(h) << j;
+        bias |= std::uint64_t(b) << j, candidateQ |= std::uint64_t(keptQ) << j, candidateE |= std::uint64_t(keptE) << j;
+    }
+    out.common = common, out.agree = agree, out.hit = hit, out.bias = bias;
+    out.largest[0] = _mm512_reduce_max_epi64(largestQ);
+    out.largest[1] = _mm512_reduce_max_epi64(largestE);
+    out.largest[2] = _mm512_reduce_max_epi64(largestR);
+    const std::size_t commons = std::size_t(__builtin_popcountll(common));
+    counts.errorQuanta.addCandidates(errorQuantaOfLane, candidateQ, commons);
+    counts.relativeEyeZ.addCandidates(relativeOfLane, candidateE, commons);
+}
+ZCHECK_INTRINSICS_END
+#endif
 
 }  // namespace
 
@@ -398,6 +621,7 @@ struct TileComparison::Impl {
 
     // Rows [rowBegin, rowEnd) of a tile (TileComparison::compareTileRows).
     void compare(int tile, int rowBegin, int rowEnd, const RoutePixels& ray, const RoutePixels& raster);
+    template <bool kAvx512>
     void compareBody(int tile, int rowBegin, int rowEnd, const RoutePixels& ray, const RoutePixels& raster);
     void compareBaseline(int tile, int rowBegin, int rowEnd, const RoutePixels& ray, const RoutePixels& raster);
 #ifdef ZCHECK_X86_AVX512
@@ -421,11 +645,13 @@ struct TileComparison::Impl {
 // compareAvx512; kernel_choice.h), bit-identical to each other and to the pixel-by-pixel
 // tally they replaced: the same IEEE operations in the same order wherever the order can change
 // a result. Row by row: first the common case's measures for the whole row, lane by lane
-// (several pixels per instruction); then its tally, lane by lane where the order cannot matter
-// (counts, maxima, the keepers), in scan order for the bias sum; then, in scan order, the pixels
-// off the common case and those of it that may be the worst (noteWorst).
+// (several pixels per instruction), and their tally where the order cannot matter (counts,
+// maxima, the keepers: the row's lane pass, each form's own); then the bias sum in scan order;
+// then, in scan order, the pixels off the common case and those of it that may be the worst
+// (noteWorst).
 // A tile's rows may come in several calls, in order: all that carries from one row to the next
 // is in the tile's tally (comparedBefore is derived from its counts).
+template <bool kAvx512>
 ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tile, int rowBegin, int rowEnd,
                                                                    const RoutePixels& ray, const RoutePixels& raster)
 {
@@ -439,16 +665,7 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tile, int
     // Pixel (col, row): a in the ray's arrays, b in the raster's, i in the image.
     auto quantumAt = [&](std::size_t a, std::size_t b) ZCHECK_ALWAYS_INLINE { return measures.quantum(ray, raster, a, b); };
     auto signedErrorQuantaAt = [&](std::size_t a, std::size_t b, double q) ZCHECK_ALWAYS_INLINE {
-        return PixelMeasures::signedErrorQuanta(ray, raster, a, b, q);
-    };
-    // |Δ| / tolerance, as the report and the heatmap give it.
-    // (The division and both comparisons are made whatever the bound, so that a loop of these
-    // needs no branch: a compiler may not make a trapping operation the code skipped.)
-    auto ratioOf = [](double error, double bound) ZCHECK_ALWAYS_INLINE {
-        const double quotient = error / bound;
-        const bool boundPositive = bound > 0, errorPositive = error > 0;
-        const double unbounded = errorPositive ? INFINITY : 0.0;
-        return boundPositive ? quotient : unbounded;
+        return PixelMeasures::signedErrorQuanta(ray.windowDepth[a], raster.windowDepth[b], q);
     };
     // A pixel compared on depth (agree or depth error), in scan order: whether it is the worst so
     // far (its finding is then r.worst): the first compared, or a ratio above every one before.
@@ -475,18 +692,14 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tile, int
         if (perPixel) perPixel->pixelClass[i] = c;
     };
 
-    // A row's measures of the common case, both routes on one triangle (PixelJudge::bothHit's
-    // rule for a single surface: one slope, no edge or clip-plane question). Lanes where it is
-    // not the case are computed too, and not used.
-    constexpr int kLanes = kTileSize;
+    const std::optional<double> constantQuantum = measures.constantQuantum(raster);
+    const std::optional<CameraRays::RelativeForm> relativeForm = measures.relativeForm(ray);
+
     constexpr int kRowsAhead = 2;
     alignas(64) std::uint32_t surface[kLanes];  // the triangle both routes hit, else kNoPrimitive
-    alignas(64) std::uint8_t common[kLanes];  // 0 or 1 (bytes, not bool: GCC vectorises their loops)
-    alignas(64) double slope[kLanes], quantum[kLanes], bound[kLanes], signedErrorQuanta[kLanes], ratio[kLanes];
-    alignas(64) double relative[kLanes];
-    alignas(64) std::uint8_t agree[kLanes], biasSample[kLanes], visit[kLanes];
-    alignas(64) double errorQuanta[kLanes];
-    alignas(64) float errorQuantaOfLane[kLanes], relativeOfLane[kLanes];
+    alignas(64) double slope[kLanes], quantum[kLanes], relative[kLanes];
+    auto quantumOfLane = [&](std::size_t j) ZCHECK_ALWAYS_INLINE { return constantQuantum ? *constantQuantum : quantum[j]; };
+    RowLanes lanes;
 
     for (int row = row0; row < row1; ++row) {
         const std::size_t a0 = ray.at(col0, row), b0 = raster.at(col0, row);
@@ -507,134 +720,85 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tile, int
         const double* rayDepths = ray.windowDepth + a0;
         const double* rasterDepths = raster.windowDepth + b0;
         for (int j = 0; j < n; ++j) {
-            common[j] = rayPrimitives[j] != kNoPrimitive && rayPrimitives[j] == rasterPrimitives[j];
-            surface[j] = common[j] ? rayPrimitives[j] : kNoPrimitive;
+            const bool common = rayPrimitives[j] != kNoPrimitive && rayPrimitives[j] == rasterPrimitives[j];
+            surface[j] = common ? rayPrimitives[j] : kNoPrimitive;
         }
-        judge.slopes(surface, std::size_t(n), slope);
-        measures.quanta(ray, raster, a0, b0, std::size_t(n), quantum);
-        for (int j = 0; j < n; ++j) {
-            const double q = quantum[j], m = slope[j], rayDepth = rayDepths[j];
-            bound[j] = judge.toleranceForSlope(m, q);
-            const double error = std::abs(rasterDepths[j] - rayDepth);
-            signedErrorQuanta[j] = signedErrorQuantaAt(a0 + j, b0 + j, q);
-            ratio[j] = ratioOf(error, bound[j]);
-            agree[j] = error <= bound[j];
-            // Where quantization dominates, a common-case pixel feeds the bias test (its signed
-            // error, and where its exact depth falls in the quantum, computed there: a division
-            // per pixel).
-            biasSample[j] = common[j] & (S * m <= 0.1 * q);
+        // The row's slopes, quanta and relative errors, except those the AVX-512 form computes itself.
+        RowInputs in;
+        in.rayPrimitive = rayPrimitives, in.rasterPrimitive = rasterPrimitives;
+        in.rayDepth = rayDepths, in.rasterDepth = rasterDepths;
+        in.slope = slope, in.quantum = quantum, in.relative = relative, in.n = n;
+        if constexpr (kAvx512) {
+            in.slopeTable = judge.slopeTableFor(surface, std::size_t(n)), in.slopeTableNone = judge.slopeTableNone();
+            in.constantQuantum = constantQuantum, in.relativeForm = relativeForm;
         }
-        measures.relativeEyeZErrors(ray, raster, a0, b0, col0, row, std::size_t(n), relative);
-        if (perPixel) {  // every pixel of the row, as the common case or a miss would have it
-            PixelClass* classes = perPixel->pixelClass.data() + std::size_t(row) * W + col0;
-            float* ratios = perPixel->errorOverTolerance.data() + std::size_t(row) * W + col0;
-            // Without a branch, so that the loop stays SIMD: the class as arithmetic, the ratio's
-            // bits masked (0.0f where not common).
-            static_assert(int(PixelClass::BothMiss) == 0 && int(PixelClass::Agree) == 1 &&
-                              int(PixelClass::DepthError) == 3,
-                          "the class arithmetic below");
-            std::uint8_t* classBytes = reinterpret_cast<std::uint8_t*>(classes);
-            AliasedBits32* ratioBits = reinterpret_cast<AliasedBits32*>(ratios);
-            for (int j = 0; j < n; ++j) {
-                classBytes[j] = std::uint8_t(common[j] + 2 * (common[j] & (agree[j] ^ 1)));
-                const float ratioOfLane = static_cast<float>(ratio[j]);
-                ratioBits[j] = *reinterpret_cast<const AliasedBits32*>(&ratioOfLane) & (0u - std::uint32_t(common[j]));
-            }
-        }
+        if (!in.slopeTable) judge.slopes(surface, std::size_t(n), slope);
+        if (!in.constantQuantum) measures.quanta(ray, raster, a0, b0, std::size_t(n), quantum);
+        if (!in.relativeForm) measures.relativeEyeZErrors(ray, raster, a0, b0, col0, row, std::size_t(n), relative);
+        const std::size_t i0 = std::size_t(row) * W + col0;
+        in.pixelClass = perPixel ? perPixel->pixelClass.data() + i0 : nullptr;
+        in.errorOverTolerance = perPixel ? perPixel->errorOverTolerance.data() + i0 : nullptr;
+#ifdef ZCHECK_X86_AVX512
+        if constexpr (kAvx512) rowLanesAvx512(in, judge.toleranceTerms(), counts, lanes);
+#endif
+        if constexpr (!kAvx512) rowLanesBaseline(in, judge.toleranceTerms(), counts, lanes);
 
-        // The common case's tally, in any order where the result cannot depend on it (counts,
-        // maxima, the percentiles' keepers, and the row's largest ratio), several pixels per
-        // instruction.
-        int commons = 0, agreeing = 0, hits = 0;
-        for (int j = 0; j < n; ++j) {
-            commons += common[j];
-            agreeing += common[j] & agree[j];
-            hits += (rayPrimitives[j] != kNoPrimitive) | (rasterPrimitives[j] != kNoPrimitive);
-        }
-        for (int j = 0; j < n; ++j) {
-            errorQuanta[j] = std::abs(signedErrorQuanta[j]);
-            errorQuantaOfLane[j] = float(errorQuanta[j]);
-            relativeOfLane[j] = float(relative[j]);
-        }
-        // The three maxima over the row's common lanes, in one loop (its mask widened once:
-        // three loops measured slower). std::max(start, x[j]) over them in turn, for values ≥ +0
-        // or NaN (which std::max skips), is the largest of their bit patterns as integers, taken
-        // here with -1 for a lane left out; maxOfCommon(start, k) is then maximum k's value.
-        std::int64_t largest[3] = {-1, -1, -1};  // errorQuanta, relative, ratio
-        {
-            const AliasedBits64* bitsQ = reinterpret_cast<const AliasedBits64*>(errorQuanta);
-            const AliasedBits64* bitsE = reinterpret_cast<const AliasedBits64*>(relative);
-            const AliasedBits64* bitsR = reinterpret_cast<const AliasedBits64*>(ratio);
-            std::int64_t lq = -1, le = -1, lr = -1;
-            for (int j = 0; j < n; ++j) {
-                const std::int64_t keep = -std::int64_t(common[j]);  // all ones where common
-                const std::int64_t q = (errorQuanta[j] == errorQuanta[j]) ? (bitsQ[j] & keep) | ~keep : -1;
-                const std::int64_t e = (relative[j] == relative[j]) ? (bitsE[j] & keep) | ~keep : -1;
-                const std::int64_t t = (ratio[j] == ratio[j]) ? (bitsR[j] & keep) | ~keep : -1;
-                lq = lq < q ? q : lq;
-                le = le < e ? e : le;
-                lr = lr < t ? t : lr;
-            }
-            largest[0] = lq, largest[1] = le, largest[2] = lr;
-        }
+        const int commons = __builtin_popcountll(lanes.common), hits = __builtin_popcountll(lanes.hit);
+        const int agreeing = __builtin_popcountll(lanes.common & lanes.agree);
         auto maxOfCommon = [&](double start, int k) ZCHECK_ALWAYS_INLINE {
             double largestValue;
-            std::memcpy(&largestValue, &largest[k], sizeof largestValue);
-            return largest[k] < 0 ? start : std::max(start, largestValue);
+            std::memcpy(&largestValue, &lanes.largest[k], sizeof largestValue);
+            return lanes.largest[k] < 0 ? start : std::max(start, largestValue);
         };
         r.bothMiss += n - hits;  // their class and ratio are written already
         r.bothHit += commons, r.agree += agreeing, r.depthErrors += commons - agreeing;
         r.maxErrorQuanta = maxOfCommon(r.maxErrorQuanta, 0);
         r.maxRelativeEyeZError = maxOfCommon(r.maxRelativeEyeZError, 1);
         const double rowMaxRatio = maxOfCommon(-1.0, 2);
-        counts.errorQuanta.add(errorQuantaOfLane, common, std::size_t(n));
-        counts.relativeEyeZ.add(relativeOfLane, common, std::size_t(n));
-        // The bias test's sum in scan order (its rounding depends on the order).
+        // The bias test's sum in scan order (its rounding depends on the order): its signed
+        // error, and where its exact depth falls in the quantum (a division per pixel).
         double signedErrorSum = tally.signedErrorSum;
-        std::int64_t quarters[4] = {0, 0, 0, 0}, biasSamples = 0;
-        forEachSetLane(biasSample, std::size_t(n), [&](std::size_t j) ZCHECK_ALWAYS_INLINE {
-            signedErrorSum += signedErrorQuanta[j];
-            const double position = rayDepths[j] / quantum[j];  // d/q
+        std::int64_t quarters[4] = {0, 0, 0, 0};
+        forEachSetBit(lanes.bias, [&](std::size_t j) ZCHECK_ALWAYS_INLINE {
+            signedErrorSum += lanes.signedErrorQuanta[j];
+            const double position = rayDepths[j] / quantumOfLane(j);  // d/q
             ++quarters[std::clamp(int(4 * (position - std::floor(position))), 0, 3)];
-            ++biasSamples;
         });
         tally.signedErrorSum = signedErrorSum;
         for (int k = 0; k < 4; ++k) tally.quarterCounts[k] += quarters[k];
-        r.biasSamples += biasSamples;
+        r.biasSamples += __builtin_popcountll(lanes.bias);
 
         // What is left in scan order (noteWorst): the pixels off the common case, the common
         // case's depth errors (a NaN ratio is one), its first pixel when nothing was compared
         // before, and its first with the row's largest ratio when that may be the worst.
-        for (int j = 0; j < n; ++j) {
-            const int hit = (rayPrimitives[j] != kNoPrimitive) | (rasterPrimitives[j] != kNoPrimitive);
-            visit[j] = std::uint8_t((common[j] & (agree[j] ^ 1)) | ((common[j] ^ 1) & hit));
-        }
-        if (commons > 0 && !comparedBefore) visit[std::find(common, common + n, std::uint8_t(1)) - common] = 1;
+        std::uint64_t visit = (lanes.common & ~lanes.agree) | (~lanes.common & lanes.hit);
+        if (commons > 0 && !comparedBefore) visit |= lanes.common & (0 - lanes.common);
         if (commons > 0 && rowMaxRatio > r.maxErrorOverTolerance)
-            for (int j = 0; j < n; ++j)
-                if (common[j] && ratio[j] == rowMaxRatio) {
-                    visit[j] = 1;
+            for (std::uint64_t c = lanes.common; c != 0; c &= c - 1)
+                if (lanes.ratio[__builtin_ctzll(c)] == rowMaxRatio) {
+                    visit |= c & (0 - c);
                     break;
                 }
 
         auto visitPixel = [&](int j) ZCHECK_ALWAYS_INLINE {
             const int col = col0 + j;
-            const std::size_t a = a0 + std::size_t(j), b = b0 + std::size_t(j), i = std::size_t(row) * W + col;
+            const std::size_t a = a0 + std::size_t(j), b = b0 + std::size_t(j), i = i0 + std::size_t(j);
             const std::uint32_t rayPrimitive = rayPrimitives[j], rasterPrimitive = rasterPrimitives[j];
             const bool rayHit = rayPrimitive != kNoPrimitive, rasterHit = rasterPrimitive != kNoPrimitive;
-            if (common[j]) {  // tallied already
-                const PixelClass c = agree[j] ? PixelClass::Agree : PixelClass::DepthError;  // written already
-                const bool worst = noteWorst(ratio[j]);
-                if (agree[j] && !worst) return;  // nothing to note: no finding is built
+            if (lanes.common >> j & 1) {  // tallied already
+                const bool agree = lanes.agree >> j & 1;
+                const PixelClass c = agree ? PixelClass::Agree : PixelClass::DepthError;  // written already
+                const bool worst = noteWorst(lanes.ratio[j]);
+                if (agree && !worst) return;  // nothing to note: no finding is built
                 PixelFinding f;
                 f.col = col, f.row = row;
                 f.rayWindowDepth = rayDepths[j], f.rasterWindowDepth = rasterDepths[j];
                 f.rayPrimitive = f.rasterPrimitive = rayPrimitive;
                 f.pixelClass = c;
-                f.errorQuanta = errorQuanta[j];
-                f.toleranceQuanta = bound[j] / quantum[j];
+                f.errorQuanta = lanes.errorQuanta[j];
+                f.toleranceQuanta = lanes.bound[j] / quantumOfLane(j);
                 if (worst) r.worst = f;
-                if (!agree[j]) noteUnexplained(r, f);
+                if (!agree) noteUnexplained(r, f);
                 return;
             }
             const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
@@ -681,21 +845,21 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tile, int
             if (isUnexplained(f.pixelClass)) noteUnexplained(r, f);
         };
         // The pixels to visit (a few per row, mostly none), in scan order.
-        forEachSetLane(visit, std::size_t(n), [&](std::size_t j) ZCHECK_ALWAYS_INLINE { visitPixel(int(j)); });
+        forEachSetBit(visit, [&](std::size_t j) ZCHECK_ALWAYS_INLINE { visitPixel(int(j)); });
     }
 }
 
 void TileComparison::Impl::compareBaseline(int tile, int rowBegin, int rowEnd, const RoutePixels& ray,
                                            const RoutePixels& raster)
 {
-    compareBody(tile, rowBegin, rowEnd, ray, raster);
+    compareBody<false>(tile, rowBegin, rowEnd, ray, raster);
 }
 
 #ifdef ZCHECK_X86_AVX512
 ZCHECK_TARGET_AVX512 void TileComparison::Impl::compareAvx512(int tile, int rowBegin, int rowEnd, const RoutePixels& ray,
                                                               const RoutePixels& raster)
 {
-    compareBody(tile, rowBegin, rowEnd, ray, raster);
+    compareBody<true>(tile, rowBegin, rowEnd, ray, raster);
 }
 #endif
 
@@ -817,7 +981,7 @@ Comparison compareRoutes(const PixelJudge& judge, const RenderResult& ray, const
                 measures.quanta(rayPixels, rasterPixels, i0, i0, std::size_t(W), errorQuanta);  // q, then |Δ|/q
                 for (std::size_t j = 0; j < std::size_t(W); ++j)
                     errorQuanta[j] =
-                        std::abs(PixelMeasures::signedErrorQuanta(rayPixels, rasterPixels, i0 + j, i0 + j, errorQuanta[j]));
+                        std::abs(PixelMeasures::signedErrorQuanta(rayPixels.windowDepth[i0 + j], rasterPixels.windowDepth[i0 + j], errorQuanta[j]));
             });
         },
         [&] {

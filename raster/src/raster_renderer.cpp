@@ -337,13 +337,7 @@ void drawInTile(const Viewport& vp, const DepthKeys& keys, const TriangleSetup& 
 }
 
 #ifdef ZCHECK_X86_AVX512
-// GCC 12's intrinsics headers start many conversions from an "undefined" vector, which its
-// -W(maybe-)uninitialized then reports inside the headers (GCC bug 105593).
-#if !defined(__clang__)
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#pragma GCC diagnostic ignored "-Wuninitialized"
-#endif
+ZCHECK_INTRINSICS_BEGIN
 
 // std::clamp(v, lo, hi) per lane: v < lo ? lo : hi < v ? hi : v, NaN and signed zeros included.
 ZCHECK_TARGET_AVX512 inline __m512d clamp(__m512d v, __m512d lo, __m512d hi)
@@ -557,9 +551,7 @@ ZCHECK_TARGET_AVX512 bool binItemsOfEight(const Viewport& vp, const glm::uvec3* 
     }
     return true;
 }
-#if !defined(__clang__)
-#pragma GCC diagnostic pop
-#endif
+ZCHECK_INTRINSICS_END
 #endif
 
 // Whether the vector kernels run (the clean chain's pixels eight at a time, the set-up of

@@ -190,7 +190,14 @@ public:
     // C·q + S·m + E (m = 0 for kUnknownPrimitive, which earns no slope credit).
     double surfaceTolerance(std::uint32_t primitive, double q) const;
     // The same for a surface whose slope m = slope(primitive) is known already.
-    double toleranceForSlope(double m, double q) const { return C_ * q + S_ * m + E_; }
+    double toleranceForSlope(double m, double q) const { return terms_.of(m, q); }
+    // Its terms, for a kernel that computes it several lanes at a time (the same operations
+    // in the same order as of()).
+    struct ToleranceTerms {
+        double C, S, E;
+        double of(double m, double q) const { return C * q + S * m + E; }
+    };
+    const ToleranceTerms& toleranceTerms() const { return terms_; }
     // Both routes hit: d_ray on `rayPrimitive`, d_raster on `rasterPrimitive`, at window point
     // pWindow. Returns Agree, EdgeSurface or DepthError; `bound` receives the tolerance used.
     PixelClass bothHit(double rayDepth, std::uint32_t rayPrimitive, double rasterDepth,
@@ -217,9 +224,22 @@ public:
     // block asked about ready (most rows of a frame after its first few).
     ZCHECK_ALWAYS_INLINE void slopes(const std::uint32_t* primitive, std::size_t n, double* slope) const
     {
-        bool ready = source_ == SlopeSource::TableOfSeen;
+        if (const double* table = slopeTableFor(primitive, n)) {
+            const std::uint32_t none = slopeTableNone();
+            for (std::size_t j = 0; j < n; ++j) slope[j] = table[std::min(primitive[j], none)];
+            return;
+        }
+        for (std::size_t j = 0; j < n; ++j) slope[j] = this->slope(primitive[j]);
+    }
+    // The table of slopes when it holds those of every primitive[0, n) (TableOfSeen, every
+    // block asked about ready), else null: slope(p) is then table[min(p, slopeTableNone())],
+    // for a kernel that looks them up itself.
+    ZCHECK_ALWAYS_INLINE const double* slopeTableFor(const std::uint32_t* primitive, std::size_t n) const
+    {
+        if (source_ != SlopeSource::TableOfSeen) return nullptr;
         // Each block asked about once per run of lanes in it (a row of a frame crosses few),
         // found 64 lanes at a time without a branch per lane; none for a primitive not of the scene.
+        bool ready = true;
         const std::uint32_t blocks = blockCount_;
         for (std::size_t j0 = 0; j0 < n && ready; j0 += kSlopeBlock) {
             const std::uint32_t* p = primitive + j0;
@@ -232,18 +252,16 @@ public:
                 ready &= blockState(p[j] / kSlopeBlock).load(std::memory_order_relaxed) == kBlockReady;
             });
         }
-        if (!ready) {
-            for (std::size_t j = 0; j < n; ++j) slope[j] = this->slope(primitive[j]);
-            return;
-        }
+        if (!ready) return nullptr;
         std::atomic_thread_fence(std::memory_order_acquire);  // the relaxed loads above saw each block's release
-        const std::uint32_t none = std::uint32_t(scene_.triangles.size());  // its entry: 0, and always there
-        for (std::size_t j = 0; j < n; ++j) slope[j] = slopeOfTriangle_[std::min(primitive[j], none)];
+        return slopeOfTriangle_.data();
     }
+    // The table's entry for any primitive not of the scene: 0, and always there.
+    std::uint32_t slopeTableNone() const { return std::uint32_t(scene_.triangles.size()); }
     // Whether the comparison's AVX-512 forms run (ZCHECK_COMPARE_KERNEL, read when the judge
     // was made).
     bool avx512Form() const { return avx512_; }
-    double snapPixels() const { return S_; }
+    double snapPixels() const { return terms_.S; }
     // What it was made for.
     const Scene& scene() const { return scene_; }
     const Camera& camera() const { return camera_; }
@@ -266,7 +284,7 @@ private:
     const Scene& scene_;
     const Camera& camera_;
     ToleranceModel tolerance_;
-    double C_, S_, E_;
+    ToleranceTerms terms_;
     bool avx512_;  // ZCHECK_COMPARE_KERNEL: the AVX-512 forms (avx512Form())
     DepthSlopeFrame slopeFrame_;
     SlopeSource source_;

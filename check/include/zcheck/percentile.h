@@ -52,20 +52,29 @@ public:
         constexpr std::size_t kChunk = 64;
         for (std::size_t first = 0; first < n; first += kChunk) {
             const std::size_t m = std::min(kChunk, n - first);
-            // Which values might be kept, one byte each (a superset: keepIfLargest decides, and
-            // what it would refuse now it refuses later too, as the threshold only rises).
             alignas(8) std::uint8_t candidate[kChunk] = {};
             int used = 0;
-            const std::uint32_t full = kept_.size() >= keep_;
+            const std::uint64_t least = leastKeepable();
             for (std::size_t k = 0; k < m; ++k) {
-                const std::uint32_t b = bits[first + k];
                 used += use[first + k];
-                candidate[k] = std::uint8_t(use[first + k] & (b >= floor_) & ((full ^ 1) | (b > threshold_)));
+                candidate[k] = std::uint8_t(use[first + k] & (bits[first + k] >= least));
             }
-            count_ += std::size_t(used);
-            // The candidates (a few per row of a tile), without a branch per value.
-            forEachSetLane(candidate, m, [&](std::size_t k) ZCHECK_ALWAYS_INLINE { keepIfLargest(bits[first + k]); });
+            addCandidates(values + first, laneBits(candidate, m), std::size_t(used));
         }
+    }
+    // The smallest bit pattern a value must have to be kept now (2^32: none can be); it only
+    // rises. For a kernel that finds its candidates itself, several per instruction.
+    std::uint64_t leastKeepable() const
+    {
+        return kept_.size() >= keep_ ? std::max<std::uint64_t>(floor_, std::uint64_t(threshold_) + 1) : floor_;
+    }
+    // `used` values added, of which values[k] for each bit k set in `candidates` (k < 64) may be
+    // kept: the candidates must include every one at or above leastKeepable() (keepIfLargest
+    // decides, and what it would refuse now it refuses later too); the rest are only counted.
+    void addCandidates(const float* values, std::uint64_t candidates, std::size_t used)
+    {
+        count_ += used;
+        for (; candidates != 0; candidates &= candidates - 1) keepIfLargest(floatBits(values[__builtin_ctzll(candidates)]));
     }
     std::size_t count() const { return count_; }  // values added
 
@@ -85,7 +94,7 @@ private:
     }
     void keepIfLargest(std::uint32_t bits)
     {
-        if (bits < floor_ || (kept_.size() >= keep_ && bits <= threshold_)) return;  // not among the largest
+        if (bits < leastKeepable()) return;  // not among the largest
         kept_.push_back(bits);
         if (kept_.size() == 2 * keep_) shrink();
     }

@@ -38,6 +38,19 @@
 #define ZCHECK_TARGET_AVX512 __attribute__((target("avx512f,avx512dq,avx512vl")))
 #endif
 
+// Around hand-written intrinsics: GCC 12's intrinsics headers start many conversions from an
+// "undefined" vector, which its -W(maybe-)uninitialized then reports inside the headers (GCC
+// bug 105593).
+#if defined(__GNUC__) && !defined(__clang__)
+#define ZCHECK_INTRINSICS_BEGIN                                                                  \
+    _Pragma("GCC diagnostic push") _Pragma("GCC diagnostic ignored \"-Wmaybe-uninitialized\"") \
+        _Pragma("GCC diagnostic ignored \"-Wuninitialized\"")
+#define ZCHECK_INTRINSICS_END _Pragma("GCC diagnostic pop")
+#else
+#define ZCHECK_INTRINSICS_BEGIN
+#define ZCHECK_INTRINSICS_END
+#endif
+
 namespace zcheck {
 
 // Whether the AVX-512 form runs: the processor has AVX-512 F, DQ and VL (and the build

@@ -12,6 +12,7 @@
 // array must hold them). Always inlined, so that each form of a kernel compiles its own copy.
 #include "zcheck/kernel_choice.h"
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -25,20 +26,33 @@ ZCHECK_ALWAYS_INLINE inline std::uint64_t laneBitsOfBytes(std::uint64_t word)
     return (word * 0x0102040810204080ull) >> 56;
 }
 
+// The bytes of mask[0, n), n <= 64, as bits: lane k's as bit k.
+ZCHECK_ALWAYS_INLINE inline std::uint64_t laneBits(const std::uint8_t* mask, std::size_t n)
+{
+    static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "byte k of a mask word is lane w + k");
+    std::uint64_t bits = 0;
+    for (std::size_t w = 0; w < n; w += 8) {
+        std::uint64_t word;
+        std::memcpy(&word, mask + w, sizeof word);
+        if (n - w < 8) word &= (std::uint64_t(1) << (8 * (n - w))) - 1;
+        bits |= laneBitsOfBytes(word) << w;
+    }
+    return bits;
+}
+
+// visit(k) for each bit k set in `bits`, in increasing order.
+template <class Visit>
+ZCHECK_ALWAYS_INLINE inline void forEachSetBit(std::uint64_t bits, Visit&& visit)
+{
+    for (; bits != 0; bits &= bits - 1) visit(std::size_t(__builtin_ctzll(bits)));
+}
+
 template <class Visit>
 ZCHECK_ALWAYS_INLINE inline void forEachSetLane(const std::uint8_t* mask, std::size_t n, Visit&& visit)
 {
-    static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "byte k of a mask word is lane w + k");
-    for (std::size_t first = 0; first < n; first += 64) {
-        std::uint64_t bits = 0;
-        for (std::size_t w = first; w < n && w < first + 64; w += 8) {
-            std::uint64_t word;
-            std::memcpy(&word, mask + w, sizeof word);
-            if (n - w < 8) word &= (std::uint64_t(1) << (8 * (n - w))) - 1;
-            bits |= laneBitsOfBytes(word) << (w - first);
-        }
-        for (; bits != 0; bits &= bits - 1) visit(first + std::size_t(__builtin_ctzll(bits)));
-    }
+    for (std::size_t first = 0; first < n; first += 64)
+        forEachSetBit(laneBits(mask + first, std::min<std::size_t>(64, n - first)),
+                      [&](std::size_t k) ZCHECK_ALWAYS_INLINE { visit(first + k); });
 }
 
 }  // namespace zcheck

@@ -99,6 +99,19 @@ public:
         return true;
     }
 
+    // The closed form relativeEyeZDifferences computes, for a kernel that computes it itself
+    // (the same operations): window depth = A + B/z (perspective) or A + B·z (parallel).
+    // None for a raw-matrix camera.
+    struct RelativeForm {
+        double A;
+        bool parallel;
+    };
+    std::optional<RelativeForm> relativeForm() const
+    {
+        if (fromMatrix_) return std::nullopt;
+        return RelativeForm{depthA_, parallel_};
+    }
+
 private:
     // The closed forms of relativeEyeZDifference. Perspective: z = B/(w − A), so
     // (z_o − z_r)/z_r = (w_r − w_o)/(w_o − A); parallel: z = (w − A)/B, so (w_o − w_r)/(w_r − A).
