@@ -1,17 +1,17 @@
 #pragma once
 // The choice, at run time, between a routine's AVX-512 form and its baseline form.
 //
-// The raster's vector kernels (hand-written, eight lanes at a time), the trace and the
-// comparison (each the same source compiled twice, once for AVX-512) run their AVX-512 forms
-// where the processor has AVX-512 F, DQ and VL, and their baseline forms elsewhere. The two
-// forms do the same IEEE operations in the same order (the build has -ffp-contract=off, so no
-// multiply and add are fused into one rounding), so their outputs are bit-identical; the
-// tests run both and compare them bit for bit. An environment variable per stage forces the
-// baseline form:
+// The raster's vector kernels and the comparison's row pass (hand-written, eight lanes at a
+// time), the trace and the rest of the comparison (the same source compiled twice, once for
+// AVX-512) run their AVX-512 forms where the processor has AVX-512 F, DQ and VL, and their
+// baseline forms elsewhere. The two forms do the same IEEE operations in the same order (the
+// build has -ffp-contract=off, so no multiply and add are fused into one rounding), so their
+// outputs are bit-identical; the tests run both and compare them bit for bit. An environment
+// variable per stage forces the baseline form:
 //
 //   ZCHECK_RASTER_KERNEL=scalar     the raster's scalar loops
 //   ZCHECK_RAY_KERNEL=baseline      the trace compiled for the build's baseline (x86-64: SSE2)
-//   ZCHECK_COMPARE_KERNEL=baseline  the comparison's row pass and slopes, likewise
+//   ZCHECK_COMPARE_KERNEL=baseline  the comparison's row pass (its lane loops) and slopes, likewise
 //
 // A variable unset, empty or `auto` lets the processor decide.
 //
