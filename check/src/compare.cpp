@@ -494,7 +494,7 @@ ZCHECK_INTRINSICS_BEGIN
 // rowLanesBaseline's results, written out eight lanes at a time for AVX-512: the same IEEE
 // operations lane for lane (bit-identical), its masks in mask registers and the keepers'
 // candidates found among them, a row in one pass. (The lane loops above compiled for AVX-512,
-// each through arrays of bytes, made the whole comparison ~1.25× as long; bench/speed-log.md.)
+// each through arrays of bytes, made the whole comparison ~1.3× as long; bench/speed-log.md.)
 ZCHECK_TARGET_AVX512 void rowLanesAvx512(const RowInputs& in, const PixelJudge::ToleranceTerms& terms,
                                          StatisticCounts& counts, RowLanes& out)
 {
