@@ -389,7 +389,7 @@ struct RowInputs {
     // rowLanesAvx512 only: where these are given, it computes the three arrays above itself
     // (which are then not read): the slopes from PixelJudge::slopeTableFor, the quantum one for
     // all, the relative error in closed form.
-    const double* slopeTable = nullptr;
+    const double* slopeTable = nullptr;  // PixelJudge::slopeTableFor (where gatherable())
     std::uint32_t slopeTableNone = 0;
     std::optional<double> constantQuantum;
     std::optional<CameraRays::RelativeForm> relativeForm;
@@ -488,6 +488,11 @@ ZCHECK_ALWAYS_INLINE inline void rowLanesBaseline(const RowInputs& in, const Pix
     out.common = laneBits(common, std::size_t(n)), out.agree = laneBits(agree, std::size_t(n));
     out.hit = laneBits(hit, std::size_t(n)), out.bias = laneBits(bias, std::size_t(n));
 }
+
+// Whether rowLanesAvx512 can look up slopes in a table whose largest index (slopeTableNone())
+// is this itself: its gathers take signed 32-bit indices (so not for 2^31 triangles or more,
+// beyond any scene a machine of today holds; the lane loops then look them up).
+inline bool gatherable(std::uint32_t largestIndex) { return largestIndex < (1u << 31); }
 
 #ifdef ZCHECK_X86_AVX512
 ZCHECK_INTRINSICS_BEGIN
@@ -729,7 +734,8 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tile, int
         in.rayDepth = rayDepths, in.rasterDepth = rasterDepths;
         in.slope = slope, in.quantum = quantum, in.relative = relative, in.n = n;
         if constexpr (kAvx512) {
-            in.slopeTable = judge.slopeTableFor(surface, std::size_t(n)), in.slopeTableNone = judge.slopeTableNone();
+            if (gatherable(judge.slopeTableNone()))
+                in.slopeTable = judge.slopeTableFor(surface, std::size_t(n)), in.slopeTableNone = judge.slopeTableNone();
             in.constantQuantum = constantQuantum, in.relativeForm = relativeForm;
         }
         if (!in.slopeTable) judge.slopes(surface, std::size_t(n), slope);
