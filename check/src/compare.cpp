@@ -380,6 +380,7 @@ constexpr int kLanes = TileComparison::kTileSize;
 struct RowInputs {
     const std::uint32_t* rayPrimitive = nullptr;
     const std::uint32_t* rasterPrimitive = nullptr;
+    const std::uint32_t* surface = nullptr;  // the triangle both routes hit (the common case), else kNoPrimitive
     const double* rayDepth = nullptr;
     const double* rasterDepth = nullptr;
     const double* slope = nullptr;     // of the triangle both routes hit (where they hit one)
@@ -435,9 +436,8 @@ ZCHECK_ALWAYS_INLINE inline void rowLanesBaseline(const RowInputs& in, const Pix
     alignas(64) std::uint8_t common[kLanes], agree[kLanes], hit[kLanes], bias[kLanes];
     alignas(64) float errorQuantaOfLane[kLanes], relativeOfLane[kLanes];
     for (int j = 0; j < n; ++j) {
-        const std::uint32_t rayPrimitive = in.rayPrimitive[j], rasterPrimitive = in.rasterPrimitive[j];
-        common[j] = rayPrimitive != kNoPrimitive && rayPrimitive == rasterPrimitive;
-        hit[j] = (rayPrimitive != kNoPrimitive) | (rasterPrimitive != kNoPrimitive);
+        common[j] = in.surface[j] != kNoPrimitive;
+        hit[j] = (in.rayPrimitive[j] != kNoPrimitive) | (in.rasterPrimitive[j] != kNoPrimitive);
     }
     for (int j = 0; j < n; ++j) {
         const double q = in.quantum[j], m = in.slope[j];
@@ -612,7 +612,6 @@ struct TileComparison::Impl {
           camera(judge.camera()),
           perPixel(perPixel),
           measures(camera),
-          S(judge.snapPixels()),
           W(camera.width()),
           H(camera.height()),
           grid(W, H, kTileSize),
@@ -639,7 +638,6 @@ struct TileComparison::Impl {
     const Camera& camera;
     Comparison* perPixel;
     const PixelMeasures measures;
-    const double S;
     const int W, H;
     const TileGrid grid;
     std::vector<TileTally> tallies;  // one per tile
@@ -730,7 +728,7 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tile, int
         }
         // The row's slopes, quanta and relative errors, except those the AVX-512 form computes itself.
         RowInputs in;
-        in.rayPrimitive = rayPrimitives, in.rasterPrimitive = rasterPrimitives;
+        in.rayPrimitive = rayPrimitives, in.rasterPrimitive = rasterPrimitives, in.surface = surface;
         in.rayDepth = rayDepths, in.rasterDepth = rasterDepths;
         in.slope = slope, in.quantum = quantum, in.relative = relative, in.n = n;
         if constexpr (kAvx512) {
