@@ -576,6 +576,30 @@ TEST_CASE("a released large buffer is handed back, faulted in, to the next one o
     REQUIRE(cachedLargeBufferBytes() == 0);
 }
 
+// Regression: a comparison's per-pixel class (one byte a pixel, 2,073,600 bytes at 1080p,
+// just under one huge page) came from operator new, a fresh mmap faulted in 4 KiB at a
+// time: ~580 faults in every cold comparison. From 1 MiB up a buffer is whole huge pages.
+TEST_CASE("a 1080p byte-per-pixel buffer gets a huge page of its own and is kept for the next one",
+          "[core][large_buffer]")
+{
+    constexpr std::size_t kHugePage = std::size_t(2) << 20;
+    releaseCachedLargeBuffers();
+    {
+        LargeVector<std::uint8_t> pixelClass(1920 * 1080);
+        REQUIRE(reinterpret_cast<std::uintptr_t>(pixelClass.data()) % kHugePage == 0);
+    }
+    REQUIRE(cachedLargeBufferBytes() == kHugePage);
+    {
+        LargeVector<std::uint8_t> halfPage(kHugePage / 2);  // the least that gets a huge page
+        REQUIRE(reinterpret_cast<std::uintptr_t>(halfPage.data()) % kHugePage == 0);
+        REQUIRE(cachedLargeBufferBytes() == 0);  // it took the kept page
+    }
+    REQUIRE(cachedLargeBufferBytes() == kHugePage);
+    releaseCachedLargeBuffers();
+    { LargeVector<std::uint8_t> below(kHugePage / 2 - 1); }  // from operator new, not kept
+    REQUIRE(cachedLargeBufferBytes() == 0);
+}
+
 // The lane loops' sparse walks (forEachSetLane) must visit exactly the set lanes below n, in
 // order: against a plain loop, over masks dense and sparse, lengths not a multiple of eight
 // and longer than the 64 lanes packed at a time, and set bytes past n that must be ignored.

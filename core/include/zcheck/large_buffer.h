@@ -28,10 +28,11 @@
 
 namespace zcheck {
 
-// Memory for `bytes`: from 2 MiB up on a 2 MiB boundary, advised huge pages; smaller from
-// operator new. Release with releaseLarge and the same byte count. Throws std::bad_alloc.
+// Memory for `bytes`: from 1 MiB up, whole 2 MiB pages on a 2 MiB boundary, advised huge
+// pages (a 1080p byte-per-pixel image fits one); smaller from operator new. Release with
+// releaseLarge and the same byte count. Throws std::bad_alloc.
 //
-// Released blocks of 2 MiB and more are kept (up to 1 GiB), already faulted in, and handed
+// Released blocks of huge pages are kept (up to 1 GiB), already faulted in, and handed
 // back to the next allocation of the same size rounded up to 2 MiB: a program that renders
 // frame after frame pays the page faults of its buffers once, not per frame (as a GPU
 // driver's reused framebuffer does). An allocation that finds no block of its size first
