@@ -8,6 +8,7 @@
 
 #include "zcheck/embree_reference.h"
 #include "zcheck/error.h"
+#include "zcheck/large_buffer.h"
 #include "zcheck/mesh_loader.h"
 
 #include <CLI/CLI.hpp>
@@ -33,6 +34,13 @@ double peakResidentMiB()
     return double(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
 }
 
+long minorFaults()
+{
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    return usage.ru_minflt;
+}
+
 struct Stats {
     double median, best;
 };
@@ -48,6 +56,7 @@ Stats timeRepeated(int repeats, F&& run)
 
 // `phase` other than "all" times one phase alone, for A/B comparisons of its code: "raster"
 // (no BVH is built), "trace", "compare" (both routes rendered once, the comparison repeated),
+// "compare-cold" (before each comparison, both routes rendered into fresh buffers),
 // "floor" (what the comparison costs at least: its arrays read and written, nothing computed),
 // or "tiles" (the whole check drawn, traced and compared tile by tile, as `zcheck check` runs).
 void runPhase(const std::string& phase, const Scene& scene, const Camera& camera, int repeats)
@@ -134,6 +143,25 @@ void runPhase(const std::string& phase, const Scene& scene, const Camera& camera
             pass((camera.height() + kRows - 1) / kRows, [&](int block) {
                 return PixelRect{0, block * kRows, camera.width(), std::min(camera.height(), (block + 1) * kRows)};
             });
+        } else if (phase == "compare-cold") {
+            // As in `zcheck bench`'s cold full-frame check: the kept buffers given back, both
+            // routes rendered into fresh ones (not timed), then the comparison, timed with the
+            // page faults it takes (getrusage: every thread's, 4 KiB and huge pages alike).
+            std::vector<double> faults;
+            const Stats ms = timeRepeated(repeats, [&] {
+                releaseCachedLargeBuffers();
+                ray = rays.render(camera);
+                const RenderResult drawn = raster.render(camera);
+                const long faultsBefore = minorFaults();
+                const auto start = std::chrono::steady_clock::now();
+                const Comparison c = compareRoutes(scene, camera, ray, drawn);
+                const double elapsed = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+                faults.push_back(double(minorFaults() - faultsBefore));
+                return elapsed;
+            });
+            std::sort(faults.begin(), faults.end());
+            std::printf("compare cold %7.1f ms (best %7.1f), %5.0f page faults (fewest %5.0f)", ms.median, ms.best,
+                        faults[faults.size() / 2], faults.front());
         } else {
             const RenderResult drawn = raster.render(camera);
             const Stats ms = timeRepeated(repeats, [&] {
@@ -199,9 +227,9 @@ int main(int argc, char** argv)
     app.add_option("--only", only, "run only workloads whose label contains this text");
     app.add_option("--scene", sceneName, "one workload: this scene (a built-in name or a mesh file) instead of the named ones");
     app.add_option("--camera", cameraFile, "with --scene: a camera file (its size overrides --width/--height)");
-    app.add_option("--phase", phase, "all, or one phase alone: raster (no BVH built), trace, compare, floor (what any comparison costs at least: its arrays read and written, nothing computed), tiles (a check tile by tile), "
+    app.add_option("--phase", phase, "all, or one phase alone: raster (no BVH built), trace, compare, compare-cold (each comparison after renders into fresh buffers, with its page faults), floor (what any comparison costs at least: its arrays read and written, nothing computed), tiles (a check tile by tile), "
                    "or embree (the trace's yardstick: Embree's own best packet trace)")
-        ->check(CLI::IsMember({"all", "raster", "trace", "compare", "floor", "tiles", "embree"}))
+        ->check(CLI::IsMember({"all", "raster", "trace", "compare", "compare-cold", "floor", "tiles", "embree"}))
         ->capture_default_str();
     CLI11_PARSE(app, argc, argv);
 

@@ -576,9 +576,9 @@ TEST_CASE("a released large buffer is handed back, faulted in, to the next one o
     REQUIRE(cachedLargeBufferBytes() == 0);
 }
 
-// Regression: a comparison's per-pixel class (one byte a pixel, 2,073,600 bytes at 1080p,
-// just under one huge page) came from operator new, a fresh mmap faulted in 4 KiB at a
-// time: ~580 faults in every cold comparison. From 1 MiB up a buffer is whole huge pages.
+// A comparison's per-pixel class (one byte a pixel, 2,073,600 bytes at 1080p, just under one
+// huge page) came from operator new, mostly a fresh mmap faulted in 4 KiB at a time: ~480
+// faults in a cold comparison. From 1 MiB up a buffer is whole huge pages, kept for reuse.
 TEST_CASE("a 1080p byte-per-pixel buffer gets a huge page of its own and is kept for the next one",
           "[core][large_buffer]")
 {
@@ -598,6 +598,29 @@ TEST_CASE("a 1080p byte-per-pixel buffer gets a huge page of its own and is kept
     releaseCachedLargeBuffers();
     { LargeVector<std::uint8_t> below(kHugePage / 2 - 1); }  // from operator new, not kept
     REQUIRE(cachedLargeBufferBytes() == 0);
+}
+
+// Regression: releaseCachedLargeBuffers handed its blocks to free(), and glibc, whose mmap
+// threshold rises to the size of the last large block freed, kept them in its heap and gave
+// them to the next allocations already faulted in, values and all: a "cold" render or
+// comparison in `zcheck bench` (which releases the cache first to time fresh buffers) then
+// often took no page fault at all. Memory given back must be the system's again: the next
+// large buffers are fresh, zero-filled memory.
+TEST_CASE("large buffers given back are the system's again: the next ones are fresh memory", "[core][large_buffer]")
+{
+    constexpr std::size_t kValues = std::size_t(8) << 20 >> 3;  // 8 MiB of double
+    for (int round = 0; round < 4; ++round) {
+        releaseCachedLargeBuffers();
+        std::vector<LargeVector<double>> buffers;
+        for (std::size_t size : {kValues, 2 * kValues, kValues / 2, kValues}) {
+            buffers.emplace_back();
+            buffers.back().resize(size);  // uninitialised: what the memory held
+            INFO("round " << round << ", " << size << " values");
+            REQUIRE(std::all_of(buffers.back().begin(), buffers.back().end(), [](double v) { return v == 0.0; }));
+        }
+        for (LargeVector<double>& buffer : buffers) std::fill(buffer.begin(), buffer.end(), 0.75);
+    }
+    releaseCachedLargeBuffers();
 }
 
 // The lane loops' sparse walks (forEachSetLane) must visit exactly the set lanes below n, in

@@ -1,5 +1,6 @@
 #include "zcheck/large_buffer.h"
 
+#include <malloc.h>
 #include <sys/mman.h>
 #include <unistd.h>
 
@@ -15,10 +16,11 @@ namespace {
 
 constexpr std::size_t kHugePage = std::size_t(2) << 20;
 // From here up a buffer gets whole huge pages of its own, below 2 MiB too: a 1080p image of
-// one byte a pixel (2,073,600 bytes) from operator new was a fresh glibc mmap, faulted in
-// 4 KiB at a time (~580 faults in a comparison made right after its renders, ~1.4 ms of its
-// 11), where one huge page costs one fault. A buffer of 1 to 2 MiB leaves at most half of its
-// page unused.
+// one byte a pixel (2,073,600 bytes) from operator new was mostly a fresh glibc mmap, faulted
+// in 4 KiB at a time (~480 of the faults of a comparison made right after its renders), where
+// one huge page takes one fault and one entry of the address cache. (The time those faults
+// took was within the noise of this machine: the kernel's zeroing of the pages dominates, and
+// that is the same either way.) A buffer of 1 to 2 MiB leaves at most half of its page unused.
 constexpr std::size_t kLargeFrom = kHugePage / 2;
 constexpr std::size_t kCacheLimit = std::size_t(1) << 30;  // bytes the cache may hold at most
 
@@ -141,7 +143,13 @@ void releaseLarge(void* data, std::size_t bytes) noexcept
     }
 }
 
-void releaseCachedLargeBuffers() noexcept { blockCache().releaseAll(); }
+void releaseCachedLargeBuffers() noexcept
+{
+    blockCache().releaseAll();
+#ifdef __GLIBC__
+    malloc_trim(0);  // the heap's free pages too, not only those at its top
+#endif
+}
 
 std::size_t cachedLargeBufferBytes() noexcept { return blockCache().held(); }
 

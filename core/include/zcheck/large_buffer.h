@@ -44,7 +44,10 @@ namespace zcheck {
 // its last user left.
 void* allocateLarge(std::size_t bytes);
 void releaseLarge(void* data, std::size_t bytes) noexcept;
-// Gives every kept block back to the system (a first frame measured as a fresh process pays it).
+// Gives every kept block back to the system, and has the C library give back the free memory
+// its heap holds (glibc keeps freed blocks of up to its raised mmap threshold, tens of MiB,
+// and hands them out again faulted in): the next large buffers are fresh memory, and a first
+// frame measured as a fresh process pays what one pays. Takes milliseconds; not per frame.
 void releaseCachedLargeBuffers() noexcept;
 // The bytes the kept blocks hold.
 std::size_t cachedLargeBufferBytes() noexcept;
