@@ -1054,9 +1054,10 @@ the top, one per non-miss pixel, in scan order.)doc");
     m.def(
         "release_cached_buffers", [] { releaseCachedLargeBuffers(); },
         R"doc(Gives back to the system the per-frame buffers zcheck keeps for the next render of the same
-size (renders and comparisons of 2 MiB and more, up to 1 GiB in all; see cached_buffer_bytes).
-A loop over many cameras or maps pays their page faults once because of them; a long-lived
-program that is done checking calls this. Safe at any time: buffers in use are not touched.)doc");
+size (renders and comparisons of 1 MiB and more, up to 1 GiB in all; see cached_buffer_bytes),
+and has the C library give back the free memory its heap holds. A loop over many cameras or
+maps pays their page faults once because of them; a long-lived program that is done checking
+calls this. Safe at any time: buffers in use are not touched.)doc");
     m.def("cached_buffer_bytes", [] { return cachedLargeBufferBytes(); },
           "The bytes zcheck's kept per-frame buffers hold (see release_cached_buffers).");
 
