@@ -1047,9 +1047,10 @@ TEST_CASE("a comparison through a judge of the caller's, asked before, reports w
 
 TEST_CASE("a tile compared a few rows at a time, tiles interleaved, reports what whole tiles report", "[compare][rows]")
 {
-    // compareRoutes compares a band of tiles image row by image row (compareTileRows); a tile's
-    // rows then arrive in several calls, between other tiles' calls. Whole tiles in reverse
-    // order against pieces of 1 to 9 rows, the next piece taken from a random unfinished tile:
+    // compareRoutes compares a band of tiles image row by image row (compareBandRows); a tile's
+    // rows may also arrive in several calls, between other tiles' calls (compareTileRows). Whole
+    // tiles in reverse order against pieces of 1 to 9 rows, the next piece taken from a random
+    // unfinished tile, and against bands from the bottom in pieces of 1 to 9 rows:
     // the same report (counts, maxima, percentiles, bias, the worst pixel and the unexplained
     // samples in scan order) and the same per-pixel classes and ratios, clean and with rows
     // flipped (thousands of unexplained pixels) or a depth bias, on tiles cut by both edges.
@@ -1059,12 +1060,22 @@ TEST_CASE("a tile compared a few rows at a time, tiles interleaved, reports what
     for (const CheckOptions& options : cleanFlippedAndBiased()) {
         const RenderResult ray = checker.renderRay(camera, options.faults.ray);
         const RenderResult raster = checker.renderRaster(camera, options.faults.raster);
-        auto reportOf = [&](Comparison& c, bool inPieces) {
+        enum class Order { WholeTiles, TilePieces, BandPieces };
+        auto reportOf = [&](Comparison& c, Order order) {
             TileComparison tiles(checker.scene(), camera, {}, &c);
             const TileGrid& grid = tiles.tiles();
-            if (!inPieces) {
+            if (order == Order::WholeTiles) {
                 for (int tile = grid.count() - 1; tile >= 0; --tile)
                     tiles.compareTile(tile, RoutePixels::of(ray), RoutePixels::of(raster));
+            } else if (order == Order::BandPieces) {  // bands from the bottom, each in pieces of 1 to 9 rows
+                for (int band = grid.tilesY() - 1; band >= 0; --band) {
+                    const PixelRect first = grid.rect(band * grid.tilesX());
+                    for (int from = first.row0; from < first.row1;) {
+                        const int to = from + 1 + int(random() % 9);
+                        tiles.compareBandRows(band, from, to, RoutePixels::of(ray), RoutePixels::of(raster));
+                        from = to;
+                    }
+                }
             } else {
                 std::vector<int> nextRow(std::size_t(grid.count()));
                 for (int tile = 0; tile < grid.count(); ++tile) nextRow[std::size_t(tile)] = grid.rect(tile).row0;
@@ -1084,13 +1095,17 @@ TEST_CASE("a tile compared a few rows at a time, tiles interleaved, reports what
             report.comparison = tiles.finish().value();
             return report;
         };
-        Comparison whole, pieces;
-        const CheckReport byTiles = reportOf(whole, false), byPieces = reportOf(pieces, true);
+        Comparison whole, pieces, bands;
+        const CheckReport byTiles = reportOf(whole, Order::WholeTiles), byPieces = reportOf(pieces, Order::TilePieces);
+        const CheckReport byBands = reportOf(bands, Order::BandPieces);
         INFO("faults: rows flipped " << options.faults.ray.flipRows << ", truncated " << options.faults.raster.truncateUnorm);
         REQUIRE(byTiles.comparison.bothHit > 1000);
         if (options.faults.ray.flipRows) REQUIRE(byTiles.comparison.unexplainedSamples.size() == 20);
         REQUIRE(checkReportJson(byPieces) == checkReportJson(byTiles));
         REQUIRE(testing::sameBits(pieces.pixelClass, whole.pixelClass));
         REQUIRE(testing::sameBits(pieces.errorOverTolerance, whole.errorOverTolerance));
+        REQUIRE(checkReportJson(byBands) == checkReportJson(byTiles));
+        REQUIRE(testing::sameBits(bands.pixelClass, whole.pixelClass));
+        REQUIRE(testing::sameBits(bands.errorOverTolerance, whole.errorOverTolerance));
     }
 }

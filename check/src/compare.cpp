@@ -623,13 +623,16 @@ struct TileComparison::Impl {
     {
     }
 
-    // Rows [rowBegin, rowEnd) of a tile (TileComparison::compareTileRows).
-    void compare(int tile, int rowBegin, int rowEnd, const RoutePixels& ray, const RoutePixels& raster);
+    // Rows [rowBegin, rowEnd) of tiles [tileBegin, tileEnd), consecutive tiles of one band,
+    // image row by image row across them (TileComparison::compareTileRows, compareBandRows).
+    void compare(int tileBegin, int tileEnd, int rowBegin, int rowEnd, const RoutePixels& ray, const RoutePixels& raster);
     template <bool kAvx512>
-    void compareBody(int tile, int rowBegin, int rowEnd, const RoutePixels& ray, const RoutePixels& raster);
-    void compareBaseline(int tile, int rowBegin, int rowEnd, const RoutePixels& ray, const RoutePixels& raster);
+    void compareBody(int tileBegin, int tileEnd, int rowBegin, int rowEnd, const RoutePixels& ray,
+                     const RoutePixels& raster);
+    void compareBaseline(int tileBegin, int tileEnd, int rowBegin, int rowEnd, const RoutePixels& ray,
+                         const RoutePixels& raster);
 #ifdef ZCHECK_X86_AVX512
-    ZCHECK_TARGET_AVX512 void compareAvx512(int tile, int rowBegin, int rowEnd, const RoutePixels& ray,
+    ZCHECK_TARGET_AVX512 void compareAvx512(int tileBegin, int tileEnd, int rowBegin, int rowEnd, const RoutePixels& ray,
                                             const RoutePixels& raster);
 #endif
 
@@ -653,43 +656,22 @@ struct TileComparison::Impl {
 // then, in scan order, the pixels off the common case and those of it that may be the worst
 // (noteWorst).
 // A tile's rows may come in several calls, in order: all that carries from one row to the next
-// is in the tile's tally (comparedBefore is derived from its counts).
+// is in the tile's tally (comparedBefore is derived from its counts). A call takes a row of
+// each of its tiles in turn, so that what does not depend on the tile (the thread's keepers,
+// the quantum's and the relative error's forms) is found once per call, not once per 64 pixels.
 template <bool kAvx512>
-ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tile, int rowBegin, int rowEnd,
-                                                                   const RoutePixels& ray, const RoutePixels& raster)
+ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tileBegin, int tileEnd, int rowBegin,
+                                                                   int rowEnd, const RoutePixels& ray,
+                                                                   const RoutePixels& raster)
 {
-    TileTally& tally = tallies[std::size_t(tile)];
-    ComparisonReport& r = tally.report;
     StatisticCounts& counts = statisticCounts.local();
-    const PixelRect rect = grid.rect(tile);
-    const int col0 = rect.col0, col1 = rect.col1;
-    const int row0 = std::max(rect.row0, rowBegin), row1 = std::min(rect.row1, rowEnd);
+    const PixelRect band = grid.rect(tileBegin);  // the rows of every tile of the call
+    const int row0 = std::max(band.row0, rowBegin), row1 = std::min(band.row1, rowEnd);
 
     // Pixel (col, row): a in the ray's arrays, b in the raster's, i in the image.
     auto quantumAt = [&](std::size_t a, std::size_t b) ZCHECK_ALWAYS_INLINE { return measures.quantum(ray, raster, a, b); };
     auto signedErrorQuantaAt = [&](std::size_t a, std::size_t b, double q) ZCHECK_ALWAYS_INLINE {
         return PixelMeasures::signedErrorQuanta(ray.windowDepth[a], raster.windowDepth[b], q);
-    };
-    // A pixel compared on depth (agree or depth error), in scan order: whether it is the worst so
-    // far (its finding is then r.worst): the first compared, or a ratio above every one before.
-    // So the worst is the first pixel in scan order with the largest ratio (NaN ratios aside), and
-    // a row's common-case pixels that are neither its first compared one nor the first with its
-    // largest ratio can be left out without changing it.
-    bool comparedBefore = r.agree + r.depthErrors > 0;
-    auto noteWorst = [&](double ratio) ZCHECK_ALWAYS_INLINE {
-        const bool worst = ratio > r.maxErrorOverTolerance || !comparedBefore;
-        comparedBefore = true;
-        if (worst) r.maxErrorOverTolerance = std::max(r.maxErrorOverTolerance, ratio);
-        return worst;
-    };
-    // A pixel compared on depth off the common case: its count, the statistics, noteWorst.
-    auto noteCompared = [&](bool agree, double ratio, double errorQuanta, double relative) ZCHECK_ALWAYS_INLINE {
-        agree ? ++r.agree : ++r.depthErrors;
-        counts.errorQuanta.add(float(errorQuanta));
-        counts.relativeEyeZ.add(float(relative));
-        r.maxRelativeEyeZError = std::max(r.maxRelativeEyeZError, relative);
-        r.maxErrorQuanta = std::max(r.maxErrorQuanta, errorQuanta);
-        return noteWorst(ratio);
     };
     auto setClass = [&](std::size_t i, PixelClass c) ZCHECK_ALWAYS_INLINE {
         if (perPixel) perPixel->pixelClass[i] = c;
@@ -705,174 +687,204 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tile, int
     RowLanes lanes;
 
     for (int row = row0; row < row1; ++row) {
-        const std::size_t a0 = ray.at(col0, row), b0 = raster.at(col0, row);
-        const int n = col1 - col0;
-        // A later row's pixels asked for now: a tile's row of a full-frame image is a few cache
-        // lines, too short for the hardware to see a stream, and each row began with misses.
-        if (row + kRowsAhead < row1) {
-            const std::size_t aAhead = ray.at(col0, row + kRowsAhead), bAhead = raster.at(col0, row + kRowsAhead);
-            for (int j = 0; j < n; j += 16) {
-                __builtin_prefetch(ray.primitive + aAhead + j), __builtin_prefetch(raster.primitive + bAhead + j);
-                __builtin_prefetch(ray.windowDepth + aAhead + j), __builtin_prefetch(ray.windowDepth + aAhead + j + 8);
-                __builtin_prefetch(raster.windowDepth + bAhead + j);
-                __builtin_prefetch(raster.windowDepth + bAhead + j + 8);
-            }
-        }
-        const std::uint32_t* rayPrimitives = ray.primitive + a0;
-        const std::uint32_t* rasterPrimitives = raster.primitive + b0;
-        const double* rayDepths = ray.windowDepth + a0;
-        const double* rasterDepths = raster.windowDepth + b0;
-        for (int j = 0; j < n; ++j) {
-            const bool common = rayPrimitives[j] != kNoPrimitive && rayPrimitives[j] == rasterPrimitives[j];
-            surface[j] = common ? rayPrimitives[j] : kNoPrimitive;
-        }
-        // The row's slopes, quanta and relative errors, except those the AVX-512 form computes itself.
-        RowInputs in;
-        in.rayPrimitive = rayPrimitives, in.rasterPrimitive = rasterPrimitives, in.surface = surface;
-        in.rayDepth = rayDepths, in.rasterDepth = rasterDepths;
-        in.slope = slope, in.quantum = quantum, in.relative = relative, in.n = n;
-        if constexpr (kAvx512) {
-            if (gatherable(judge.slopeTableNone()))
-                in.slopeTable = judge.slopeTableFor(surface, std::size_t(n)), in.slopeTableNone = judge.slopeTableNone();
-            in.constantQuantum = constantQuantum, in.relativeForm = relativeForm;
-        }
-        if (!in.slopeTable) judge.slopes(surface, std::size_t(n), slope);
-        if (!in.constantQuantum) measures.quanta(ray, raster, a0, b0, std::size_t(n), quantum);
-        if (!in.relativeForm) measures.relativeEyeZErrors(ray, raster, a0, b0, col0, row, std::size_t(n), relative);
-        const std::size_t i0 = std::size_t(row) * W + col0;
-        in.pixelClass = perPixel ? perPixel->pixelClass.data() + i0 : nullptr;
-        in.errorOverTolerance = perPixel ? perPixel->errorOverTolerance.data() + i0 : nullptr;
-#ifdef ZCHECK_X86_AVX512
-        if constexpr (kAvx512) rowLanesAvx512(in, judge.toleranceTerms(), counts, lanes);
-#endif
-        if constexpr (!kAvx512) rowLanesBaseline(in, judge.toleranceTerms(), counts, lanes);
+        for (int tile = tileBegin; tile < tileEnd; ++tile) {
+            TileTally& tally = tallies[std::size_t(tile)];
+            ComparisonReport& r = tally.report;
+            const PixelRect rect = grid.rect(tile);
+            const int col0 = rect.col0, col1 = rect.col1;
+            // A pixel compared on depth (agree or depth error), in scan order: whether it is the worst so
+            // far (its finding is then r.worst): the first compared, or a ratio above every one before.
+            // So the worst is the first pixel in scan order with the largest ratio (NaN ratios aside), and
+            // a row's common-case pixels that are neither its first compared one nor the first with its
+            // largest ratio can be left out without changing it.
+            bool comparedBefore = r.agree + r.depthErrors > 0;
+            auto noteWorst = [&](double ratio) ZCHECK_ALWAYS_INLINE {
+                const bool worst = ratio > r.maxErrorOverTolerance || !comparedBefore;
+                comparedBefore = true;
+                if (worst) r.maxErrorOverTolerance = std::max(r.maxErrorOverTolerance, ratio);
+                return worst;
+            };
+            // A pixel compared on depth off the common case: its count, the statistics, noteWorst.
+            auto noteCompared = [&](bool agree, double ratio, double errorQuanta, double relative) ZCHECK_ALWAYS_INLINE {
+                agree ? ++r.agree : ++r.depthErrors;
+                counts.errorQuanta.add(float(errorQuanta));
+                counts.relativeEyeZ.add(float(relative));
+                r.maxRelativeEyeZError = std::max(r.maxRelativeEyeZError, relative);
+                r.maxErrorQuanta = std::max(r.maxErrorQuanta, errorQuanta);
+                return noteWorst(ratio);
+            };
 
-        const int commons = __builtin_popcountll(lanes.common), hits = __builtin_popcountll(lanes.hit);
-        const int agreeing = __builtin_popcountll(lanes.common & lanes.agree);
-        auto maxOfCommon = [&](double start, int k) ZCHECK_ALWAYS_INLINE {
-            double largestValue;
-            std::memcpy(&largestValue, &lanes.largest[k], sizeof largestValue);
-            return lanes.largest[k] < 0 ? start : std::max(start, largestValue);
-        };
-        r.bothMiss += n - hits;  // their class and ratio are written already
-        r.bothHit += commons, r.agree += agreeing, r.depthErrors += commons - agreeing;
-        r.maxErrorQuanta = maxOfCommon(r.maxErrorQuanta, 0);
-        r.maxRelativeEyeZError = maxOfCommon(r.maxRelativeEyeZError, 1);
-        const double rowMaxRatio = maxOfCommon(-1.0, 2);
-        // The bias test's sum in scan order (its rounding depends on the order): its signed
-        // error, and where its exact depth falls in the quantum (a division per pixel).
-        double signedErrorSum = tally.signedErrorSum;
-        std::int64_t quarters[4] = {0, 0, 0, 0};
-        forEachSetBit(lanes.bias, [&](std::size_t j) ZCHECK_ALWAYS_INLINE {
-            signedErrorSum += lanes.signedErrorQuanta[j];
-            const double position = rayDepths[j] / quantumOfLane(j);  // d/q
-            ++quarters[std::clamp(int(4 * (position - std::floor(position))), 0, 3)];
-        });
-        tally.signedErrorSum = signedErrorSum;
-        for (int k = 0; k < 4; ++k) tally.quarterCounts[k] += quarters[k];
-        r.biasSamples += __builtin_popcountll(lanes.bias);
-
-        // What is left in scan order (noteWorst): the pixels off the common case, the common
-        // case's depth errors (a NaN ratio is one), its first pixel when nothing was compared
-        // before, and its first with the row's largest ratio when that may be the worst.
-        std::uint64_t visit = (lanes.common & ~lanes.agree) | (~lanes.common & lanes.hit);
-        if (commons > 0 && !comparedBefore) visit |= lanes.common & (0 - lanes.common);
-        if (commons > 0 && rowMaxRatio > r.maxErrorOverTolerance)
-            for (std::uint64_t c = lanes.common; c != 0; c &= c - 1)
-                if (lanes.ratio[__builtin_ctzll(c)] == rowMaxRatio) {
-                    visit |= c & (0 - c);
-                    break;
+            const std::size_t a0 = ray.at(col0, row), b0 = raster.at(col0, row);
+            const int n = col1 - col0;
+            // A later row's pixels asked for now, for a tile alone: its row of a full-frame image
+            // is a few cache lines, too short for the hardware to see a stream, and each row began
+            // with misses. (Across a band's tiles a row is one stream.)
+            if (tileEnd - tileBegin == 1 && row + kRowsAhead < row1) {
+                const std::size_t aAhead = ray.at(col0, row + kRowsAhead), bAhead = raster.at(col0, row + kRowsAhead);
+                for (int j = 0; j < n; j += 16) {
+                    __builtin_prefetch(ray.primitive + aAhead + j), __builtin_prefetch(raster.primitive + bAhead + j);
+                    __builtin_prefetch(ray.windowDepth + aAhead + j), __builtin_prefetch(ray.windowDepth + aAhead + j + 8);
+                    __builtin_prefetch(raster.windowDepth + bAhead + j);
+                    __builtin_prefetch(raster.windowDepth + bAhead + j + 8);
                 }
+            }
+            const std::uint32_t* rayPrimitives = ray.primitive + a0;
+            const std::uint32_t* rasterPrimitives = raster.primitive + b0;
+            const double* rayDepths = ray.windowDepth + a0;
+            const double* rasterDepths = raster.windowDepth + b0;
+            for (int j = 0; j < n; ++j) {
+                const bool common = rayPrimitives[j] != kNoPrimitive && rayPrimitives[j] == rasterPrimitives[j];
+                surface[j] = common ? rayPrimitives[j] : kNoPrimitive;
+            }
+            // The row's slopes, quanta and relative errors, except those the AVX-512 form computes itself.
+            RowInputs in;
+            in.rayPrimitive = rayPrimitives, in.rasterPrimitive = rasterPrimitives, in.surface = surface;
+            in.rayDepth = rayDepths, in.rasterDepth = rasterDepths;
+            in.slope = slope, in.quantum = quantum, in.relative = relative, in.n = n;
+            if constexpr (kAvx512) {
+                if (gatherable(judge.slopeTableNone()))
+                    in.slopeTable = judge.slopeTableFor(surface, std::size_t(n)), in.slopeTableNone = judge.slopeTableNone();
+                in.constantQuantum = constantQuantum, in.relativeForm = relativeForm;
+            }
+            if (!in.slopeTable) judge.slopes(surface, std::size_t(n), slope);
+            if (!in.constantQuantum) measures.quanta(ray, raster, a0, b0, std::size_t(n), quantum);
+            if (!in.relativeForm) measures.relativeEyeZErrors(ray, raster, a0, b0, col0, row, std::size_t(n), relative);
+            const std::size_t i0 = std::size_t(row) * W + col0;
+            in.pixelClass = perPixel ? perPixel->pixelClass.data() + i0 : nullptr;
+            in.errorOverTolerance = perPixel ? perPixel->errorOverTolerance.data() + i0 : nullptr;
+    #ifdef ZCHECK_X86_AVX512
+            if constexpr (kAvx512) rowLanesAvx512(in, judge.toleranceTerms(), counts, lanes);
+    #endif
+            if constexpr (!kAvx512) rowLanesBaseline(in, judge.toleranceTerms(), counts, lanes);
 
-        auto visitPixel = [&](int j) ZCHECK_ALWAYS_INLINE {
-            const int col = col0 + j;
-            const std::size_t a = a0 + std::size_t(j), b = b0 + std::size_t(j), i = i0 + std::size_t(j);
-            const std::uint32_t rayPrimitive = rayPrimitives[j], rasterPrimitive = rasterPrimitives[j];
-            const bool rayHit = rayPrimitive != kNoPrimitive, rasterHit = rasterPrimitive != kNoPrimitive;
-            if (lanes.common >> j & 1) {  // tallied already
-                const bool agree = lanes.agree >> j & 1;
-                const PixelClass c = agree ? PixelClass::Agree : PixelClass::DepthError;  // written already
-                const bool worst = noteWorst(lanes.ratio[j]);
-                if (agree && !worst) return;  // nothing to note: no finding is built
+            const int commons = __builtin_popcountll(lanes.common), hits = __builtin_popcountll(lanes.hit);
+            const int agreeing = __builtin_popcountll(lanes.common & lanes.agree);
+            auto maxOfCommon = [&](double start, int k) ZCHECK_ALWAYS_INLINE {
+                double largestValue;
+                std::memcpy(&largestValue, &lanes.largest[k], sizeof largestValue);
+                return lanes.largest[k] < 0 ? start : std::max(start, largestValue);
+            };
+            r.bothMiss += n - hits;  // their class and ratio are written already
+            r.bothHit += commons, r.agree += agreeing, r.depthErrors += commons - agreeing;
+            r.maxErrorQuanta = maxOfCommon(r.maxErrorQuanta, 0);
+            r.maxRelativeEyeZError = maxOfCommon(r.maxRelativeEyeZError, 1);
+            const double rowMaxRatio = maxOfCommon(-1.0, 2);
+            // The bias test's sum in scan order (its rounding depends on the order): its signed
+            // error, and where its exact depth falls in the quantum (a division per pixel).
+            double signedErrorSum = tally.signedErrorSum;
+            std::int64_t quarters[4] = {0, 0, 0, 0};
+            forEachSetBit(lanes.bias, [&](std::size_t j) ZCHECK_ALWAYS_INLINE {
+                signedErrorSum += lanes.signedErrorQuanta[j];
+                const double position = rayDepths[j] / quantumOfLane(j);  // d/q
+                ++quarters[std::clamp(int(4 * (position - std::floor(position))), 0, 3)];
+            });
+            tally.signedErrorSum = signedErrorSum;
+            for (int k = 0; k < 4; ++k) tally.quarterCounts[k] += quarters[k];
+            r.biasSamples += __builtin_popcountll(lanes.bias);
+
+            // What is left in scan order (noteWorst): the pixels off the common case, the common
+            // case's depth errors (a NaN ratio is one), its first pixel when nothing was compared
+            // before, and its first with the row's largest ratio when that may be the worst.
+            std::uint64_t visit = (lanes.common & ~lanes.agree) | (~lanes.common & lanes.hit);
+            if (commons > 0 && !comparedBefore) visit |= lanes.common & (0 - lanes.common);
+            if (commons > 0 && rowMaxRatio > r.maxErrorOverTolerance)
+                for (std::uint64_t c = lanes.common; c != 0; c &= c - 1)
+                    if (lanes.ratio[__builtin_ctzll(c)] == rowMaxRatio) {
+                        visit |= c & (0 - c);
+                        break;
+                    }
+
+            auto visitPixel = [&](int j) ZCHECK_ALWAYS_INLINE {
+                const int col = col0 + j;
+                const std::size_t a = a0 + std::size_t(j), b = b0 + std::size_t(j), i = i0 + std::size_t(j);
+                const std::uint32_t rayPrimitive = rayPrimitives[j], rasterPrimitive = rasterPrimitives[j];
+                const bool rayHit = rayPrimitive != kNoPrimitive, rasterHit = rasterPrimitive != kNoPrimitive;
+                if (lanes.common >> j & 1) {  // tallied already
+                    const bool agree = lanes.agree >> j & 1;
+                    const PixelClass c = agree ? PixelClass::Agree : PixelClass::DepthError;  // written already
+                    const bool worst = noteWorst(lanes.ratio[j]);
+                    if (agree && !worst) return;  // nothing to note: no finding is built
+                    PixelFinding f;
+                    f.col = col, f.row = row;
+                    f.rayWindowDepth = rayDepths[j], f.rasterWindowDepth = rasterDepths[j];
+                    f.rayPrimitive = f.rasterPrimitive = rayPrimitive;
+                    f.pixelClass = c;
+                    f.errorQuanta = lanes.errorQuanta[j];
+                    f.toleranceQuanta = lanes.bound[j] / quantumOfLane(j);
+                    if (worst) r.worst = f;
+                    if (!agree) noteUnexplained(r, f);
+                    return;
+                }
+                const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
                 PixelFinding f;
                 f.col = col, f.row = row;
-                f.rayWindowDepth = rayDepths[j], f.rasterWindowDepth = rasterDepths[j];
-                f.rayPrimitive = f.rasterPrimitive = rayPrimitive;
-                f.pixelClass = c;
-                f.errorQuanta = lanes.errorQuanta[j];
-                f.toleranceQuanta = lanes.bound[j] / quantumOfLane(j);
-                if (worst) r.worst = f;
-                if (!agree) noteUnexplained(r, f);
-                return;
-            }
-            const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
-            PixelFinding f;
-            f.col = col, f.row = row;
-            f.rayWindowDepth = ray.windowDepth[a];
-            f.rasterWindowDepth = raster.windowDepth[b];
-            f.rayPrimitive = rayPrimitive;
-            f.rasterPrimitive = rasterPrimitive;
+                f.rayWindowDepth = ray.windowDepth[a];
+                f.rasterWindowDepth = raster.windowDepth[b];
+                f.rayPrimitive = rayPrimitive;
+                f.rasterPrimitive = rasterPrimitive;
 
-            if (rayHit && rasterHit) {
-                // Different surfaces: the raster's may legitimately win near an edge or a clip plane.
-                ++r.bothHit;
-                const double q = quantumAt(a, b);
-                const double error = std::abs(f.rasterWindowDepth - f.rayWindowDepth);
-                double bound = 0;
-                f.pixelClass = judge.bothHit(f.rayWindowDepth, f.rayPrimitive, f.rasterWindowDepth, f.rasterPrimitive, q,
-                                             pWindow, bound);
-                f.errorQuanta = std::abs(signedErrorQuantaAt(a, b, q));
-                const double ratio = ratioOf(error, bound);
-                auto withTolerance = [&](PixelFinding& finding) -> PixelFinding& {  // a finding kept
-                    finding.toleranceQuanta = bound / q;
-                    return finding;
-                };
-                if (f.pixelClass == PixelClass::EdgeSurface) {
-                    ++r.edgeSurface;
+                if (rayHit && rasterHit) {
+                    // Different surfaces: the raster's may legitimately win near an edge or a clip plane.
+                    ++r.bothHit;
+                    const double q = quantumAt(a, b);
+                    const double error = std::abs(f.rasterWindowDepth - f.rayWindowDepth);
+                    double bound = 0;
+                    f.pixelClass = judge.bothHit(f.rayWindowDepth, f.rayPrimitive, f.rasterWindowDepth, f.rasterPrimitive, q,
+                                                 pWindow, bound);
+                    f.errorQuanta = std::abs(signedErrorQuantaAt(a, b, q));
+                    const double ratio = ratioOf(error, bound);
+                    auto withTolerance = [&](PixelFinding& finding) -> PixelFinding& {  // a finding kept
+                        finding.toleranceQuanta = bound / q;
+                        return finding;
+                    };
+                    if (f.pixelClass == PixelClass::EdgeSurface) {
+                        ++r.edgeSurface;
+                    } else {
+                        if (perPixel) perPixel->errorOverTolerance[i] = static_cast<float>(ratio);
+                        if (noteCompared(f.pixelClass == PixelClass::Agree, ratio, f.errorQuanta,
+                                         measures.relativeEyeZError(ray, raster, a, b, col, row)))
+                            r.worst = withTolerance(f);
+                    }
+                    if (f.pixelClass == PixelClass::DepthError) withTolerance(f);
                 } else {
-                    if (perPixel) perPixel->errorOverTolerance[i] = static_cast<float>(ratio);
-                    if (noteCompared(f.pixelClass == PixelClass::Agree, ratio, f.errorQuanta,
-                                     measures.relativeEyeZError(ray, raster, a, b, col, row)))
-                        r.worst = withTolerance(f);
+                    // Coverage mismatch: only one route sees a surface (PixelJudge::oneHit).
+                    rayHit ? ++r.rayOnly : ++r.rasterOnly;
+                    f.pixelClass = judge.oneHit(rayHit, rayHit ? f.rayWindowDepth : f.rasterWindowDepth,
+                                                rayHit ? f.rayPrimitive : f.rasterPrimitive, quantumAt(a, b), pWindow);
+                    if (f.pixelClass == PixelClass::RayOnlyAtClear) ++r.lostAtClearValue;
+                    if (f.pixelClass == PixelClass::AtClipPlane) ++r.atClipPlane;
+                    isUnexplained(f.pixelClass) ? ++r.coverageUnexplained : ++r.coverageExplained;
                 }
-                if (f.pixelClass == PixelClass::DepthError) withTolerance(f);
-            } else {
-                // Coverage mismatch: only one route sees a surface (PixelJudge::oneHit).
-                rayHit ? ++r.rayOnly : ++r.rasterOnly;
-                f.pixelClass = judge.oneHit(rayHit, rayHit ? f.rayWindowDepth : f.rasterWindowDepth,
-                                            rayHit ? f.rayPrimitive : f.rasterPrimitive, quantumAt(a, b), pWindow);
-                if (f.pixelClass == PixelClass::RayOnlyAtClear) ++r.lostAtClearValue;
-                if (f.pixelClass == PixelClass::AtClipPlane) ++r.atClipPlane;
-                isUnexplained(f.pixelClass) ? ++r.coverageUnexplained : ++r.coverageExplained;
-            }
-            setClass(i, f.pixelClass);
-            if (isUnexplained(f.pixelClass)) noteUnexplained(r, f);
-        };
-        // The pixels to visit (a few per row, mostly none), in scan order.
-        forEachSetBit(visit, [&](std::size_t j) ZCHECK_ALWAYS_INLINE { visitPixel(int(j)); });
+                setClass(i, f.pixelClass);
+                if (isUnexplained(f.pixelClass)) noteUnexplained(r, f);
+            };
+            // The pixels to visit (a few per row, mostly none), in scan order.
+            forEachSetBit(visit, [&](std::size_t j) ZCHECK_ALWAYS_INLINE { visitPixel(int(j)); });
+        }
     }
 }
 
-void TileComparison::Impl::compareBaseline(int tile, int rowBegin, int rowEnd, const RoutePixels& ray,
+void TileComparison::Impl::compareBaseline(int tileBegin, int tileEnd, int rowBegin, int rowEnd, const RoutePixels& ray,
                                            const RoutePixels& raster)
 {
-    compareBody<false>(tile, rowBegin, rowEnd, ray, raster);
+    compareBody<false>(tileBegin, tileEnd, rowBegin, rowEnd, ray, raster);
 }
 
 #ifdef ZCHECK_X86_AVX512
-ZCHECK_TARGET_AVX512 void TileComparison::Impl::compareAvx512(int tile, int rowBegin, int rowEnd, const RoutePixels& ray,
-                                                              const RoutePixels& raster)
+ZCHECK_TARGET_AVX512 void TileComparison::Impl::compareAvx512(int tileBegin, int tileEnd, int rowBegin, int rowEnd,
+                                                              const RoutePixels& ray, const RoutePixels& raster)
 {
-    compareBody<true>(tile, rowBegin, rowEnd, ray, raster);
+    compareBody<true>(tileBegin, tileEnd, rowBegin, rowEnd, ray, raster);
 }
 #endif
 
-void TileComparison::Impl::compare(int tile, int rowBegin, int rowEnd, const RoutePixels& ray, const RoutePixels& raster)
+void TileComparison::Impl::compare(int tileBegin, int tileEnd, int rowBegin, int rowEnd, const RoutePixels& ray,
+                                   const RoutePixels& raster)
 {
 #ifdef ZCHECK_X86_AVX512
-    if (judge.avx512Form()) return compareAvx512(tile, rowBegin, rowEnd, ray, raster);
+    if (judge.avx512Form()) return compareAvx512(tileBegin, tileEnd, rowBegin, rowEnd, ray, raster);
 #endif
-    compareBaseline(tile, rowBegin, rowEnd, ray, raster);
+    compareBaseline(tileBegin, tileEnd, rowBegin, rowEnd, ray, raster);
 }
 
 TileComparison::TileComparison(const Scene& scene, const Camera& camera, const ToleranceModel& tolerance,
@@ -906,12 +918,18 @@ const TileGrid& TileComparison::tiles() const { return impl_->grid; }
 void TileComparison::compareTile(int tile, const RoutePixels& ray, const RoutePixels& raster)
 {
     const PixelRect rect = impl_->grid.rect(tile);
-    impl_->compare(tile, rect.row0, rect.row1, ray, raster);
+    impl_->compare(tile, tile + 1, rect.row0, rect.row1, ray, raster);
 }
 
 void TileComparison::compareTileRows(int tile, int rowBegin, int rowEnd, const RoutePixels& ray, const RoutePixels& raster)
 {
-    impl_->compare(tile, rowBegin, rowEnd, ray, raster);
+    impl_->compare(tile, tile + 1, rowBegin, rowEnd, ray, raster);
+}
+
+void TileComparison::compareBandRows(int band, int rowBegin, int rowEnd, const RoutePixels& ray, const RoutePixels& raster)
+{
+    const int tilesX = impl_->grid.tilesX();
+    impl_->compare(band * tilesX, (band + 1) * tilesX, rowBegin, rowEnd, ray, raster);
 }
 
 std::optional<ComparisonReport> TileComparison::finish()
@@ -1002,12 +1020,7 @@ Comparison compareRoutes(const PixelJudge& judge, const RenderResult& ray, const
         // pieces 15 KB apart (a pass that only reads and writes the arrays takes ~3× as long
         // tile by tile: `bench/zcheck_bench --phase floor`). Each tile still sees its rows in order.
         const TileGrid& grid = tiles.tiles();
-        tbb::parallel_for(0, grid.tilesY(), [&](int band) {
-            const PixelRect first = grid.rect(band * grid.tilesX());
-            for (int row = first.row0; row < first.row1; ++row)
-                for (int tile = band * grid.tilesX(); tile < (band + 1) * grid.tilesX(); ++tile)
-                    tiles.compareTileRows(tile, row, row + 1, rayPixels, rasterPixels);
-        });
+        tbb::parallel_for(0, grid.tilesY(), [&](int band) { tiles.compareBandRows(band, 0, H, rayPixels, rasterPixels); });
         if (std::optional<ComparisonReport> report = tiles.finish()) {
             out.report = std::move(*report);
             return out;

@@ -341,6 +341,10 @@ public:
     // call after the one before it returned), interleaved with other tiles' calls in any way:
     // the report is the same as compareTile's.
     void compareTileRows(int tile, int rowBegin, int rowEnd, const RoutePixels& ray, const RoutePixels& raster);
+    // compareTileRows for every tile of band `band` (the tiles of one row of tiles, numbered from
+    // the top), image row by image row across the band: each row of the arrays is read as one
+    // stream. The same rules: a band's tiles are not compared by other calls at the same time.
+    void compareBandRows(int band, int rowBegin, int rowEnd, const RoutePixels& ray, const RoutePixels& raster);
     std::optional<ComparisonReport> finish();
 
 private:
