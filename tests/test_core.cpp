@@ -518,10 +518,11 @@ TEST_CASE("a tile grid cuts the image into row-major tiles, the last ones cut by
     CHECK(same(small.rect(0), 0, 0, 5, 3));
 }
 
+constexpr std::size_t kHugePage = std::size_t(2) << 20;  // the large buffers' page (large_buffer.h)
+
 TEST_CASE("a LargeVector sits on 2 MiB boundaries and leaves elements made without a value as they were",
           "[core][large_buffer]")
 {
-    constexpr std::size_t kHugePage = std::size_t(2) << 20;
     // A 1080p window-depth buffer: on a huge-page boundary, where the advice can take effect.
     LargeVector<double> depth;
     depth.resize(1920 * 1080);
@@ -582,7 +583,6 @@ TEST_CASE("a released large buffer is handed back, faulted in, to the next one o
 TEST_CASE("a 1080p byte-per-pixel buffer gets a huge page of its own and is kept for the next one",
           "[core][large_buffer]")
 {
-    constexpr std::size_t kHugePage = std::size_t(2) << 20;
     releaseCachedLargeBuffers();
     {
         LargeVector<std::uint8_t> pixelClass(1920 * 1080);

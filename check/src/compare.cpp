@@ -752,9 +752,9 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tileBegin
             const std::size_t i0 = std::size_t(row) * W + col0;
             in.pixelClass = perPixel ? perPixel->pixelClass.data() + i0 : nullptr;
             in.errorOverTolerance = perPixel ? perPixel->errorOverTolerance.data() + i0 : nullptr;
-    #ifdef ZCHECK_X86_AVX512
+#ifdef ZCHECK_X86_AVX512
             if constexpr (kAvx512) rowLanesAvx512(in, judge.toleranceTerms(), counts, lanes);
-    #endif
+#endif
             if constexpr (!kAvx512) rowLanesBaseline(in, judge.toleranceTerms(), counts, lanes);
 
             const int commons = __builtin_popcountll(lanes.common), hits = __builtin_popcountll(lanes.hit);
