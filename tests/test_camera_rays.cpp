@@ -90,6 +90,71 @@ TEST_CASE("the folded depth mapping is the inverse-projection module's, and its 
     });
 }
 
+TEST_CASE("the depth mapping lane by lane is windowDepth's, bit for bit; a raw matrix has none", "[camera_rays]")
+{
+    forEachExampleCamera([](const Camera& camera) {
+        const CameraRays rays(camera);
+        const double n = camera.nearDistance();
+        const double far = std::isinf(camera.farDistance()) ? 1000 * n : camera.farDistance();
+        const std::vector<double> eyeZ = {n, 1.5 * n, 0.5 * (n + far), far, 0.3 * n, 2 * far, -n};
+        std::vector<double> together(eyeZ.size(), -7.0);
+        REQUIRE(rays.windowDepths(eyeZ.data(), eyeZ.size(), together.data()));
+        for (std::size_t j = 0; j < eyeZ.size(); ++j) {
+            INFO("eye-z " << eyeZ[j]);
+            REQUIRE(testing::sameBits(std::vector<double>{together[j]},
+                                      std::vector<double>{rays.windowDepth({11.5, 7.5}, eyeZ[j])}));
+        }
+    });
+    CameraSpec matrix = readCameraFile(std::string(ZCHECK_TESTS_DIR) + "/../examples/matrix-direct3d.json");
+    const Camera camera(matrix);
+    const double eyeZ = 1.0;
+    double out = -7.0;
+    REQUIRE_FALSE(CameraRays(camera).windowDepths(&eyeZ, 1, &out));
+    REQUIRE(out == -7.0);
+}
+
+TEST_CASE("each hit's depth is its triangle's plane met by the pixel's ray in double, recomputed from the corners",
+          "[ray]")
+{
+    // The trace reads each hit triangle's plane from a table made with the BVH. Here the plane
+    // comes from the scene's corners again, through the affine ray of the pixel centre, and the
+    // depth must match bit for bit (-ffp-contract=off: the same operations round the same way).
+    // A table entry from the wrong corners, triangle or precision would not.
+    for (const bool inside : {true, false}) {
+        const Scene soup = testing::triangleSoup(inside, inside ? 41 : 42);
+        const RayRenderer renderer(soup);
+        for (const char* convention : kConventions)
+            for (const bool reversed : {false, true}) {
+                const Camera camera(testing::kernelCamera(convention, DepthFormat::Float32, reversed, false));
+                const CameraRays rays(camera);
+                const AffineRays affine = *rays.affine();
+                const RenderResult result = renderer.render(camera);
+                std::size_t hits = 0;
+                for (int row = 0; row < camera.height(); ++row)
+                    for (int col = 0; col < camera.width(); ++col) {
+                        const std::size_t i = std::size_t(row) * std::size_t(camera.width()) + std::size_t(col);
+                        const std::uint32_t primitive = result.primitiveId[i];
+                        if (primitive == kNoPrimitive) continue;
+                        ++hits;
+                        const glm::uvec3& corners = soup.triangles[primitive];
+                        const glm::dvec3 a(soup.positions[corners[0]]), b(soup.positions[corners[1]]),
+                            c(soup.positions[corners[2]]);
+                        const glm::dvec3 normal = glm::cross(b - a, c - a);
+                        const glm::dvec2 pImage(col + 0.5, row + 0.5);
+                        const glm::dvec3 origin = affine.originAt(pImage), direction = affine.directionAt(pImage);
+                        const double t = glm::dot(normal, a - origin) / glm::dot(normal, direction);
+                        REQUIRE(std::isfinite(t));
+                        const double expected = rays.windowDepth(pImage, rays.eyeZ(origin + t * direction));
+                        INFO(convention << (reversed ? " reversed" : "") << " pixel (" << col << ", " << row
+                                        << ") triangle " << primitive);
+                        REQUIRE(testing::sameBits(std::vector<double>{result.windowDepth.value[i]},
+                                                  std::vector<double>{expected}));
+                    }
+                REQUIRE(hits > 1000);
+            }
+    }
+}
+
 TEST_CASE("the trace compiled for AVX-512 is bit-identical to its baseline form", "[ray][kernel]")
 {
     // RayRenderer::traceRect is one source compiled twice (kernel_choice.h): rays generated,

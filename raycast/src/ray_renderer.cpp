@@ -83,6 +83,36 @@ struct PacketInFlight {
     bool hit(int k) const { return valid[k] && packet.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID; }
 };
 
+// A triangle's plane as the re-evaluation reads it, made once per scene: the normal
+// cross(b − a, c − a) in double and the first corner a, binary32 as the scene holds it (exact
+// in double), so the same values the re-evaluation computed from the corners per hit before.
+// A hit now reads one 40-byte entry, where it read an index triple and three vertices far
+// apart, and computes no cross product.
+struct HitPlane {
+    double normal[3];
+    float vertex[3];
+    float unused;  // zero
+};
+static_assert(sizeof(HitPlane) == 40, "5 entries in 200 bytes: half of them span two cache lines");
+
+std::unique_ptr<HitPlane[]> hitPlanesOf(const Scene& scene)
+{
+    std::unique_ptr<HitPlane[]> planes(new HitPlane[scene.triangles.size()]);  // each written below
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, scene.triangles.size(), 4096),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                          for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                              const glm::uvec3& corners = scene.triangles[i];
+                              const glm::vec3& a = scene.positions[corners[0]];
+                              const glm::dvec3 b(scene.positions[corners[1]]), c(scene.positions[corners[2]]);
+                              const glm::dvec3 normal = glm::cross(b - glm::dvec3(a), c - glm::dvec3(a));
+                              HitPlane& plane = planes[i];
+                              for (int axis = 0; axis < 3; ++axis) plane.normal[axis] = normal[axis], plane.vertex[axis] = a[axis];
+                              plane.unused = 0;
+                          }
+                      });
+    return planes;
+}
+
 }  // namespace
 
 struct RayRenderer::Embree {
@@ -93,6 +123,7 @@ struct RayRenderer::Embree {
     ErrorLog errors;
     DeviceHandle device;
     SceneHandle scene;
+    std::unique_ptr<HitPlane[]> planes;  // by primitive id (hitPlanesOf)
 
     void check(const char* step)
     {
@@ -137,6 +168,7 @@ RayRenderer::RayRenderer(const Scene& scene)
     rtcAttachGeometryByID(embree_->scene.get(), geometry.get(), 0);
     rtcCommitScene(embree_->scene.get());
     embree_->check("building the BVH");
+    embree_->planes = hitPlanesOf(scene);
     buildMilliseconds_ = millisecondsSince(start);
 }
 
@@ -200,7 +232,7 @@ namespace {
 // RayRenderer::traceRect's work, inlined into two functions: one compiled for the build's
 // baseline and one for AVX-512 (kernel_choice.h). Its per-packet steps are lambdas that must
 // be inlined too, or they would stay baseline code.
-ZCHECK_ALWAYS_INLINE inline void traceRectBody(RTCScene rtcScene, const glm::dvec3& frameOrigin, const Scene& scene,
+ZCHECK_ALWAYS_INLINE inline void traceRectBody(RTCScene rtcScene, const glm::dvec3& frameOrigin, const HitPlane* planes,
                                         const Camera& camera, const PixelRect& rect, double* windowDepth,
                                         std::uint32_t* primitiveId, std::size_t stride, const RayFaults& fault,
                                         glm::dvec3* pEye)
@@ -275,34 +307,26 @@ ZCHECK_ALWAYS_INLINE inline void traceRectBody(RTCScene rtcScene, const glm::dve
             p.packet.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
         }
         rtcIntersect16(p.valid, rtcScene, &context, &p.packet);
-        for (int k = 0; k < kPacketRays; ++k)
-            if (p.hit(k)) __builtin_prefetch(&scene.triangles[p.packet.hit.primID[k]]);
-    };
-    // The hit triangles' vertices asked for (their indices were asked for one packet earlier).
-    auto fetchVertices = [&](const PacketInFlight& p) ZCHECK_ALWAYS_INLINE {
-        for (int k = 0; k < kPacketRays; ++k)
-            if (p.hit(k))
-                for (int corner = 0; corner < 3; ++corner)
-                    __builtin_prefetch(&scene.positions[scene.triangles[p.packet.hit.primID[k]][corner]]);
+        for (int k = 0; k < kPacketRays; ++k)  // the hit planes asked for: both ends of each entry
+            if (p.hit(k)) {
+                const char* entry = reinterpret_cast<const char*>(planes + p.packet.hit.primID[k]);
+                __builtin_prefetch(entry);
+                __builtin_prefetch(entry + sizeof(HitPlane) - 1);
+            }
     };
     // Each hit again, in double: the ray against the hit triangle's plane; then the pixels written.
     auto finish = [&](const PacketInFlight& p) ZCHECK_ALWAYS_INLINE {
-        // The planes, every lane's own, without a branch: a vertex a and the normal
-        // cross(b − a, c − a), in double. (Keeping a plane while the next lanes hit the same
-        // triangle, as this did before, cost more in mispredicted branches than the arithmetic
-        // it saved.) A miss takes triangle 0's plane (a scene has one, RayRenderer checked), and
-        // its result is not used.
+        // The planes, every lane's own, without a branch, from the table (HitPlane). (Keeping
+        // a plane while the next lanes hit the same triangle, as this did before, cost more in
+        // mispredicted branches than the arithmetic it saved.) A miss takes triangle 0's plane
+        // (a scene has one, RayRenderer checked), and its result is not used.
         std::uint32_t triangle[kPacketRays];
         for (int k = 0; k < kPacketRays; ++k) triangle[k] = p.hit(k) ? p.packet.hit.primID[k] : 0;
-        alignas(64) double corner[3][3][kPacketRays];  // corner, axis, lane
-        cornersInLanes(scene, triangle, kPacketRays, corner);
         alignas(64) double plane[6][kPacketRays];  // a vertex x, y, z and the normal x, y, z
         for (int k = 0; k < kPacketRays; ++k) {
-            const glm::dvec3 a(corner[0][0][k], corner[0][1][k], corner[0][2][k]);
-            const glm::dvec3 b(corner[1][0][k], corner[1][1][k], corner[1][2][k]);
-            const glm::dvec3 c(corner[2][0][k], corner[2][1][k], corner[2][2][k]);
-            const glm::dvec3 normal = glm::cross(b - a, c - a);
-            for (int axis = 0; axis < 3; ++axis) plane[axis][k] = a[axis], plane[3 + axis][k] = normal[axis];
+            const HitPlane& h = planes[triangle[k]];
+            for (int axis = 0; axis < 3; ++axis)
+                plane[axis][k] = double(h.vertex[axis]), plane[3 + axis][k] = h.normal[axis];
         }
         // Lane by lane in plain arrays (several lanes per instruction): the ray parameter t
         // of the hit (Embree's, where the plane gives none) and its eye-z.
@@ -320,12 +344,16 @@ ZCHECK_ALWAYS_INLINE inline void traceRectBody(RTCScene rtcScene, const glm::dve
         }
         // The pixels, lane by lane into plain arrays, then a row of the packet at a time: four
         // adjacent pixels, copied whole where all four lie in the rectangle.
+        // Every lane's window depth at once where the camera has a closed form (a miss's is
+        // computed too, from triangle 0's plane, and not used); a raw-matrix camera's, hits only.
         alignas(64) double depthOf[kPacketRays];
         alignas(64) std::uint32_t primitiveOf[kPacketRays];
+        const bool closedForm = cameraRays.windowDepths(eyeZ, kPacketRays, depthOf);
         for (int k = 0; k < kPacketRays; ++k) {
             const bool hit = p.hit(k);
             primitiveOf[k] = hit ? p.packet.hit.primID[k] : kNoPrimitive;
-            depthOf[k] = hit ? cameraRays.windowDepth(p.pImage(k), eyeZ[k]) : clearDepth;
+            if (!closedForm && hit) depthOf[k] = cameraRays.windowDepth(p.pImage(k), eyeZ[k]);
+            depthOf[k] = hit ? depthOf[k] : clearDepth;
         }
         const int cols = std::min(kPacketSide, col1 - p.col0), rows = std::min(kPacketSide, row1 - p.row0);
         for (int r = 0; r < rows; ++r) {
@@ -345,39 +373,36 @@ ZCHECK_ALWAYS_INLINE inline void traceRectBody(RTCScene rtcScene, const glm::dve
         }
     };
 
-    // Packets row by row over the rectangle, three in flight: packet i is traced and its hit
-    // triangles' indices asked for; while packet i + 1 is traced they arrive, and its
-    // vertices are asked for; while packet i + 2 is traced those arrive, and packet i is
-    // finished. (Finishing each packet straight after its trace waited on those reads: this
-    // order measured 1-3 % faster for the trace, 3 % for a check tile by tile; the reads are
-    // still most of what the trace spends beyond Embree's own, see README "Speed".)
-    constexpr int kInFlight = 3;
+    // Packets row by row over the rectangle, two in flight: packet i is traced and its hit
+    // planes asked for; while packet i + 1 is traced they arrive, and packet i is finished.
+    // (Finishing each packet straight after its trace waited on those reads. With the corners
+    // read through the index triples, a third packet in flight fetched the vertices.)
+    constexpr int kInFlight = 2;
     PacketInFlight inFlight[kInFlight];
     const int packetsX = (col1 - col0 + kPacketSide - 1) / kPacketSide;
     const int packets = packetsX * ((row1 - row0 + kPacketSide - 1) / kPacketSide);
     for (int i = 0; i < packets + kInFlight - 1; ++i) {
         if (i < packets)
             trace(inFlight[i % kInFlight], col0 + (i % packetsX) * kPacketSide, row0 + (i / packetsX) * kPacketSide);
-        if (i >= 1 && i - 1 < packets) fetchVertices(inFlight[(i - 1) % kInFlight]);
-        if (i >= 2) finish(inFlight[(i - 2) % kInFlight]);
+        if (i >= 1) finish(inFlight[(i - 1) % kInFlight]);
     }
 }
 
 
-void traceRectBaseline(RTCScene rtcScene, const glm::dvec3& frameOrigin, const Scene& scene, const Camera& camera,
+void traceRectBaseline(RTCScene rtcScene, const glm::dvec3& frameOrigin, const HitPlane* planes, const Camera& camera,
                        const PixelRect& rect, double* windowDepth, std::uint32_t* primitiveId, std::size_t stride,
                        const RayFaults& fault, glm::dvec3* pEye)
 {
-    traceRectBody(rtcScene, frameOrigin, scene, camera, rect, windowDepth, primitiveId, stride, fault, pEye);
+    traceRectBody(rtcScene, frameOrigin, planes, camera, rect, windowDepth, primitiveId, stride, fault, pEye);
 }
 
 #ifdef ZCHECK_X86_AVX512
-ZCHECK_TARGET_AVX512 void traceRectAvx512(RTCScene rtcScene, const glm::dvec3& frameOrigin, const Scene& scene,
+ZCHECK_TARGET_AVX512 void traceRectAvx512(RTCScene rtcScene, const glm::dvec3& frameOrigin, const HitPlane* planes,
                                           const Camera& camera, const PixelRect& rect, double* windowDepth,
                                           std::uint32_t* primitiveId, std::size_t stride, const RayFaults& fault,
                                           glm::dvec3* pEye)
 {
-    traceRectBody(rtcScene, frameOrigin, scene, camera, rect, windowDepth, primitiveId, stride, fault, pEye);
+    traceRectBody(rtcScene, frameOrigin, planes, camera, rect, windowDepth, primitiveId, stride, fault, pEye);
 }
 #endif
 
@@ -390,7 +415,7 @@ void RayRenderer::traceRect(const Camera& camera, const PixelRect& rect, double*
 #ifdef ZCHECK_X86_AVX512
     if (avx512_) form = &traceRectAvx512;
 #endif
-    form(embree_->scene.get(), embree_->frameOrigin, scene_, camera, rect, windowDepth, primitiveId, stride, fault, pEye);
+    form(embree_->scene.get(), embree_->frameOrigin, embree_->planes.get(), camera, rect, windowDepth, primitiveId, stride, fault, pEye);
 }
 
 }  // namespace zcheck

@@ -67,6 +67,19 @@ public:
         if (fromMatrix_) return matrixWindowDepth(pImage, eyeZ);
         return depthA_ + (parallel_ ? depthB_ * eyeZ : depthB_ / eyeZ);
     }
+    // windowDepth of n eye-z values into out[j], several per instruction (the same operations);
+    // false (nothing written) for a raw-matrix camera, whose pixels differ.
+    bool windowDepths(const double* eyeZ, std::size_t n, double* out) const
+    {
+        if (fromMatrix_) return false;
+        const double A = depthA_, B = depthB_;
+        if (parallel_) {
+            for (std::size_t j = 0; j < n; ++j) out[j] = A + B * eyeZ[j];
+        } else {
+            for (std::size_t j = 0; j < n; ++j) out[j] = A + B / eyeZ[j];
+        }
+        return true;
+    }
     // Its inverse: the eye-z at which the ray through pImage has window depth `windowDepth`.
     double eyeZFromWindowDepth(const glm::dvec2& pImage, double windowDepth) const
     {

@@ -7,10 +7,11 @@
 // as coherent 4×4 packets (rtcIntersect16), row by row of packets over 64×64 regions, the
 // regions in parallel with TBB (traceRect traces one rectangle), each into a buffer of its
 // worker's own, copied into the image when the region is done. Each hit is then recomputed
-// in double against the hit triangle's plane (two packets later, once the triangle's indices
-// and vertices have been fetched while Embree traced), and its eye-z turned into the exact
-// window depth the depth buffer should hold by the convention's depth mapping in closed
-// form — never through the raster route's matrices.
+// in double against the hit triangle's plane (one packet later, once the plane has been
+// fetched while Embree traced), and its eye-z turned into the exact window depth the depth
+// buffer should hold by the convention's depth mapping in closed form — never through the
+// raster route's matrices. The planes (a corner and the normal cross(b − a, c − a) in double)
+// are made once with the BVH and kept beside it: 40 bytes per triangle.
 //
 //   const zcheck::RayRenderer rays(scene);              // builds the BVH once
 //   const zcheck::RenderResult truth = rays.render(camera);
@@ -45,7 +46,7 @@ enum class EyePoints { Omit, Keep };
 
 class RayRenderer {
 public:
-    // Builds the BVH (timed); throws Error. `scene` must outlive it: Embree reads its index
+    // Builds the BVH and the triangles' planes (timed together); throws Error. `scene` must outlive it: Embree reads its index
     // buffer in place. Where the processor has AVX-512 (F, DQ, VL) the trace runs a form of
     // itself compiled for it, bit-identical to the baseline form (kernel_choice.h); the
     // environment variable ZCHECK_RAY_KERNEL=baseline, read here, forces the baseline form,
