@@ -239,23 +239,33 @@ public:
         if (source_ != SlopeSource::TableOfSeen) return nullptr;
         // Each block asked about once per run of lanes in it (a row of a frame crosses few),
         // found 64 lanes at a time without a branch per lane; none for a primitive not of the scene.
-        bool ready = true;
         const std::uint32_t blocks = blockCount_;
-        for (std::size_t j0 = 0; j0 < n && ready; j0 += kSlopeBlock) {
+        for (std::size_t j0 = 0; j0 < n; j0 += kSlopeBlock) {
             const std::uint32_t* p = primitive + j0;
             const std::size_t lanes = std::min<std::size_t>(kSlopeBlock, n - j0);
             alignas(64) std::uint8_t runStart[kSlopeBlock];
             runStart[0] = p[0] / kSlopeBlock < blocks && (j0 == 0 || p[0] / kSlopeBlock != p[-1] / kSlopeBlock);
             for (std::size_t j = 1; j < lanes; ++j)
                 runStart[j] = (p[j] / kSlopeBlock < blocks) & (p[j] / kSlopeBlock != p[j - 1] / kSlopeBlock);
-            forEachSetLane(runStart, lanes, [&](std::size_t j) ZCHECK_ALWAYS_INLINE {
-                ready &= blockState(p[j] / kSlopeBlock).load(std::memory_order_relaxed) == kBlockReady;
-            });
+            if (!blocksReady(p, laneBits(runStart, lanes))) return nullptr;
         }
-        if (!ready) return nullptr;
-        std::atomic_thread_fence(std::memory_order_acquire);  // the relaxed loads above saw each block's release
+        std::atomic_thread_fence(std::memory_order_acquire);  // blocksReady's relaxed loads saw each block's release
         return slopeOfTriangle_.data();
     }
+    // slopeTableFor of up to 64 lanes whose run starts the caller found itself: the lanes j of
+    // `runStarts` (bits) whose primitive[j] lies in a block of the scene (< slopeBlockCount()
+    // after division by kSlopeBlock) and in another block than primitive[j − 1], and lane 0
+    // when it does. (The comparison's AVX-512 form finds them while it makes the row's surface.)
+    ZCHECK_ALWAYS_INLINE const double* slopeTableForRuns(const std::uint32_t* primitive, std::uint64_t runStarts) const
+    {
+        if (source_ != SlopeSource::TableOfSeen || !blocksReady(primitive, runStarts)) return nullptr;
+        std::atomic_thread_fence(std::memory_order_acquire);  // as in slopeTableFor
+        return slopeOfTriangle_.data();
+    }
+    // TableOfSeen: triangles [b·kSlopeBlock, (b+1)·kSlopeBlock) are block b; there are
+    // slopeBlockCount() (none for another source).
+    static constexpr std::uint32_t kSlopeBlock = 64;
+    std::uint32_t slopeBlockCount() const { return blockCount_; }
     // The table's entry for any primitive not of the scene: 0, and always there.
     std::uint32_t slopeTableNone() const { return std::uint32_t(scene_.triangles.size()); }
     // Whether the comparison's AVX-512 forms run (ZCHECK_COMPARE_KERNEL, read when the judge
@@ -272,14 +282,23 @@ private:
     glm::dvec3 vertex(std::uint32_t primitive, int corner) const;
     double computeSlope(std::uint32_t primitive) const;  // DepthSlopeFrame::slope of its corners
 
-    // TableOfSeen: triangles [b·kSlopeBlock, (b+1)·kSlopeBlock) are block b, whose byte in
-    // blockState_ goes 0 (not computed) → 1 (being computed, by the thread that made it so) →
-    // kBlockReady (its slopes in the table, stored with release: read them after an acquire).
-    static constexpr std::uint32_t kSlopeBlock = 64;
+    // TableOfSeen: block b's byte in blockState_ goes 0 (not computed) → 1 (being computed, by
+    // the thread that made it so) → kBlockReady (its slopes in the table, stored with release:
+    // read them after an acquire).
     static constexpr std::uint8_t kBlockReady = 2;
     std::atomic<std::uint8_t>& blockState(std::uint32_t block) const { return blockState_[block]; }
     // Computes block b into the table unless another thread is computing it; whether it is ready.
     bool makeBlockReady(std::uint32_t block) const;
+    // Whether the blocks of primitive[j] for the set bits j of `runStarts` are all ready
+    // (relaxed loads: the caller fences before it reads the table).
+    ZCHECK_ALWAYS_INLINE bool blocksReady(const std::uint32_t* primitive, std::uint64_t runStarts) const
+    {
+        bool ready = true;
+        forEachSetBit(runStarts, [&](std::size_t j) ZCHECK_ALWAYS_INLINE {
+            ready &= blockState(primitive[j] / kSlopeBlock).load(std::memory_order_relaxed) == kBlockReady;
+        });
+        return ready;
+    }
 
     const Scene& scene_;
     const Camera& camera_;
