@@ -4,6 +4,7 @@
 #include "zcheck/camera_rays.h"
 #include "zcheck/inverse_projection.h"
 #include "zcheck/kernel_choice.h"
+#include "zcheck/large_buffer.h"
 
 #include <embree3/rtcore.h>
 #include <tbb/blocked_range.h>
@@ -95,9 +96,10 @@ struct HitPlane {
 };
 static_assert(sizeof(HitPlane) == 40, "5 entries in 200 bytes: half of them span two cache lines");
 
-std::unique_ptr<HitPlane[]> hitPlanesOf(const Scene& scene)
+LargeVector<HitPlane> hitPlanesOf(const Scene& scene)
 {
-    std::unique_ptr<HitPlane[]> planes(new HitPlane[scene.triangles.size()]);  // each written below
+    LargeVector<HitPlane> planes;  // on huge pages (40 MB for a million triangles)
+    planes.resize(scene.triangles.size());  // uninitialised: each entry written below
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, scene.triangles.size(), 4096),
                       [&](const tbb::blocked_range<std::size_t>& range) {
                           for (std::size_t i = range.begin(); i != range.end(); ++i) {
@@ -123,7 +125,7 @@ struct RayRenderer::Embree {
     ErrorLog errors;
     DeviceHandle device;
     SceneHandle scene;
-    std::unique_ptr<HitPlane[]> planes;  // by primitive id (hitPlanesOf)
+    LargeVector<HitPlane> planes;  // by primitive id (hitPlanesOf)
 
     void check(const char* step)
     {
@@ -415,7 +417,7 @@ void RayRenderer::traceRect(const Camera& camera, const PixelRect& rect, double*
 #ifdef ZCHECK_X86_AVX512
     if (avx512_) form = &traceRectAvx512;
 #endif
-    form(embree_->scene.get(), embree_->frameOrigin, embree_->planes.get(), camera, rect, windowDepth, primitiveId, stride, fault, pEye);
+    form(embree_->scene.get(), embree_->frameOrigin, embree_->planes.data(), camera, rect, windowDepth, primitiveId, stride, fault, pEye);
 }
 
 }  // namespace zcheck
