@@ -108,7 +108,8 @@ LargeVector<HitPlane> hitPlanesOf(const Scene& scene)
                               const glm::dvec3 b(scene.positions[corners[1]]), c(scene.positions[corners[2]]);
                               const glm::dvec3 normal = glm::cross(b - glm::dvec3(a), c - glm::dvec3(a));
                               HitPlane& plane = planes[i];
-                              for (int axis = 0; axis < 3; ++axis) plane.normal[axis] = normal[axis], plane.vertex[axis] = a[axis];
+                              for (int axis = 0; axis < 3; ++axis)
+                                  plane.normal[axis] = normal[axis], plane.vertex[axis] = a[axis];
                               plane.unused = 0;
                           }
                       });
@@ -345,9 +346,9 @@ ZCHECK_ALWAYS_INLINE inline void traceRectBody(RTCScene rtcScene, const glm::dve
             for (int k = 0; k < kPacketRays; ++k) eyeZ[k] = cameraRays.eyeZ(p.origin(k) + t[k] * p.direction(k));
         }
         // The pixels, lane by lane into plain arrays, then a row of the packet at a time: four
-        // adjacent pixels, copied whole where all four lie in the rectangle.
-        // Every lane's window depth at once where the camera has a closed form (a miss's is
-        // computed too, from triangle 0's plane, and not used); a raw-matrix camera's, hits only.
+        // adjacent pixels, copied whole where all four lie in the rectangle. Every lane's window
+        // depth at once where the camera has a closed form (a miss's is computed too, from
+        // triangle 0's plane, and not used); a raw-matrix camera's, hits only.
         alignas(64) double depthOf[kPacketRays];
         alignas(64) std::uint32_t primitiveOf[kPacketRays];
         const bool closedForm = cameraRays.windowDepths(eyeZ, kPacketRays, depthOf);
@@ -417,7 +418,8 @@ void RayRenderer::traceRect(const Camera& camera, const PixelRect& rect, double*
 #ifdef ZCHECK_X86_AVX512
     if (avx512_) form = &traceRectAvx512;
 #endif
-    form(embree_->scene.get(), embree_->frameOrigin, embree_->planes.data(), camera, rect, windowDepth, primitiveId, stride, fault, pEye);
+    form(embree_->scene.get(), embree_->frameOrigin, embree_->planes.data(), camera, rect, windowDepth, primitiveId,
+         stride, fault, pEye);
 }
 
 }  // namespace zcheck
