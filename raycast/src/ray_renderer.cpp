@@ -352,11 +352,12 @@ ZCHECK_ALWAYS_INLINE inline void traceRectBody(RTCScene rtcScene, const glm::dve
         alignas(64) double depthOf[kPacketRays];
         alignas(64) std::uint32_t primitiveOf[kPacketRays];
         const bool closedForm = cameraRays.windowDepths(eyeZ, kPacketRays, depthOf);
-        for (int k = 0; k < kPacketRays; ++k) {
-            const bool hit = p.hit(k);
-            primitiveOf[k] = hit ? p.packet.hit.primID[k] : kNoPrimitive;
-            if (!closedForm && hit) depthOf[k] = cameraRays.windowDepth(p.pImage(k), eyeZ[k]);
-            depthOf[k] = hit ? depthOf[k] : clearDepth;
+        for (int k = 0; k < kPacketRays; ++k) primitiveOf[k] = p.hit(k) ? p.packet.hit.primID[k] : kNoPrimitive;
+        if (closedForm) {
+            for (int k = 0; k < kPacketRays; ++k) depthOf[k] = p.hit(k) ? depthOf[k] : clearDepth;
+        } else {
+            for (int k = 0; k < kPacketRays; ++k)
+                depthOf[k] = p.hit(k) ? cameraRays.windowDepth(p.pImage(k), eyeZ[k]) : clearDepth;
         }
         const int cols = std::min(kPacketSide, col1 - p.col0), rows = std::min(kPacketSide, row1 - p.row0);
         for (int r = 0; r < rows; ++r) {

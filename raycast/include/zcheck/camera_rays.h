@@ -65,7 +65,7 @@ public:
     double windowDepth(const glm::dvec2& pImage, double eyeZ) const
     {
         if (fromMatrix_) return matrixWindowDepth(pImage, eyeZ);
-        return depthA_ + (parallel_ ? depthB_ * eyeZ : depthB_ / eyeZ);
+        return parallel_ ? parallelWindowDepth(depthA_, depthB_, eyeZ) : perspectiveWindowDepth(depthA_, depthB_, eyeZ);
     }
     // windowDepth of n eye-z values into out[j], several per instruction (the same operations);
     // false (nothing written) for a raw-matrix camera, whose pixels differ.
@@ -74,9 +74,9 @@ public:
         if (fromMatrix_) return false;
         const double A = depthA_, B = depthB_;
         if (parallel_) {
-            for (std::size_t j = 0; j < n; ++j) out[j] = A + B * eyeZ[j];
+            for (std::size_t j = 0; j < n; ++j) out[j] = parallelWindowDepth(A, B, eyeZ[j]);
         } else {
-            for (std::size_t j = 0; j < n; ++j) out[j] = A + B / eyeZ[j];
+            for (std::size_t j = 0; j < n; ++j) out[j] = perspectiveWindowDepth(A, B, eyeZ[j]);
         }
         return true;
     }
@@ -126,6 +126,9 @@ public:
     }
 
 private:
+    // The closed forms of windowDepth: window = A + B/z (perspective) or A + B·z (parallel).
+    static double perspectiveWindowDepth(double A, double B, double eyeZ) { return A + B / eyeZ; }
+    static double parallelWindowDepth(double A, double B, double eyeZ) { return A + B * eyeZ; }
     // The closed forms of relativeEyeZDifference. Perspective: z = B/(w − A), so
     // (z_o − z_r)/z_r = (w_r − w_o)/(w_o − A); parallel: z = (w − A)/B, so (w_o − w_r)/(w_r − A).
     static double perspectiveRelative(double A, double reference, double other)
