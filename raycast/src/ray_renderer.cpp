@@ -9,11 +9,12 @@
 #include <embree3/rtcore.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <xmmintrin.h>
+#include <immintrin.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 #include <limits>
 #include <mutex>
@@ -78,10 +79,19 @@ struct PacketInFlight {
     alignas(64) double imageX[kPacketRays], imageY[kPacketRays];  // the rays' image points
     alignas(64) double lane[6][kPacketRays];  // origin x, y, z and direction x, y, z, in double
 
+    alignas(64) int hits[kPacketRays];  // after the trace: lane valid and hit, −1; else 0 (noteHits)
+
     glm::dvec2 pImage(int k) const { return {imageX[k], imageY[k]}; }
     glm::dvec3 origin(int k) const { return {lane[0][k], lane[1][k], lane[2][k]}; }
     glm::dvec3 direction(int k) const { return {lane[3][k], lane[4][k], lane[5][k]}; }
-    bool hit(int k) const { return valid[k] && packet.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID; }
+    // Once per packet, every lane at once (asked as `valid && hit` per lane, it compiled to two
+    // branches per lane in every loop that asked).
+    void noteHits()
+    {
+        for (int k = 0; k < kPacketRays; ++k)
+            hits[k] = -int((valid[k] != 0) & (packet.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID));
+    }
+    bool hit(int k) const { return hits[k] != 0; }
 };
 
 // A triangle's plane as the re-evaluation reads it, made once per scene: the normal
@@ -232,9 +242,43 @@ RenderResult RayRenderer::render(const Camera& camera, const RayFaults& fault, E
 
 namespace {
 
+#ifdef ZCHECK_X86_AVX512
+// The AVX-512 form's reading of a packet's planes (the baseline form reads them lane by lane):
+// four entries at a time, each as one 32-byte load (the normal and the vertex's x and y) and
+// one of 8 bytes (its z), transposed into the lanes. The same values: only the loads differ.
+// (Lane by lane, GCC made 96 scalar loads and as many inserts per packet.)
+ZCHECK_INTRINSICS_BEGIN
+ZCHECK_TARGET_AVX512 inline void planesInLanesAvx512(const HitPlane* planes, const std::uint32_t* triangle,
+                                                     double (*plane)[kPacketRays])
+{
+    static_assert(kPacketRays % 4 == 0 && offsetof(HitPlane, vertex) == 24, "four entries at a time, as laid out");
+    for (int k = 0; k < kPacketRays; k += 4) {
+        const double* e[4];
+        __m256d r[4];  // nx ny nz (vx vy)
+        for (int j = 0; j < 4; ++j) e[j] = reinterpret_cast<const double*>(planes + triangle[k + j]), r[j] = _mm256_loadu_pd(e[j]);
+        const __m256d x0x1z0z1 = _mm256_unpacklo_pd(r[0], r[1]), y0y1v0v1 = _mm256_unpackhi_pd(r[0], r[1]);
+        const __m256d x2x3z2z3 = _mm256_unpacklo_pd(r[2], r[3]), y2y3v2v3 = _mm256_unpackhi_pd(r[2], r[3]);
+        _mm256_store_pd(plane[3] + k, _mm256_permute2f128_pd(x0x1z0z1, x2x3z2z3, 0x20));
+        _mm256_store_pd(plane[4] + k, _mm256_permute2f128_pd(y0y1v0v1, y2y3v2v3, 0x20));
+        _mm256_store_pd(plane[5] + k, _mm256_permute2f128_pd(x0x1z0z1, x2x3z2z3, 0x31));
+        // The vertices: x0 y0 x1 y1 x2 y2 x3 y3 as binary32, then x0..x3 and y0..y3; z0..z3 from
+        // the second loads (z and the unused word of each entry).
+        const __m256 xy = _mm256_castpd_ps(_mm256_permute2f128_pd(y0y1v0v1, y2y3v2v3, 0x31));
+        const __m256 xxyy = _mm256_permutevar8x32_ps(xy, _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7));
+        const __m128 z01 = _mm_castpd_ps(_mm_loadh_pd(_mm_load_sd(e[0] + 4), e[1] + 4));
+        const __m128 z23 = _mm_castpd_ps(_mm_loadh_pd(_mm_load_sd(e[2] + 4), e[3] + 4));
+        _mm256_store_pd(plane[0] + k, _mm256_cvtps_pd(_mm256_castps256_ps128(xxyy)));
+        _mm256_store_pd(plane[1] + k, _mm256_cvtps_pd(_mm256_extractf128_ps(xxyy, 1)));
+        _mm256_store_pd(plane[2] + k, _mm256_cvtps_pd(_mm_shuffle_ps(z01, z23, _MM_SHUFFLE(2, 0, 2, 0))));
+    }
+}
+ZCHECK_INTRINSICS_END
+#endif
+
 // RayRenderer::traceRect's work, inlined into two functions: one compiled for the build's
 // baseline and one for AVX-512 (kernel_choice.h). Its per-packet steps are lambdas that must
-// be inlined too, or they would stay baseline code.
+// be inlined too, or they would stay baseline code. kAvx512: the AVX-512 form's own steps.
+template <bool kAvx512>
 ZCHECK_ALWAYS_INLINE inline void traceRectBody(RTCScene rtcScene, const glm::dvec3& frameOrigin, const HitPlane* planes,
                                         const Camera& camera, const PixelRect& rect, double* windowDepth,
                                         std::uint32_t* primitiveId, std::size_t stride, const RayFaults& fault,
@@ -275,10 +319,9 @@ ZCHECK_ALWAYS_INLINE inline void traceRectBody(RTCScene rtcScene, const glm::dve
             for (int c = 0; c < 3; ++c) {
                 const double o = affine->origin[c], oX = affine->originPerX[c], oY = affine->originPerY[c];
                 const double d = affine->direction[c], dX = affine->directionPerX[c], dY = affine->directionPerY[c];
-                for (int k = 0; k < kPacketRays; ++k) {
-                    p.lane[c][k] = o + p.imageX[k] * oX + p.imageY[k] * oY;
-                    p.lane[3 + c][k] = d + p.imageX[k] * dX + p.imageY[k] * dY;
-                }
+                // Origins and directions in loops apart: in one loop, GCC made the origins lane by lane.
+                for (int k = 0; k < kPacketRays; ++k) p.lane[c][k] = o + p.imageX[k] * oX + p.imageY[k] * oY;
+                for (int k = 0; k < kPacketRays; ++k) p.lane[3 + c][k] = d + p.imageX[k] * dX + p.imageY[k] * dY;
             }
             const float nearT = float(near), farT = std::isinf(far) ? INFINITY : float(far);
             for (int k = 0; k < kPacketRays; ++k) ray.tnear[k] = nearT, ray.tfar[k] = farT;
@@ -310,6 +353,7 @@ ZCHECK_ALWAYS_INLINE inline void traceRectBody(RTCScene rtcScene, const glm::dve
             p.packet.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
         }
         rtcIntersect16(p.valid, rtcScene, &context, &p.packet);
+        p.noteHits();
         for (int k = 0; k < kPacketRays; ++k)  // the hit planes asked for: both ends of each entry
             if (p.hit(k)) {
                 const char* entry = reinterpret_cast<const char*>(planes + p.packet.hit.primID[k]);
@@ -326,11 +370,15 @@ ZCHECK_ALWAYS_INLINE inline void traceRectBody(RTCScene rtcScene, const glm::dve
         std::uint32_t triangle[kPacketRays];
         for (int k = 0; k < kPacketRays; ++k) triangle[k] = p.hit(k) ? p.packet.hit.primID[k] : 0;
         alignas(64) double plane[6][kPacketRays];  // a vertex x, y, z and the normal x, y, z
-        for (int k = 0; k < kPacketRays; ++k) {
-            const HitPlane& h = planes[triangle[k]];
-            for (int axis = 0; axis < 3; ++axis)
-                plane[axis][k] = double(h.vertex[axis]), plane[3 + axis][k] = h.normal[axis];
-        }
+#ifdef ZCHECK_X86_AVX512
+        if constexpr (kAvx512) planesInLanesAvx512(planes, triangle, plane);
+#endif
+        if constexpr (!kAvx512)
+            for (int k = 0; k < kPacketRays; ++k) {
+                const HitPlane& h = planes[triangle[k]];
+                for (int axis = 0; axis < 3; ++axis)
+                    plane[axis][k] = double(h.vertex[axis]), plane[3 + axis][k] = h.normal[axis];
+            }
         // Lane by lane in plain arrays (several lanes per instruction): the ray parameter t
         // of the hit (Embree's, where the plane gives none) and its eye-z.
         alignas(64) double tEmbree[kPacketRays], t[kPacketRays], eyeZ[kPacketRays];
@@ -397,7 +445,7 @@ void traceRectBaseline(RTCScene rtcScene, const glm::dvec3& frameOrigin, const H
                        const PixelRect& rect, double* windowDepth, std::uint32_t* primitiveId, std::size_t stride,
                        const RayFaults& fault, glm::dvec3* pEye)
 {
-    traceRectBody(rtcScene, frameOrigin, planes, camera, rect, windowDepth, primitiveId, stride, fault, pEye);
+    traceRectBody<false>(rtcScene, frameOrigin, planes, camera, rect, windowDepth, primitiveId, stride, fault, pEye);
 }
 
 #ifdef ZCHECK_X86_AVX512
@@ -406,7 +454,7 @@ ZCHECK_TARGET_AVX512 void traceRectAvx512(RTCScene rtcScene, const glm::dvec3& f
                                           std::uint32_t* primitiveId, std::size_t stride, const RayFaults& fault,
                                           glm::dvec3* pEye)
 {
-    traceRectBody(rtcScene, frameOrigin, planes, camera, rect, windowDepth, primitiveId, stride, fault, pEye);
+    traceRectBody<true>(rtcScene, frameOrigin, planes, camera, rect, windowDepth, primitiveId, stride, fault, pEye);
 }
 #endif
 
