@@ -55,7 +55,8 @@ Stats timeRepeated(int repeats, F&& run)
 }
 
 // `phase` other than "all" times one phase alone, for A/B comparisons of its code: "raster"
-// (no BVH is built), "trace", "compare" (both routes rendered once, the comparison repeated),
+// (no BVH is built), "trace", "raster-cold" and "trace-cold" (each render into fresh buffers,
+// the kept ones given back first), "compare" (both routes rendered once, the comparison repeated),
 // "compare-cold" (before each comparison, both routes rendered into fresh buffers),
 // "floor" (what the comparison costs at least: its arrays read and written, nothing computed),
 // or "tiles" (the whole check drawn, traced and compared tile by tile, as `zcheck check` runs).
@@ -86,9 +87,10 @@ void runPhase(const std::string& phase, const Scene& scene, const Camera& camera
         return;
     }
     const RasterRenderer raster(scene);
-    if (phase == "raster") {
+    if (phase == "raster" || phase == "raster-cold") {
         RenderResult last;
         const Stats ms = timeRepeated(repeats, [&] {
+            if (phase == "raster-cold") last = RenderResult(), releaseCachedLargeBuffers();  // fresh buffers, as a new process's
             last = raster.render(camera);
             return last.renderMilliseconds;
         });
@@ -97,8 +99,9 @@ void runPhase(const std::string& phase, const Scene& scene, const Camera& camera
     } else {
         const RayRenderer rays(scene);
         RenderResult ray = rays.render(camera);
-        if (phase == "trace") {
+        if (phase == "trace" || phase == "trace-cold") {
             const Stats ms = timeRepeated(repeats, [&] {
+                if (phase == "trace-cold") ray = RenderResult(), releaseCachedLargeBuffers();  // fresh buffers
                 ray = rays.render(camera);
                 return ray.renderMilliseconds;
             });
@@ -227,9 +230,9 @@ int main(int argc, char** argv)
     app.add_option("--only", only, "run only workloads whose label contains this text");
     app.add_option("--scene", sceneName, "one workload: this scene (a built-in name or a mesh file) instead of the named ones");
     app.add_option("--camera", cameraFile, "with --scene: a camera file (its size overrides --width/--height)");
-    app.add_option("--phase", phase, "all, or one phase alone: raster (no BVH built), trace, compare, compare-cold (each comparison after renders into fresh buffers, with its page faults), floor (what any comparison costs at least: its arrays read and written, nothing computed), tiles (a check tile by tile), "
+    app.add_option("--phase", phase, "all, or one phase alone: raster (no BVH built), trace, raster-cold and trace-cold (each render into fresh buffers), compare, compare-cold (each comparison after renders into fresh buffers, with its page faults), floor (what any comparison costs at least: its arrays read and written, nothing computed), tiles (a check tile by tile), "
                    "or embree (the trace's yardstick: Embree's own best packet trace)")
-        ->check(CLI::IsMember({"all", "raster", "trace", "compare", "compare-cold", "floor", "tiles", "embree"}))
+        ->check(CLI::IsMember({"all", "raster", "raster-cold", "trace", "trace-cold", "compare", "compare-cold", "floor", "tiles", "embree"}))
         ->capture_default_str();
     CLI11_PARSE(app, argc, argv);
 

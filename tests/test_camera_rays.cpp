@@ -180,6 +180,11 @@ TEST_CASE("the trace compiled for AVX-512 is bit-identical to its baseline form"
         spec.view = View::lookAt({0.3, -0.2, 1.0}, {0, 0, -4}, {0, 1, 0});
         cameras.push_back(spec);
     }
+    {  // rows of whole cache lines (width a multiple of 16): render() copies them with streaming stores
+        CameraSpec spec = testing::kernelCamera("vulkan", DepthFormat::Unorm24, false, false);
+        spec.width = 272, spec.height = 141;
+        cameras.push_back(spec);
+    }
     RayFaults shifted, rowsFlipped, colsFlipped, distance;
     shifted.shiftPixels = {0.5, -0.25};
     rowsFlipped.flipRows = true;
