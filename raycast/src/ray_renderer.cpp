@@ -127,28 +127,6 @@ LargeVector<HitPlane> hitPlanesOf(const Scene& scene)
     return planes;
 }
 
-// A region's row of n values into the image. Where the row is whole cache lines, with
-// streaming stores: the image is tens of MB, written once and read back only after the raster
-// has drawn as much again, so ordinary stores first read each line in for nothing and then
-// evict what the trace works on (the trace ~5 % faster; the comparison after it no slower).
-template <class T>
-void copyRow(const T* from, int n, T* to)
-{
-    const std::size_t bytes = sizeof(T) * std::size_t(n);
-#ifdef __SSE2__
-    if (reinterpret_cast<std::uintptr_t>(to) % 64 == 0 && bytes % 64 == 0) {
-        static_assert(alignof(T) <= 16 && 64 % sizeof(T) == 0, "whole values per 16 bytes");
-        for (std::size_t offset = 0; offset < bytes; offset += 16) {
-            const char* source = reinterpret_cast<const char*>(from) + offset;
-            _mm_stream_si128(reinterpret_cast<__m128i*>(reinterpret_cast<char*>(to) + offset),
-                             _mm_loadu_si128(reinterpret_cast<const __m128i*>(source)));
-        }
-        return;
-    }
-#endif
-    std::memcpy(to, from, bytes);
-}
-
 }  // namespace
 
 struct RayRenderer::Embree {
@@ -239,8 +217,8 @@ RenderResult RayRenderer::render(const Camera& camera, const RayFaults& fault, E
     // traced into a buffer of the worker's own and then copied into the image a row at a time:
     // written straight into the image, a packet's four rows went to eight cache lines far apart
     // that were not in the cache, and the stores waiting on them stalled the packets behind
-    // (the trace 88–92 → 70–79 ms for the speed workload). Eye points, rarely asked for, are
-    // written straight.
+    // (the trace 88–92 → 70–79 ms for the speed workload); streaming stores where they can
+    // (large_buffer.h) made it ~5 % faster again. Eye points, rarely asked for, are written straight.
     const TileGrid regions(W, H, kRegion);
     tbb::parallel_for(0, regions.count(), [&](int region) {
         const PixelRect rect = regions.rect(region);
@@ -255,12 +233,10 @@ RenderResult RayRenderer::render(const Camera& camera, const RayFaults& fault, E
         traceRect(camera, rect, depth, primitive, kRegion, fault, nullptr);
         for (int r = 0; r < rect.height(); ++r) {
             const std::size_t to = first + std::size_t(r) * std::size_t(W), from = std::size_t(r) * kRegion;
-            copyRow(depth + from, rect.width(), result.windowDepth.value.data() + to);
-            copyRow(primitive + from, rect.width(), result.primitiveId.data() + to);
+            copyRowStreaming(depth + from, std::size_t(rect.width()), result.windowDepth.value.data() + to);
+            copyRowStreaming(primitive + from, std::size_t(rect.width()), result.primitiveId.data() + to);
         }
-#ifdef __SSE2__
-        _mm_sfence();  // the streaming stores visible before the task is seen done
-#endif
+        finishStreamingCopies();
     });
     result.renderMilliseconds = millisecondsSince(start);
     return result;

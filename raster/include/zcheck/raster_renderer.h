@@ -61,10 +61,14 @@ public:
     RasterFrame(RasterFrame&&) noexcept = default;
 
     const TileGrid& tiles() const;  // kTileSize squares over the camera's image
+    // How drawTile writes: for a reader soon after (Cached: a tile compared as it is drawn), or
+    // into a whole image read much later (Streaming: copyRowStreaming, large_buffer.h).
+    enum class Stores { Cached, Streaming };
     // The tile's stored depth values and primitive ids (kNoPrimitive where nothing was drawn)
     // into windowDepth/primitive, which point at the tile's first pixel: pixel (col, row) of
     // the tile goes to entry (row − row0)·stride + (col − col0). Thread-safe (const).
-    void drawTile(int tile, double* windowDepth, std::uint32_t* primitive, std::size_t stride) const;
+    void drawTile(int tile, double* windowDepth, std::uint32_t* primitive, std::size_t stride,
+                  Stores stores = Stores::Cached) const;
 
 private:
     friend struct RasterFrameTesting;  // white-box tests (raster/src/raster_testing.h)
