@@ -645,7 +645,11 @@ void RasterFrame::Impl::prepare()
     tbb::parallel_for(std::size_t(0), chunks.size(), [&](std::size_t c) {
         Chunk& chunk = chunks[c];
         const std::size_t first = c * kChunkTriangles, last = std::min(triangleCount, first + kChunkTriangles);
-        std::vector<BinItem> items;
+        // The worker's own list, kept from chunk to chunk and frame to frame: a new one per chunk
+        // (~330 KB) was memory the C library mapped afresh, ~110 page faults of a cold frame's
+        // 430 (the raster ~1.5 ms faster cold in process).
+        static thread_local std::vector<BinItem> items;
+        items.clear();
         items.reserve(last - first);
         auto setUp = [&](std::size_t p) {
             const glm::uvec3& tri = scene.triangles[p];
