@@ -111,7 +111,7 @@ ZCHECK_ALWAYS_INLINE inline void slopesTogether(const DepthSlopeFrame& frame, co
     for (std::size_t k = 0; k < n; ++k) triangle[k] = first + std::uint32_t(k);
     // Every corner asked for before the first is read (the loads then overlap, where reading
     // them in order waited on each few in turn), and the next block's index triples too: the
-    // comparison often asks for blocks in order (~17 % fewer samples in this function).
+    // comparison often asks for blocks in order (the comparison ~5 % faster in process).
     for (std::size_t k = 0; k < n; ++k)
         for (int corner = 0; corner < 3; ++corner) __builtin_prefetch(&scene.positions[scene.triangles[first + k][corner]]);
     const std::size_t nextBlock = first + n, nextBlockEnd = std::min(scene.triangles.size(), nextBlock + kSlopeLanes);
