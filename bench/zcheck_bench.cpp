@@ -94,8 +94,8 @@ void runPhase(const std::string& phase, const Scene& scene, const Camera& camera
             last = raster.render(camera);
             return last.renderMilliseconds;
         });
-        std::printf("raster %7.1f ms (best %7.1f) %6.2f Mtris/s", ms.median, ms.best,
-                    double(scene.triangleCount()) / ms.median / 1e3);
+        std::printf("%s %7.1f ms (best %7.1f) %6.2f Mtris/s", phase == "raster-cold" ? "raster cold" : "raster", ms.median,
+                    ms.best, double(scene.triangleCount()) / ms.median / 1e3);
     } else {
         const RayRenderer rays(scene);
         RenderResult ray = rays.render(camera);
@@ -105,8 +105,8 @@ void runPhase(const std::string& phase, const Scene& scene, const Camera& camera
                 ray = rays.render(camera);
                 return ray.renderMilliseconds;
             });
-            std::printf("trace %7.1f ms (best %7.1f) %6.2f Mrays/s", ms.median, ms.best,
-                        double(camera.width()) * camera.height() / ms.median / 1e3);
+            std::printf("%s %7.1f ms (best %7.1f) %6.2f Mrays/s", phase == "trace-cold" ? "trace cold" : "trace", ms.median,
+                        ms.best, double(camera.width()) * camera.height() / ms.median / 1e3);
         } else if (phase == "floor") {
             // What any comparison of these renders costs at least: the same four arrays read and
             // two per-pixel arrays written (LargeVectors, as Comparison's: fresh memory only for

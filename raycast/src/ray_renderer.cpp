@@ -71,7 +71,7 @@ constexpr int kRegion = 64;      // render() traces 64×64 regions in parallel
 constexpr int kPacketSide = 4;   // a packet covers 4×4 pixels (rtcIntersect16)
 constexpr int kPacketRays = kPacketSide * kPacketSide;
 
-// A packet of rays between its trace and its re-evaluation in double (traceRect keeps three
+// A packet of rays between its trace and its re-evaluation in double (traceRect keeps two
 // in flight): its rays in double and as Embree traced them, and Embree's hits.
 struct PacketInFlight {
     int col0, row0;  // the packet's top-left pixel
