@@ -223,7 +223,7 @@ TEST_CASE("bad matrices and models are refused with a message naming them", "[mo
     refuses(R"({"projection": {"type": "matrix", "clip_from_eye": [1,2,3], "layout": "row-major", "vectors": "column"}, )" + lookAt + "}",
             "16 numbers");
     refuses(R"({"projection": {"type": "perspective", "fovy_deg": 60, "near": 0.1, "far": 9}, "view": {"eye_from_world": [2,0,0,0, 0,2,0,0, 0,0,2,0, 0,0,0,1], "layout": "row-major", "vectors": "column"}})",
-            "not rigid");
+            "not a rigid transform");
     refuses(R"({"projection": {"type": "pinhole", "fx": 0, "fy": 400, "cx": 1, "cy": 1, "near": 0.1, "far": 9}, )" + lookAt + "}", "projection.fx");
     refuses(R"({"projection": {"type": "lens", "focal_mm": -5, "near": 0.1, "far": 9}, )" + lookAt + "}", "projection.focal_mm");
     refuses(R"({"projection": {"type": "oblique", "left": -1, "right": 1, "bottom": -1, "top": 1, "near": 1, "far": 9, "angle_deg": 45, "foreshortening": -1}, )" + lookAt + "}",

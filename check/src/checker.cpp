@@ -1,4 +1,5 @@
 #include "zcheck/checker.h"
+#include "zcheck/pose.h"
 
 #include "zcheck/error.h"
 #include "zcheck/export.h"
@@ -126,6 +127,7 @@ void CheckReport::describeInputs(const Scene& checked, const Camera& used, const
     triangles = checked.triangleCount();
     warnings.clear();
     if (const std::string w = checked.planarity.warning(checked.name); !w.empty()) warnings.push_back(w);
+    for (const std::string& note : cameraNotes(used.spec())) warnings.push_back(note);
     camera = used.spec();
     tolerance = model;
 }

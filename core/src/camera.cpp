@@ -1,7 +1,9 @@
 #include "zcheck/camera.h"
 
 #include "zcheck/error.h"
+#include "zcheck/pose.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace zcheck {
@@ -197,7 +199,8 @@ void validateProjection(const CameraSpec& spec)
 
 void validateLookAt(const CameraSpec& spec);
 
-void validate(const CameraSpec& spec)
+// Validates `spec`, re-orthonormalising a raw view's rotation within the pose rule (pose.h).
+void validate(CameraSpec& spec)
 {
     for (auto [value, name] : {std::pair{spec.width, "image.width"}, {spec.height, "image.height"}})
         if (value < 1 || value > kMaxImageSide)
@@ -208,19 +211,11 @@ void validate(const CameraSpec& spec)
                     std::to_string(kMaxImagePixels) + " pixels (8192x4096)");
     validateProjection(spec);
     if (spec.view.hasMatrix) {
-        // A view is a rigid motion (a rotation, possibly with a reflection between
-        // handedness conventions, and a translation): eye-z must be a world distance.
-        const glm::dmat4& m = spec.view.eyeFromWorld;
-        requireMatrixFinite(m, "view.eye_from_world");
-        const glm::dmat3 rotation(m);
-        const glm::dmat3 gram = glm::transpose(rotation) * rotation;
-        for (int c = 0; c < 3; ++c)
-            for (int r = 0; r < 3; ++r)
-                if (std::abs(gram[c][r] - (c == r ? 1.0 : 0.0)) > 1e-6)
-                    throw Error("camera matrix 'view.eye_from_world' is not rigid (its 3x3 part is not orthonormal: "
-                                "scale or shear)");
-        if (m[0][3] != 0 || m[1][3] != 0 || m[2][3] != 0 || m[3][3] != 1)
-            throw Error("camera matrix 'view.eye_from_world' must have the last row 0 0 0 1 (for column vectors)");
+        // A view is a rigid motion with the convention's handedness (pose.h): eye-z must be a
+        // world distance, and a reflection would mirror the picture.
+        const RigidTransform rigid = requireRigid(spec.view.eyeFromWorld, eyeHandedness(spec.convention), "view.eye_from_world");
+        spec.view.eyeFromWorld = rigid.matrix;
+        spec.view.rotationDeparture = std::max(spec.view.rotationDeparture, rigid.departure);
     } else {
         validateLookAt(spec);
     }

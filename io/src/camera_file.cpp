@@ -4,6 +4,7 @@
 
 #include "zcheck/error.h"
 #include "zcheck/input_file.h"
+#include "zcheck/pose.h"
 
 #include <algorithm>
 #include <cctype>
@@ -103,6 +104,7 @@ public:
     {
         throw Error(source_ + ": '" + name(key) + "' " + what);
     }
+    [[noreturn]] void failWith(const std::string& message) const { throw Error(source_ + ": " + message); }
     [[noreturn]] void fail(const std::string& what) const
     {
         throw Error(source_ + ": " + (path_.empty() ? "" : "'" + path_ + "' ") + what);
@@ -196,18 +198,22 @@ Projection readProjection(ObjectReader projection)
     return p;
 }
 
-View readView(ObjectReader view)
+View readView(ObjectReader view, const Convention& convention)
 {
     View v;
     if (view.has("eye_from_world") || view.has("world_from_eye")) {
         if (view.has("eye_from_world") && view.has("world_from_eye"))
             view.fail("takes one of 'eye_from_world' and 'world_from_eye', not both");
         const bool eyeFromWorld = view.has("eye_from_world");
-        const glm::dmat4 m = readMatrix(view, eyeFromWorld ? "eye_from_world" : "world_from_eye");
-        if (!(std::abs(glm::determinant(m)) > 1e-12))
-            view.failKey(eyeFromWorld ? "eye_from_world" : "world_from_eye", "is singular");
-        v.hasMatrix = true;
-        v.eyeFromWorld = eyeFromWorld ? m : glm::inverse(m);
+        const std::string key = eyeFromWorld ? "eye_from_world" : "world_from_eye";
+        const glm::dmat4 m = readMatrix(view, key);
+        // The pose rule (pose.h): checked, re-orthonormalised within the bound, inverted rigidly.
+        try {
+            v = viewFromPose(m, eyeFromWorld ? PoseDirection::CameraFromWorld : PoseDirection::WorldFromCamera,
+                             convention, convention, "view." + key);
+        } catch (const Error& e) {
+            view.failWith(e.what());
+        }
     } else if (view.has("axonometric")) {
         const std::string kind = view.string("axonometric", "");
         const glm::dvec3 target = view.vec3("target");
@@ -254,7 +260,7 @@ CameraSpec cameraSpecFromJson(const json& document, const std::string& source)
         image.finish();
     }
     spec.projection = readProjection(root.child("projection"));
-    spec.view = readView(root.child("view"));
+    spec.view = readView(root.child("view"), spec.convention);
     if (root.has("depth")) {
         ObjectReader depth = root.child("depth");
         const std::string format = depth.string("format", "float32");

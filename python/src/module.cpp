@@ -6,6 +6,8 @@
 // paper for column vectors (M[r, c], p' = M·p), while GLM stores m[c][r].
 // The GIL is released around every render, check, verify, diagnosis, scene load and BVH build.
 #include "bindings.h"
+
+#include "zcheck/pose.h"
 #include "camera_json.h"
 #include "zcheck/camera.h"
 #include "zcheck/camera_file.h"
@@ -17,6 +19,7 @@
 #include "zcheck/large_buffer.h"
 #include "zcheck/mesh_loader.h"
 #include "zcheck/mistakes.h"
+#include "zcheck/pose.h"
 #include "zcheck/quantity.h"
 #include "zcheck/report.h"
 #include "zcheck/scene.h"
@@ -119,28 +122,16 @@ py::array_t<double> arrayFromVec3(const glm::dvec3& p)
     return out;
 }
 
-// The 3×3 part of a view must be a rotation (possibly with a reflection): the rule of
-// Camera's constructor (gram matrix within 1e-6 of the identity), with the argument's name.
-void requireRotation(const glm::dmat4& m, const std::string& what)
+// Runs `make` and prefixes a refusal with `where` ("Camera.from_opencv"): the rules are the
+// library's (pose.h, camera.h), the names of the arguments the caller's.
+template <class Make>
+auto prefixedErrors(const std::string& where, Make&& make)
 {
-    const glm::dmat3 rotation(m);
-    const glm::dmat3 gram = glm::transpose(rotation) * rotation;
-    double worst = 0;
-    for (int c = 0; c < 3; ++c)
-        for (int r = 0; r < 3; ++r) worst = std::max(worst, std::abs(gram[c][r] - (c == r ? 1.0 : 0.0)));
-    if (worst > 1e-6)
-        fail(what + " is not a rigid transform: its 3x3 rotation part is not orthonormal (R^T R differs from the identity "
-                    "by " +
-             formatNumber(worst) + "; scale or shear)");
-}
-
-// Rigid inverse [Rᵀ, −Rᵀt] of a rigid transform (exact transposition, no general inverse).
-glm::dmat4 rigidInverse(const glm::dmat4& m)
-{
-    const glm::dmat3 rt = glm::transpose(glm::dmat3(m));
-    glm::dmat4 out(rt);
-    out[3] = glm::dvec4(-(rt * glm::dvec3(m[3])), 1.0);
-    return out;
+    try {
+        return make();
+    } catch (const Error& e) {
+        throw Error(where + ": " + e.what());
+    }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -280,32 +271,22 @@ Camera cameraFromOpencv(py::object K, py::object R, py::object t, std::optional<
     const std::string where = "Camera.from_opencv";
     const std::string at = where + ": ";
     requireImageSize(width, height, where);
-    if (pixelCenter != 0.0 && pixelCenter != 0.5)
-        fail(at + "pixel_center must be 0.0 (OpenCV: the top-left pixel's centre is (0, 0)) or 0.5 (COLMAP, nerfstudio: "
-                  "it is (0.5, 0.5)), got " +
-             formatNumber(pixelCenter));
     CameraSpec spec;
     spec.convention = conventionNamed(convention, where);
     spec.width = *width, spec.height = *height;
     spec.depth = depthSettings(depthFormat, reversed, depthRange, where);
 
-    // Intrinsics: [[fx, 0, cx], [0, fy, cy], [0, 0, 1]].
+    // Intrinsics: [[fx, 0, cx], [0, fy, cy], [0, 0, 1]], by the pose rule's reading (pose.h).
     const py::array k = numericArray(K, at + "K");
     if (k.ndim() != 2 || k.shape(0) != 3 || k.shape(1) != 3) fail(at + "K must be a 3x3 matrix, got shape " + shapeText(k));
     const DoubleArray kd = asDoubles(k);
     const auto kv = kd.unchecked<2>();
+    double kRows[3][3];
     for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c)
-            if (!std::isfinite(kv(r, c)))
-                fail(at + "K[" + std::to_string(r) + ", " + std::to_string(c) + "] is not finite (" +
-                     formatNumber(kv(r, c)) + ")");
-    if (kv(0, 1) != 0) fail(at + "K[0, 1] (skew) must be 0: zcheck's pinhole model has no skew, got " + formatNumber(kv(0, 1)));
-    if (kv(1, 0) != 0 || kv(2, 0) != 0 || kv(2, 1) != 0 || kv(2, 2) != 1)
-        fail(at + "K must have the form [[fx, 0, cx], [0, fy, cy], [0, 0, 1]] (K[1, 0], K[2, 0], K[2, 1] = 0, K[2, 2] = 1)");
-    spec.projection.type = ProjectionType::Pinhole;
-    spec.projection.fx = kv(0, 0), spec.projection.fy = kv(1, 1);
-    spec.projection.cx = kv(0, 2) - pixelCenter, spec.projection.cy = kv(1, 2) - pixelCenter;
-    spec.projection.near = near, spec.projection.far = far;
+        for (int c = 0; c < 3; ++c) kRows[r][c] = kv(r, c);
+    spec.projection = prefixedErrors(where, [&] {
+        return PinholeIntrinsics::fromK(kRows, pixelCenter, "K").projection(near, far, "K");
+    });
 
     // Extrinsics: exactly one of (R, t), cam_from_world, world_from_cam.
     const int given = int(!R.is_none() || !t.is_none()) + int(!camFromWorld.is_none()) + int(!worldFromCam.is_none());
@@ -334,28 +315,17 @@ Camera cameraFromOpencv(py::object K, py::object R, py::object t, std::optional<
             eyeFromWorld[3][i] = tv[i];
         }
         named = "R";
-        requireRotation(eyeFromWorld, at + "R");
     } else if (!camFromWorld.is_none()) {
         eyeFromWorld = matrixFromArray(camFromWorld, at + "cam_from_world", true);
         named = "cam_from_world";
-        requireRotation(eyeFromWorld, at + named);
     } else {
-        const glm::dmat4 worldFromEye = matrixFromArray(worldFromCam, at + "world_from_cam", true);
+        eyeFromWorld = matrixFromArray(worldFromCam, at + "world_from_cam", true);
         named = "world_from_cam";
-        requireRotation(worldFromEye, at + named);
-        eyeFromWorld = rigidInverse(worldFromEye);
     }
-    // The world is right-handed, and so is every convention's eye space but direct3d's: a
-    // rotation with the wrong determinant mirrors the picture (one axis flipped, not two).
-    const int handedness = spec.convention.eyeUpY * -spec.convention.eyeForwardZ;
-    const double det = glm::determinant(glm::dmat3(eyeFromWorld));
-    if (det * handedness < 0)
-        fail(at + "the rotation of " + named + " has determinant " + formatNumber(std::round(det)) +
-             ": a reflection that mirrors the picture, not a camera pose (the " + spec.convention.name +
-             " camera axes need determinant " + (handedness > 0 ? "+1" : "-1") +
-             "; was one axis flipped instead of two?)");
-    spec.view.hasMatrix = true;
-    spec.view.eyeFromWorld = eyeFromWorld;
+    // The pose rule (pose.h): rigid, with the convention's handedness, re-orthonormalised
+    // within the rounding bound, inverted by transposition when given camera-to-world.
+    const PoseDirection direction = named == "world_from_cam" ? PoseDirection::WorldFromCamera : PoseDirection::CameraFromWorld;
+    spec.view = prefixedErrors(where, [&] { return viewFromPose(eyeFromWorld, direction, spec.convention, spec.convention, named); });
     return makeCamera(spec, where);
 }
 
@@ -383,11 +353,8 @@ Camera cameraFromMatrices(py::object clipFromEye, py::object eyeFromWorld, std::
         fail(at + "give the view as exactly one of eye_from_world and world_from_eye=");
     const std::string name = eyeFromWorld.is_none() ? "world_from_eye" : "eye_from_world";
     const glm::dmat4 view = read(eyeFromWorld.is_none() ? worldFromEye : eyeFromWorld, name);
-    requireRotation(view, at + name);
-    if (view[0][3] != 0 || view[1][3] != 0 || view[2][3] != 0 || view[3][3] != 1)
-        fail(at + name + " must have the last row 0 0 0 1 (for column vectors)");
-    spec.view.hasMatrix = true;
-    spec.view.eyeFromWorld = eyeFromWorld.is_none() ? rigidInverse(view) : view;
+    const PoseDirection direction = eyeFromWorld.is_none() ? PoseDirection::WorldFromCamera : PoseDirection::CameraFromWorld;
+    spec.view = prefixedErrors(where, [&] { return viewFromPose(view, direction, spec.convention, spec.convention, name); });
     return makeCamera(spec, where);
 }
 

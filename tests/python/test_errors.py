@@ -144,16 +144,16 @@ def test_from_opencv_refusals():
         (dict(K=K[:2]), r"K must be a 3x3 matrix, got shape \(2, 3\)"),
         (dict(K=K + [[0, 1, 0], [0, 0, 0], [0, 0, 0]]), r"K\[0, 1\] \(skew\) must be 0"),
         (dict(K=K * 2), r"K must have the form \[\[fx, 0, cx\], \[0, fy, cy\], \[0, 0, 1\]\]"),
-        (dict(R=R * 1.1), "R is not a rigid transform: its 3x3 rotation part is not orthonormal"),
+        (dict(R=R * 1.1), "'R' is not a rigid transform: its 3x3 rotation part is not orthonormal"),
         (dict(R=R[:2]), r"R must be a 3x3 matrix, got shape \(2, 3\)"),
         (dict(t=np.zeros(4)), r"t must have 3 elements \(shape \(3,\) or \(3, 1\)\), got shape \(4,\)"),
-        (dict(R=np.diag([1.0, -1, 1])), "the rotation of R has determinant -1: a reflection"),
-        (dict(pixel_center=0.25), "pixel_center must be 0.0 .* or 0.5 .*, got 0.25"),
+        (dict(R=np.diag([1.0, -1, 1])), "the rotation of 'R' has determinant -1: a reflection"),
+        (dict(pixel_center=0.25), "K: pixel_center must be 0.0 .* or 0.5 .*, got 0.25"),
         (dict(width=None), "width and height \\(the image size in pixels\\) are required"),
         (dict(world_from_cam=np.eye(4)), "give the view as exactly one of R and t, cam_from_world= or world_from_cam="),
         (dict(R=None, t=None, cam_from_world=np.eye(4)[:2]), r"cam_from_world must be a 4x4 or 3x4 matrix, got shape"),
         (dict(R=None, t=None, world_from_cam=np.diag([1, 1, 1, 2.0])), "world_from_cam must have the last row 0 0 0 1"),
-        (dict(K=K * [[-1], [1], [1]]), "'projection.fx' must be > 0, got -100"),
+        (dict(K=K * [[-1], [1], [1]]), "K: the focal length fx must be a positive finite number of pixels, got -100"),
         (dict(far=0.01), "'projection.far' must be > projection.near"),
         (dict(convention="opengles"), "convention is invalid: "),
         (dict(depth_format="float16"), "depth_format is invalid: "),
@@ -170,7 +170,7 @@ def test_from_matrices_refusals():
     at = "^Camera.from_matrices: "
     with pytest.raises(zcheck.Error, match=at + r"clip_from_eye must be a 4x4 matrix, got shape \(3, 4\)"):
         zcheck.Camera.from_matrices(P[:3], np.eye(4), W, H)
-    with pytest.raises(zcheck.Error, match=at + "eye_from_world is not a rigid transform"):
+    with pytest.raises(zcheck.Error, match=at + "'eye_from_world' is not a rigid transform"):
         zcheck.Camera.from_matrices(P, np.diag([1, 2, 1, 1.0]), W, H)
     with pytest.raises(zcheck.Error, match=at + "give the view as exactly one of eye_from_world and world_from_eye="):
         zcheck.Camera.from_matrices(P, None, W, H)
@@ -181,6 +181,9 @@ def test_from_matrices_refusals():
     # the camera's own message, naming the matrix and asking about the convention
     with pytest.raises(zcheck.Error, match=at + "camera matrix 'projection.clip_from_eye' puts the near plane at eye-z "
                                                 ".*is 'convention' or 'depth.reversed' right"):
+        zcheck.Camera.from_matrices(P, np.diag([1, 1, -1, 1.0]), W, H, convention="direct3d")
+    # a view whose rotation mirrors the picture in the convention's eye space (the pose rule)
+    with pytest.raises(zcheck.Error, match=at + "the rotation of 'eye_from_world' has determinant 1: a reflection"):
         zcheck.Camera.from_matrices(P, np.eye(4), W, H, convention="direct3d")
     with pytest.raises(zcheck.Error, match="'image.width' must be in 1..16384 pixels, got 0"):
         zcheck.Camera.from_matrices(P, np.eye(4), 0, H)

@@ -32,6 +32,7 @@
 
 #include <cmath>
 #include <string>
+#include <vector>
 
 namespace zcheck {
 
@@ -94,9 +95,15 @@ struct View {
     // from +z towards +x) and elevation e (above the horizontal plane).
     std::string axonometric;
     double distance = 0.0, azimuthDeg = 0.0, elevationDeg = 0.0;
-    // A raw view matrix: the convention's eye space from world, p' = M·p; rigid.
+    // A raw view matrix: the convention's eye space from world, p' = M·p; rigid, its rotation
+    // with the convention's handedness (pose.h: the rule, and how far from orthonormal a
+    // rotation may be and still be re-orthonormalised).
     bool hasMatrix = false;
     glm::dmat4 eyeFromWorld{1.0};
+    // How far the rotation as given departed from orthonormal (pose.h) when it was
+    // re-orthonormalised — by the Camera constructor or an importer — 0 when it was not.
+    // Reports say so.
+    double rotationDeparture = 0;
 
     static View lookAt(const glm::dvec3& eye, const glm::dvec3& target, const glm::dvec3& up)
     {
@@ -117,6 +124,10 @@ struct CameraSpec {
     Projection projection;
     View view;
     DepthSettings depth;
+    // What was assumed when this camera was made from a file that did not say (near and far
+    // taken from the scene, an image size from the depth map, ...), one sentence each; reports
+    // print them beside the pose rule's note (poseNotes). Not part of the camera's geometry.
+    std::vector<std::string> notes;
 };
 
 class Camera {
