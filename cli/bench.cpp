@@ -177,7 +177,7 @@ int runBenchCommand(const BenchOptions& o)
 {
     const int threads = o.threads > 0 ? o.threads : int(std::max(1u, std::thread::hardware_concurrency()));
     const bool progress = isatty(STDERR_FILENO) && !o.json;
-    const bool workload = o.input.scene == kWorkloadScene && o.input.cameraFile.empty();
+    const bool workload = o.input.scene == kWorkloadScene && o.input.camera.reference.empty();
 
     // The camera comes from a first load (a file is read once before timing: cold-cache
     // effects are not what this measures). TBB is not started before the children fork.

@@ -26,7 +26,7 @@ int runCheckCommand(const CheckCommandOptions& o)
     const auto threadLimit = limitThreads(o.threads);
     OutputFiles outputs;
     outputs.addInput(o.input.scene);
-    outputs.addInput(o.input.cameraFile);
+    outputs.addInput(cameraInputPath(o.input.camera));
     const RunFolder folder{o.outDir, "raster_depth.exr"};
     if (!o.outDir.empty()) folder.plan(outputs);
     Scene scene = loadScene(o.input.scene);

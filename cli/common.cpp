@@ -1,6 +1,7 @@
 #include "common.h"
 
 #include "zcheck/camera_file.h"
+#include "zcheck/camera_sources.h"
 #include "zcheck/error.h"
 
 #include <cmath>
@@ -45,16 +46,32 @@ void addThreadsOption(CLI::App* command, int& threads)
     command->add_option("--threads", threads, "worker threads, 1..1024 (default: all cores)")->check(kThreadRange);
 }
 
+void addCameraOptions(CLI::App* command, CameraOptions& options, const std::string& cameraHelp)
+{
+    command->add_option("--camera", options.reference, cameraHelp)->check(kNonEmptyPath);
+    command->add_option("--camera-format", options.format,
+                        "the camera file's format when its content should not decide:\n"
+                        "zcheck | colmap | nerfstudio (instant-ngp) | opencv | ros | gltf");
+    command->add_option("--near", options.near, "near plane distance (eye-z > 0); default: the camera file's, else\n"
+                                                "the scene's nearest point as the camera sees it, less 1 %")
+        ->check(kPositiveFinite);
+    command->add_option("--far", options.far, "far plane distance; default: the camera file's, else the scene's\n"
+                                              "farthest point as the camera sees it, plus 1 %")
+        ->check(kPositiveFinite);
+    command->add_option("--convention", options.convention,
+                        "override the convention: opengl | direct3d | vulkan | metal | opencv");
+}
+
 void addSceneAndCameraOptions(CLI::App* command, SceneAndCamera& options)
 {
     command->add_option("--scene", options.scene,
                         "builtin:default | builtin:terrain[?n=N] | builtin:near-crossing | a mesh file (OBJ, PLY, STL, glTF/glb)")
         ->capture_default_str()
         ->check(kNonEmptyPath);
-    command->add_option("--camera", options.cameraFile, "camera file (JSON, see README); default: the scene's own camera")
-        ->check(kNonEmptyPath);
-    command->add_option("--convention", options.convention,
-                        "override the convention: opengl | direct3d | vulkan | metal | opencv");
+    addCameraOptions(command, options.camera,
+                     "FILE or FILE#FRAME: a zcheck camera (JSON), a COLMAP model folder (sparse/0#img_014.png),\n"
+                     "a transforms.json (nerfstudio, instant-ngp; #frame_003 or #3), an OpenCV FileStorage or\n"
+                     "ROS CameraInfo YAML, a glTF's camera nodes; default: the scene's own camera");
 }
 
 void addImageSizeOptions(CLI::App* command, ImageSize& size)
@@ -63,18 +80,63 @@ void addImageSizeOptions(CLI::App* command, ImageSize& size)
     command->add_option("--height", size.height, "override the image height in pixels (1..16384)")->check(kImageSideRange);
 }
 
-CameraSpec cameraSpecFor(const Scene& scene, const SceneAndCamera& options)
+namespace {
+
+std::optional<CameraFormat> formatOption(const CameraOptions& options)
 {
-    CameraSpec spec = options.cameraFile.empty() ? scene.defaultCamera : readCameraFile(options.cameraFile);
-    if (!options.convention.empty()) spec.convention = Convention::preset(options.convention);
+    if (options.format.empty()) return std::nullopt;
+    return cameraFormatFromName(options.format);
+}
+
+CameraSpec withConvention(CameraSpec spec, const std::string& convention)
+{
+    if (!convention.empty()) spec.convention = Convention::preset(convention);
     return spec;
 }
 
-CameraSpec cameraSpecFrom(const std::string& cameraFile, const std::string& convention)
+CameraCompletion completionOf(const CameraOptions& o, std::optional<std::pair<int, int>> size)
 {
-    CameraSpec spec = readCameraFile(cameraFile);
-    if (!convention.empty()) spec.convention = Convention::preset(convention);
-    return spec;
+    CameraCompletion given{o.near, o.far, std::nullopt, std::nullopt};
+    if (size) given.width = size->first, given.height = size->second;
+    return given;
+}
+
+}  // namespace
+
+const std::string kCameraFileHelp =
+    "FILE or FILE#FRAME: a zcheck camera (JSON), a COLMAP model folder, a transforms.json, an OpenCV\n"
+    "FileStorage or ROS CameraInfo YAML, a glTF's camera nodes (near and far: the file's, or --near/--far)";
+
+std::string cameraInputPath(const CameraOptions& options) { return splitCameraReference(options.reference).first; }
+
+bool cameraTakesMapSize(const CameraOptions& options)
+{
+    return !importCamera(options.reference, formatOption(options)).hasImageSize;
+}
+
+bool cameraTakesMapSize(const Scene& scene, const SceneAndCamera& options)
+{
+    if (options.camera.reference.empty()) return !scene.cameras.empty() && !scene.cameras.front().hasImageSize;
+    return cameraTakesMapSize(options.camera);
+}
+
+CameraSpec cameraSpecFor(const Scene& scene, const SceneAndCamera& options, std::optional<std::pair<int, int>> size)
+{
+    const CameraOptions& o = options.camera;
+    if (o.reference.empty() && scene.cameras.empty()) {  // the scene's own framing camera
+        CameraSpec spec = scene.defaultCamera;
+        if (o.near) spec.projection.near = *o.near;
+        if (o.far) spec.projection.far = *o.far;
+        return withConvention(spec, o.convention);
+    }
+    const ImportedCamera camera = o.reference.empty() ? scene.cameras.front() : importCamera(o.reference, formatOption(o));
+    return withConvention(completeCamera(camera, &scene, completionOf(o, size)), o.convention);
+}
+
+CameraSpec cameraSpecFrom(const CameraOptions& options, std::optional<std::pair<int, int>> size)
+{
+    const ImportedCamera camera = importCamera(options.reference, formatOption(options));
+    return withConvention(completeCamera(camera, nullptr, completionOf(options, size)), options.convention);
 }
 
 std::vector<double> parseNumberList(const std::string& text, const std::string& option)

@@ -33,6 +33,7 @@ Command addExportCommand(CLI::App& app);
 Command addVerifyCommand(CLI::App& app);
 Command addSuiteCommand(CLI::App& app);
 Command addBenchCommand(CLI::App& app);
+Command addCameraCommand(CLI::App& app);
 
 // Option validators, the same in every subcommand.
 extern const CLI::Validator kNonEmptyPath;
@@ -45,17 +46,38 @@ extern const CLI::Range kImageSideRange;
 std::unique_ptr<tbb::global_control> limitThreads(int threads);
 void addThreadsOption(CLI::App* command, int& threads);
 
-// --scene, --camera and --convention, as check, export and verify take them.
-struct SceneAndCamera {
-    std::string scene = "builtin:default";
-    std::string cameraFile;
+// --camera FILE[#FRAME], --camera-format, --near and --far: a camera from any file zcheck
+// imports (camera_import.h, camera_sources.h).
+struct CameraOptions {
+    std::string reference;  // FILE or FILE#FRAME
+    std::string format;     // "" : told by content
+    std::optional<double> near, far;
     std::string convention;
 };
+void addCameraOptions(CLI::App* command, CameraOptions& options, const std::string& cameraHelp);
+
+// --scene and the camera options, as check, export and verify take them.
+struct SceneAndCamera {
+    std::string scene = "builtin:default";
+    CameraOptions camera;
+};
 void addSceneAndCameraOptions(CLI::App* command, SceneAndCamera& options);
-// The camera a command uses: the camera file, or the scene's own camera; then --convention.
-CameraSpec cameraSpecFor(const Scene& scene, const SceneAndCamera& options);
-// A camera file (required), then --convention.
-CameraSpec cameraSpecFrom(const std::string& cameraFile, const std::string& convention);
+// The camera a command uses: --camera completed for the scene (near and far from the file, the
+// options or the scene; the image size from the file, `size` — a depth map's, --width and
+// --height — or, for a file without one, a default with a note), else the scene's own camera
+// (a glTF's first camera, or one framing the mesh); then --convention.
+CameraSpec cameraSpecFor(const Scene& scene, const SceneAndCamera& options, std::optional<std::pair<int, int>> size = {});
+// Whether the camera --camera names (or the scene's glTF camera) leaves its image size to the
+// depth map: verify reads the map's size first for it.
+bool cameraTakesMapSize(const Scene& scene, const SceneAndCamera& options);
+// The --camera help of commands without a scene.
+extern const std::string kCameraFileHelp;
+// The file part of --camera (an input a run must not overwrite).
+std::string cameraInputPath(const CameraOptions& options);
+bool cameraTakesMapSize(const CameraOptions& options);
+// A camera without a scene (matrices, precision, unproject): near and far must be in the file
+// or given; then --convention.
+CameraSpec cameraSpecFrom(const CameraOptions& options, std::optional<std::pair<int, int>> size = {});
 
 // --width and --height, as check and bench take them: they override the camera's image size.
 struct ImageSize {

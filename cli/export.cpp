@@ -42,7 +42,7 @@ int runExportCommand(const ExportOptions& o)
     const auto threadLimit = limitThreads(o.threads);
     OutputFiles outputs;
     outputs.addInput(o.input.scene);
-    outputs.addInput(o.input.cameraFile);
+    outputs.addInput(cameraInputPath(o.input.camera));
     outputs.add(o.output, "-o");
     outputs.add(o.output + ".json", "the sidecar of -o");
     if (!o.preview.empty()) outputs.add(o.preview, "--preview");

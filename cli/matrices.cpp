@@ -10,7 +10,7 @@ namespace zcheck::cli {
 Command addMatricesCommand(CLI::App& app)
 {
     struct Options {
-        std::string cameraFile, convention;
+        CameraOptions camera;
     };
     auto o = std::make_shared<Options>();
     CLI::App* command = app.add_subcommand(
@@ -18,10 +18,10 @@ Command addMatricesCommand(CLI::App& app)
                     "eye_from_clip, clip_from_world, window_from_ndc, ndc_from_window (4 rows of 4, column\n"
                     "vectors p' = M·p), and a 'native' block in the convention's own form (row vectors for\n"
                     "direct3d).");
-    command->add_option("--camera", o->cameraFile, "camera file (JSON, see README)")->required()->check(kNonEmptyPath);
-    command->add_option("--convention", o->convention, "override the convention");
+    addCameraOptions(command, o->camera, kCameraFileHelp);
+    command->get_option("--camera")->required();
     return {command, [o] {
-                std::cout << matricesJsonText(Camera(cameraSpecFrom(o->cameraFile, o->convention))) << "\n";
+                std::cout << matricesJsonText(Camera(cameraSpecFrom(o->camera))) << "\n";
                 return kExitConsistent;
             }};
 }

@@ -11,9 +11,9 @@ namespace zcheck::cli {
 
 namespace {
 
-int runPrecisionCommand(const std::string& cameraFile, const std::string& convention, const std::string& at, bool json)
+int runPrecisionCommand(const CameraOptions& cameraOptions, const std::string& at, bool json)
 {
-    const CameraSpec spec = cameraSpecFrom(cameraFile, convention);
+    const CameraSpec spec = cameraSpecFrom(cameraOptions);
     const PrecisionTable table = depthPrecision(spec, parseNumberList(at, "--at"));
     if (json) {
         std::cout << precisionJson(spec, table) << "\n";
@@ -52,7 +52,8 @@ int runPrecisionCommand(const std::string& cameraFile, const std::string& conven
 Command addPrecisionCommand(CLI::App& app)
 {
     struct Options {
-        std::string cameraFile, convention, at;
+        CameraOptions camera;
+        std::string at;
         bool json = false;
     };
     auto o = std::make_shared<Options>();
@@ -60,12 +61,12 @@ Command addPrecisionCommand(CLI::App& app)
         "precision", "How finely each depth layout (unorm16, unorm24, float32 x standard, reversed, infinite far)\n"
                      "resolves eye depth for a camera's near/far: the eye-z step between neighbouring stored\n"
                      "values at each distance, and which layout is best.");
-    command->add_option("--camera", o->cameraFile, "camera file (JSON, see README)")->required()->check(kNonEmptyPath);
+    addCameraOptions(command, o->camera, kCameraFileHelp);
+    command->get_option("--camera")->required();
     command->add_option("--at", o->at, "eye-z distances, comma-separated (default: 9 log-spaced from near to far)")
         ->check(kNonEmptyList);
-    command->add_option("--convention", o->convention, "override the convention");
     command->add_flag("--json", o->json, "print JSON instead of tables");
-    return {command, [o] { return runPrecisionCommand(o->cameraFile, o->convention, o->at, o->json); }};
+    return {command, [o] { return runPrecisionCommand(o->camera, o->at, o->json); }};
 }
 
 }  // namespace zcheck::cli

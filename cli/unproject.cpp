@@ -19,7 +19,8 @@ namespace zcheck::cli {
 namespace {
 
 struct UnprojectOptions {
-    std::string cameraFile, convention, pixel, depthMap, quantity = "window", output, space = "world";
+    CameraOptions camera;
+    std::string pixel, depthMap, quantity = "window", output, space = "world";
     std::optional<double> depth;
     DepthMapOptions reading;
     int stride = 1;
@@ -43,7 +44,14 @@ int runUnprojectCommand(const UnprojectOptions& o)
 {
     if (o.space != "eye" && o.space != "world") throw Error("--space must be eye or world, got '" + o.space + "'");
     const DepthQuantity quantity = depthQuantityFromName(o.quantity);
-    const Camera camera(cameraSpecFrom(o.cameraFile, o.convention));
+    // A camera file without an image size (instant-ngp, glTF) takes the depth map's.
+    std::optional<std::pair<int, int>> mapSize;
+    std::optional<DepthMapFile> sized;
+    if (!o.depthMap.empty() && cameraTakesMapSize(o.camera)) {
+        sized = images().readDepthMap(o.depthMap, o.reading.reading(o.quantity), 0, 0);
+        mapSize = std::pair{sized->width, sized->height};
+    }
+    const Camera camera(cameraSpecFrom(o.camera, mapSize));
     auto toWorld = [&](const glm::dvec3& pEye) { return glm::dvec3(camera.worldFromEye * glm::dvec4(pEye, 1.0)); };
 
     if (!o.pixel.empty() && (!o.depthMap.empty() || !o.output.empty()))
@@ -82,11 +90,12 @@ int runUnprojectCommand(const UnprojectOptions& o)
     if (o.depthMap.empty()) throw Error("unproject needs --pixel COL,ROW or --depth-map FILE");
     if (o.output.empty()) throw Error("--depth-map needs -o FILE.ply");
     OutputFiles outputs;
-    outputs.addInput(o.cameraFile);
+    outputs.addInput(cameraInputPath(o.camera));
     outputs.addInput(o.depthMap);
     outputs.addInput(o.reading.sidecar);
     outputs.add(o.output, "-o");
-    const DepthMapFile map = images().readDepthMap(o.depthMap, o.reading.reading(o.quantity), camera.width(), camera.height());
+    const DepthMapFile map =
+        sized ? std::move(*sized) : images().readDepthMap(o.depthMap, o.reading.reading(o.quantity), camera.width(), camera.height());
     const UnprojectedMap cloud =
         unprojectMap(camera, map.value, quantity, o.space == "eye" ? PointSpace::Eye : PointSpace::World, o.stride);
     outputs.write(o.output, [&](const std::string& temporary) {
@@ -111,8 +120,8 @@ Command addUnprojectCommand(CLI::App& app)
     CLI::App* command = app.add_subcommand(
         "unproject", "The inverse projection: the ray through a pixel centre, the point at a depth value, or a\n"
                      "whole depth map (EXR, PFM, TIFF, 16-bit PNG with --scale) as a PLY point cloud, misses skipped.");
-    command->add_option("--camera", o->cameraFile, "camera file (JSON, see README)")->required()->check(kNonEmptyPath);
-    command->add_option("--convention", o->convention, "override the convention");
+    addCameraOptions(command, o->camera, kCameraFileHelp);
+    command->get_option("--camera")->required();
     command->add_option("--pixel", o->pixel, "COL,ROW (row 0 at the top): print the ray through its centre");
     command->add_option("--depth", o->depth, "with --pixel: print the point at this depth value");
     command->add_option("--quantity", o->quantity, "what --depth / the map holds: window | ndc | eye-z | distance")

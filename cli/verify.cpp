@@ -26,15 +26,22 @@ int runVerifyCommand(const VerifyOptions& o)
     const auto threadLimit = limitThreads(o.threads);
     OutputFiles outputs;
     outputs.addInput(o.input.scene);
-    outputs.addInput(o.input.cameraFile);
+    outputs.addInput(cameraInputPath(o.input.camera));
     outputs.addInput(o.depthMap);
     outputs.addInput(o.reading.sidecar);
     const RunFolder folder{o.outDir, "map_depth.exr"};
     if (!o.outDir.empty()) folder.plan(outputs);
     Scene scene = loadScene(o.input.scene);
-    const Camera camera(cameraSpecFor(scene, o.input));
     const DepthMapReading reading = o.reading.reading(o.quantity);
-    const DepthMapFile file = images().readDepthMap(o.depthMap, reading, camera.width(), camera.height());
+    // A camera file without an image size (instant-ngp, glTF) takes the depth map's.
+    std::optional<DepthMapFile> sized;
+    std::optional<std::pair<int, int>> mapSize;
+    if (cameraTakesMapSize(scene, o.input)) {
+        sized = images().readDepthMap(o.depthMap, reading, 0, 0);
+        mapSize = std::pair{sized->width, sized->height};
+    }
+    const Camera camera(cameraSpecFor(scene, o.input, mapSize));
+    const DepthMapFile file = sized ? std::move(*sized) : images().readDepthMap(o.depthMap, reading, camera.width(), camera.height());
     const DepthMap map{file.width, file.height, quantity, file.value, file.valueQuantum};
     const Checker checker(std::move(scene));
     const VerifyOutcome verified =

@@ -58,8 +58,16 @@ void writeExr(const std::string& path, int width, int height, const std::vector<
 
 namespace {
 
+// The size a file declares against the camera's; expected 0 × 0 (a camera that takes the map's
+// size) accepts any size a camera may have: 1..16384 per side, 2^25 pixels in all.
 void requireSize(const std::string& path, long long width, long long height, int expectedWidth, int expectedHeight)
 {
+    if (expectedWidth == 0 && expectedHeight == 0) {
+        if (width < 1 || height < 1 || width > 16384 || height > 16384 || width * height > (1LL << 25))
+            throw Error("depth map '" + path + "' is " + std::to_string(width) + "x" + std::to_string(height) +
+                        ", outside the 1..16384 pixels per side (2^25 in all) a camera may have");
+        return;
+    }
     if (width != expectedWidth || height != expectedHeight)
         throw Error("depth map '" + path + "' is " + std::to_string(width) + "x" + std::to_string(height) +
                     " but the camera's image is " + std::to_string(expectedWidth) + "x" + std::to_string(expectedHeight));

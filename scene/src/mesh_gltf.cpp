@@ -19,7 +19,9 @@
 //            KHR_mesh_quantization is declared.
 //   extensionsRequired: KHR_mesh_quantization, and extensions that change only appearance
 //            (KHR_materials_*, KHR_texture_*, EXT_texture_*, KHR_lights_punctual).
-// Ignored: materials, textures, images, animations, cameras, morph targets (the base
+// Cameras: the camera nodes of the same scene, with their world transforms (camera_sources.h
+// states the rules), in Scene::cameras; readGltfCameraNodes reads them alone.
+// Ignored: materials, textures, images, animations, morph targets (the base
 // positions are read), skins (the node transform is applied as for a static mesh), unknown
 // keys and extensions that are not required.
 // Refused (Error, one line, naming the JSON path or value and the rule): JSON nested deeper
@@ -35,6 +37,7 @@
 #include "zcheck/error.h"
 #include "zcheck/large_buffer.h"
 #include "zcheck/mesh_formats.h"
+#include "zcheck/pose.h"
 #include "zcheck/scene.h"
 
 #include <nlohmann/json.hpp>
@@ -281,9 +284,24 @@ public:
                 if (m == kNone) return;
                 for (const Primitive& primitive : meshes_[m].primitives) emit(scene, primitive, node, world);
             });
+            scene.cameras = cameras(roots);
             return scene;
         } catch (const json::exception& e) {
             // Every value is type-checked before use; this is a last line of defence.
+            fail(std::string("unexpected JSON error: ") + e.what());
+        }
+    }
+
+    // The camera nodes alone: no buffer is read.
+    std::vector<ImportedCamera> readCameras()
+    {
+        try {
+            parseJson(jsonText());
+            checkAsset();
+            checkExtensions();
+            buildHierarchy();
+            return cameras(sceneRoots());
+        } catch (const json::exception& e) {
             fail(std::string("unexpected JSON error: ") + e.what());
         }
     }
@@ -934,6 +952,90 @@ private:
         return result;  // T · R · S
     }
 
+    // ---- cameras ---------------------------------------------------------------------
+
+    // The camera nodes below `roots` in traversal order (camera_sources.h states the rules).
+    std::vector<ImportedCamera> cameras(const std::vector<std::size_t>& roots) const
+    {
+        std::vector<ImportedCamera> out;
+        const std::size_t count = topArray("cameras").size();
+        traverse(roots, [&](std::size_t node, const glm::dmat4& world) {
+            const json* c = member(topElement("nodes", node), "camera");
+            if (!c) return;
+            out.push_back(camera(node, reference(*c, at("nodes", node) + ".camera", "cameras", count), world));
+        });
+        return out;
+    }
+
+    ImportedCamera camera(std::size_t node, std::size_t index, const glm::dmat4& world) const
+    {
+        const std::string where = at("cameras", index);
+        const json& c = asObject(topElement("cameras", index), where);
+        const std::string& type = asString(required(c, "type", where), where + ".type");
+        ImportedCamera out;
+        const json& n = topElement("nodes", node);
+        const json* nodeName = member(n, "name");
+        out.name = nodeName ? asString(*nodeName, at("nodes", node) + ".name") : at("nodes", node);
+        if (const json* cameraName = member(c, "name")) out.aliases.push_back(asString(*cameraName, where + ".name"));
+        CameraSpec& spec = out.spec;
+        spec.convention = Convention::preset("opengl");
+        Projection& p = spec.projection;
+        double aspect = 0;
+        auto positive = [&](const json& object, const char* key, const std::string& at) {
+            const double v = asNumber(required(object, key, at), at + "." + key);
+            if (!(v > 0)) fail(at + "." + key + " " + formatNumber(v) + " must be > 0");
+            return v;
+        };
+        if (type == "perspective") {
+            const std::string at = where + ".perspective";
+            const json& q = asObject(required(c, "perspective", where), at);
+            const double yfov = positive(q, "yfov", at);
+            if (!(yfov < M_PI)) fail(at + ".yfov " + formatNumber(yfov) + " must be below pi radians");
+            if (member(q, "aspectRatio")) aspect = positive(q, "aspectRatio", at);
+            p.type = ProjectionType::Perspective;
+            p.fovyDeg = yfov * 180 / M_PI;
+            p.aspect = aspect;  // 0: the image's, as glTF says when it is absent
+            p.near = positive(q, "znear", at);
+            p.far = member(q, "zfar") ? positive(q, "zfar", at) : INFINITY;  // absent: an infinite far plane
+            if (!(p.far > p.near)) fail(at + ".zfar must be greater than znear");
+            out.hasClipPlanes = true;
+        } else if (type == "orthographic") {
+            const std::string at = where + ".orthographic";
+            const json& q = asObject(required(c, "orthographic", where), at);
+            const double xmag = positive(q, "xmag", at), ymag = positive(q, "ymag", at);
+            const double znear = asNumber(required(q, "znear", at), at + ".znear");
+            const double zfar = positive(q, "zfar", at);
+            if (!(znear >= 0 && zfar > znear)) fail(at + " needs 0 <= znear < zfar");
+            p.type = ProjectionType::Orthographic;
+            p.left = -xmag, p.right = xmag, p.bottom = -ymag, p.top = ymag;  // xmag, ymag: half the view's extents
+            aspect = xmag / ymag;
+            out.hasClipPlanes = znear > 0;  // zcheck needs near > 0: a znear of 0 is taken from the scene
+            p.near = znear > 0 ? znear : kPlaceholderNear, p.far = znear > 0 ? zfar : kPlaceholderFar;
+        } else {
+            fail(where + ".type '" + printable(type) + "' is neither perspective nor orthographic");
+        }
+        // No image size in glTF: the depth map's when one is verified, else 640 wide at the aspect.
+        out.hasImageSize = false;
+        out.projectionForSize = [p](int, int) { return p; };
+        spec.width = kPlaceholderWidth;
+        spec.height = aspect > 0 ? std::max(1, int(std::lround(kPlaceholderWidth / aspect))) : kPlaceholderHeight;
+        // The node's world transform without its scale (glTF: cameras ignore it), camera-to-world.
+        glm::dmat4 worldFromCamera = world;
+        for (int axis = 0; axis < 3; ++axis) {
+            const double length = glm::length(glm::dvec3(world[axis]));
+            if (!(length > 0)) fail(at("nodes", node) + " scales its camera to zero");
+            worldFromCamera[axis] = world[axis] / length;
+        }
+        try {
+            spec.view = viewFromPose(worldFromCamera, PoseDirection::WorldFromCamera, spec.convention, spec.convention,
+                                     "the world transform of " + at("nodes", node));
+            Camera validated(spec);
+        } catch (const Error& e) {
+            fail(where + " at " + at("nodes", node) + ": " + e.what());
+        }
+        return out;
+    }
+
     // ---- output ----------------------------------------------------------------------
 
     static double component(const unsigned char* p, std::uint32_t type, bool normalized)
@@ -1032,6 +1134,11 @@ private:
 Scene readGltf(const std::string& path, std::string_view bytes)
 {
     return GltfReader(path, bytes).read();
+}
+
+std::vector<ImportedCamera> readGltfCameraNodes(const std::string& path, std::string_view bytes)
+{
+    return GltfReader(path, bytes).readCameras();
 }
 
 }  // namespace zcheck

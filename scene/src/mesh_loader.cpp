@@ -1,5 +1,7 @@
 #include "zcheck/mesh_loader.h"
 
+#include "zcheck/camera_sources.h"
+
 #include "zcheck/error.h"
 #include "zcheck/input_file.h"
 #include "zcheck/mesh_formats.h"
@@ -30,7 +32,15 @@ Scene loadMesh(const std::string& path)
     if (bytes.rfind("ply\n", 0) == 0 || bytes.rfind("ply\r\n", 0) == 0 || ext == ".ply") return framed(readPly(path, bytes));
     if (ext == ".glb" && bytes.rfind("glTF", 0) != 0)
         throw Error("cannot load mesh '" + path + "': malformed GLB: it does not begin with the magic 'glTF'");
-    if (bytes.rfind("glTF", 0) == 0 || ext == ".glb" || ext == ".gltf") return framed(readGltf(path, bytes));
+    if (bytes.rfind("glTF", 0) == 0 || ext == ".glb" || ext == ".gltf") {
+        Scene scene = framed(readGltf(path, bytes));
+        if (!scene.cameras.empty()) {  // the file's first camera is the scene's own
+            const ImportedCamera& first = scene.cameras.front();
+            scene.defaultCamera = completeCamera(first, &scene, {});
+            scene.defaultCamera.notes.push_back("the camera is the glTF's first, '" + first.name + "'");
+        }
+        return scene;
+    }
     if (ext == ".obj") return framed(readObj(path, bytes));
     if (ext == ".stl") return framed(readStl(path, bytes));
     throw Error("cannot load mesh '" + path + "': unsupported format '" + (ext.empty() ? "(no extension)" : ext) +

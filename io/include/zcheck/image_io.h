@@ -30,7 +30,8 @@ struct DepthMapFile {
 
 // Reads a map as `reading` says (depth_map_reading.h): its channel, scale, offset and misses.
 // The file must be a regular file of at most 2 GiB, and its declared size must be
-// expectedWidth × expectedHeight, checked before any pixel is allocated (for EXR after
+// expectedWidth × expectedHeight (0 × 0: any size a camera may have, for a camera that takes the
+// map's size), checked before any pixel is allocated (for EXR after
 // walking its header, whose attribute sizes must fit in the file). Integer files of 8 bits
 // are refused (8 bits cannot hold depth). PFM is read by zcheck itself; EXR, TIFF and PNG by
 // OpenImageIO, each only by its own reader (unknown bytes are never offered to OpenImageIO's

@@ -19,6 +19,10 @@ inline constexpr InputKind kMeshInput{"mesh", std::uint64_t(4) << 30};          
 inline constexpr InputKind kCameraInput{"camera file", std::uint64_t(1) << 20};  // 1 MiB
 inline constexpr InputKind kDepthMapInput{"depth map", std::uint64_t(2) << 30};  // 2 GiB
 inline constexpr InputKind kSidecarInput{"sidecar", std::uint64_t(1) << 20};     // 1 MiB
+// Files of many cameras: a transforms.json of thousands of frames (JSON is held as a DOM of a
+// few times its size), a COLMAP model's files (images.bin holds every 2-D observation).
+inline constexpr InputKind kCameraSetInput{"camera file", std::uint64_t(512) << 20};       // 512 MiB
+inline constexpr InputKind kColmapModelInput{"COLMAP model file", std::uint64_t(4) << 30};  // 4 GiB
 
 // Throws Error unless `path` names a readable regular file within the kind's size limit;
 // returns its size in bytes.

@@ -14,10 +14,12 @@
 //   STL   binary (size must be 84 + 50·n) and ascii.
 //   glTF  .gltf and .glb 2.0: triangle, strip and fan primitives of the default scene,
 //         node transforms applied; buffers in the GLB, data: URIs or files beside it.
+#include "zcheck/camera_import.h"
 #include "zcheck/scene.h"
 
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace zcheck {
 
@@ -25,5 +27,7 @@ Scene readPly(const std::string& path, std::string_view bytes);
 Scene readObj(const std::string& path, std::string_view bytes);
 Scene readStl(const std::string& path, std::string_view bytes);
 Scene readGltf(const std::string& path, std::string_view bytes);
+// The camera nodes of a glTF's default scene, without reading its buffers (camera_sources.h).
+std::vector<ImportedCamera> readGltfCameraNodes(const std::string& path, std::string_view bytes);
 
 }  // namespace zcheck

@@ -5,6 +5,7 @@
 // double before it transforms them. Scenes are addressed by name: `builtin:NAME[?k=v&…]`
 // or a mesh file path (loaded by mesh_loader.h).
 #include "zcheck/camera.h"
+#include "zcheck/camera_import.h"
 #include "zcheck/kernel_choice.h"
 
 #include <glm/glm.hpp>
@@ -40,6 +41,8 @@ struct Scene {
     std::vector<glm::uvec3> triangles;    // indices into positions; the index is the primitive id
     CameraSpec defaultCamera;             // used when the user gives no camera file
     PolygonPlanarity planarity;           // of the file's polygons (mesh files; none built in)
+    std::vector<ImportedCamera> cameras;  // the file's camera nodes (glTF), in file order; the
+                                          // first is the default camera (camera_sources.h)
 
     std::size_t triangleCount() const { return triangles.size(); }
     glm::dvec3 boundsMin() const;

@@ -1,0 +1,417 @@
+// Calibration files: OpenCV FileStorage (YAML, XML or JSON) and ROS CameraInfo (the
+// camera_calibration_parsers file and the message as `topic echo` prints it).
+//
+// OpenCV FileStorage (docs.opencv.org, persistence.hpp; the calibration samples):
+//   intrinsics  camera_matrix (or K, cameraMatrix), a 3x3 !!opencv-matrix {rows, cols, dt, data}
+//               or a plain list; keys matched ignoring case (older samples wrote Camera_Matrix)
+//   size        image_width, image_height (or width, height, or image_size [w, h])
+//   distortion  distortion_coefficients (or D, dist_coeffs, distCoeffs): all zero, or the
+//               camera is refused
+//   pose        optional, world-to-camera as solvePnP returns it: R (3x3, or a rotation
+//               vector) and T (or t, tvec), or rvec and tvec (Rodrigues); without one the
+//               camera's own frame is the world
+//   axes        OpenCV: x right, y down, z forward
+//   pixels      the centre of the top-left pixel is (0, 0): a centred camera has cx = (W−1)/2
+//
+// ROS CameraInfo (REP 104 and the message's comments):
+//   K           intrinsics of the raw (distorted) image; D its distortion (distortion_model
+//               plumb_bob, rational_polynomial: all zero or refused; equidistant: a fisheye,
+//               refused)
+//   P           3x4 projection of the rectified image: intrinsics fx' cx' fy' cy' and, for a
+//               stereo pair's second camera, Tx = −fx'·B, Ty
+//   frame       the optical frame (x right, y down, z forward) is the world: no pose
+//   pixels      as OpenCV's (image_geometry wraps OpenCV)
+//   cameras     "raw" (K, the default) and "rectified" (P, moved by (Tx/fx', Ty/fy', 0))
+//   binning_x/y above 1 and a non-empty roi are refused (the image is not the calibrated one).
+#include "camera_importers.h"
+
+#include "camera_json.h"
+#include "xml_lite.h"
+#include "yaml_lite.h"
+#include "zcheck/error.h"
+#include "zcheck/input_file.h"
+#include "zcheck/pose.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <sstream>
+
+namespace zcheck::importers {
+
+namespace {
+
+using yaml::Node;
+
+// XML and JSON documents as the YAML tree, so that one reader reads all three forms of a
+// FileStorage: an element with children is a map, one with text only a scalar, type_id a tag.
+Node nodeFromXml(const xml::Element& element, const std::string& source)
+{
+    Node node;
+    node.line = element.line;
+    if (const std::string* type = element.attribute("type_id")) node.tag = *type;
+    if (element.children.empty()) {
+        node.kind = Node::Kind::Scalar;
+        node.scalar = element.text;
+        return node;
+    }
+    // OpenCV writes a sequence's items as <_> elements; any other repeated name would let one
+    // value hide another (the YAML reader refuses repeated keys too).
+    const bool sequence = std::all_of(element.children.begin(), element.children.end(),
+                                      [](const xml::Element& child) { return child.name == "_"; });
+    node.kind = sequence ? Node::Kind::Sequence : Node::Kind::Map;
+    for (const xml::Element& child : element.children) {
+        if (sequence) {
+            node.items.push_back(nodeFromXml(child, source));
+            continue;
+        }
+        if (node.find(child.name))
+            throw Error(source + ": line " + std::to_string(child.line) + ": the element <" + child.name +
+                        "> is repeated inside <" + element.name + ">");
+        node.entries.emplace_back(child.name, nodeFromXml(child, source));
+    }
+    return node;
+}
+
+Node nodeFromJson(const nlohmann::json& value, int depth = 0)
+{
+    Node node;
+    if (depth > 64) throw Error("JSON nested deeper than 64 levels");
+    if (value.is_object()) {
+        node.kind = Node::Kind::Map;
+        for (const auto& item : value.items()) {
+            if (item.key() == "type_id" && item.value().is_string()) {
+                node.tag = item.value().get<std::string>();
+                continue;
+            }
+            node.entries.emplace_back(item.key(), nodeFromJson(item.value(), depth + 1));
+        }
+    } else if (value.is_array()) {
+        node.kind = Node::Kind::Sequence;
+        for (const auto& item : value) node.items.push_back(nodeFromJson(item, depth + 1));
+    } else {
+        node.kind = Node::Kind::Scalar;
+        node.scalar = value.is_string() ? value.get<std::string>() : value.dump();
+        node.quoted = value.is_string();
+    }
+    return node;
+}
+
+struct Matrix {
+    std::size_t rows = 0, cols = 0;
+    std::vector<double> values;  // row-major
+    double at(std::size_t r, std::size_t c) const { return values[r * cols + c]; }
+    bool allZero() const
+    {
+        for (double v : values)
+            if (v != 0) return false;
+        return true;
+    }
+};
+
+class CalibrationReader {
+public:
+    CalibrationReader(const std::string& path, CameraFormat format) : path_(path), format_(format)
+    {
+        const std::string text = readInputFile(path, kCameraInput);
+        std::size_t start = text.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;
+        while (start < text.size() && std::isspace(static_cast<unsigned char>(text[start]))) ++start;
+        if (text.compare(start, 1, "<") == 0) {
+            const xml::Element root = xml::parse(text, source());
+            if (root.name != "opencv_storage") fail("an XML calibration file's root element must be <opencv_storage>");
+            root_ = nodeFromXml(root, source());
+        } else if (text.compare(start, 1, "{") == 0) {
+            root_ = nodeFromJson(parseJsonStrictly(text, source()));
+        } else {
+            root_ = yaml::parse(text, source());
+        }
+        if (root_.kind != Node::Kind::Map) fail("the document must be a map of keys");
+    }
+
+    CameraSet read() { return format_ == CameraFormat::Ros ? readRos() : readOpenCv(); }
+
+private:
+    std::string source() const { return (format_ == CameraFormat::Ros ? "ROS CameraInfo '" : "OpenCV calibration file '") + path_ + "'"; }
+    [[noreturn]] void fail(const std::string& why) const { throw Error(source() + ": " + why); }
+
+    // The first of `keys` present (ignoring case), or nullptr.
+    const Node* anyOf(std::initializer_list<const char*> keys, std::string* found = nullptr) const
+    {
+        for (const char* key : keys)
+            if (const Node* node = root_.findIgnoringCase(key)) {
+                if (found) *found = key;
+                return node;
+            }
+        return nullptr;
+    }
+
+    double number(const Node& node, const std::string& what) const
+    {
+        double value = 0;
+        if (node.kind != Node::Kind::Scalar || !parseFiniteNumber(node.scalar, value))
+            fail("'" + what + "' (line " + std::to_string(node.line) + ") must be a finite number");
+        return value;
+    }
+    int pixels(const Node& node, const std::string& what) const
+    {
+        const double value = number(node, what);
+        if (value != std::floor(value) || value < 1 || value > 16384)
+            fail("'" + what + "' must be a whole number of pixels in 1..16384, got " + formatNumber(value));
+        return int(value);
+    }
+
+    // A matrix: {rows, cols, data} (OpenCV's !!opencv-matrix, ROS's calibration file), a flat
+    // list, or a list of rows. `rows`, `cols` of 0 accept any shape.
+    Matrix matrix(const Node& node, const std::string& key) const
+    {
+        Matrix m;
+        auto numbersOf = [&](const Node& data) {
+            std::vector<double> out;
+            if (data.kind == Node::Kind::Scalar) {  // XML: whitespace-separated numbers
+                std::istringstream in(data.scalar);
+                for (std::string token; in >> token;) {
+                    double v = 0;
+                    if (!parseFiniteNumber(token, v)) fail("'" + key + "' holds '" + printableExcerpt(token, 30) + "', not a finite number");
+                    out.push_back(v);
+                }
+                return out;
+            }
+            if (data.kind != Node::Kind::Sequence) fail("'" + key + "' data must be a list of numbers");
+            for (const Node& item : data.items) out.push_back(number(item, key));
+            return out;
+        };
+        if (node.kind == Node::Kind::Map) {
+            const Node* rows = node.find("rows");
+            const Node* cols = node.find("cols");
+            const Node* data = node.find("data");
+            if (!rows || !cols || !data) fail("'" + key + "' must have rows, cols and data");
+            m.rows = std::size_t(pixels(*rows, key + ".rows"));
+            m.cols = std::size_t(pixels(*cols, key + ".cols"));
+            if (const Node* dt = node.find("dt"); dt && dt->kind == Node::Kind::Scalar) {
+                const std::string type = dt->scalar;
+                if (type != "d" && type != "f" && type != "i" && type != "s" && type != "w" && type != "u" && type != "c")
+                    fail("'" + key + ".dt' is '" + printableExcerpt(type, 10) + "': a one-channel matrix (d, f, i, ...) is expected");
+            }
+            m.values = numbersOf(*data);
+            if (m.values.size() != m.rows * m.cols)
+                fail("'" + key + "' is " + std::to_string(m.rows) + "x" + std::to_string(m.cols) + " but its data holds " +
+                     std::to_string(m.values.size()) + " numbers");
+            return m;
+        }
+        if (node.kind == Node::Kind::Sequence && !node.items.empty() && node.items[0].kind == Node::Kind::Sequence) {
+            m.rows = node.items.size();
+            for (const Node& row : node.items) {
+                const std::vector<double> values = numbersOf(row);
+                if (m.cols == 0) m.cols = values.size();
+                if (values.size() != m.cols || m.cols == 0) fail("'" + key + "' rows must all have the same number of numbers");
+                m.values.insert(m.values.end(), values.begin(), values.end());
+            }
+            return m;
+        }
+        m.values = numbersOf(node);
+        m.rows = 1, m.cols = m.values.size();
+        return m;
+    }
+    Matrix shaped(const Node& node, const std::string& key, std::size_t rows, std::size_t cols) const
+    {
+        Matrix m = matrix(node, key);
+        if (m.values.size() != rows * cols)
+            fail("'" + key + "' must hold " + std::to_string(rows) + "x" + std::to_string(cols) + " numbers, it holds " +
+                 std::to_string(m.values.size()));
+        m.rows = rows, m.cols = cols;
+        return m;
+    }
+
+    PinholeIntrinsics intrinsicsOf(const Matrix& k, const std::string& key) const
+    {
+        double rows[3][3];
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 3; ++c) rows[r][c] = k.at(std::size_t(r), std::size_t(c));
+        try {
+            return PinholeIntrinsics::fromK(rows, 0.0, key);
+        } catch (const Error& e) {
+            fail(e.what());
+        }
+    }
+
+    std::vector<std::pair<std::string, double>> named(const Matrix& d, const std::vector<const char*>& names) const
+    {
+        std::vector<std::pair<std::string, double>> out;
+        for (std::size_t i = 0; i < d.values.size(); ++i)
+            out.emplace_back(i < names.size() ? names[i] : "d[" + std::to_string(i) + "]", d.values[i]);
+        return out;
+    }
+
+    ImportedCamera camera(const std::string& name, int width, int height, const PinholeIntrinsics& k, const glm::dmat4& camFromWorld,
+                          const std::string& poseName) const
+    {
+        ImportedCamera out;
+        out.name = name;
+        const Convention opencv = Convention::preset("opencv");
+        CameraSpec& spec = out.spec;
+        spec.convention = opencv;
+        spec.width = width, spec.height = height;
+        try {
+            spec.projection = k.projection(kPlaceholderNear, kPlaceholderFar, "intrinsics");
+            spec.view = viewFromPose(camFromWorld, PoseDirection::CameraFromWorld, opencv, opencv, poseName);
+            Camera validated(spec);
+        } catch (const Error& e) {
+            fail(e.what());
+        }
+        return out;
+    }
+
+    // ---- OpenCV ---------------------------------------------------------------------
+
+    glm::dmat3 rotationOf(const Matrix& r, const std::string& key) const
+    {
+        if (r.values.size() == 3) {  // a rotation vector: axis × angle (Rodrigues)
+            const glm::dvec3 v(r.values[0], r.values[1], r.values[2]);
+            const double angle = glm::length(v);
+            if (angle == 0) return glm::dmat3(1.0);
+            const glm::dvec3 axis = v / angle;
+            const double s = std::sin(angle / 2);
+            return rotationFromQuaternion(std::cos(angle / 2), s * axis.x, s * axis.y, s * axis.z, key);
+        }
+        if (r.values.size() != 9) fail("'" + key + "' must be a 3x3 rotation or a rotation vector of 3 numbers");
+        glm::dmat3 m;
+        for (int row = 0; row < 3; ++row)
+            for (int col = 0; col < 3; ++col) m[col][row] = r.values[std::size_t(3 * row + col)];
+        return m;
+    }
+
+    CameraSet readOpenCv() const
+    {
+        std::string kKey, dKey, wKey, hKey;
+        const Node* k = anyOf({"camera_matrix", "K", "cameraMatrix", "intrinsic_matrix", "intrinsics"}, &kKey);
+        if (!k) fail("it has no camera matrix (camera_matrix or K)");
+        const PinholeIntrinsics intrinsics = intrinsicsOf(shaped(*k, kKey, 3, 3), kKey);
+        int width = 0, height = 0;
+        if (const Node* w = anyOf({"image_width", "width"}, &wKey)) {
+            const Node* h = anyOf({"image_height", "height"}, &hKey);
+            if (!h) fail("it gives '" + wKey + "' but no image height (image_height)");
+            width = pixels(*w, wKey), height = pixels(*h, hKey);
+        } else if (const Node* size = anyOf({"image_size", "imageSize"}, &wKey)) {
+            const Matrix s = shaped(*size, wKey, 1, 2);
+            width = int(s.values[0]), height = int(s.values[1]);
+            if (s.values[0] != width || s.values[1] != height || width < 1 || height < 1 || width > 16384 || height > 16384)
+                fail("'" + wKey + "' must be two whole numbers of pixels in 1..16384");
+        } else {
+            fail("it has no image size (image_width and image_height)");
+        }
+
+        // The pose, world-to-camera; none: the camera's own frame is the world.
+        glm::dmat4 camFromWorld(1.0);
+        std::string rKey, tKey;
+        const Node* r = anyOf({"R", "rvec", "rotation"}, &rKey);
+        const Node* t = anyOf({"T", "t", "tvec", "translation"}, &tKey);
+        if (bool(r) != bool(t)) fail("a pose needs both a rotation (R or rvec) and a translation (T or tvec)");
+        if (r) {
+            camFromWorld = glm::dmat4(rotationOf(matrix(*r, rKey), rKey));
+            const Matrix tv = shaped(*t, tKey, 3, 1);
+            camFromWorld[3] = glm::dvec4(tv.values[0], tv.values[1], tv.values[2], 1.0);
+        }
+        CameraSet set{path_, CameraFormat::OpenCv, {}, std::nullopt};
+        const std::size_t slash = path_.find_last_of('/');
+        ImportedCamera imported = camera(slash == std::string::npos ? path_ : path_.substr(slash + 1), width, height, intrinsics,
+                                         camFromWorld, r ? rKey + ", " + tKey : "pose");
+        if (!r)
+            imported.spec.notes.push_back(source() +
+                                          " has no pose (R and T, or rvec and tvec): the camera's own frame is the world "
+                                          "(x right, y down, z forward)");
+        if (const Node* d = anyOf({"distortion_coefficients", "D", "dist_coeffs", "distCoeffs", "distortion"}, &dKey))
+            imported.refusal = distortionRefusal(source(), "OpenCV",
+                                                 named(matrix(*d, dKey), {"k1", "k2", "p1", "p2", "k3", "k4", "k5", "k6", "s1",
+                                                                          "s2", "s3", "s4", "tx", "ty"}));
+        set.cameras.push_back(imported);
+        return set;
+    }
+
+    // ---- ROS --------------------------------------------------------------------------
+
+    CameraSet readRos() const
+    {
+        // The calibration file's keys, else the message's (ROS 1 upper case, ROS 2 lower case).
+        std::string kKey, pKey, dKey, wKey, hKey;
+        const Node* k = anyOf({"camera_matrix", "K"}, &kKey);
+        const Node* p = anyOf({"projection_matrix", "P"}, &pKey);
+        const Node* d = anyOf({"distortion_coefficients", "D"}, &dKey);
+        const Node* w = anyOf({"image_width", "width"}, &wKey);
+        const Node* h = anyOf({"image_height", "height"}, &hKey);
+        if (!k) fail("it has no camera matrix (camera_matrix, K or k)");
+        if (!w || !h) fail("it has no image size (image_width and image_height, or width and height)");
+        const int width = pixels(*w, wKey), height = pixels(*h, hKey);
+        const Matrix K = shaped(*k, kKey, 3, 3);
+
+        std::string refusal;
+        if (K.at(0, 0) == 0) refusal = source() + ": " + kKey + "[0] is 0: the camera is uncalibrated (REP 104)";
+        for (const char* key : {"binning_x", "binning_y"})
+            if (const Node* b = root_.findIgnoringCase(key); b && number(*b, key) > 1)
+                refusal = source() + ": " + key + " is " + b->scalar +
+                          ": the image is binned, not the calibrated one; zcheck reads unbinned CameraInfo";
+        if (const Node* roi = root_.findIgnoringCase("roi"); roi && roi->kind == Node::Kind::Map)
+            for (const char* key : {"x_offset", "y_offset", "height", "width"})
+                if (const Node* v = roi->find(key); v && number(*v, std::string("roi.") + key) != 0)
+                    refusal = source() + ": roi." + key + " is " + v->scalar +
+                              ": the image is a region of the calibrated one; zcheck reads CameraInfo without a roi";
+
+        CameraSet set{path_, CameraFormat::Ros, {}, std::size_t(0)};
+        ImportedCamera raw = camera("raw", width, height, intrinsicsOf(K, kKey), glm::dmat4(1.0), "pose");
+        std::string model = "plumb_bob";
+        if (const Node* m = root_.findIgnoringCase("distortion_model"); m && m->kind == Node::Kind::Scalar && !m->scalar.empty())
+            model = m->scalar;
+        raw.refusal = refusal;
+        if (raw.refusal.empty() && model == "equidistant")
+            raw.refusal = source() + ": distortion_model equidistant is a fisheye projection, not a pinhole: zcheck checks "
+                                     "linear projections; give the rectified camera (FILE#rectified) for a rectified image";
+        if (raw.refusal.empty() && d) {
+            raw.refusal = distortionRefusal(source(), model,
+                                            named(matrix(*d, dKey), {"k1", "k2", "p1", "p2", "k3", "k4", "k5", "k6"}));
+            if (!raw.refusal.empty()) raw.refusal += " (a rectified image's camera is P: FILE#rectified)";
+        }
+        raw.spec.notes.push_back(source() + ": the optical frame (x right, y down, z forward) is the world");
+        set.cameras.push_back(raw);
+
+        if (p) {
+            const Matrix P = shaped(*p, pKey, 3, 4);
+            ImportedCamera rectified;
+            if (P.allZero()) {
+                rectified.name = "rectified";
+                rectified.refusal = source() + ": " + pKey + " is all zero: there is no rectified camera";
+            } else {
+                double rows[3][3];
+                for (int r = 0; r < 3; ++r)
+                    for (int c = 0; c < 3; ++c) rows[r][c] = P.at(std::size_t(r), std::size_t(c));
+                PinholeIntrinsics kp;
+                try {
+                    kp = PinholeIntrinsics::fromK(rows, 0.0, pKey);
+                } catch (const Error& e) {
+                    fail(e.what());
+                }
+                // u = (fx'·X + cx'·Z + Tx)/Z: the camera moved by Tx/fx' along x (likewise y).
+                glm::dmat4 camFromWorld(1.0);
+                camFromWorld[3] = glm::dvec4(P.at(0, 3) / kp.fx, P.at(1, 3) / kp.fy, 0.0, 1.0);
+                rectified = camera("rectified", width, height, kp, camFromWorld, pKey);
+                rectified.refusal = refusal;
+                rectified.spec.notes = raw.spec.notes;
+            }
+            set.cameras.push_back(rectified);
+        }
+        if (const Node* name = root_.findIgnoringCase("camera_name"); name && name->kind == Node::Kind::Scalar)
+            set.cameras[0].aliases.push_back(name->scalar);
+        return set;
+    }
+
+    std::string path_;
+    CameraFormat format_;
+    Node root_;
+};
+
+}  // namespace
+
+CameraSet readCalibration(const std::string& path, CameraFormat format)
+{
+    return CalibrationReader(path, format).read();
+}
+
+}  // namespace zcheck::importers

@@ -1,0 +1,59 @@
+#pragma once
+// Cameras for a scene, from any camera file (library zcheck::scene): the formats of
+// camera_import.h and glTF camera nodes, opened by content, a frame chosen by FILE#FRAME,
+// and completed with what the file does not say.
+//
+//   const zcheck::Scene scene = zcheck::loadScene("mesh.ply");
+//   const zcheck::CameraSet set = zcheck::openCameraSet("sparse/0", std::nullopt);      // a COLMAP model
+//   const zcheck::CameraSpec spec = zcheck::completeCamera(set.cameras[set.find("img_014.png")], scene, {});
+//
+// Near and far: only zcheck's camera files and glTF give them. An imported camera needs them
+// only to clip (and to map window depth), so, unless given, they hug the scene as seen from
+// the camera: near and far are the smallest and largest eye-z of the scene's triangles
+// clipped to the camera's view (its four side planes and the eye plane), less and more 1 %
+// (clipPlanesFor). A window or NDC map depends on near and far: give the renderer's.
+#include "zcheck/camera_import.h"
+#include "zcheck/scene.h"
+
+#include <optional>
+#include <string>
+
+namespace zcheck {
+
+// Every camera of a file (camera_import.h), glTF camera nodes included; `format` forces the
+// format, else it is told by content (detectCameraFormat).
+CameraSet openCameraSet(const std::string& path, std::optional<CameraFormat> format);
+
+// The glTF file's camera nodes in the default scene, in the order the node hierarchy is
+// walked (depth first): perspective (yfov, aspectRatio or the image's, znear, zfar or an
+// infinite far plane) and orthographic (xmag, ymag half extents, znear, zfar) cameras, posed by
+// the node's world transform without its scale (as glTF says), looking down −Z with +Y up.
+// glTF has no image size: the cameras carry hasImageSize false. Named by the node's name, else
+// "nodes[i]"; the camera's own name is an alias.
+CameraSet readGltfCameras(const std::string& path);
+
+struct ClipPlanes {
+    double near = 0, far = 0;
+    std::string note;  // what was assumed, for the report ("" when the scene decided alone)
+};
+// Near and far hugging `scene` as `spec`'s camera sees it (the header's rule); near is held at
+// far·1e-7 or more. Throws Error when the camera sees none of the scene.
+ClipPlanes clipPlanesFor(const Scene& scene, const CameraSpec& spec);
+
+// What the user gives beside a camera file (--near, --far, --width, --height, a depth map's size).
+struct CameraCompletion {
+    std::optional<double> near, far;
+    std::optional<int> width, height;
+};
+
+// The camera FILE#FRAME names (splitCameraReference, openCameraSet, CameraSet::find).
+ImportedCamera importCamera(const std::string& reference, std::optional<CameraFormat> format);
+
+// An imported camera made usable: the image size (`given`'s — a depth map's, --width and
+// --height — else the file's, else a default of 640 wide, noted), near and far (`given`'s,
+// else the file's, else clipPlanesFor `scene`), each assumption added to its notes. Throws
+// Error for a camera the file refused (ImportedCamera::refusal), one whose near and far are
+// unknown without a scene (`scene` nullptr), and one that cannot be built.
+CameraSpec completeCamera(const ImportedCamera& camera, const Scene* scene, const CameraCompletion& given);
+
+}  // namespace zcheck

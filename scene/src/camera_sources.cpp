@@ -1,0 +1,166 @@
+#include "zcheck/camera_sources.h"
+
+#include "zcheck/error.h"
+#include "zcheck/input_file.h"
+#include "zcheck/large_buffer.h"
+#include "zcheck/mesh_formats.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace zcheck {
+
+CameraSet openCameraSet(const std::string& path, std::optional<CameraFormat> format)
+{
+    const CameraFormat f = format ? *format : detectCameraFormat(path);
+    return f == CameraFormat::Gltf ? readGltfCameras(path) : readCameraSet(path, f);
+}
+
+CameraSet readGltfCameras(const std::string& path)
+{
+    const LargeVector<char> file = readInputBytes(path, kMeshInput);
+    CameraSet set{path, CameraFormat::Gltf, readGltfCameraNodes(path, std::string_view(file.data(), file.size())), std::nullopt};
+    return set;
+}
+
+namespace {
+
+// A vertex as the clipping sees it: clip x, y, w (linear in eye space) and eye-z.
+struct ClipVertex {
+    double x, y, w, d;
+};
+
+// The five planes of the view, as functions that are ≥ 0 inside: |x| ≤ w, |y| ≤ w, eye-z ≥ 0.
+double planeValue(const ClipVertex& v, int plane)
+{
+    switch (plane) {
+    case 0: return v.w - v.x;
+    case 1: return v.w + v.x;
+    case 2: return v.w - v.y;
+    case 3: return v.w + v.y;
+    default: return v.d;
+    }
+}
+
+// The eye-z range of a triangle clipped to the view (Sutherland–Hodgman); false when nothing
+// of it is inside. Clip coordinates and eye-z are linear in eye space, so interpolating them
+// along an edge is exact.
+bool clippedRange(const ClipVertex (&corner)[3], double& lo, double& hi)
+{
+    ClipVertex polygon[8], next[8];
+    int count = 3;
+    std::copy(corner, corner + 3, polygon);
+    for (int plane = 0; plane < 5 && count > 0; ++plane) {
+        int kept = 0;
+        for (int i = 0; i < count; ++i) {
+            const ClipVertex& a = polygon[i];
+            const ClipVertex& b = polygon[(i + 1) % count];
+            const double fa = planeValue(a, plane), fb = planeValue(b, plane);
+            if (fa >= 0) next[kept++] = a;
+            if ((fa >= 0) != (fb >= 0)) {
+                const double t = fa / (fa - fb);
+                next[kept++] = {a.x + t * (b.x - a.x), a.y + t * (b.y - a.y), a.w + t * (b.w - a.w), a.d + t * (b.d - a.d)};
+            }
+        }
+        count = kept;
+        std::copy(next, next + count, polygon);
+    }
+    if (count == 0) return false;
+    for (int i = 0; i < count; ++i) lo = std::min(lo, polygon[i].d), hi = std::max(hi, polygon[i].d);
+    return true;
+}
+
+}  // namespace
+
+ClipPlanes clipPlanesFor(const Scene& scene, const CameraSpec& spec)
+{
+    const Camera camera(spec);  // its near and far may be placeholders: the side planes do not depend on them
+    std::vector<ClipVertex> vertices(scene.positions.size());
+    for (std::size_t i = 0; i < vertices.size(); ++i) {
+        const glm::dvec4 pEye = camera.eyeFromWorld * glm::dvec4(glm::dvec3(scene.positions[i]), 1.0);
+        const glm::dvec4 pClip = camera.clipFromEye * pEye;
+        vertices[i] = {pClip.x, pClip.y, pClip.w, camera.eyeZOf(glm::dvec3(pEye))};
+    }
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const glm::uvec3& t : scene.triangles) {
+        const ClipVertex corner[3] = {vertices[t[0]], vertices[t[1]], vertices[t[2]]};
+        int inside = 0;
+        bool outside = false;
+        for (int plane = 0; plane < 5 && !outside; ++plane) {
+            int in = 0;
+            for (const ClipVertex& v : corner) in += planeValue(v, plane) >= 0;
+            outside = in == 0;
+            inside += in == 3;
+        }
+        if (outside) continue;
+        if (inside == 5) {
+            for (const ClipVertex& v : corner) lo = std::min(lo, v.d), hi = std::max(hi, v.d);
+        } else {
+            clippedRange(corner, lo, hi);
+        }
+    }
+    if (!(hi > 0))
+        throw Error("the camera sees none of scene '" + scene.name +
+                    "', so near and far cannot be taken from it (is the pose inverted, or in other axes?)");
+    ClipPlanes planes;
+    planes.far = hi * 1.01;
+    planes.near = lo * 0.99;
+    const double floor = planes.far * 1e-7;
+    if (!(planes.near >= floor)) {
+        planes.near = floor;
+        planes.note = "the scene reaches the eye (eye-z " + formatNumber(std::max(lo, 0.0)) + "), so near is held at far/1e7";
+    }
+    return planes;
+}
+
+ImportedCamera importCamera(const std::string& reference, std::optional<CameraFormat> format)
+{
+    const auto [file, frame] = splitCameraReference(reference);
+    const CameraSet set = openCameraSet(file, format);
+    return set.cameras[set.find(frame)];
+}
+
+CameraSpec completeCamera(const ImportedCamera& camera, const Scene* scene, const CameraCompletion& given)
+{
+    if (!camera.refusal.empty()) throw Error(camera.refusal);
+    CameraSpec spec = camera.spec;
+    std::vector<std::string>& notes = spec.notes;
+    if (given.width.has_value() != given.height.has_value())
+        throw Error("give both the image width and height, or neither");
+    if (given.width) {
+        spec.width = *given.width, spec.height = *given.height;
+        if (camera.projectionForSize) spec.projection = camera.projectionForSize(spec.width, spec.height);
+    } else if (!camera.hasImageSize) {
+        notes.push_back("the camera file gives no image size: " + std::to_string(spec.width) + "x" +
+                        std::to_string(spec.height) + " (--width and --height set it; verify takes the depth map's)");
+    }
+    const bool isMatrix = spec.projection.type == ProjectionType::Matrix;
+    if (isMatrix && (given.near || given.far))
+        throw Error("a raw projection matrix holds its own near and far: --near and --far do not apply");
+    if (!isMatrix) {
+        if (!camera.hasClipPlanes && !(given.near && given.far)) {
+            if (!scene)
+                throw Error("camera '" + camera.name +
+                            "' has no near and far in its file, and there is no scene to take them from: give them "
+                            "(--near and --far)");
+            const ClipPlanes planes = clipPlanesFor(*scene, spec);
+            spec.projection.near = given.near.value_or(planes.near);
+            spec.projection.far = given.far.value_or(planes.far);
+            notes.push_back("near and far are not in the camera file: taken from the scene as the camera sees it (near " +
+                            formatNumber(spec.projection.near) + ", far " + formatNumber(spec.projection.far) +
+                            (planes.note.empty() ? "" : "; " + planes.note) + "); pass --near and --far to set them");
+        } else {
+            if (given.near) spec.projection.near = *given.near;
+            if (given.far) spec.projection.far = *given.far;
+        }
+    }
+    try {
+        Camera validated(spec);
+    } catch (const Error& e) {
+        throw Error("camera '" + camera.name + "': " + e.what());
+    }
+    return spec;
+}
+
+}  // namespace zcheck
