@@ -8,7 +8,9 @@
 #include <OpenImageIO/imageio.h>
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <unistd.h>
@@ -187,4 +189,143 @@ TEST_CASE("integer maps: depth = stored / scale + offset, 0 a miss unless --miss
     DepthMapReading badOffset;
     badOffset.offset = INFINITY;
     REQUIRE_THROWS_WITH(read(path, badOffset), Catch::Contains("--offset must be a finite number"));
+}
+
+namespace {
+
+std::string bytesFile(const std::string& name, const std::string& bytes)
+{
+    const std::string path = scratchPath(name);
+    std::ofstream(path, std::ios::binary) << bytes;
+    return path;
+}
+
+// A .npy file built by hand from the format's definition (numpy.org, NEP 1): the magic, the
+// version, the header length, the header dict padded to 64 bytes, then the data.
+std::string npy(const std::string& dict, const std::string& data, int major = 1)
+{
+    std::string header = dict;
+    const std::size_t lengthBytes = major == 1 ? 2 : 4;
+    while ((8 + lengthBytes + header.size() + 1) % 64 != 0) header += ' ';
+    header += '\n';
+    std::string out("\x93NUMPY", 6);
+    out += char(major), out += char(0);
+    for (std::size_t k = 0; k < lengthBytes; ++k) out += char((header.size() >> (8 * k)) & 0xFF);
+    return out + header + data;
+}
+
+template <class T>
+std::string raw(const std::vector<T>& values, bool bigEndian = false)
+{
+    std::string out;
+    for (T v : values) {
+        char b[sizeof(T)];
+        std::memcpy(b, &v, sizeof(T));
+        if (bigEndian) std::reverse(b, b + sizeof(T));
+        out.append(b, sizeof(T));
+    }
+    return out;
+}
+
+}  // namespace
+
+TEST_CASE("NumPy .npy maps: float32, big-endian float64, float16, Fortran order, uint16 with a scale, channels", "[depthmap][npy]")
+{
+    // Row 0 = {1, 2, 3}, row 1 = {4, 5, 6}: a 3x2 map.
+    const std::vector<float> rows = {1, 2, 3, 4, 5, 6};
+    auto values = [](const DepthMapFile& m) { return m.value; };
+    const std::vector<double> expected = {1, 2, 3, 4, 5, 6};
+    REQUIRE(values(read(bytesFile("f4.npy", npy("{'descr': '<f4', 'fortran_order': False, 'shape': (2, 3), }", raw(rows))))) == expected);
+    REQUIRE(values(read(bytesFile("f8be.npy", npy("{'descr': '>f8', 'fortran_order': False, 'shape': (2, 3), }",
+                                                   raw(std::vector<double>(rows.begin(), rows.end()), true), 2)))) == expected);
+    // Fortran order stores column by column: 1, 4, 2, 5, 3, 6.
+    REQUIRE(values(read(bytesFile("fortran.npy", npy("{'descr': '<f4', 'fortran_order': True, 'shape': (2, 3), }",
+                                                      raw(std::vector<float>{1, 4, 2, 5, 3, 6}))))) == expected);
+    // float16: 1.0 = 0x3C00, 2.0 = 0x4000, 0.5 = 0x3800, 1.5 = 0x3E00, 65504 = 0x7BFF, NaN = 0x7E00.
+    const DepthMapFile half = read(bytesFile("f2.npy", npy("{'descr': '<f2', 'fortran_order': False, 'shape': (2, 3), }",
+                                                          raw(std::vector<std::uint16_t>{0x3C00, 0x4000, 0x3800, 0x3E00, 0x7BFF, 0x7E00}))));
+    REQUIRE(half.value[0] == 1.0);
+    REQUIRE(half.value[2] == 0.5);
+    REQUIRE(half.value[4] == 65504.0);
+    REQUIRE(std::isnan(half.value[5]));
+    // uint16 millimetres: a scale is required, 0 is a miss.
+    const std::string mm = bytesFile("u2.npy", npy("{'descr': '<u2', 'fortran_order': False, 'shape': (2, 3), }",
+                                                   raw(std::vector<std::uint16_t>{1000, 0, 2500, 1, 2, 3})));
+    REQUIRE_THROWS_WITH(read(mm), Catch::Contains("stores integers (.npy <u2): give --scale"));
+    DepthMapReading millimetres;
+    millimetres.scale = 1000;
+    const DepthMapFile metres = read(mm, millimetres);
+    REQUIRE(metres.value[0] == 1.0);
+    REQUIRE(std::isnan(metres.value[1]));
+    REQUIRE(metres.valueQuantum == 0.001);
+    // (H, W, C): channels are named by index; several need --channel.
+    std::vector<float> three;
+    for (float v : rows) three.insert(three.end(), {v, 10 * v, 100 * v});
+    const std::string rgb = bytesFile("hwc.npy", npy("{'descr': '<f4', 'fortran_order': False, 'shape': (2, 3, 3), }", raw(three)));
+    REQUIRE_THROWS_WITH(read(rgb), Catch::Contains("name the one to read with --channel"));
+    REQUIRE(read(rgb, channelNamed("1")).value[5] == 60.0);
+}
+
+TEST_CASE("NumPy .npy maps that are not depth maps are refused by name", "[depthmap][npy][validation]")
+{
+    const std::string six = raw(std::vector<float>{1, 2, 3, 4, 5, 6});
+    auto refuses = [&](const std::string& name, const std::string& bytes, const std::string& what) {
+        INFO(name);
+        REQUIRE_THROWS_WITH(read(bytesFile(name, bytes)), Catch::Contains(what));
+    };
+    refuses("u1.npy", npy("{'descr': '|u1', 'fortran_order': False, 'shape': (2, 3), }", "123456"), "8-bit integers");
+    refuses("bool.npy", npy("{'descr': '|b1', 'fortran_order': False, 'shape': (2, 3), }", "123456"), "is not one zcheck reads");
+    refuses("i8.npy", npy("{'descr': '<i8', 'fortran_order': False, 'shape': (2, 3), }", six + six), "is not one zcheck reads");
+    refuses("c8.npy", npy("{'descr': '<c8', 'fortran_order': False, 'shape': (2, 3), }", six + six), "is not one zcheck reads");
+    refuses("struct.npy", npy("{'descr': [('a', '<f4')], 'fortran_order': False, 'shape': (2, 3), }", six), "structured");
+    refuses("1d.npy", npy("{'descr': '<f4', 'fortran_order': False, 'shape': (6,), }", six), "1 dimensions");
+    refuses("short.npy", npy("{'descr': '<f4', 'fortran_order': False, 'shape': (2, 3), }", six.substr(0, 20)), "(truncated)");
+    refuses("size.npy", npy("{'descr': '<f4', 'fortran_order': False, 'shape': (3, 3), }", six), "but the camera's image is 3x2");
+    refuses("huge.npy", npy("{'descr': '<f4', 'fortran_order': False, 'shape': (99999999999, 3), }", six), "but the camera's image");
+    refuses("dict.npy", npy("{'descr': '<f4', 'shape': (2, 3), }", six), "lacks one of");
+    refuses("v9.npy", npy("{'descr': '<f4', 'fortran_order': False, 'shape': (2, 3), }", six, 9), "version 9");
+    refuses("header.npy", std::string("\x93NUMPY\x01\x00\xff\xff{", 11), "more than the file holds");
+}
+
+TEST_CASE("COLMAP dense depth maps: W&H&C& then float32 rows, 0 where there is no depth", "[depthmap][colmap]")
+{
+    const DepthMapFile map = read(bytesFile("d.geometric.bin", "3&2&1&" + raw(std::vector<float>{1, 0, 3, 4, -1, 6})));
+    REQUIRE(map.value[0] == 1.0);
+    REQUIRE(std::isnan(map.value[1]));  // 0: no depth
+    REQUIRE(std::isnan(map.value[4]));  // below 0: no depth either
+    REQUIRE(map.value[5] == 6.0);
+    REQUIRE_THROWS_WITH(read(bytesFile("n.bin", "3&2&3&" + raw(std::vector<float>(18, 1.0f)))), Catch::Contains("normal map"));
+    REQUIRE_THROWS_WITH(read(bytesFile("t.bin", "3&2&1&" + raw(std::vector<float>(5, 1.0f)))), Catch::Contains("(truncated)"));
+    REQUIRE_THROWS_WITH(read(bytesFile("w.bin", "4&2&1&" + raw(std::vector<float>(8, 1.0f)))), Catch::Contains("camera's image is 3x2"));
+}
+
+TEST_CASE("HDF5 maps: a dataset chosen by --channel or by its name; malformed files are refused, not fatal", "[depthmap][hdf5]")
+{
+    QuantityImage depth, distance;
+    depth.quantity = ExportQuantity::EyeZ, depth.width = W, depth.height = H, depth.channels = {"depth"};
+    depth.value = {1, 2, 3, 4, 5, 6};
+    distance = depth;
+    distance.quantity = ExportQuantity::Distance, distance.channels = {"distance"};
+    distance.value = {10, 20, 30, 40, 50, 60};
+    const std::string path = scratchPath("blenderproc.h5");
+    REQUIRE(writeQuantityFile(path, {depth, distance}, 0) == "hdf5");
+    REQUIRE_THROWS_WITH(read(path), Catch::Contains("several of its channels are named as depth ('depth', 'distance')"));
+    REQUIRE(read(path, channelNamed("depth")).value[5] == 6.0);
+    DepthMapReading asDistance;
+    asDistance.quantityChannel = "distance";  // --quantity distance prefers its own name
+    REQUIRE(read(path, asDistance).value[0] == 10.0);
+    REQUIRE_THROWS_WITH(read(path, channelNamed("colors")), Catch::Contains("it has no channel 'colors'"));
+
+    // The HDF5 signature and then garbage: the library refuses (or dies) in a child process.
+    std::string garbage("\x89HDF\r\n\x1a\n", 8);
+    for (int i = 0; i < 4000; ++i) garbage += char((i * 7919) % 251);
+    REQUIRE_THROWS_WITH(read(bytesFile("garbage.h5", garbage)), Catch::StartsWith("cannot read depth map") && Catch::Contains("HDF5"));
+    // Truncated after a good start.
+    std::string whole;
+    {
+        std::ifstream in(path, std::ios::binary);
+        whole.assign(std::istreambuf_iterator<char>(in), {});
+    }
+    REQUIRE_THROWS_WITH(read(bytesFile("cut.h5", whole.substr(0, whole.size() / 2)), channelNamed("depth")),
+                        Catch::StartsWith("cannot read depth map"));
 }

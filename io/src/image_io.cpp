@@ -1,5 +1,7 @@
 #include "zcheck/image_io.h"
 
+#include "depth_formats.h"
+
 #include "png_codec.h"
 #include "zcheck/atomic_file.h"
 #include "zcheck/error.h"
@@ -203,11 +205,18 @@ DepthMapFile readDepthMap(const std::string& path, const DepthMapReading& readin
     // The format is decided by the file's first bytes, and only that format's reader sees it:
     // OpenImageIO would otherwise offer unknown bytes to every plugin it has (video, camera
     // raw, DICOM, ...). PFM is read by zcheck itself (see readPfm).
-    unsigned char magic[4] = {0, 0, 0, 0};
+    char head[32] = {};
+    std::streamsize headBytes = 0;
     {
         std::ifstream probe(path, std::ios::binary);
-        probe.read(reinterpret_cast<char*>(magic), 4);
+        probe.read(head, sizeof head);
+        headBytes = probe.gcount();
     }
+    const std::string_view first(head, std::size_t(headBytes));
+    if (depthformats::isNpy(first)) return depthformats::readNpy(path, reading, expectedWidth, expectedHeight);
+    if (depthformats::isHdf5(first)) return depthformats::readHdf5(path, reading, expectedWidth, expectedHeight);
+    if (depthformats::isColmapDepth(first)) return depthformats::readColmapDepth(path, reading, expectedWidth, expectedHeight);
+    const auto* magic = reinterpret_cast<const unsigned char*>(head);
     if (magic[0] == 'P' && (magic[1] == 'f' || magic[1] == 'F') && std::isspace(magic[2])) {
         DepthMapFile map = readPfm(path, readInputFile(path, kDepthMapInput), reading, expectedWidth, expectedHeight);
         for (double& v : map.value) v = reading.depthOf(v, false);
@@ -219,7 +228,8 @@ DepthMapFile readDepthMap(const std::string& path, const DepthMapReading& readin
                              ? "tiff"
                          : magic[0] == 0x89 && magic[1] == 'P' && magic[2] == 'N' && magic[3] == 'G' ? "png"
                                                                                                       : nullptr;
-    if (!plugin) refuseDepthMap(path, "not an EXR, TIFF, PNG or PFM file (judged by its first bytes)");
+    if (!plugin)
+        refuseDepthMap(path, "not an EXR, TIFF, PNG, PFM, NumPy .npy, HDF5 or COLMAP depth map file (judged by its first bytes)");
     auto requireScale = [&](const std::string& what) {
         if (!(scale > 0))
             throw Error("depth map '" + path + "' stores integers (" + what +
@@ -347,12 +357,29 @@ std::string writeQuantityFile(const std::string& path, const std::vector<Quantit
 {
     const std::string ext = lowerExtension(path);
     const std::string format = ext == ".exr" ? "exr" : ext == ".pfm" ? "pfm" : (ext == ".tif" || ext == ".tiff") ? "tiff"
-                                                                            : ext == ".png" ? "png" : "";
+                               : ext == ".png"                    ? "png"
+                               : ext == ".npy"                    ? "npy"
+                               : (ext == ".h5" || ext == ".hdf5") ? "hdf5"
+                               : ext == ".bin"                    ? "colmap"
+                                                                  : "";
     if (format.empty())
-        throw Error("cannot write '" + path + "': unknown format '" + ext + "' (expected .exr, .pfm, .tif or .png)");
+        throw Error("cannot write '" + path + "': unknown format '" + ext +
+                    "' (expected .exr, .pfm, .tif, .png, .npy, .h5 or .bin for a COLMAP depth map)");
     if (images.empty()) throw Error("nothing to write to '" + path + "'");
-    if (format != "exr" && images.size() > 1)
-        throw Error("cannot write '" + path + "': several quantities go into one file only as .exr");
+    if (format != "exr" && format != "hdf5" && images.size() > 1)
+        throw Error("cannot write '" + path + "': several quantities go into one file only as .exr or .h5");
+    if (format == "npy") {
+        depthformats::writeNpy(path, images[0]);
+        return format;
+    }
+    if (format == "colmap") {
+        depthformats::writeColmapDepth(path, images[0]);
+        return format;
+    }
+    if (format == "hdf5") {
+        depthformats::writeHdf5(path, images);
+        return format;
+    }
     if (format == "png") {
         writePng16(path, images[0], scale);
         return format;
