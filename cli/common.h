@@ -34,6 +34,7 @@ Command addVerifyCommand(CLI::App& app);
 Command addSuiteCommand(CLI::App& app);
 Command addBenchCommand(CLI::App& app);
 Command addCameraCommand(CLI::App& app);
+Command addDatasetCommand(CLI::App& app);
 
 // Option validators, the same in every subcommand.
 extern const CLI::Validator kNonEmptyPath;

@@ -21,7 +21,8 @@ int main(int argc, char** argv)
     app.set_version_flag("--version", std::string(zcheck::kVersion));
     const Command commands[] = {addCheckCommand(app),  addMatricesCommand(app), addPrecisionCommand(app),
                                 addUnprojectCommand(app), addExportCommand(app), addVerifyCommand(app),
-                                addSuiteCommand(app),  addBenchCommand(app),    addCameraCommand(app)};
+                                addSuiteCommand(app),  addBenchCommand(app),    addCameraCommand(app),
+                                addDatasetCommand(app)};
 
     // CLI11 says only "a subcommand is required" for a misspelt one: name it.
     if (argc > 1 && argv[1][0] != '-') {

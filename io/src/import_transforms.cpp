@@ -51,6 +51,17 @@ public:
     {
         CameraSet set{path_, CameraFormat::Nerfstudio, {}};
         const std::vector<std::string> notes = documentNotes();
+        if (const json* integer = find(root_, "integer_depth_scale")) {
+            if (!integer->is_number() || !(integer->get<double>() > 0) || !std::isfinite(integer->get<double>()))
+                fail("'integer_depth_scale' must be a positive number");
+            set.depthScale = 1 / integer->get<double>();
+            set.depthScaleNote = "depth = stored value x " + formatNumber(integer->get<double>()) +
+                                 " (the file's integer_depth_scale, instant-ngp)";
+        } else {
+            set.depthScale = 1000;
+            set.depthScaleNote = "depth files hold millimetres, nerfstudio's default (depth_unit_scale_factor 1e-3): "
+                                 "scale 1000; --scale replaces it";
+        }
         for (std::size_t i = 0; i < frames_->size(); ++i) {
             const json& frame = (*frames_)[i];
             const std::string where = "frames[" + std::to_string(i) + "]";

@@ -1,6 +1,7 @@
 #include "zcheck/report.h"
 
 #include "camera_json.h"
+#include "report_json.h"
 #include "zcheck/png_file.h"
 #include "zcheck/report_images.h"
 #include "zcheck/version.h"
@@ -39,19 +40,84 @@ std::string percent(std::int64_t part, std::int64_t whole)
 
 }  // namespace
 
-namespace {
+namespace reportjson {
 
-nlohmann::json toJson(const CheckReport& report)
+nlohmann::json pixelsJson(const ComparisonReport& c)
 {
-    const ComparisonReport& c = report.comparison;
-    nlohmann::json unexplained = nlohmann::json::array();
-    for (const auto& f : c.unexplainedSamples) unexplained.push_back(toJson(f));
+    return {{"total", std::int64_t(c.width) * c.height},
+            {"both_hit", c.bothHit},
+            {"both_miss", c.bothMiss},
+            {"ray_only", c.rayOnly},
+            {"raster_only", c.rasterOnly},
+            {"agree", c.agree},
+            {"edge_surface", c.edgeSurface},
+            {"depth_errors", c.depthErrors},
+            {"coverage_explained", c.coverageExplained},
+            {"lost_at_clear_value", c.lostAtClearValue},
+            {"at_clip_plane", c.atClipPlane},
+            {"coverage_unexplained", c.coverageUnexplained}};
+}
+
+nlohmann::json depthErrorJson(const ComparisonReport& c)
+{
+    return {{"max_quanta", c.maxErrorQuanta},
+            {"p99_quanta", c.p99ErrorQuanta},
+            {"max_over_tolerance", c.maxErrorOverTolerance},
+            {"max_relative_eye_z", c.maxRelativeEyeZError},
+            {"p99_relative_eye_z", c.p99RelativeEyeZError},
+            {"bias_samples", c.biasSamples},
+            {"mean_signed_error_quanta", c.meanSignedErrorQuanta},
+            {"depth_bias", c.depthBias},
+            {"worst_pixel", toJson(c.worst)}};
+}
+
+nlohmann::json unexplainedJson(const ComparisonReport& c, bool samples)
+{
     nlohmann::json box = nullptr;
     if (c.unexplainedMaxCol >= 0)
         box = {{"min_col", c.unexplainedMinCol},
                {"min_row", c.unexplainedMinRow},
                {"max_col", c.unexplainedMaxCol},
                {"max_row", c.unexplainedMaxRow}};
+    nlohmann::json out = {{"count", c.unexplained()}, {"bounding_box", box}};
+    if (samples) {
+        nlohmann::json list = nlohmann::json::array();
+        for (const auto& f : c.unexplainedSamples) list.push_back(toJson(f));
+        out["samples"] = list;
+    }
+    return out;
+}
+
+nlohmann::json depthMapJson(const DepthMapSource& source)
+{
+    const DepthMapReading& r = source.reading;
+    return {{"file", source.file},
+            {"quantity", source.quantity},
+            {"channel", source.channel},
+            {"scale", r.scale},
+            {"offset", r.offset},
+            {"miss", r.miss.given() ? nlohmann::json(r.miss.text()) : nlohmann::json(nullptr)}};
+}
+
+nlohmann::json hypothesisJson(const Hypothesis& h)
+{
+    nlohmann::json fitted = nlohmann::json::array();
+    for (const FittedValue& v : h.fitted) fitted.push_back({{"name", v.name}, {"value", v.value}, {"declared", v.declared}});
+    return {{"hypothesis", h.name}, {"variant", h.variant}, {"explanation", h.explanation},
+            {"consistent", h.consistent}, {"consistent_except_edges", h.consistentExceptEdges()},
+            {"unexplained", h.unexplained}, {"unexplained_estimated", h.estimated},
+            {"unexplained_at_edges", h.unexplainedAtEdges}, {"fitted", fitted}};
+}
+
+}  // namespace reportjson
+
+namespace {
+
+using namespace reportjson;
+
+nlohmann::json toJson(const CheckReport& report)
+{
+    const ComparisonReport& c = report.comparison;
     return {
         {"zcheck_version", kVersion},
         {"scene", report.scene},
@@ -65,30 +131,9 @@ nlohmann::json toJson(const CheckReport& report)
           {"rule", report.tolerance.slopeCredit == SlopeCredit::SampleOffset
                        ? "|d_map - d_ray| <= C*q + S*m, m = |dd/dx| + |dd/dy| (sum over both surfaces when they differ)"
                        : "|d_raster - d_ray| <= C*q + S*m, m = max(|dd/dx|, |dd/dy|) (sum over both surfaces when they differ)"}}},
-        {"pixels",
-         {{"total", std::int64_t(c.width) * c.height},
-          {"both_hit", c.bothHit},
-          {"both_miss", c.bothMiss},
-          {"ray_only", c.rayOnly},
-          {"raster_only", c.rasterOnly},
-          {"agree", c.agree},
-          {"edge_surface", c.edgeSurface},
-          {"depth_errors", c.depthErrors},
-          {"coverage_explained", c.coverageExplained},
-          {"lost_at_clear_value", c.lostAtClearValue},
-          {"at_clip_plane", c.atClipPlane},
-          {"coverage_unexplained", c.coverageUnexplained}}},
-        {"depth_error",
-         {{"max_quanta", c.maxErrorQuanta},
-          {"p99_quanta", c.p99ErrorQuanta},
-          {"max_over_tolerance", c.maxErrorOverTolerance},
-          {"max_relative_eye_z", c.maxRelativeEyeZError},
-          {"p99_relative_eye_z", c.p99RelativeEyeZError},
-          {"bias_samples", c.biasSamples},
-          {"mean_signed_error_quanta", c.meanSignedErrorQuanta},
-          {"depth_bias", c.depthBias},
-          {"worst_pixel", toJson(c.worst)}}},
-        {"unexplained", {{"count", c.unexplained()}, {"bounding_box", box}, {"samples", unexplained}}},
+        {"pixels", pixelsJson(c)},
+        {"depth_error", depthErrorJson(c)},
+        {"unexplained", unexplainedJson(c, true)},
         {"timings_ms",
          {{"bvh_build", report.timings.bvhBuildMs},
           {"trace", report.timings.traceMs},
@@ -187,24 +232,10 @@ std::string verifyReportJson(const CheckReport& report, const DepthMapSource& so
                              const std::vector<Hypothesis>* diagnosis)
 {
     nlohmann::json document = toJson(report);
-    const DepthMapReading& r = source.reading;
-    document["depth_map"] = {{"file", source.file},
-                             {"quantity", source.quantity},
-                             {"channel", source.channel},
-                             {"scale", r.scale},
-                             {"offset", r.offset},
-                             {"miss", r.miss.given() ? nlohmann::json(r.miss.text()) : nlohmann::json(nullptr)}};
+    document["depth_map"] = depthMapJson(source);
     if (diagnosis) {
         nlohmann::json list = nlohmann::json::array();
-        for (const auto& h : *diagnosis) {
-            nlohmann::json fitted = nlohmann::json::array();
-            for (const FittedValue& v : h.fitted)
-                fitted.push_back({{"name", v.name}, {"value", v.value}, {"declared", v.declared}});
-            list.push_back({{"hypothesis", h.name}, {"variant", h.variant}, {"explanation", h.explanation},
-                            {"consistent", h.consistent}, {"consistent_except_edges", h.consistentExceptEdges()},
-                            {"unexplained", h.unexplained}, {"unexplained_estimated", h.estimated},
-                            {"unexplained_at_edges", h.unexplainedAtEdges}, {"fitted", fitted}});
-        }
+        for (const auto& h : *diagnosis) list.push_back(hypothesisJson(h));
         document["diagnosis"] = list;
     }
     return prettyJson(document);
@@ -214,10 +245,10 @@ VerifyOutcome verifyAndReport(const Checker& checker, const Camera& camera, cons
                               const DepthMapSource& source, bool diagnose)
 {
     VerifyOutcome out;
-    out.run = checker.verify(camera, map);
-    requireSomethingCompared(out.run.comparison.report, checker.scene().name);
-    out.diagnosed = diagnose && !out.run.comparison.report.consistent();
-    if (out.diagnosed) out.diagnosis = checker.diagnose(camera, map);
+    VerifiedMap verified = verifyMap(checker, camera, map, diagnose);
+    out.run = std::move(verified.run);
+    out.diagnosed = verified.diagnosed;
+    out.diagnosis = std::move(verified.diagnosis);
     out.json = verifyReportJson(out.run.report, source, out.diagnosed ? &out.diagnosis : nullptr);
     out.summary = formatSummary(out.run.report, "ground truth (Embree) vs depth map '" + source.file + "' channel '" +
                                                     source.channel + "' (" + source.quantity + ")");

@@ -62,6 +62,11 @@ struct CameraSet {
     // The camera a reference without #FRAME means when the file holds several (a ROS
     // CameraInfo's raw camera beside its rectified one); none: the reference must name one.
     std::optional<std::size_t> defaultCamera;
+    // How the file's depth maps store depth, when it says: stored value = depth × depthScale
+    // (nerfstudio: 1000, millimetres by default; instant-ngp: 1 / integer_depth_scale), and
+    // the sentence a report prints about it.
+    std::optional<double> depthScale;
+    std::string depthScaleNote;
 
     // The camera `frame` names: "" for a file's only camera (or its default camera); else its index (digits), its name,
     // or an alias (a leading "./" ignored). Throws Error naming the file and the frame (listing a

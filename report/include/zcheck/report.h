@@ -7,6 +7,7 @@
 #include "zcheck/depth_map_reading.h"
 #include "zcheck/precision.h"
 #include "zcheck/suite.h"
+#include "zcheck/verify_map.h"
 
 #include <string>
 #include <vector>
@@ -19,18 +20,11 @@ std::string checkReportJson(const CheckReport& report);
 std::string formatSummary(const CheckReport& report,
                           const std::string& comparing = "ray route (Embree) vs raster route (z-buffer)");
 
-// Where a verified map came from, for its report.
-struct DepthMapSource {
-    std::string file, quantity, channel;  // channel: the one read
-    DepthMapReading reading;               // as asked (scale 0: not given)
-};
 // `zcheck verify --json`: the check report plus the map's source and, when given, the diagnosis.
 std::string verifyReportJson(const CheckReport& report, const DepthMapSource& source,
                              const std::vector<Hypothesis>* diagnosis = nullptr);
-// One verification as `zcheck verify` reports it: the comparison (refused with Error "nothing to
-// compare" when neither side sees a surface), the diagnosis when asked for and the map is
-// inconsistent, the JSON document and the summary. The command line and the Python module
-// both go through it.
+// One verification as `zcheck verify` reports it: verifyMap (verify_map.h), the JSON document
+// and the summary. The command line and the Python module both go through it.
 struct VerifyOutcome {
     VerifyResult run;
     bool diagnosed = false;

@@ -1,0 +1,543 @@
+// zcheck dataset: a whole dataset as one job — verify (sharded, resumable), report, import,
+// submit (a Slurm job array).
+#include "common.h"
+#include "image_plugin.h"
+
+#include "zcheck/atomic_file.h"
+#include "zcheck/camera_sources.h"
+#include "zcheck/dataset.h"
+#include "zcheck/dataset_report.h"
+#include "zcheck/error.h"
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <climits>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+#include <cstdio>
+#include <cstring>
+#include <iostream>
+#include <set>
+
+extern char** environ;
+
+namespace zcheck::cli {
+
+namespace {
+
+// The options `dataset verify` takes, and `dataset submit` passes on to it.
+struct DatasetVerifyOptions {
+    std::string source, scene = "builtin:default", quantity, depthPattern, miss, channel, cameraFormat, convention, shard;
+    std::optional<double> scale, offset, near, far;
+    std::string output;
+    bool resume = false, diagnose = false;
+    int threads = 0;
+};
+
+void addDatasetVerifyOptions(CLI::App* command, DatasetVerifyOptions& o)
+{
+    command->add_option("source", o.source, "a transforms.json, a COLMAP model folder, or a manifest (.jsonl)")
+        ->required()
+        ->check(kNonEmptyPath);
+    command->add_option("--scene", o.scene, "the mesh every frame is checked against (a manifest line may name its own)")
+        ->capture_default_str()
+        ->check(kNonEmptyPath);
+    command->add_option("--quantity", o.quantity, "what the maps hold: window | ndc | eye-z | distance (a manifest line may say)");
+    command->add_option("--depth", o.depthPattern,
+                        "COLMAP: each image's depth map, {name} the image name, {stem} without its extension\n"
+                        "(dense/stereo/depth_maps/{name}.geometric.bin)");
+    command->add_option("--scale", o.scale, "stored value = depth x scale (integer maps; replaces nerfstudio's 1000)")
+        ->check(kPositiveFinite);
+    command->add_option("--offset", o.offset, "added to every depth after --scale");
+    command->add_option("--miss", o.miss, "the stored value meaning 'no surface': 0, 65535, 1e10, nan, inf, '>=1e9'");
+    command->add_option("--channel", o.channel, "the channel or HDF5 dataset to read (depth, distance, Z, ...)");
+    command->add_option("--camera-format", o.cameraFormat, "the source's format when its content should not decide");
+    command->add_option("--near", o.near, "near plane of cameras whose file has none (default: from the scene)")
+        ->check(kPositiveFinite);
+    command->add_option("--far", o.far, "far plane of cameras whose file has none (default: from the scene)")
+        ->check(kPositiveFinite);
+    command->add_option("--convention", o.convention, "replace every camera's convention");
+    command->add_flag("--diagnose", o.diagnose, "diagnose the inconsistent frames (only they pay for it)");
+    addThreadsOption(command, o.threads);
+}
+
+Dataset openSource(const DatasetVerifyOptions& o)
+{
+    DatasetSourceOptions options;
+    options.depthPattern = o.depthPattern;
+    if (!o.cameraFormat.empty()) options.cameraFormat = cameraFormatFromName(o.cameraFormat);
+    return openDataset(o.source, options, [](const std::string& path, std::optional<CameraFormat> format) {
+        return openCameraSet(path, format);
+    });
+}
+
+DatasetRunOptions runOptions(const DatasetVerifyOptions& o)
+{
+    DatasetRunOptions options;
+    options.scene = o.scene, options.quantity = o.quantity;
+    options.scale = o.scale, options.offset = o.offset, options.miss = o.miss, options.channel = o.channel;
+    options.near = o.near, options.far = o.far, options.convention = o.convention;
+    options.diagnose = o.diagnose;
+    if (!o.shard.empty()) options.parseShard(o.shard);
+    return options;
+}
+
+// Appends records to a results file as frames finish: one write(2) per line, so a killed run
+// leaves at most its last line torn (which --resume drops).
+class ResultsSink {
+public:
+    explicit ResultsSink(const std::string& path) : path_(path) {}
+    ~ResultsSink()
+    {
+        if (fd_ >= 0) ::close(fd_);
+    }
+    void truncateTo(std::uint64_t bytes)
+    {
+        if (::truncate(path_.c_str(), off_t(bytes)) != 0)
+            throw Error("cannot drop the torn last line of results file '" + path_ + "': " + std::strerror(errno));
+    }
+    void write(const std::string& line)
+    {
+        if (path_ == "-") {
+            std::fwrite(line.data(), 1, line.size(), stdout);
+            std::fputc('\n', stdout);
+            std::fflush(stdout);
+            return;
+        }
+        if (fd_ < 0) {  // created with the first record: a run that verifies nothing writes nothing
+            fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+            if (fd_ < 0) throw Error("cannot write results file '" + path_ + "': " + std::strerror(errno));
+        }
+        const std::string whole = line + "\n";
+        std::size_t done = 0;
+        while (done < whole.size()) {
+            const ssize_t n = ::write(fd_, whole.data() + done, whole.size() - done);
+            if (n < 0 && errno == EINTR) continue;
+            if (n <= 0) throw Error("cannot write results file '" + path_ + "': " + std::strerror(errno));
+            done += std::size_t(n);
+        }
+    }
+    void finish()
+    {
+        if (fd_ >= 0 && ::fsync(fd_) != 0) throw Error("cannot write results file '" + path_ + "': " + std::strerror(errno));
+    }
+
+private:
+    std::string path_;
+    int fd_ = -1;
+};
+
+// Frames done / total, frames per second, ETA and failures on a terminal; nothing otherwise.
+class Progress {
+public:
+    Progress(std::size_t total, std::size_t already) : total_(total), done_(already), start_(std::chrono::steady_clock::now())
+    {
+        enabled_ = ::isatty(STDERR_FILENO);
+        base_ = already;
+    }
+    void frameDone(bool failed)
+    {
+        ++done_;
+        failures_ += failed;
+        if (!enabled_) return;
+        const auto now = std::chrono::steady_clock::now();
+        if (done_ < total_ && now - last_ < std::chrono::milliseconds(100)) return;
+        last_ = now;
+        const double seconds = std::chrono::duration<double>(now - start_).count();
+        const double rate = seconds > 0 ? double(done_ - base_) / seconds : 0;
+        const double eta = rate > 0 ? double(total_ - done_) / rate : 0;
+        std::fprintf(stderr, "\rframes %zu/%zu  %.1f frames/s  ETA %d:%02d  failed %zu   ", done_, total_, rate, int(eta) / 60,
+                     int(eta) % 60, failures_);
+        if (done_ == total_) std::fputc('\n', stderr);
+        std::fflush(stderr);
+    }
+
+private:
+    bool enabled_ = false;
+    std::size_t total_, done_, base_ = 0, failures_ = 0;
+    std::chrono::steady_clock::time_point start_, last_{};
+};
+
+bool fileHasContent(const std::string& path)
+{
+    struct stat status {};
+    return ::stat(path.c_str(), &status) == 0 && status.st_size > 0;
+}
+
+namespace fs = std::filesystem;
+
+// 'text' for a POSIX shell: single quotes, each ' written as '\''.
+std::string shellQuoted(const std::string& text)
+{
+    std::string out = "'";
+    for (char c : text) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return out + "'";
+}
+
+// Runs a program (found on PATH) and returns its standard output; its exit status in `status`.
+std::string runProgram(const std::vector<std::string>& argv, int& status)
+{
+    int fds[2];
+    if (::pipe(fds) != 0) throw std::runtime_error(std::string("pipe: ") + std::strerror(errno));
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_adddup2(&actions, fds[1], STDOUT_FILENO);
+    posix_spawn_file_actions_addclose(&actions, fds[0]);
+    std::vector<char*> args;
+    for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+    args.push_back(nullptr);
+    pid_t pid = 0;
+    const int spawned = posix_spawnp(&pid, args[0], &actions, nullptr, args.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    ::close(fds[1]);
+    if (spawned != 0) {
+        ::close(fds[0]);
+        throw Error("cannot run '" + argv[0] + "': " + std::strerror(spawned) + " (is Slurm installed and on PATH?)");
+    }
+    std::string out;
+    char buffer[4096];
+    for (ssize_t n; (n = ::read(fds[0], buffer, sizeof buffer)) != 0;) {
+        if (n < 0 && errno == EINTR) continue;
+        if (n < 0) break;
+        out.append(buffer, std::size_t(n));
+    }
+    ::close(fds[0]);
+    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    return out;
+}
+
+// The job id `sbatch --parsable` prints ("123" or "123;cluster").
+std::string submitted(const std::vector<std::string>& argv)
+{
+    int status = 0;
+    std::string out = runProgram(argv, status);
+    const std::string id = out.substr(0, out.find_first_of(";\n"));
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || id.empty() || id.find_first_not_of("0123456789_") != std::string::npos)
+        throw Error("sbatch refused the job (" + argv.back() + "): " + (out.empty() ? "no output" : printableExcerpt(out, 200)));
+    return id;
+}
+
+std::string executablePath()
+{
+    char path[PATH_MAX];
+    const ssize_t n = ::readlink("/proc/self/exe", path, sizeof path - 1);
+    if (n <= 0) throw std::runtime_error("cannot find the zcheck executable's path (/proc/self/exe)");
+    return std::string(path, std::size_t(n));
+}
+
+
+// The command line of `dataset verify` that `o` stands for (without -o, --shard, --resume).
+std::vector<std::string> verifyArgumentsOf(const DatasetVerifyOptions& o)
+{
+    std::vector<std::string> args = {o.source, "--scene", o.scene};
+    auto add = [&](const char* option, const std::string& value) {
+        if (!value.empty()) args.insert(args.end(), {option, value});
+    };
+    auto addNumber = [&](const char* option, const std::optional<double>& value) {
+        char text[40];
+        if (value) std::snprintf(text, sizeof text, "%.17g", *value), args.insert(args.end(), {option, text});
+    };
+    add("--quantity", o.quantity), add("--depth", o.depthPattern), add("--miss", o.miss), add("--channel", o.channel);
+    add("--camera-format", o.cameraFormat), add("--convention", o.convention);
+    addNumber("--scale", o.scale), addNumber("--offset", o.offset), addNumber("--near", o.near), addNumber("--far", o.far);
+    if (o.diagnose) args.push_back("--diagnose");
+    if (o.threads > 0) args.insert(args.end(), {"--threads", std::to_string(o.threads)});
+    return args;
+}
+
+int runDatasetVerify(const DatasetVerifyOptions& o)
+{
+    const auto threadLimit = limitThreads(o.threads);
+    const std::string output = o.output.empty() ? "-" : o.output;
+    if (o.resume && output == "-") throw Error("--resume completes a results file: give it with -o FILE");
+    if (!o.resume && output != "-" && fileHasContent(output))
+        throw Error("results file '" + output + "' exists: --resume completes it; remove it to start over");
+    if (output != "-") {
+        OutputFiles check;  // the path rules (a folder, an input, a missing parent) before any work
+        check.addInput(o.source);
+        check.addInput(o.scene.rfind("builtin:", 0) == 0 ? "" : o.scene);
+        check.add(output, "-o");
+    }
+    const DatasetRunner runner(openSource(o), runOptions(o), [](const std::string& path, const DepthMapReading& reading,
+                                                               int width, int height) {
+        return images().readDepthMap(path, reading, width, height);
+    });
+    ResultsSink sink(output);
+    std::set<std::size_t> done;
+    std::vector<FrameRecord> previous;
+    if (o.resume && fileHasContent(output)) {
+        const ResultsFile existing = readResults(output);
+        for (const FrameRecord& r : existing.records) {
+            if (r.source != runner.dataset().source || r.of != runner.dataset().frames.size())
+                throw Error("results file '" + output + "' line " + std::to_string(r.line) + " is of dataset '" + r.source +
+                            "' (" + std::to_string(r.of) + " frames), not this run's '" + runner.dataset().source + "' (" +
+                            std::to_string(runner.dataset().frames.size()) + " frames)");
+            if (done.insert(r.index).second) previous.push_back(r);
+        }
+        if (existing.torn) sink.truncateTo(existing.completeBytes);
+    }
+    std::vector<std::size_t> frames;
+    for (std::size_t i : runner.shardFrames())
+        if (!done.count(i)) frames.push_back(i);
+    Progress progress(runner.shardFrames().size(), runner.shardFrames().size() - frames.size());
+    bool allConsistent = true;
+    for (const FrameRecord& r : previous) allConsistent = allConsistent && r.consistent;
+    ResultsFile thisRun;
+    thisRun.path = output;
+    runner.run(frames, [&](FrameResult&& result) {
+        sink.write(frameRecordJson(result));
+        allConsistent = allConsistent && result.consistent();
+        progress.frameDone(!result.consistent());
+        FrameRecord r;
+        r.index = result.index, r.of = result.of, r.frame = result.frame, r.source = result.source, r.scene = result.scene;
+        r.consistent = result.consistent(), r.error = result.error, r.seconds = result.seconds;
+        r.unexplained = result.verified ? result.report.comparison.unexplained() : 0;
+        r.depthErrors = result.verified ? result.report.comparison.depthErrors : 0;
+        r.maxOverTolerance = result.verified ? result.report.comparison.maxErrorOverTolerance : 0;
+        for (const Hypothesis& h : result.diagnosis)
+            if (h.consistent || h.consistentExceptEdges()) r.explainedBy.push_back(h.name), r.explanations.push_back(h.explanation);
+        r.file = output;
+        thisRun.records.push_back(r);
+    });
+    sink.finish();
+    if (output != "-" && !thisRun.records.empty()) {  // the shard's frames, as `dataset report` would say
+        thisRun.records.insert(thisRun.records.end(), previous.begin(), previous.end());
+        std::cout << datasetSummaryText(summarizeResults({thisRun}));
+    }
+    return allConsistent ? kExitConsistent : kExitInconsistent;
+}
+
+// A failing frame verified again from its record, for the HTML report's pictures.
+FramePictures picturesOf(const FrameRecord& r, const std::shared_ptr<SceneCheckers>& checkers)
+{
+    try {
+        DatasetVerifyOptions source;
+        source.source = r.source;
+        source.depthPattern = "{name}";  // a COLMAP model names no depth maps: the record's file is used
+        const Dataset dataset = openSource(source);
+        if (r.index >= dataset.frames.size() || dataset.frames[r.index].name != r.frame)
+            return {{}, {}, {}, "the dataset '" + r.source + "' no longer has frame '" + r.frame + "' at index " + std::to_string(r.index)};
+        DatasetFrame frame = dataset.frames[r.index];
+        frame.index = 0;
+        frame.depth = r.depth;
+        frame.quantity = r.quantity;
+        if (!r.channel.empty()) frame.channel = r.channel;
+        if (r.scale > 0) frame.scale = r.scale;
+        frame.offset = r.offset;
+        if (!r.miss.empty()) frame.miss = r.miss;
+        if (r.projection != "matrix") {  // the camera as it was used: near and far as recorded
+            frame.near = r.near;
+            if (std::isfinite(r.far)) frame.far = r.far;
+        }
+        DatasetRunOptions options;
+        options.scene = r.scene, options.convention = r.convention;
+        const DatasetRunner runner(Dataset{dataset.source, dataset.kind, {frame}}, options,
+                                   [](const std::string& path, const DepthMapReading& reading, int width, int height) {
+                                       return images().readDepthMap(path, reading, width, height);
+                                   },
+                                   checkers);
+        VerifiedMap kept;
+        const FrameResult again = runner.verify(0, &kept);
+        if (!again.error.empty()) return {{}, {}, {}, again.error};
+        return framePictures(kept);
+    } catch (const Error& e) {
+        return {{}, {}, {}, e.what()};
+    }
+}
+
+int runDatasetReport(const std::vector<std::string>& files, const std::string& html, const std::string& json)
+{
+    OutputFiles outputs;
+    for (const std::string& f : files) outputs.addInput(f);
+    if (!html.empty()) outputs.add(html, "--html");
+    if (!json.empty()) outputs.add(json, "--json");
+    std::vector<ResultsFile> results;
+    for (const std::string& f : files) results.push_back(readResults(f));
+    const DatasetSummary summary = summarizeResults(results);
+    if (!json.empty()) outputs.writeText(json, datasetSummaryJson(summary) + "\n");
+    if (!html.empty()) {
+        const auto checkers = std::make_shared<SceneCheckers>();
+        outputs.writeText(html, datasetReportHtml(summary, [&](const FrameRecord& r) { return picturesOf(r, checkers); }));
+    }
+    outputs.commit();
+    std::cout << datasetSummaryText(summary);
+    const bool all = summary.missing.empty() && summary.consistent == summary.frames;
+    return all ? kExitConsistent : kExitInconsistent;
+}
+
+int runDatasetImport(const DatasetVerifyOptions& o, const std::string& manifest)
+{
+    OutputFiles outputs;
+    outputs.addInput(o.source);
+    outputs.add(manifest, "-o");
+    const Dataset dataset = openSource(o);
+    if (dataset.kind == "manifest") throw Error("'" + o.source + "' is a manifest already");
+    std::string text;
+    std::size_t skipped = 0;
+    for (const DatasetFrame& frame : dataset.frames) {
+        if (!frame.camera) {
+            ++skipped;
+            continue;
+        }
+        text += manifestLine(frame, o.source + "#" + frame.name, manifest) + "\n";
+    }
+    outputs.writeText(manifest, text);
+    outputs.commit();
+    std::cout << "wrote " << dataset.frames.size() - skipped << " frames of " << dataset.kind << " '" << o.source << "' to "
+              << manifest << "\n";
+    return kExitConsistent;
+}
+
+struct SubmitOptions {
+    DatasetVerifyOptions verify;
+    std::string out;
+    int tasks = 0;
+    std::vector<std::string> sbatchArguments;
+    bool wait = false, dryRun = false;
+};
+
+int runDatasetSubmit(const SubmitOptions& o)
+{
+    // The source and options are checked here, once, before anything is submitted: a bad option
+    // fails now, not in every task.
+    {
+        DatasetRunOptions options = runOptions(o.verify);
+        options.parseShard("0/" + std::to_string(o.tasks));
+        const DatasetRunner check(openSource(o.verify), options, [](const std::string&, const DepthMapReading&, int, int) -> DepthMapFile {
+            throw Error("not read");
+        });
+    }
+    const std::vector<std::string> verifyArguments = verifyArgumentsOf(o.verify);
+    const std::string exe = executablePath();
+    const std::string dir = fs::absolute(o.out).lexically_normal().string();
+    const std::string cwd = fs::current_path().string();
+    OutputFiles outputs;
+    outputs.addFolder(dir, "--out");
+    outputs.add(dir + "/verify.sbatch", "--out");
+    outputs.add(dir + "/report.sbatch", "--out");
+    std::string header;
+    for (const std::string& a : o.sbatchArguments) header += "#SBATCH " + a + "\n";
+    std::string verify = "#!/bin/bash\n# zcheck dataset submit: shard $SLURM_ARRAY_TASK_ID of " + std::to_string(o.tasks) +
+                         "\n#SBATCH --job-name=zcheck-verify\n#SBATCH --array=0-" + std::to_string(o.tasks - 1) +
+                         "\n#SBATCH --chdir=" + cwd + "\n#SBATCH --output=" + dir + "/logs/verify-%a.out\n" + header +
+                         "set -uo pipefail\nexec " + shellQuoted(exe) + " dataset verify";
+    for (const std::string& a : verifyArguments) verify += " " + shellQuoted(a);
+    verify += " --shard \"$SLURM_ARRAY_TASK_ID/" + std::to_string(o.tasks) + "\" -o " + shellQuoted(dir) +
+              "/results-\"$SLURM_ARRAY_TASK_ID\".jsonl --resume\n";
+    const std::string report = "#!/bin/bash\n# zcheck dataset submit: the report after every shard\n"
+                               "#SBATCH --job-name=zcheck-report\n#SBATCH --chdir=" + cwd + "\n#SBATCH --output=" + dir +
+                               "/logs/report.out\n" + header + "set -uo pipefail\nresults=()\nfor i in $(seq 0 " +
+                               std::to_string(o.tasks - 1) + "); do\n  f=" + shellQuoted(dir) +
+                               "/results-$i.jsonl\n  [[ -s $f ]] && results+=(\"$f\")\ndone\n" + shellQuoted(exe) +
+                               " dataset report \"${results[@]}\" --json " + shellQuoted(dir + "/summary.json") + " --html " +
+                               shellQuoted(dir + "/report.html") + "\nstatus=$?\necho $status > " +
+                               shellQuoted(dir + "/report.status") + "\nexit $status\n";
+    outputs.writeText(dir + "/verify.sbatch", verify);
+    outputs.writeText(dir + "/report.sbatch", report);
+    outputs.commit();
+    fs::create_directories(dir + "/logs");
+    std::error_code ignored;
+    fs::remove(dir + "/report.status", ignored);
+    if (o.dryRun) {
+        std::cout << "wrote " << dir << "/verify.sbatch (" << o.tasks << " tasks) and " << dir << "/report.sbatch\n";
+        return kExitConsistent;
+    }
+    const std::string verifyJob = submitted({"sbatch", "--parsable", dir + "/verify.sbatch"});
+    const std::string reportJob = submitted({"sbatch", "--parsable", "--dependency=afterany:" + verifyJob, dir + "/report.sbatch"});
+    std::cout << "verify job " << verifyJob << " (" << o.tasks << " tasks), report job " << reportJob << "\nresults in " << dir
+              << "\n"
+              << std::flush;
+    if (!o.wait) return kExitConsistent;
+    // The report job is done when squeue no longer lists it.
+    while (true) {
+        int status = 0;
+        const std::string listed = runProgram({"squeue", "-h", "-j", reportJob, "-o", "%i"}, status);
+        if (WIFEXITED(status) && WEXITSTATUS(status) == 0 && listed.find_first_not_of(" \n") == std::string::npos) break;
+        std::this_thread::sleep_for(std::chrono::seconds(2));
+    }
+    std::ifstream statusFile(dir + "/report.status");
+    int reportStatus = -1;
+    if (!(statusFile >> reportStatus))
+        throw Error("the report job " + reportJob + " ended without a status: see " + dir + "/logs/report.out");
+    std::ifstream summary(dir + "/summary.json");
+    std::cout << summary.rdbuf();
+    return reportStatus == 0 ? kExitConsistent : reportStatus == 1 ? kExitInconsistent : kExitUsage;
+}
+
+}  // namespace
+
+Command addDatasetCommand(CLI::App& app)
+{
+    CLI::App* dataset = app.add_subcommand(
+        "dataset", "A dataset of depth maps as one job: verify every frame of a transforms.json, a COLMAP model or\n"
+                   "a manifest (sharded, resumable), report on results, import a source as a manifest, or submit\n"
+                   "the job to a Slurm cluster.");
+    dataset->require_subcommand(1);
+
+    auto verify = std::make_shared<DatasetVerifyOptions>();
+    CLI::App* verifyCommand = dataset->add_subcommand(
+        "verify", "Verify every frame (of a shard) against its scene; one JSON line per frame, appended as it finishes.\n"
+                  "Exit 0 when every frame is consistent, 1 when any is not (or could not be read), 2 for a bad\n"
+                  "source or option. Example:\n"
+                  "  zcheck dataset verify transforms.json --scene mesh.ply --quantity eye-z -o results.jsonl");
+    addDatasetVerifyOptions(verifyCommand, *verify);
+    verifyCommand->add_option("--shard", verify->shard, "I/N: frames I, I+N, I+2N, ... (N tasks cover the dataset once)");
+    verifyCommand->add_option("-o,--output", verify->output, "the results file (JSON Lines); '-' or none: standard output");
+    verifyCommand->add_flag("--resume", verify->resume,
+                            "complete the -o file: frames already in it are skipped, a torn last line is dropped");
+
+    struct ReportOptions {
+        std::vector<std::string> files;
+        std::string html, json;
+    };
+    auto report = std::make_shared<ReportOptions>();
+    CLI::App* reportCommand = dataset->add_subcommand(
+        "report", "Merge result files (of shards, resumed runs) and say what they hold: frames consistent,\n"
+                  "inconsistent, in error, missing or recorded twice, the mistakes found, the worst frames.");
+    reportCommand->add_option("results", report->files, "results files (JSON Lines)")->required()->check(kNonEmptyPath);
+    reportCommand->add_option("--html", report->html, "write a self-contained HTML report")->check(kNonEmptyPath);
+    reportCommand->add_option("--json", report->json, "write the summary as JSON")->check(kNonEmptyPath);
+
+    auto import = std::make_shared<DatasetVerifyOptions>();
+    auto manifest = std::make_shared<std::string>();
+    CLI::App* importCommand = dataset->add_subcommand(
+        "import", "Write the manifest (JSON Lines, one frame a line) a transforms.json or COLMAP model implies.");
+    importCommand->add_option("source", import->source, "a transforms.json or a COLMAP model folder")->required()->check(kNonEmptyPath);
+    importCommand->add_option("--depth", import->depthPattern, "COLMAP: the depth map pattern ({name}, {stem})");
+    importCommand->add_option("--camera-format", import->cameraFormat, "the source's format when its content should not decide");
+    importCommand->add_option("-o,--output", *manifest, "the manifest to write")->required()->check(kNonEmptyPath);
+
+    auto submit = std::make_shared<SubmitOptions>();
+    CLI::App* submitCommand = dataset->add_subcommand(
+        "submit", "Run `dataset verify` as a Slurm job array of --tasks shards, each resuming its own results file\n"
+                  "(DIR/results-I.jsonl), and a report job after them all (DIR/summary.json, DIR/report.html).\n"
+                  "Every node needs zcheck at the same path and the dataset on a shared file system. Example:\n"
+                  "  zcheck dataset submit transforms.json --scene mesh.ply --quantity eye-z --tasks 64 --out run1 --wait");
+    addDatasetVerifyOptions(submitCommand, submit->verify);
+    submitCommand->add_option("--tasks", submit->tasks, "the number of shards (array tasks), 1..100000")
+        ->required()
+        ->check(CLI::Range(1, 100000));
+    submitCommand->add_option("--out", submit->out, "the folder for the scripts, results, logs and report")
+        ->required()
+        ->check(kNonEmptyPath);
+    submitCommand->add_option("--sbatch-arg", submit->sbatchArguments,
+                              "an #SBATCH line for both jobs, e.g. --sbatch-arg=--partition=batch (repeatable)");
+    submitCommand->add_flag("--wait", submit->wait, "wait for the report job, print the summary and exit with its status");
+    submitCommand->add_flag("--dry-run", submit->dryRun, "only write the scripts");
+
+    return {dataset, [=] {
+                if (verifyCommand->parsed()) return runDatasetVerify(*verify);
+                if (reportCommand->parsed()) return runDatasetReport(report->files, report->html, report->json);
+                if (importCommand->parsed()) return runDatasetImport(*import, *manifest);
+                return runDatasetSubmit(*submit);
+            }};
+}
+
+}  // namespace zcheck::cli

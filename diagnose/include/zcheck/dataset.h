@@ -1,0 +1,102 @@
+#pragma once
+// A dataset verified as one job (library zcheck::diagnose): every frame of a transforms.json, a
+// COLMAP model or a manifest (dataset_source.h) against the ground truth of its scene.
+//
+//   zcheck::DatasetRunOptions options;
+//   options.scene = "mesh.ply", options.quantity = "eye-z";
+//   const zcheck::DatasetRunner runner(zcheck::openDataset("transforms.json", {}), options, readDepthMap);
+//   runner.run(runner.shardFrames(), [](zcheck::FrameResult result) { ... });   // as each frame finishes
+//
+// A scene is loaded and its BVH and raster set-up built once per runner (the run's scene up
+// front; a scene a manifest line names, on first use); frames run in parallel on TBB's threads,
+// each itself parallel inside. A frame that cannot be run — a missing or malformed depth map, a
+// camera the file refused, a camera that sees nothing — becomes a result with that one-line
+// error; the run goes on. Thread-safe: run() and verify() may be called from several threads.
+#include "zcheck/checker.h"
+#include "zcheck/dataset_source.h"
+#include "zcheck/image_io.h"
+#include "zcheck/verify_map.h"
+
+#include <cstddef>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace zcheck {
+
+struct DatasetRunOptions {
+    std::string scene = "builtin:default";  // every frame's, unless its manifest line names one
+    std::string quantity;                   // unless the line says; one of them is required
+    // How maps are read (a manifest line's own values win; these win over what a camera file
+    // implies, such as nerfstudio's millimetres).
+    std::optional<double> scale, offset;
+    std::string miss, channel;
+    std::optional<double> near, far;        // the clip planes of cameras whose file has none
+    std::string convention;                 // replaces every camera's convention ("" keeps it)
+    bool diagnose = false;                  // diagnose the inconsistent frames
+    std::size_t shard = 0, shards = 1;      // frames shard, shard + shards, ...
+
+    // "I/N" (0 ≤ I < N ≤ 100000) into shard and shards; throws Error naming the text.
+    void parseShard(const std::string& text);
+};
+
+// The result of one frame.
+struct FrameResult {
+    std::size_t index = 0, of = 0;     // the frame's index in the dataset, and the dataset's size
+    std::string frame, source, scene;  // names
+    std::string error;                 // the frame was not verified: why (one line)
+    DepthMapSource map;                // the depth map as read (file, quantity, channel, reading)
+    bool verified = false;             // report and diagnosis hold a verification
+    CheckReport report;                // the comparison, as `zcheck verify --json` reports it
+    bool diagnosed = false;
+    std::vector<Hypothesis> diagnosis;  // ranked (Checker::diagnose)
+    double seconds = 0;                // wall time of the frame: reading, verifying, diagnosing
+
+    bool consistent() const { return verified && report.comparison.consistent(); }
+};
+
+// Reads a depth map (image_io.h's readDepthMap, or the command line's plugin of it).
+using DepthMapReader = std::function<DepthMapFile(const std::string& path, const DepthMapReading& reading, int width,
+                                                  int height)>;
+
+// Scenes loaded and their checkers built once, by name, for any number of runners (thread-safe).
+class SceneCheckers {
+public:
+    const Checker& operator()(const std::string& scene);
+
+private:
+    std::mutex mutex_;
+    std::map<std::string, std::shared_ptr<const Checker>> checkers_;
+};
+
+class DatasetRunner {
+public:
+    // Loads the run's scene and builds its checker (or finds it in `checkers`, shared with other
+    // runners): an Error here (a bad mesh, a bad option) is the run's, not a frame's.
+    DatasetRunner(Dataset dataset, DatasetRunOptions options, DepthMapReader readDepthMap,
+                  std::shared_ptr<SceneCheckers> checkers = nullptr);
+    ~DatasetRunner();
+
+    const Dataset& dataset() const { return dataset_; }
+    const DatasetRunOptions& options() const { return options_; }
+    // The indices of the frames of this run's shard, ascending.
+    std::vector<std::size_t> shardFrames() const;
+
+    // One frame. `keep` (optional) receives the verification's per-pixel results, for pictures.
+    FrameResult verify(std::size_t index, VerifiedMap* keep = nullptr) const;
+    // The frames in parallel; `done` is called once per frame as it finishes, never twice at
+    // once. An exception from `done` stops the run and is rethrown.
+    void run(const std::vector<std::size_t>& frames, const std::function<void(FrameResult&&)>& done) const;
+
+private:
+    Dataset dataset_;
+    DatasetRunOptions options_;
+    DepthMapReader readDepthMap_;
+    std::shared_ptr<SceneCheckers> checkers_;
+};
+
+}  // namespace zcheck

@@ -1,0 +1,34 @@
+#pragma once
+// Verifying a map and diagnosing it: the one entry point the command line, Python and datasets
+// call (library zcheck::diagnose).
+//
+//   const zcheck::VerifiedMap verified = zcheck::verifyMap(checker, camera, map, /*diagnose=*/true);
+//   if (!verified.run.comparison.report.consistent())
+//       for (const zcheck::Hypothesis& h : verified.diagnosis) ...   // ranked, consistent ones first
+//
+// Thread-safe as Checker is: call it for many maps at once.
+#include "zcheck/checker.h"
+#include "zcheck/depth_map_reading.h"
+
+#include <string>
+#include <vector>
+
+namespace zcheck {
+
+// Where a verified map came from, for its report.
+struct DepthMapSource {
+    std::string file, quantity, channel;  // channel: the one read
+    DepthMapReading reading;              // as asked (scale 0: not given)
+};
+
+struct VerifiedMap {
+    VerifyResult run;
+    bool diagnosed = false;             // the map was inconsistent and a diagnosis was asked for
+    std::vector<Hypothesis> diagnosis;  // Checker::diagnose's ranking
+};
+
+// Checker::verify; then a comparison with nothing in it is refused (Error "nothing to compare",
+// requireSomethingCompared); then, when `diagnose` and the map is inconsistent, Checker::diagnose.
+VerifiedMap verifyMap(const Checker& checker, const Camera& camera, const DepthMap& map, bool diagnose);
+
+}  // namespace zcheck

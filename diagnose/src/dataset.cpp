@@ -1,0 +1,137 @@
+#include "zcheck/dataset.h"
+
+#include "zcheck/camera_sources.h"
+#include "zcheck/error.h"
+#include "zcheck/export.h"
+#include "zcheck/mesh_loader.h"
+
+#include <tbb/parallel_for_each.h>
+
+#include <atomic>
+#include <charconv>
+#include <chrono>
+#include <exception>
+
+namespace zcheck {
+
+void DatasetRunOptions::parseShard(const std::string& text)
+{
+    const std::size_t slash = text.find('/');
+    std::size_t i = 0, n = 0;
+    bool ok = slash != std::string::npos;
+    if (ok) {
+        const auto [endI, errorI] = std::from_chars(text.data(), text.data() + slash, i);
+        const auto [endN, errorN] = std::from_chars(text.data() + slash + 1, text.data() + text.size(), n);
+        ok = errorI == std::errc() && endI == text.data() + slash && errorN == std::errc() &&
+             endN == text.data() + text.size() && slash > 0 && n >= 1 && n <= 100000 && i < n;
+    }
+    if (!ok) throw Error("--shard '" + text + "' must be I/N with 0 <= I < N <= 100000 (frames I, I+N, I+2N, ...)");
+    shard = i, shards = n;
+}
+
+const Checker& SceneCheckers::operator()(const std::string& scene)
+{
+    const std::lock_guard<std::mutex> lock(mutex_);
+    auto& checker = checkers_[scene];
+    if (!checker) checker = std::make_shared<const Checker>(loadScene(scene));
+    return *checker;
+}
+
+DatasetRunner::DatasetRunner(Dataset dataset, DatasetRunOptions options, DepthMapReader readDepthMap,
+                             std::shared_ptr<SceneCheckers> checkers)
+    : dataset_(std::move(dataset)), options_(std::move(options)), readDepthMap_(std::move(readDepthMap)),
+      checkers_(checkers ? std::move(checkers) : std::make_shared<SceneCheckers>())
+{
+    if (options_.shards < 1 || options_.shard >= options_.shards) throw Error("the shard must be I/N with 0 <= I < N");
+    if (!options_.quantity.empty()) depthQuantityFromName(options_.quantity);  // a bad --quantity is the run's error
+    if (!options_.miss.empty()) MissRule::parse(options_.miss);
+    if (!options_.convention.empty()) Convention::preset(options_.convention);
+    (*checkers_)(options_.scene);
+}
+
+DatasetRunner::~DatasetRunner() = default;
+
+std::vector<std::size_t> DatasetRunner::shardFrames() const
+{
+    std::vector<std::size_t> out;
+    for (std::size_t i = options_.shard; i < dataset_.frames.size(); i += options_.shards) out.push_back(i);
+    return out;
+}
+
+FrameResult DatasetRunner::verify(std::size_t index, VerifiedMap* keep) const
+{
+    const auto start = std::chrono::steady_clock::now();
+    const DatasetFrame& frame = dataset_.frames.at(index);
+    FrameResult result;
+    result.index = index, result.of = dataset_.frames.size();
+    result.frame = frame.name, result.source = dataset_.source;
+    result.scene = frame.scene.value_or(options_.scene);
+    result.map.file = frame.depth;
+    try {
+        if (!frame.error.empty()) throw Error(frame.error);
+        const std::string quantityName = frame.quantity.value_or(options_.quantity);
+        if (quantityName.empty())
+            throw Error("frame '" + frame.name + "' has no quantity: give --quantity (or \"quantity\" in the manifest)");
+        const DepthQuantity quantity = depthQuantityFromName(quantityName);
+        result.map.quantity = quantityName;
+        DepthMapReading& reading = result.map.reading;
+        reading.channel = frame.channel.value_or(options_.channel);
+        reading.quantityChannel = channelNameOf(exportQuantitiesFromList(quantityName).front());
+        reading.scale = frame.scale ? *frame.scale : options_.scale ? *options_.scale : frame.impliedScale.value_or(0.0);
+        reading.offset = frame.offset.value_or(options_.offset.value_or(0.0));
+        const std::string miss = frame.miss.value_or(options_.miss);
+        if (!miss.empty()) reading.miss = MissRule::parse(miss);
+
+        const Checker& checker = (*checkers_)(result.scene);
+        const ImportedCamera& imported = *frame.camera;
+        // A camera file without an image size takes the map's; otherwise the map must fit the camera.
+        std::optional<DepthMapFile> file;
+        CameraCompletion given{frame.near ? frame.near : options_.near, frame.far ? frame.far : options_.far, std::nullopt,
+                               std::nullopt};
+        if (!imported.hasImageSize) {
+            file = readDepthMap_(frame.depth, reading, 0, 0);
+            given.width = file->width, given.height = file->height;
+        }
+        CameraSpec spec = completeCamera(imported, &checker.scene(), given);
+        if (!options_.convention.empty()) spec.convention = Convention::preset(options_.convention);
+        if (!frame.scale && !options_.scale && frame.impliedScale) spec.notes.push_back(frame.impliedScaleNote);
+        const Camera camera(spec);
+        if (!file) file = readDepthMap_(frame.depth, reading, camera.width(), camera.height());
+        result.map.channel = file->channel;
+        const DepthMap map{file->width, file->height, quantity, std::move(file->value), file->valueQuantum};
+        VerifiedMap verified = verifyMap(checker, camera, map, options_.diagnose);
+        result.verified = true;
+        result.report = verified.run.report;
+        result.diagnosed = verified.diagnosed;
+        result.diagnosis = verified.diagnosis;
+        if (keep) *keep = std::move(verified);
+    } catch (const Error& e) {
+        result.error = e.what();
+    }
+    result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return result;
+}
+
+void DatasetRunner::run(const std::vector<std::size_t>& frames, const std::function<void(FrameResult&&)>& done) const
+{
+    std::mutex doneMutex;
+    std::atomic<bool> stop{false};
+    std::exception_ptr failure;
+    // Each frame is itself parallel inside (the trace, the raster, the comparison); running
+    // frames side by side too keeps the threads busy while one frame reads its file.
+    tbb::parallel_for_each(frames.begin(), frames.end(), [&](std::size_t index) {
+        if (stop) return;
+        FrameResult result = verify(index);
+        const std::lock_guard<std::mutex> lock(doneMutex);
+        if (stop) return;
+        try {
+            done(std::move(result));
+        } catch (...) {
+            failure = std::current_exception();
+            stop = true;
+        }
+    });
+    if (failure) std::rethrow_exception(failure);
+}
+
+}  // namespace zcheck

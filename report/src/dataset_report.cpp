@@ -1,0 +1,387 @@
+#include "zcheck/dataset_report.h"
+
+#include "camera_json.h"
+#include "report_json.h"
+#include "zcheck/error.h"
+#include "zcheck/input_file.h"
+#include "zcheck/png_file.h"
+#include "zcheck/report_images.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <set>
+#include <sstream>
+
+namespace zcheck {
+
+namespace {
+
+using nlohmann::json;
+
+bool explains(const Hypothesis& h) { return h.consistent || h.consistentExceptEdges(); }
+
+}  // namespace
+
+std::string frameRecordJson(const FrameResult& r)
+{
+    json record = {{"frame", r.frame}, {"index", r.index}, {"of", r.of}, {"source", r.source}, {"scene", r.scene},
+                   {"consistent", r.consistent()}, {"error", r.error.empty() ? json(nullptr) : json(r.error)},
+                   {"seconds", r.seconds}, {"depth_map", reportjson::depthMapJson(r.map)}};
+    if (r.verified) {
+        const ComparisonReport& c = r.report.comparison;
+        const CameraSpec& camera = r.report.camera;
+        record["camera"] = {{"convention", camera.convention.name}, {"type", toString(camera.projection.type)},
+                            {"width", camera.width}, {"height", camera.height}, {"near", camera.projection.near},
+                            {"far", std::isinf(camera.projection.far) ? json("inf") : json(camera.projection.far)}};
+        record["pixels"] = reportjson::pixelsJson(c);
+        record["depth_error"] = reportjson::depthErrorJson(c);
+        record["unexplained"] = reportjson::unexplainedJson(c, false);
+        record["warnings"] = r.report.warnings;
+    }
+    if (r.diagnosed) {
+        json list = json::array();
+        for (const Hypothesis& h : r.diagnosis)
+            if (explains(h)) list.push_back(reportjson::hypothesisJson(h));
+        record["diagnosis"] = list;
+        if (list.empty() && !r.diagnosis.empty()) {
+            const Hypothesis& best = r.diagnosis.front();
+            record["closest"] = {{"hypothesis", best.name}, {"variant", best.variant}, {"unexplained", best.unexplained}};
+        }
+    }
+    return record.dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
+namespace {
+
+FrameRecord recordFrom(const json& j, const std::string& where)
+{
+    auto fail = [&](const std::string& why) -> FrameRecord { throw Error(where + ": " + why); };
+    if (!j.is_object()) return fail("a result is a JSON object");
+    auto string = [&](const char* key) {
+        if (!j.contains(key) || !j[key].is_string()) fail(std::string("'") + key + "' must be a string");
+        return j[key].get<std::string>();
+    };
+    auto count = [&](const char* key) {
+        if (!j.contains(key) || !j[key].is_number_unsigned()) fail(std::string("'") + key + "' must be a whole number");
+        return std::size_t(j[key].get<std::uint64_t>());
+    };
+    FrameRecord r;
+    r.frame = string("frame");
+    r.source = string("source");
+    r.scene = string("scene");
+    r.index = count("index");
+    r.of = count("of");
+    if (r.index >= r.of) fail("'index' " + std::to_string(r.index) + " is not below 'of' " + std::to_string(r.of));
+    if (!j.contains("consistent") || !j["consistent"].is_boolean()) fail("'consistent' must be true or false");
+    r.consistent = j["consistent"].get<bool>();
+    if (j.contains("error") && j["error"].is_string()) r.error = j["error"].get<std::string>();
+    if (j.contains("seconds") && j["seconds"].is_number()) r.seconds = j["seconds"].get<double>();
+    if (j.contains("depth_map") && j["depth_map"].is_object()) {
+        const json& m = j["depth_map"];
+        auto text = [&](const char* key) { return m.contains(key) && m[key].is_string() ? m[key].get<std::string>() : std::string(); };
+        r.depth = text("file"), r.quantity = text("quantity"), r.channel = text("channel"), r.miss = text("miss");
+        if (m.contains("scale") && m["scale"].is_number()) r.scale = m["scale"].get<double>();
+        if (m.contains("offset") && m["offset"].is_number()) r.offset = m["offset"].get<double>();
+    }
+    if (j.contains("camera") && j["camera"].is_object()) {
+        const json& c = j["camera"];
+        if (c.contains("convention") && c["convention"].is_string()) r.convention = c["convention"].get<std::string>();
+        if (c.contains("type") && c["type"].is_string()) r.projection = c["type"].get<std::string>();
+        if (c.contains("near") && c["near"].is_number()) r.near = c["near"].get<double>();
+        if (c.contains("far") && c["far"].is_number()) r.far = c["far"].get<double>();
+        if (c.contains("far") && c["far"] == "inf") r.far = INFINITY;
+    }
+    auto number = [](const json& object, const char* key) {
+        return object.is_object() && object.contains(key) && object[key].is_number() ? object[key].get<double>() : 0.0;
+    };
+    if (j.contains("pixels")) {
+        const json& p = j["pixels"];
+        r.depthErrors = std::int64_t(number(p, "depth_errors"));
+        r.compared = std::int64_t(number(p, "both_hit") + number(p, "ray_only") + number(p, "raster_only"));
+    }
+    if (j.contains("depth_error")) {
+        const json& e = j["depth_error"];
+        r.maxOverTolerance = number(e, "max_over_tolerance");
+        r.maxRelativeEyeZ = number(e, "max_relative_eye_z");
+        r.p99RelativeEyeZ = number(e, "p99_relative_eye_z");
+    }
+    if (j.contains("unexplained")) r.unexplained = std::int64_t(number(j["unexplained"], "count"));
+    if (j.contains("diagnosis") && j["diagnosis"].is_array())
+        for (const json& h : j["diagnosis"])
+            if (h.is_object() && h.contains("hypothesis") && h["hypothesis"].is_string()) {
+                r.explainedBy.push_back(h["hypothesis"].get<std::string>());
+                r.explanations.push_back(h.contains("explanation") && h["explanation"].is_string() ? h["explanation"].get<std::string>() : "");
+            }
+    if (j.contains("closest") && j["closest"].is_object() && j["closest"].contains("hypothesis") &&
+        j["closest"]["hypothesis"].is_string())
+        r.closest = j["closest"]["hypothesis"].get<std::string>();
+    return r;
+}
+
+}  // namespace
+
+ResultsFile readResults(const std::string& path)
+{
+    ResultsFile out;
+    out.path = path;
+    const std::string text = readInputFile(path, kCameraSetInput);
+    std::size_t start = 0, line = 0;
+    while (start < text.size()) {
+        const std::size_t end = text.find('\n', start);
+        ++line;
+        if (end == std::string::npos) {  // a last line cut off by a killed writer
+            out.torn = true;
+            break;
+        }
+        const std::string content = text.substr(start, end - start);
+        if (content.find_first_not_of(" \t\r") != std::string::npos) {
+            const std::string where = "results file '" + path + "' line " + std::to_string(line);
+            FrameRecord record = recordFrom(parseJsonStrictly(content, where), where);
+            record.file = path, record.line = line;
+            out.records.push_back(std::move(record));
+        }
+        start = end + 1;
+        out.completeBytes = start;
+    }
+    return out;
+}
+
+DatasetSummary summarizeResults(const std::vector<ResultsFile>& files)
+{
+    DatasetSummary s;
+    std::map<std::size_t, const FrameRecord*> first;
+    std::map<std::size_t, std::vector<const FrameRecord*>> seen;
+    for (const ResultsFile& file : files)
+        for (const FrameRecord& r : file.records) {
+            if (s.frames == 0) s.source = r.source, s.frames = r.of;
+            if (r.of != s.frames || r.source != s.source)
+                throw Error("results file '" + r.file + "' line " + std::to_string(r.line) + " is of dataset '" + r.source +
+                            "' (" + std::to_string(r.of) + " frames), not '" + s.source + "' (" + std::to_string(s.frames) +
+                            " frames): results of different datasets do not merge");
+            seen[r.index].push_back(&r);
+            first.emplace(r.index, &r);
+        }
+    if (first.empty()) throw Error("no results to report: the files hold no complete record");
+    for (const auto& [index, records] : seen)
+        if (records.size() > 1) {
+            std::string where;
+            for (const FrameRecord* r : records) where += (where.empty() ? "" : ", ") + r->file + " line " + std::to_string(r->line);
+            s.duplicates.push_back("frame '" + records[0]->frame + "' (index " + std::to_string(index) + "): " + where);
+        }
+    for (std::size_t i = 0; i < s.frames; ++i)
+        if (!first.count(i)) s.missing.push_back(i);
+    std::map<std::string, std::size_t> explanationCount;
+    std::map<std::string, std::string> explanationOf;
+    for (const auto& [index, r] : first) {
+        s.all.push_back(*r);
+        s.seconds += r->seconds;
+        if (!r->error.empty()) ++s.errors;
+        else if (r->consistent) ++s.consistent;
+        else ++s.inconsistent;
+        if (r->error.empty() && !r->consistent && !r->explainedBy.empty()) {
+            ++s.byMistake[r->explainedBy.front()];
+            explanationOf.emplace(r->explainedBy.front(), r->explanations.front());
+        }
+    }
+    s.recorded = first.size();
+    // The dataset's verdict, once, when most frames fail the same way.
+    for (const auto& [name, count] : s.byMistake)
+        if (2 * count > s.recorded) {
+            s.verdict = std::to_string(count) + " of " + std::to_string(s.recorded) + " frames " +
+                        (explanationOf[name].empty() ? "are explained by " + name : explanationOf[name]) + " (" + name + ")";
+        }
+    std::vector<FrameRecord> failing;
+    for (const FrameRecord& r : s.all)
+        if (!r.consistent) failing.push_back(r);
+    std::stable_sort(failing.begin(), failing.end(), [](const FrameRecord& a, const FrameRecord& b) {
+        if (a.error.empty() != b.error.empty()) return b.error.empty();  // errors first: they were not even verified
+        if (a.unexplained + a.depthErrors != b.unexplained + b.depthErrors)
+            return a.unexplained + a.depthErrors > b.unexplained + b.depthErrors;
+        return a.maxOverTolerance > b.maxOverTolerance;
+    });
+    if (failing.size() > 12) failing.resize(12);
+    s.worst = failing;
+    return s;
+}
+
+std::string datasetSummaryText(const DatasetSummary& s)
+{
+    std::ostringstream out;
+    char line[512];
+    out << "dataset    " << s.source << "  (" << s.frames << " frames)\n";
+    std::snprintf(line, sizeof line, "frames     %zu recorded: %zu consistent, %zu inconsistent, %zu errors; %zu missing\n",
+                  s.recorded, s.consistent, s.inconsistent, s.errors, s.missing.size());
+    out << line;
+    if (!s.missing.empty()) {
+        out << "missing    indices";
+        for (std::size_t k = 0; k < s.missing.size() && k < 20; ++k) out << " " << s.missing[k];
+        out << (s.missing.size() > 20 ? " ..." : "") << "\n";
+    }
+    for (std::size_t k = 0; k < s.duplicates.size() && k < 10; ++k) out << "duplicate  " << s.duplicates[k] << "\n";
+    if (s.duplicates.size() > 10) out << "duplicate  ... (" << s.duplicates.size() << " in all)\n";
+    for (const auto& [name, count] : s.byMistake) {
+        std::snprintf(line, sizeof line, "mistake    %-28s %zu frames\n", name.c_str(), count);
+        out << line;
+    }
+    for (const FrameRecord& r : s.worst) {
+        if (!r.error.empty()) {
+            out << "error      " << r.frame << ": " << r.error << "\n";
+        } else {
+            std::snprintf(line, sizeof line, "failed     %s: %lld unexplained, %lld depth errors%s%s\n", r.frame.c_str(),
+                          static_cast<long long>(r.unexplained), static_cast<long long>(r.depthErrors),
+                          r.explainedBy.empty() ? "" : "; consistent if ",
+                          r.explainedBy.empty() ? "" : r.explainedBy.front().c_str());
+            out << line;
+        }
+    }
+    if (!s.verdict.empty()) out << "diagnosis  " << s.verdict << "\n";
+    const bool all = s.missing.empty() && s.consistent == s.frames;
+    out << "verdict    " << (all ? "CONSISTENT (every frame)" : s.missing.empty() ? "INCONSISTENT" : "INCOMPLETE") << "\n";
+    return out.str();
+}
+
+std::string datasetSummaryJson(const DatasetSummary& s)
+{
+    json worst = json::array();
+    for (const FrameRecord& r : s.worst)
+        worst.push_back({{"frame", r.frame}, {"index", r.index}, {"error", r.error.empty() ? json(nullptr) : json(r.error)},
+                         {"unexplained", r.unexplained}, {"depth_errors", r.depthErrors},
+                         {"consistent_if", r.explainedBy.empty() ? json(nullptr) : json(r.explainedBy.front())}});
+    json byMistake = json::object();
+    for (const auto& [name, count] : s.byMistake) byMistake[name] = count;
+    return prettyJson({{"source", s.source},
+                       {"frames", s.frames},
+                       {"recorded", s.recorded},
+                       {"consistent", s.consistent},
+                       {"inconsistent", s.inconsistent},
+                       {"errors", s.errors},
+                       {"missing", s.missing},
+                       {"duplicates", s.duplicates},
+                       {"by_mistake", byMistake},
+                       {"verdict", s.verdict.empty() ? json(nullptr) : json(s.verdict)},
+                       {"worst", worst}});
+}
+
+FramePictures framePictures(const VerifiedMap& verified)
+{
+    FramePictures out;
+    const Comparison& c = verified.run.comparison;
+    const int W = c.report.width, H = c.report.height;
+    QuantityImage depth;
+    depth.quantity = ExportQuantity::Window, depth.width = W, depth.height = H, depth.channels = {"window"};
+    depth.value.assign(verified.run.map.windowDepth.value.begin(), verified.run.map.windowDepth.value.end());
+    depth.missValue = NAN;
+    for (double& v : depth.value)
+        if (!std::isfinite(v)) v = NAN;
+    out.depth = pngDataUri(W, H, previewRgb(depth));
+    out.heatmap = pngDataUri(W, H, errorHeatmapRgb(c));
+    out.classes = pngDataUri(W, H, pixelClassRgb(c));
+    return out;
+}
+
+namespace {
+
+std::string escaped(const std::string& text)
+{
+    std::string out;
+    for (char c : text) out += c == '<' ? "&lt;" : c == '>' ? "&gt;" : c == '&' ? "&amp;" : c == '"' ? "&quot;" : std::string(1, c);
+    return out;
+}
+
+// Frames by their p99 relative eye-z error, in decades from 1e-9 to 1 (and beyond), as SVG bars.
+std::string histogramSvg(const std::vector<FrameRecord>& records)
+{
+    constexpr int kBins = 11;  // ≤1e-9, (1e-9, 1e-8], ..., (0.1, 1], >1
+    int counts[kBins] = {};
+    int unverified = 0;
+    for (const FrameRecord& r : records) {
+        if (!r.error.empty()) {
+            ++unverified;
+            continue;
+        }
+        const double e = r.p99RelativeEyeZ;
+        const int bin = e <= 1e-9 ? 0 : e > 1 ? kBins - 1 : std::min(kBins - 2, int(std::ceil(std::log10(e))) + 9);
+        ++counts[bin];
+    }
+    const int most = std::max(1, *std::max_element(counts, counts + kBins));
+    std::ostringstream svg;
+    const int barWidth = 56, height = 160;
+    svg << "<svg xmlns='http://www.w3.org/2000/svg' width='" << kBins * barWidth + 20 << "' height='" << height + 50 << "'>";
+    for (int b = 0; b < kBins; ++b) {
+        const int h = counts[b] * height / most;
+        svg << "<rect x='" << 10 + b * barWidth << "' y='" << 10 + height - h << "' width='" << barWidth - 6 << "' height='" << h
+            << "' fill='" << (b >= 6 ? "#c0392b" : "#2e86c1") << "'><title>" << counts[b] << " frames</title></rect>";
+        svg << "<text x='" << 10 + b * barWidth + (barWidth - 6) / 2 << "' y='" << 8 + height - h << "' font-size='11' text-anchor='middle'>"
+            << counts[b] << "</text>";
+        const std::string label = b == 0 ? "≤1e-9" : b == kBins - 1 ? ">1" : "1e" + std::to_string(b - 9);
+        svg << "<text x='" << 10 + b * barWidth + (barWidth - 6) / 2 << "' y='" << height + 26
+            << "' font-size='11' text-anchor='middle'>" << label << "</text>";
+    }
+    svg << "<text x='10' y='" << height + 45 << "' font-size='11'>p99 relative eye-z error per frame (decades)"
+        << (unverified ? "; " + std::to_string(unverified) + " frames not verified" : std::string()) << "</text></svg>";
+    return svg.str();
+}
+
+}  // namespace
+
+std::string datasetReportHtml(const DatasetSummary& s, const FramePictureMaker& pictures)
+{
+    std::ostringstream html;
+    html << "<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>zcheck dataset report: " << escaped(s.source)
+         << "</title><style>body{font-family:sans-serif;margin:2em;max-width:1200px}table{border-collapse:collapse}"
+            "td,th{padding:3px 10px;border-bottom:1px solid #ddd;text-align:left}.bad{color:#c0392b}.good{color:#1e8449}"
+            "img{image-rendering:pixelated;max-width:360px;margin-right:8px;border:1px solid #ccc}"
+            "figure{display:inline-block;margin:0 8px 8px 0}figcaption{font-size:12px;color:#555}</style></head><body>\n";
+    const bool all = s.missing.empty() && s.consistent == s.frames;
+    html << "<h1>zcheck dataset report</h1>\n<p>" << escaped(s.source) << ": " << s.frames << " frames</p>\n";
+    html << "<h2 class='" << (all ? "good'>CONSISTENT: every frame" : s.missing.empty() ? "bad'>INCONSISTENT" : "bad'>INCOMPLETE")
+         << "</h2>\n";
+    if (!s.verdict.empty()) html << "<p><b>" << escaped(s.verdict) << "</b></p>\n";
+    html << "<table><tr><th>frames recorded</th><td>" << s.recorded << "</td></tr><tr><th>consistent</th><td>" << s.consistent
+         << "</td></tr><tr><th>inconsistent</th><td>" << s.inconsistent << "</td></tr><tr><th>not verified (errors)</th><td>"
+         << s.errors << "</td></tr><tr><th>missing</th><td>" << s.missing.size() << "</td></tr><tr><th>recorded twice</th><td>"
+         << s.duplicates.size() << "</td></tr></table>\n";
+    if (!s.byMistake.empty()) {
+        html << "<h3>Mistakes found</h3><table><tr><th>consistent if</th><th>frames</th></tr>";
+        for (const auto& [name, count] : s.byMistake) html << "<tr><td>" << escaped(name) << "</td><td>" << count << "</td></tr>";
+        html << "</table>\n";
+    }
+    html << "<h3>Error per frame</h3>\n" << histogramSvg(s.all) << "\n";
+    if (!s.missing.empty()) {
+        html << "<h3>Missing frames (indices)</h3><p>";
+        for (std::size_t i : s.missing) html << i << " ";
+        html << "</p>\n";
+    }
+    if (!s.duplicates.empty()) {
+        html << "<h3>Recorded twice</h3><ul>";
+        for (const std::string& d : s.duplicates) html << "<li>" << escaped(d) << "</li>";
+        html << "</ul>\n";
+    }
+    if (!s.worst.empty()) html << "<h3>The worst frames</h3>\n";
+    for (const FrameRecord& r : s.worst) {
+        html << "<h4>" << escaped(r.frame) << " <small>(index " << r.index << ")</small></h4>\n";
+        if (!r.error.empty()) {
+            html << "<p class='bad'>not verified: " << escaped(r.error) << "</p>\n";
+            continue;
+        }
+        html << "<p>" << r.unexplained << " unexplained pixels, " << r.depthErrors << " depth errors; p99 relative eye-z error "
+             << r.p99RelativeEyeZ;
+        if (!r.explainedBy.empty()) html << "; <b>consistent if " << escaped(r.explanations.front()) << "</b>";
+        else if (!r.closest.empty()) html << "; no hypothesis explains it (closest: " << escaped(r.closest) << ")";
+        html << "</p>\n";
+        const FramePictures p = pictures ? pictures(r) : FramePictures{{}, {}, {}, "no pictures asked for"};
+        if (!p.unavailable.empty()) {
+            html << "<p><i>pictures unavailable: " << escaped(p.unavailable) << "</i></p>\n";
+            continue;
+        }
+        html << "<figure><img src='" << p.depth << "'><figcaption>the map (viridis: near dark, far yellow)</figcaption></figure>"
+             << "<figure><img src='" << p.heatmap << "'><figcaption>error / tolerance (yellow = tolerance, red beyond, magenta "
+             << "unexplained coverage)</figcaption></figure><figure><img src='" << p.classes
+             << "'><figcaption>coverage classes</figcaption></figure>\n";
+    }
+    html << "</body></html>\n";
+    return html.str();
+}
+
+}  // namespace zcheck
