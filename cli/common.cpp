@@ -109,15 +109,20 @@ const std::string kCameraFileHelp =
 
 std::string cameraInputPath(const CameraOptions& options) { return splitCameraReference(options.reference).first; }
 
-bool cameraTakesMapSize(const CameraOptions& options)
+CameraForMap cameraAndMapFor(const Scene* scene, const SceneAndCamera& options, DepthQuantity quantity,
+                             const std::function<DepthMapFile(int width, int height)>& read)
 {
-    return !importCamera(options.reference, formatOption(options)).hasImageSize;
-}
-
-bool cameraTakesMapSize(const Scene& scene, const SceneAndCamera& options)
-{
-    if (options.camera.reference.empty()) return !scene.cameras.empty() && !scene.cameras.front().hasImageSize;
-    return cameraTakesMapSize(options.camera);
+    const CameraOptions& o = options.camera;
+    if (o.reference.empty() && scene && scene->cameras.empty()) {  // the scene's own framing camera
+        CameraForMap out;
+        out.spec = cameraSpecFor(*scene, options);
+        out.map = read(out.spec.width, out.spec.height);
+        return out;
+    }
+    const ImportedCamera camera = o.reference.empty() ? scene->cameras.front() : importCamera(o.reference, formatOption(o));
+    CameraForMap out = completeCameraForMap(camera, scene, completionOf(o, std::nullopt), quantity, read);
+    out.spec = withConvention(out.spec, o.convention);
+    return out;
 }
 
 CameraSpec cameraSpecFor(const Scene& scene, const SceneAndCamera& options, std::optional<std::pair<int, int>> size)

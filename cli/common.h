@@ -1,6 +1,7 @@
 #pragma once
 // What every subcommand shares: exit statuses, option validators, the scene-and-camera
 // options, the thread limit, and the check/verify --out folder.
+#include "zcheck/camera_sources.h"
 #include "zcheck/checker.h"
 #include "zcheck/depth_map_reading.h"
 
@@ -68,14 +69,15 @@ void addSceneAndCameraOptions(CLI::App* command, SceneAndCamera& options);
 // --height — or, for a file without one, a default with a note), else the scene's own camera
 // (a glTF's first camera, or one framing the mesh); then --convention.
 CameraSpec cameraSpecFor(const Scene& scene, const SceneAndCamera& options, std::optional<std::pair<int, int>> size = {});
-// Whether the camera --camera names (or the scene's glTF camera) leaves its image size to the
-// depth map: verify reads the map's size first for it.
-bool cameraTakesMapSize(const Scene& scene, const SceneAndCamera& options);
+// The camera of a command that judges a depth map (verify, unproject), and the map, made together
+// (camera_sources.h's completeCameraForMap): a camera file without an image size takes the map's,
+// and near and far cover the map's depths. `scene` nullptr: a command without a scene.
+CameraForMap cameraAndMapFor(const Scene* scene, const SceneAndCamera& options, DepthQuantity quantity,
+                             const std::function<DepthMapFile(int width, int height)>& read);
 // The --camera help of commands without a scene.
 extern const std::string kCameraFileHelp;
 // The file part of --camera (an input a run must not overwrite).
 std::string cameraInputPath(const CameraOptions& options);
-bool cameraTakesMapSize(const CameraOptions& options);
 // A camera without a scene (matrices, precision, unproject): near and far must be in the file
 // or given; then --convention.
 CameraSpec cameraSpecFrom(const CameraOptions& options, std::optional<std::pair<int, int>> size = {});

@@ -44,14 +44,22 @@ int runUnprojectCommand(const UnprojectOptions& o)
 {
     if (o.space != "eye" && o.space != "world") throw Error("--space must be eye or world, got '" + o.space + "'");
     const DepthQuantity quantity = depthQuantityFromName(o.quantity);
-    // A camera file without an image size (instant-ngp, glTF) takes the depth map's.
-    std::optional<std::pair<int, int>> mapSize;
+    // With a map: the camera and the map made together (a camera file without an image size takes
+    // the map's; near and far, when the file has none, cover the map's depths).
     std::optional<DepthMapFile> sized;
-    if (!o.depthMap.empty() && cameraTakesMapSize(o.camera)) {
-        sized = images().readDepthMap(o.depthMap, o.reading.reading(o.quantity), 0, 0);
-        mapSize = std::pair{sized->width, sized->height};
+    CameraSpec spec;
+    if (!o.depthMap.empty()) {
+        SceneAndCamera input;
+        input.camera = o.camera;
+        CameraForMap made = cameraAndMapFor(nullptr, input, quantity, [&](int width, int height) {
+            return images().readDepthMap(o.depthMap, o.reading.reading(o.quantity), width, height);
+        });
+        spec = made.spec;
+        sized = std::move(made.map);
+    } else {
+        spec = cameraSpecFrom(o.camera);
     }
-    const Camera camera(cameraSpecFrom(o.camera, mapSize));
+    const Camera camera(spec);
     auto toWorld = [&](const glm::dvec3& pEye) { return glm::dvec3(camera.worldFromEye * glm::dvec4(pEye, 1.0)); };
 
     if (!o.pixel.empty() && (!o.depthMap.empty() || !o.output.empty()))

@@ -33,15 +33,11 @@ int runVerifyCommand(const VerifyOptions& o)
     if (!o.outDir.empty()) folder.plan(outputs);
     Scene scene = loadScene(o.input.scene);
     const DepthMapReading reading = o.reading.reading(o.quantity);
-    // A camera file without an image size (instant-ngp, glTF) takes the depth map's.
-    std::optional<DepthMapFile> sized;
-    std::optional<std::pair<int, int>> mapSize;
-    if (cameraTakesMapSize(scene, o.input)) {
-        sized = images().readDepthMap(o.depthMap, reading, 0, 0);
-        mapSize = std::pair{sized->width, sized->height};
-    }
-    const Camera camera(cameraSpecFor(scene, o.input, mapSize));
-    const DepthMapFile file = sized ? std::move(*sized) : images().readDepthMap(o.depthMap, reading, camera.width(), camera.height());
+    CameraForMap made = cameraAndMapFor(&scene, o.input, quantity, [&](int width, int height) {
+        return images().readDepthMap(o.depthMap, reading, width, height);
+    });
+    const Camera camera(made.spec);
+    DepthMapFile& file = made.map;
     const DepthMap map{file.width, file.height, quantity, file.value, file.valueQuantum};
     const Checker checker(std::move(scene));
     const VerifyOutcome verified =

@@ -156,7 +156,7 @@ QuantityImage Checker::render(const Camera& camera, ExportQuantity quantity, Rou
 
 const VertexNeighbours& Checker::neighbours() const
 {
-    std::call_once(neighboursOnce_, [&] { neighbours_ = std::make_unique<VertexNeighbours>(scene_, &rays_); });
+    std::call_once(neighboursOnce_, [&] { neighbours_ = std::make_unique<VertexNeighbours>(scene_, &rays_, &raster_); });
     return *neighbours_;
 }
 

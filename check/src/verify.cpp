@@ -84,7 +84,8 @@ double planeWindowDepth(const Scene& scene, const Camera& camera, std::uint32_t 
 }
 
 
-VertexNeighbours::VertexNeighbours(const Scene& scene, const RayRenderer* rays) : scene_(scene), rays_(rays)
+VertexNeighbours::VertexNeighbours(const Scene& scene, const RayRenderer* rays, const RasterRenderer* raster)
+    : scene_(scene), rays_(rays), raster_(raster)
 {
     for (std::uint32_t t = 0; t < scene.triangles.size(); ++t)
         for (int k = 0; k < 3; ++k) around_[key(scene.positions[scene.triangles[t][k]])].push_back(t);
@@ -200,8 +201,27 @@ MapPixel MapReader::read(int col, int row, bool search) const
             seen.push_back(seenNear);
             neighbours_.forEachNeighbour(seenNear, consider);
         });
+    // Nor them: where no ray meets a surface, one the rasterizer draws there (a sliver's or a
+    // triangle tip's snapped footprint reaches the pixel centre while no ray within S does; the
+    // regression "verify rejected the raster route's own map at a silhouette sliver").
+    if (closest == INFINITY && here == kNoPrimitive && neighbours_.raster())
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                const int c = col + dx, r = row + dy;
+                if (c < 0 || c >= W || r < 0 || r >= H) continue;
+                const std::uint32_t drawnThere = drawn().primitiveId[std::size_t(r) * W + c];
+                if (drawnThere == kNoPrimitive || std::find(seen.begin(), seen.end(), drawnThere) != seen.end()) continue;
+                seen.push_back(drawnThere);
+                neighbours_.forEachNeighbour(drawnThere, consider);
+            }
     out.primitive = primitive;
     return out;
+}
+
+const RenderResult& MapReader::drawn() const
+{
+    std::call_once(drawnOnce_, [&] { drawn_ = neighbours_.raster()->render(camera_); });
+    return drawn_;
 }
 
 PixelClass MapReader::classify(int col, int row, const MapPixel& pixel) const

@@ -84,19 +84,17 @@ FrameResult DatasetRunner::verify(std::size_t index, VerifiedMap* keep) const
 
         const Checker& checker = (*checkers_)(result.scene);
         const ImportedCamera& imported = *frame.camera;
-        // A camera file without an image size takes the map's; otherwise the map must fit the camera.
-        std::optional<DepthMapFile> file;
-        CameraCompletion given{frame.near ? frame.near : options_.near, frame.far ? frame.far : options_.far, std::nullopt,
-                               std::nullopt};
-        if (!imported.hasImageSize) {
-            file = readDepthMap_(frame.depth, reading, 0, 0);
-            given.width = file->width, given.height = file->height;
-        }
-        CameraSpec spec = completeCamera(imported, &checker.scene(), given);
+        // The map read at the camera's size (or the camera taking the map's), near and far covering it.
+        const CameraCompletion given{frame.near ? frame.near : options_.near, frame.far ? frame.far : options_.far,
+                                     std::nullopt, std::nullopt, std::nullopt};
+        CameraForMap made = completeCameraForMap(imported, &checker.scene(), given, quantity, [&](int width, int height) {
+            return readDepthMap_(frame.depth, reading, width, height);
+        });
+        CameraSpec& spec = made.spec;
+        DepthMapFile* file = &made.map;
         if (!options_.convention.empty()) spec.convention = Convention::preset(options_.convention);
         if (!frame.scale && !options_.scale && frame.impliedScale) spec.notes.push_back(frame.impliedScaleNote);
         const Camera camera(spec);
-        if (!file) file = readDepthMap_(frame.depth, reading, camera.width(), camera.height());
         result.map.channel = file->channel;
         const DepthMap map{file->width, file->height, quantity, std::move(file->value), file->valueQuantum};
         VerifiedMap verified = verifyMap(checker, camera, map, options_.diagnose);

@@ -211,11 +211,11 @@ Dataset openDataset(const std::string& source, const DatasetSourceOptions& optio
 
 std::string relativeTo(const std::string& path, const std::string& base)
 {
-    if (path.empty() || path.front() == '/' || path.rfind("builtin:", 0) == 0) return path;
-    const fs::path folder = fs::path(base).parent_path();
-    const fs::path relative = fs::path(path).lexically_normal().lexically_relative(folder.empty() ? fs::path(".") : folder);
-    const std::string text = relative.generic_string();
-    return text.empty() || text.rfind("..", 0) == 0 ? fs::absolute(path).lexically_normal().generic_string() : text;
+    if (path.empty() || path.rfind("builtin:", 0) == 0) return path;
+    const fs::path absolute = fs::absolute(path).lexically_normal();
+    const fs::path folder = fs::absolute(base).lexically_normal().parent_path();
+    const std::string relative = absolute.lexically_relative(folder).generic_string();
+    return relative.empty() || relative.rfind("..", 0) == 0 ? absolute.generic_string() : relative;
 }
 
 std::string manifestLine(const DatasetFrame& frame, const std::string& cameraReference, const std::string& manifestPath)

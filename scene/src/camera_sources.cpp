@@ -140,16 +140,35 @@ CameraSpec completeCamera(const ImportedCamera& camera, const Scene* scene, cons
         throw Error("a raw projection matrix holds its own near and far: --near and --far do not apply");
     if (!isMatrix) {
         if (!camera.hasClipPlanes && !(given.near && given.far)) {
-            if (!scene)
+            if (!scene && !given.mapEyeZ)
                 throw Error("camera '" + camera.name +
                             "' has no near and far in its file, and there is no scene to take them from: give them "
                             "(--near and --far)");
-            const ClipPlanes planes = clipPlanesFor(*scene, spec);
-            spec.projection.near = given.near.value_or(planes.near);
-            spec.projection.far = given.far.value_or(planes.far);
-            notes.push_back("near and far are not in the camera file: taken from the scene as the camera sees it (near " +
+            std::optional<ClipPlanes> planes;
+            std::string sceneFailure;
+            if (scene) {
+                try {
+                    planes = clipPlanesFor(*scene, spec);
+                } catch (const Error& e) {
+                    sceneFailure = e.what();
+                }
+            }
+            if (!planes && !given.mapEyeZ) throw Error(sceneFailure);
+            const bool sawScene = planes.has_value();
+            std::string from = "the scene as the camera sees it";
+            if (given.mapEyeZ) {  // the map's depths too: what the renderer saw must not be clipped
+                const double lo = given.mapEyeZ->first * 0.99, hi = given.mapEyeZ->second * 1.01;
+                ClipPlanes widened = planes.value_or(ClipPlanes{lo, hi, ""});
+                widened.near = std::max(std::min(widened.near, lo), hi * 1e-7);
+                widened.far = std::max(widened.far, hi);
+                planes = widened;
+                from = sawScene ? from + " and the map's depths" : "the map's depths (the camera sees none of the scene)";
+            }
+            spec.projection.near = given.near.value_or(planes->near);
+            spec.projection.far = given.far.value_or(planes->far);
+            notes.push_back("near and far are not in the camera file: taken from " + from + " (near " +
                             formatNumber(spec.projection.near) + ", far " + formatNumber(spec.projection.far) +
-                            (planes.note.empty() ? "" : "; " + planes.note) + "); pass --near and --far to set them");
+                            (planes->note.empty() ? "" : "; " + planes->note) + "); pass --near and --far to set them");
         } else {
             if (given.near) spec.projection.near = *given.near;
             if (given.far) spec.projection.far = *given.far;
@@ -161,6 +180,41 @@ CameraSpec completeCamera(const ImportedCamera& camera, const Scene* scene, cons
         throw Error("camera '" + camera.name + "': " + e.what());
     }
     return spec;
+}
+
+CameraForMap completeCameraForMap(const ImportedCamera& camera, const Scene* scene, CameraCompletion given,
+                                  DepthQuantity quantity, const std::function<DepthMapFile(int width, int height)>& read)
+{
+    if (!camera.refusal.empty()) throw Error(camera.refusal);
+    CameraForMap out;
+    const bool sized = given.width.has_value() || camera.hasImageSize;
+    out.map = sized ? read(given.width.value_or(camera.spec.width), given.height.value_or(camera.spec.height)) : read(0, 0);
+    if (!sized) given.width = out.map.width, given.height = out.map.height;
+    // The eye-z range the map holds, for eye-z and distance maps (window and NDC maps need the
+    // renderer's near and far anyway).
+    if (!camera.hasClipPlanes && (quantity == DepthQuantity::EyeZ || quantity == DepthQuantity::Distance)) {
+        double lo = INFINITY, hi = 0;
+        for (double v : out.map.value)
+            if (std::isfinite(v) && v > 0) lo = std::min(lo, v), hi = std::max(hi, v);
+        if (hi > 0) {
+            if (quantity == DepthQuantity::Distance) {
+                // eye-z = distance · cos θ ≥ distance · cos θ at the image's corners (perspective);
+                // parallel projections measure distance from the eye plane: eye-z itself.
+                CameraSpec sizedSpec = camera.spec;
+                sizedSpec.width = given.width.value_or(sizedSpec.width), sizedSpec.height = given.height.value_or(sizedSpec.height);
+                if (camera.projectionForSize) sizedSpec.projection = camera.projectionForSize(sizedSpec.width, sizedSpec.height);
+                const Camera c(sizedSpec);
+                if (sizedSpec.projection.isPerspective()) {
+                    const double n = c.nearDistance();
+                    const double x = std::max(std::abs(c.left()), std::abs(c.right())), y = std::max(std::abs(c.top()), std::abs(c.bottom()));
+                    lo *= n / std::sqrt(x * x + y * y + n * n);
+                }
+            }
+            given.mapEyeZ = std::pair{lo, hi};
+        }
+    }
+    out.spec = completeCamera(camera, scene, given);
+    return out;
 }
 
 }  // namespace zcheck

@@ -7,12 +7,14 @@
 // the comparison's rule (PixelJudge) accepts the map's depth on it; otherwise, among the
 // triangles within 2 pixels and those sharing a vertex with them, one drawn within S of the
 // pixel centre whose tolerance interval joined with the truth's holds the depth and under
-// which the comparison explains the pixel; otherwise the truth's surface (a depth error) or
-// kUnknownPrimitive. The accepted depths at a pixel are therefore one interval around the
+// which the comparison explains the pixel — and, where no ray meets one, among the triangles
+// zcheck's rasterizer draws at and around the pixel (a sliver's or a tip's snapped footprint);
+// otherwise the truth's surface (a depth error) or kUnknownPrimitive. The accepted depths at a pixel are therefore one interval around the
 // true depth: a map nearer the truth never fails where a farther one passes.
 #include "zcheck/checker.h"
 
 #include <cmath>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <unordered_map>
@@ -25,7 +27,10 @@ namespace zcheck {
 // near a pixel centre. Holds references to the scene and the renderer. Immutable once built.
 class VertexNeighbours {
 public:
-    explicit VertexNeighbours(const Scene& scene, const RayRenderer* rays = nullptr);
+    explicit VertexNeighbours(const Scene& scene, const RayRenderer* rays = nullptr, const RasterRenderer* raster = nullptr);
+    // The rasterizer whose drawing proposes surfaces no ray meets (a sliver or a triangle's tip
+    // that snapping moves over a pixel centre); nullptr without one.
+    const RasterRenderer* raster() const { return raster_; }
     // The triangles the ray route sees at the four corners of the box of half-side `reach`
     // pixels around pWindow (none without a ray renderer): surfaces a sample that close to the
     // centre may show that no neighbouring pixel shows (the far side of a ridge).
@@ -49,6 +54,7 @@ private:
     static std::string key(const glm::vec3& p);
     const Scene& scene_;
     const RayRenderer* rays_;
+    const RasterRenderer* raster_;
     std::unordered_map<std::string, std::vector<std::uint32_t>> around_;
 };
 
@@ -92,12 +98,17 @@ public:
     PixelClass classify(int col, int row, const MapPixel& pixel) const;
 
 private:
+    // The surfaces the rasterizer draws through the camera, drawn once on first need.
+    const RenderResult& drawn() const;
+
     const Scene& scene_;
     const Camera& camera_;
     const DepthMap& map_;
     const RenderResult& truth_;
     const VertexNeighbours& neighbours_;
     const PixelJudge& judge_;
+    mutable std::once_flag drawnOnce_;
+    mutable RenderResult drawn_;
 };
 
 // The map as the raster side of a comparison (window depth per pixel, a hit where the value is

@@ -13,8 +13,11 @@
 // clipped to the camera's view (its four side planes and the eye plane), less and more 1 %
 // (clipPlanesFor). A window or NDC map depends on near and far: give the renderer's.
 #include "zcheck/camera_import.h"
+#include "zcheck/image_io.h"
+#include "zcheck/quantity.h"
 #include "zcheck/scene.h"
 
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -40,10 +43,13 @@ struct ClipPlanes {
 // far·1e-7 or more. Throws Error when the camera sees none of the scene.
 ClipPlanes clipPlanesFor(const Scene& scene, const CameraSpec& spec);
 
-// What the user gives beside a camera file (--near, --far, --width, --height, a depth map's size).
+// What the user gives beside a camera file (--near, --far, --width, --height, a depth map's size),
+// and the eye-z range a depth map holds (its eye-z values, or its distances times the cosine of
+// the widest ray's angle), which near and far must also cover.
 struct CameraCompletion {
     std::optional<double> near, far;
     std::optional<int> width, height;
+    std::optional<std::pair<double, double>> mapEyeZ;
 };
 
 // The camera FILE#FRAME names (splitCameraReference, openCameraSet, CameraSet::find).
@@ -51,9 +57,21 @@ ImportedCamera importCamera(const std::string& reference, std::optional<CameraFo
 
 // An imported camera made usable: the image size (`given`'s — a depth map's, --width and
 // --height — else the file's, else a default of 640 wide, noted), near and far (`given`'s,
-// else the file's, else clipPlanesFor `scene`), each assumption added to its notes. Throws
-// Error for a camera the file refused (ImportedCamera::refusal), one whose near and far are
-// unknown without a scene (`scene` nullptr), and one that cannot be built.
+// else the file's, else clipPlanesFor `scene` widened to the map's eye-z range; only the map's
+// when the camera sees none of the scene, as a wrong pose does), each assumption added to its
+// notes. Throws Error for a camera the file refused (ImportedCamera::refusal), one whose near
+// and far are unknown (no scene, or one it does not see, and no map), and one that cannot be built.
 CameraSpec completeCamera(const ImportedCamera& camera, const Scene* scene, const CameraCompletion& given);
+
+// A camera and the depth map it is to judge, made together: the map is read at the camera's
+// size (or, for a camera file without one, at its own, which the camera then takes), and the
+// camera's near and far cover what the map holds (completeCamera). `read(width, height)` reads
+// the map (0 × 0: any size).
+struct CameraForMap {
+    CameraSpec spec;
+    DepthMapFile map;
+};
+CameraForMap completeCameraForMap(const ImportedCamera& camera, const Scene* scene, CameraCompletion given,
+                                  DepthQuantity quantity, const std::function<DepthMapFile(int width, int height)>& read);
 
 }  // namespace zcheck

@@ -1,0 +1,299 @@
+"""Datasets made at test time (nothing is downloaded): a trajectory of cameras around a shared
+mesh, written in the formats datasets come in, with depth maps rendered by zcheck's raster route
+(the route `verify` does not use for its truth) and written by writers independent of zcheck
+(numpy, h5py, a PNG encoder here, OpenImageIO's oiiotool, COLMAP's model_converter), and copies
+broken the way datasets break.
+
+Every format's conventions are written here from the formats' own documentation, not from
+zcheck's importers: COLMAP world-to-camera quaternions in OpenCV axes with pixel centres at +0.5,
+nerfstudio camera-to-world matrices in OpenGL axes with centres at +0.5 and millimetre PNGs,
+OpenCV FileStorage with centres at 0.
+"""
+import base64
+import json
+import math
+import shutil
+import struct
+import subprocess
+import zlib
+from pathlib import Path
+
+import numpy as np
+
+import zcheck
+
+W, H = 320, 240
+FX = FY = 300.0
+CX, CY = W / 2, H / 2  # COLMAP's and nerfstudio's coordinates: a centred camera
+FRAMES = 24
+OPENCV_TO_OPENGL = np.diag([1.0, -1.0, -1.0, 1.0])  # flips y and z: one camera frame to the other
+
+
+def look_at_cam_from_world(eye, target, up=(0.0, 1.0, 0.0)):
+    """OpenCV's [R | t] (x right, y down, z forward) of a camera at `eye` looking at `target`."""
+    eye, target, up = (np.asarray(v, float) for v in (eye, target, up))
+    forward = target - eye
+    forward /= np.linalg.norm(forward)
+    right = np.cross(forward, up)
+    right /= np.linalg.norm(right)
+    down = np.cross(forward, right)
+    m = np.eye(4)
+    m[:3, :3] = np.stack([right, down, forward])
+    m[:3, 3] = -m[:3, :3] @ eye
+    return m
+
+
+def quaternion_of(r):
+    """Hamilton (w, x, y, z) of a rotation matrix, w >= 0 (Shepperd's method)."""
+    t = np.trace(r)
+    if t > 0:
+        s = 2 * math.sqrt(1 + t)
+        q = [s / 4, (r[2, 1] - r[1, 2]) / s, (r[0, 2] - r[2, 0]) / s, (r[1, 0] - r[0, 1]) / s]
+    else:
+        i = int(np.argmax(np.diag(r)))
+        j, k = (i + 1) % 3, (i + 2) % 3
+        s = 2 * math.sqrt(1 + r[i, i] - r[j, j] - r[k, k])
+        q = [0.0] * 4
+        q[0] = (r[k, j] - r[j, k]) / s
+        q[1 + i] = s / 4
+        q[1 + j] = (r[j, i] + r[i, j]) / s
+        q[1 + k] = (r[k, i] + r[i, k]) / s
+    q = np.array(q)
+    return q if q[0] >= 0 else -q
+
+
+def write_png16(path, codes):
+    """A 16-bit greyscale PNG (big-endian samples, filter 0 on every row)."""
+    codes = np.asarray(codes, dtype=">u2")
+    h, w = codes.shape
+    raw = b"".join(b"\x00" + codes[row].tobytes() for row in range(h))
+
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
+
+    Path(path).write_bytes(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 16, 0, 0, 0, 0)) +
+                           chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
+
+
+def write_exr(path, depth):
+    """A float EXR through OpenImageIO's oiiotool, from a PFM written here (rows bottom to top)."""
+    pfm = Path(str(path) + ".pfm")
+    data = np.ascontiguousarray(np.asarray(depth, "<f4")[::-1])
+    pfm.write_bytes(b"Pf\n%d %d\n-1\n" % (data.shape[1], data.shape[0]) + data.tobytes())
+    subprocess.run(["oiiotool", str(pfm), "-d", "float", "-o", str(path)], check=True, capture_output=True)
+    pfm.unlink()
+
+
+def write_colmap_depth(path, depth):
+    """COLMAP's dense depth map: "W&H&C&", then float32 rows; 0 where there is no depth."""
+    d = np.where(np.isfinite(depth), depth, 0).astype("<f4")
+    Path(path).write_bytes(b"%d&%d&1&" % (d.shape[1], d.shape[0]) + d.tobytes())
+
+
+def write_hdf5(path, **datasets):
+    import h5py
+    with h5py.File(path, "w") as f:
+        for name, values in datasets.items():
+            f.create_dataset(name, data=np.asarray(values, np.float32))
+
+
+class Trajectory:
+    """FRAMES cameras on a ring around the scene's bounds, looking at its centre."""
+
+    def __init__(self, scene, frames=FRAMES):
+        lo, hi = scene.bounds
+        self.center = (lo + hi) / 2
+        radius = np.linalg.norm(hi - lo) / 2
+        self.poses = []  # OpenCV cam_from_world, 4x4
+        for i in range(frames):
+            a = 2 * math.pi * i / frames
+            eye = self.center + radius * np.array([2.2 * math.sin(a), 0.8 + 0.3 * math.sin(3 * a), 2.2 * math.cos(a)])
+            self.poses.append(look_at_cam_from_world(eye, self.center))
+        self.names = [f"frame_{i:03d}.png" for i in range(frames)]
+        self.k = np.array([[FX, 0, CX - 0.5], [0, FY, CY - 0.5], [0, 0, 1]])  # OpenCV's coordinates
+
+    def camera(self, i, near=None, far=None):
+        """The frame's camera as zcheck sees it, near and far hugging the scene (for rendering)."""
+        return zcheck.Camera.from_opencv(self.k, cam_from_world=self.poses[i], width=W, height=H,
+                                         near=near or 0.05, far=far or 100.0)
+
+
+class DatasetMaker:
+    def __init__(self, root, mesh):
+        self.root = Path(root)
+        self.root.mkdir(parents=True, exist_ok=True)
+        self.mesh = str(mesh)
+        self.scene = zcheck.Scene.from_file(self.mesh)
+        self.checker = zcheck.Checker(self.scene)
+        self.trajectory = Trajectory(self.scene)
+        self._eye_z = {}
+        self._distance = {}
+
+    # ---- depth, by the raster route ----------------------------------------------------
+    def eye_z(self, i):
+        if i not in self._eye_z:
+            self._eye_z[i] = self.checker.render(self.trajectory.camera(i), "eye-z", route="raster")
+        return self._eye_z[i]
+
+    def distance(self, i):
+        if i not in self._distance:
+            self._distance[i] = self.checker.render(self.trajectory.camera(i), "distance", route="raster")
+        return self._distance[i]
+
+    @staticmethod
+    def millimetres(depth, per_metre=1000.0):
+        return np.where(np.isfinite(depth), np.round(depth * per_metre), 0).astype(np.uint16)
+
+    # ---- COLMAP ---------------------------------------------------------------------------
+    def colmap_text(self, folder, cx=None, broken_cx=()):
+        """cameras.txt and images.txt; frames in `broken_cx` use a second camera whose principal
+        point is OpenCV's (W − 1)/2 written where COLMAP's W/2 belongs."""
+        folder = self.root / folder
+        folder.mkdir(parents=True, exist_ok=True)
+        cameras = [f"1 PINHOLE {W} {H} {FX!r} {FY!r} {CX!r} {CY!r}"]
+        if broken_cx:
+            cameras.append(f"2 PINHOLE {W} {H} {FX!r} {FY!r} {CX - 0.5!r} {CY - 0.5!r}")
+        (folder / "cameras.txt").write_text("# Camera list with one line of data per camera:\n"
+                                            "#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n"
+                                            f"# Number of cameras: {len(cameras)}\n" + "\n".join(cameras) + "\n")
+        lines = ["# Image list with two lines of data per image:",
+                 "#   IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME",
+                 "#   POINTS2D[] as (X, Y, POINT3D_ID)",
+                 f"# Number of images: {FRAMES}, mean observations per image: 0"]
+        for i, (pose, name) in enumerate(zip(self.trajectory.poses, self.trajectory.names)):
+            q, t = quaternion_of(pose[:3, :3]), pose[:3, 3]
+            camera = 2 if i in broken_cx else 1
+            lines.append(" ".join([str(i + 1)] + [repr(float(v)) for v in (*q, *t)] + [str(camera), name]))
+            lines.append("")
+        (folder / "images.txt").write_text("\n".join(lines) + "\n")
+        (folder / "points3D.txt").write_text("# 3D point list with one line of data per point:\n"
+                                             "#   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, POINT2D_IDX)\n"
+                                             "# Number of points: 0, mean track length: 0\n")
+        return folder
+
+    def colmap_convert(self, input_folder, folder, output_type):
+        """The model COLMAP itself writes (its model_converter; output_type BIN or TXT)."""
+        folder = self.root / folder
+        folder.mkdir(parents=True, exist_ok=True)
+        subprocess.run(["colmap", "model_converter", "--input_path", str(input_folder), "--output_path", str(folder),
+                        "--output_type", output_type], check=True, capture_output=True)
+        return folder
+
+    def colmap_depth_maps(self, folder, flip=()):
+        folder = self.root / folder
+        folder.mkdir(parents=True, exist_ok=True)
+        for i, name in enumerate(self.trajectory.names):
+            depth = self.eye_z(i)
+            write_colmap_depth(folder / f"{name}.geometric.bin", depth[::-1] if i in flip else depth)
+        return folder
+
+    # ---- nerfstudio -------------------------------------------------------------------------
+    def transforms(self, name="transforms.json", broken=None, missing=()):
+        """transforms.json with 16-bit millimetre PNGs. `broken` maps a frame to how it breaks:
+        "y-flip", "inverted-extrinsic", "opencv-axes", "distance", "centimetres"."""
+        broken = broken or {}
+        depth_dir = self.root / (Path(name).stem + "_depth")
+        depth_dir.mkdir(parents=True, exist_ok=True)
+        frames = []
+        for i, (pose, image) in enumerate(zip(self.trajectory.poses, self.trajectory.names)):
+            how = broken.get(i)
+            c2w_gl = np.linalg.inv(pose) @ OPENCV_TO_OPENGL  # camera-to-world, OpenGL camera axes
+            matrix = {"inverted-extrinsic": np.linalg.inv(c2w_gl), "opencv-axes": np.linalg.inv(pose)}.get(how, c2w_gl)
+            depth = self.distance(i) if how == "distance" else self.eye_z(i)
+            codes = self.millimetres(depth, 100.0 if how == "centimetres" else 1000.0)
+            if how == "y-flip":
+                codes = codes[::-1]
+            depth_path = depth_dir / image
+            if i not in missing:
+                write_png16(depth_path, codes)
+            frames.append({"file_path": f"images/{image}", "depth_file_path": str(depth_path.relative_to(self.root)),
+                           "transform_matrix": matrix.tolist()})
+        document = {"camera_model": "OPENCV", "fl_x": FX, "fl_y": FY, "cx": CX, "cy": CY, "w": float(W), "h": float(H),
+                    "k1": 0.0, "k2": 0.0, "p1": 0.0, "p2": 0.0, "frames": frames}
+        path = self.root / name
+        path.write_text(json.dumps(document, indent=1))
+        return path
+
+    # ---- a manifest over every other format ----------------------------------------------
+    def opencv_file(self, i):
+        """OpenCV FileStorage YAML of frame i: camera_matrix (centre of the top-left pixel at 0),
+        R and T world-to-camera."""
+        path = self.root / "opencv" / f"frame_{i:03d}.yml"
+        path.parent.mkdir(parents=True, exist_ok=True)
+        k, pose = self.trajectory.k, self.trajectory.poses[i]
+
+        def matrix(name, rows, cols, values):
+            data = ", ".join(repr(float(v)) for v in np.ravel(values))
+            return f"{name}: !!opencv-matrix\n   rows: {rows}\n   cols: {cols}\n   dt: d\n   data: [ {data} ]\n"
+
+        path.write_text("%YAML:1.0\n---\n" + f"image_width: {W}\nimage_height: {H}\n" + matrix("camera_matrix", 3, 3, k) +
+                        matrix("distortion_coefficients", 5, 1, np.zeros(5)) + matrix("R", 3, 3, pose[:3, :3]) +
+                        matrix("T", 3, 1, pose[:3, 3]))
+        return path
+
+    def gltf_with_cameras(self, name="scene.gltf"):
+        """The mesh and one perspective camera node per frame (camera-to-world, OpenGL axes)."""
+        vertices = np.asarray(self.scene.vertices, "<f4")
+        triangles = np.asarray(self.scene.triangles, "<u4")
+        blob = vertices.tobytes() + triangles.tobytes()
+        yfov = 2 * math.atan(H / 2 / FY)
+        nodes = [{"mesh": 0, "name": "mesh"}]
+        for i, pose in enumerate(self.trajectory.poses):
+            c2w = np.linalg.inv(pose) @ OPENCV_TO_OPENGL
+            nodes.append({"name": f"cam_{i:03d}", "camera": 0, "matrix": c2w.T.ravel().tolist()})  # column-major
+        document = {
+            "asset": {"version": "2.0"},
+            "buffers": [{"byteLength": len(blob), "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}],
+            "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": vertices.nbytes},
+                            {"buffer": 0, "byteOffset": vertices.nbytes, "byteLength": triangles.nbytes}],
+            "accessors": [{"bufferView": 0, "componentType": 5126, "count": len(vertices), "type": "VEC3",
+                           "min": vertices.min(0).tolist(), "max": vertices.max(0).tolist()},
+                          {"bufferView": 1, "componentType": 5125, "count": triangles.size, "type": "SCALAR"}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+            "cameras": [{"type": "perspective", "perspective": {"yfov": yfov, "aspectRatio": W / H, "znear": 0.05, "zfar": 100}}],
+            "nodes": nodes,
+            "scenes": [{"nodes": list(range(len(nodes)))}],
+            "scene": 0,
+        }
+        path = self.root / name
+        path.write_text(json.dumps(document))
+        return path
+
+    def manifest(self, name, colmap_folder, transforms_path, gltf_path, broken_lines=()):
+        """A manifest whose frames use every camera format and every depth format:
+        COLMAP references with .npy, transforms references with the PNGs, OpenCV files with EXR,
+        inline zcheck cameras with HDF5 (BlenderProc's depth and distance), glTF cameras with
+        COLMAP depth maps."""
+        depth_dir = self.root / "manifest_depth"
+        depth_dir.mkdir(parents=True, exist_ok=True)
+        colmap_depth = self.colmap_depth_maps("manifest_colmap_depth")
+        lines = []
+        transforms = json.loads(Path(transforms_path).read_text())
+        for i, image in enumerate(self.trajectory.names):
+            kind = i % 5
+            line = {"frame": f"f{i:03d}", "quantity": "eye-z"}
+            if kind == 0:
+                np.save(depth_dir / f"{i:03d}.npy", self.eye_z(i))
+                line.update(camera=f"{Path(colmap_folder).name}#{image}", depth=f"manifest_depth/{i:03d}.npy")
+            elif kind == 1:
+                line.update(camera=f"{Path(transforms_path).name}#{image}", depth=transforms["frames"][i]["depth_file_path"])
+            elif kind == 2:
+                write_exr(depth_dir / f"{i:03d}.exr", self.eye_z(i))
+                line.update(camera=str(self.opencv_file(i).relative_to(self.root)), depth=f"manifest_depth/{i:03d}.exr")
+            elif kind == 3:
+                write_hdf5(depth_dir / f"{i:03d}.h5", depth=self.eye_z(i), distance=self.distance(i))
+                camera = json.loads(self.trajectory.camera(i).to_json())
+                line.update(camera=camera, depth=f"manifest_depth/{i:03d}.h5", channel="depth")
+            else:
+                line.update(camera=f"{Path(gltf_path).name}#cam_{i:03d}",
+                            depth=str((colmap_depth / f"{image}.geometric.bin").relative_to(self.root)))
+            lines.append(json.dumps(line))
+        for at in sorted(broken_lines, reverse=True):
+            lines[at] = lines[at][: len(lines[at]) // 2]  # cut off mid-line: malformed JSON
+        path = self.root / name
+        path.write_text("\n".join(lines) + "\n")
+        return path
+
+
+def has(program):
+    return shutil.which(program) is not None
