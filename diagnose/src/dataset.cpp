@@ -58,6 +58,40 @@ std::vector<std::size_t> DatasetRunner::shardFrames() const
     return out;
 }
 
+FramePlan planFrame(const DatasetFrame& frame, const DatasetRunOptions& options)
+{
+    if (!frame.error.empty()) throw Error(frame.error);
+    FramePlan plan;
+    plan.quantityName = frame.quantity.value_or(options.quantity);
+    if (plan.quantityName.empty())
+        throw Error("frame '" + frame.name + "' has no quantity: give --quantity (or \"quantity\" in the manifest)");
+    plan.quantity = depthQuantityFromName(plan.quantityName);
+    DepthMapReading& reading = plan.reading;
+    reading.channel = frame.channel.value_or(options.channel);
+    reading.quantityChannel = channelNameOf(exportQuantitiesFromList(plan.quantityName).front());
+    reading.scale = frame.scale ? *frame.scale : options.scale ? *options.scale : frame.impliedScale.value_or(0.0);
+    reading.offset = frame.offset.value_or(options.offset.value_or(0.0));
+    const std::string miss = frame.miss.value_or(options.miss);
+    if (!miss.empty()) reading.miss = MissRule::parse(miss);
+    plan.given.near = frame.near ? frame.near : options.near;
+    plan.given.far = frame.far ? frame.far : options.far;
+    plan.scene = frame.scene.value_or(options.scene);
+    if (!frame.scale && !options.scale && frame.impliedScale) plan.notes.push_back(frame.impliedScaleNote);
+    return plan;
+}
+
+CameraForMap frameCameraAndMap(const DatasetFrame& frame, const FramePlan& plan, const Scene& scene,
+                               const DatasetRunOptions& options, const DepthMapReader& readDepthMap)
+{
+    // The map read at the camera's size (or the camera taking the map's), near and far covering it.
+    CameraForMap made = completeCameraForMap(*frame.camera, &scene, plan.given, plan.quantity, [&](int width, int height) {
+        return readDepthMap(frame.depth, plan.reading, width, height);
+    });
+    if (!options.convention.empty()) made.spec.convention = Convention::preset(options.convention);
+    made.spec.notes.insert(made.spec.notes.end(), plan.notes.begin(), plan.notes.end());
+    return made;
+}
+
 FrameResult DatasetRunner::verify(std::size_t index, VerifiedMap* keep) const
 {
     const auto start = std::chrono::steady_clock::now();
@@ -68,35 +102,14 @@ FrameResult DatasetRunner::verify(std::size_t index, VerifiedMap* keep) const
     result.scene = frame.scene.value_or(options_.scene);
     result.map.file = frame.depth;
     try {
-        if (!frame.error.empty()) throw Error(frame.error);
-        const std::string quantityName = frame.quantity.value_or(options_.quantity);
-        if (quantityName.empty())
-            throw Error("frame '" + frame.name + "' has no quantity: give --quantity (or \"quantity\" in the manifest)");
-        const DepthQuantity quantity = depthQuantityFromName(quantityName);
-        result.map.quantity = quantityName;
-        DepthMapReading& reading = result.map.reading;
-        reading.channel = frame.channel.value_or(options_.channel);
-        reading.quantityChannel = channelNameOf(exportQuantitiesFromList(quantityName).front());
-        reading.scale = frame.scale ? *frame.scale : options_.scale ? *options_.scale : frame.impliedScale.value_or(0.0);
-        reading.offset = frame.offset.value_or(options_.offset.value_or(0.0));
-        const std::string miss = frame.miss.value_or(options_.miss);
-        if (!miss.empty()) reading.miss = MissRule::parse(miss);
-
-        const Checker& checker = (*checkers_)(result.scene);
-        const ImportedCamera& imported = *frame.camera;
-        // The map read at the camera's size (or the camera taking the map's), near and far covering it.
-        const CameraCompletion given{frame.near ? frame.near : options_.near, frame.far ? frame.far : options_.far,
-                                     std::nullopt, std::nullopt, std::nullopt};
-        CameraForMap made = completeCameraForMap(imported, &checker.scene(), given, quantity, [&](int width, int height) {
-            return readDepthMap_(frame.depth, reading, width, height);
-        });
-        CameraSpec& spec = made.spec;
-        DepthMapFile* file = &made.map;
-        if (!options_.convention.empty()) spec.convention = Convention::preset(options_.convention);
-        if (!frame.scale && !options_.scale && frame.impliedScale) spec.notes.push_back(frame.impliedScaleNote);
-        const Camera camera(spec);
-        result.map.channel = file->channel;
-        const DepthMap map{file->width, file->height, quantity, std::move(file->value), file->valueQuantum};
+        const FramePlan plan = planFrame(frame, options_);
+        result.map.quantity = plan.quantityName;
+        result.map.reading = plan.reading;
+        const Checker& checker = (*checkers_)(plan.scene);
+        CameraForMap made = frameCameraAndMap(frame, plan, checker.scene(), options_, readDepthMap_);
+        const Camera camera(made.spec);
+        result.map.channel = made.map.channel;
+        const DepthMap map{made.map.width, made.map.height, plan.quantity, std::move(made.map.value), made.map.valueQuantum};
         VerifiedMap verified = verifyMap(checker, camera, map, options_.diagnose);
         result.verified = true;
         result.report = verified.run.report;

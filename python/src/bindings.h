@@ -51,6 +51,17 @@ void fillComparison(PyReport& r, const Comparison& c, const RenderResult& ray, c
 // A verification (verifyAndReport, report.h) as a Report: verify and verify_file share it.
 void fillVerification(PyReport& r, VerifyOutcome verified);
 
+// Pickling (pickling.cpp): each class's state as plain Python values, and back.
+py::tuple cameraState(const Camera& camera);
+Camera cameraFromState(const py::tuple& state);
+py::tuple sceneState(const Scene& scene);
+Scene sceneFromState(const py::tuple& state);
+py::tuple reportState(const PyReport& report);
+PyReport reportFromState(const py::tuple& state);
+
+// zcheck._zcheck_files's datasets (dataset.cpp), adapted for zcheck/dataset.py.
+void bindDatasets(py::module_& m);
+
 // An (height, width) array of `values` (row 0 at the top).
 template <class T, class Allocator>
 py::array_t<T> image(const std::vector<T, Allocator>& values, int width, int height)

@@ -17,6 +17,7 @@ PYBIND11_MODULE(_zcheck_files, m)
 {
     m.doc() = "Depth-map files for zcheck (OpenImageIO); use zcheck.read_depth_map and Checker.verify_file.";
     py::module_::import("zcheck._zcheck");  // Checker, Camera and Report are registered there
+    bindDatasets(m);
     m.def(
         "verify_file",
         [](const Checker& checker, const Camera& camera, const std::string& path, const std::string& quantityName,

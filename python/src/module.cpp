@@ -7,10 +7,10 @@
 // The GIL is released around every render, check, verify, diagnosis, scene load and BVH build.
 #include "bindings.h"
 
-#include "zcheck/pose.h"
 #include "camera_json.h"
 #include "zcheck/camera.h"
 #include "zcheck/camera_file.h"
+#include "zcheck/camera_sources.h"
 #include "zcheck/checker.h"
 #include "zcheck/compare.h"
 #include "zcheck/convention.h"
@@ -626,6 +626,7 @@ Raises zcheck.Error naming the argument, the entry and the rule.)doc")
         .def_property_readonly(
             "default_camera", [](const Scene& s) { return makeCamera(s.defaultCamera, "Scene.default_camera"); },
             "The camera `zcheck check` uses when no camera file is given.")
+        .def(py::pickle(&sceneState, &sceneFromState))
         .def("__repr__", [](const Scene& s) {
             return "<zcheck.Scene '" + s.name + "': " + std::to_string(s.positions.size()) + " vertices, " +
                    std::to_string(s.triangles.size()) + " triangles>";
@@ -640,8 +641,26 @@ immutable; Camera.replace returns a changed copy. Every factory refuses NaNs, de
 near <= 0, far <= near and images outside 1..16384 pixels per side with a zcheck.Error naming the
 parameter.)doc")
         .def_static(
-            "from_file", [](const std::string& path) { return Camera(readCameraFile(path)); }, py::arg("path"),
-            R"doc(Read a camera file (JSON; see the README's "The camera file"). The errors are the command line's.)doc")
+            "from_file",
+            [](const std::string& reference, std::optional<std::string> format, const Scene* scene,
+               std::optional<double> near, std::optional<double> far, std::optional<int> width, std::optional<int> height) {
+                const ImportedCamera imported =
+                    importCamera(reference, format ? std::optional<CameraFormat>(cameraFormatFromName(*format)) : std::nullopt);
+                return makeCamera(completeCamera(imported, scene, {near, far, width, height, std::nullopt}), "Camera.from_file");
+            },
+            py::arg("path"), py::kw_only(), py::arg("format") = py::none(), py::arg("scene") = py::none(),
+            py::arg("near") = py::none(), py::arg("far") = py::none(), py::arg("width") = py::none(),
+            py::arg("height") = py::none(),
+            R"doc(A camera from any camera file zcheck reads, as `--camera` reads it: "FILE" or "FILE#FRAME".
+
+FILE:   a zcheck camera (JSON), a COLMAP model folder (sparse/0#img_014.png), a transforms.json
+        (nerfstudio, instant-ngp: #frame_003, #images/frame_003.png or #3), an OpenCV FileStorage
+        or ROS CameraInfo YAML/XML (#raw, #rectified), a glTF's camera nodes; told by content.
+format: forces the format: "zcheck", "colmap", "nerfstudio", "opencv", "ros", "gltf".
+scene:  a Scene whose extent as the camera sees it gives near and far when the file has none
+        (else give near and far).
+width, height: the image size when the file has none (instant-ngp, glTF), or to replace it.
+The errors are the command line's. camera.notes says what was assumed.)doc")
         .def_static(
             "from_json",
             [](const std::string& text, const std::string& source) { return Camera(cameraSpecFromJsonText(text, source)); },
@@ -730,6 +749,19 @@ direction is a unit vector, and t in [t_near, t_far] spans near to far plane.)do
             "depth_range", [](const Camera& c) { return py::make_tuple(c.depth().rangeMin, c.depth().rangeMax); })
         .def_property_readonly("clear_value", &Camera::clearDepth,
                                "The window depth a cleared depth buffer holds (the far end of the range).")
+        .def_property_readonly(
+            "notes", [](const Camera& c) { return cameraNotes(c.spec()); },
+            "What was assumed or repaired when the camera was made (near and far taken from the scene, a rotation "
+            "re-orthonormalised, ...), one sentence each; reports print them as warnings.")
+        .def(
+            "__eq__",
+            [](const Camera& a, const py::object& b) -> py::object {
+                if (!py::isinstance<Camera>(b)) return py::reinterpret_borrow<py::object>(Py_NotImplemented);
+                return py::bool_(cameraJsonText(a.spec()) == cameraJsonText(b.cast<const Camera&>().spec()));
+            },
+            py::is_operator(), "Cameras are equal when their camera files are: the same geometry and settings.")
+        .def("__hash__", [](const Camera& c) { return py::hash(py::str(cameraJsonText(c.spec()))); })
+        .def(py::pickle(&cameraState, &cameraFromState))
         .def("__repr__", &cameraRepr);
 
     // ----------------------------------------------------------------------------- Report
@@ -824,6 +856,7 @@ verdict, and per-pixel images. to_dict() is the document `zcheck check --json` (
         .def(
             "summary", [](const PyReport& r) { return r.summary; },
             "The summary `zcheck check` / `zcheck verify` prints (with the diagnosis line when diagnosed).")
+        .def(py::pickle(&reportState, &reportFromState))
         .def("__repr__", [](const PyReport& r) {
             const auto& c = r.report.comparison;
             return std::string("<zcheck.Report ") + (r.verify ? "verify" : "check") + " " +

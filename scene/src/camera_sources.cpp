@@ -142,8 +142,7 @@ CameraSpec completeCamera(const ImportedCamera& camera, const Scene* scene, cons
         if (!camera.hasClipPlanes && !(given.near && given.far)) {
             if (!scene && !given.mapEyeZ)
                 throw Error("camera '" + camera.name +
-                            "' has no near and far in its file, and there is no scene to take them from: give them "
-                            "(--near and --far)");
+                            "' has no near and far in its file, and there is no scene to take them from: give near and far");
             std::optional<ClipPlanes> planes;
             std::string sceneFailure;
             if (scene) {

@@ -7,7 +7,10 @@ import os
 import shutil
 from pathlib import Path
 
+import numpy as np
 import pytest
+
+import zcheck
 
 from dataset_maker import DatasetMaker, FRAMES, has
 from helpers import run_cli
@@ -203,3 +206,86 @@ def test_verify_accepts_the_raster_route_s_own_map_at_a_silhouette_sliver(made):
     report = m.checker.verify(camera, m.eye_z(4), "eye-z")
     assert report.consistent, report.summary
     assert m.checker.check(camera).consistent
+
+
+# ---- Python -----------------------------------------------------------------------------------
+
+def _verify_in_worker(frame):
+    """A frame verified in another process: everything it needs arrives pickled."""
+    camera, _ = frame.load()
+    return frame.index, camera, frame.checker().verify_file(camera, frame.depth, frame.quantity, diagnose=True,
+                                                            **frame.reading)
+
+
+def test_python_verify_yields_the_records_the_command_writes(made):
+    import zcheck.dataset
+    _, p = made
+    _, cli, _, _ = verify(made, p["broken_transforms"], "--diagnose")
+    records = list(zcheck.dataset.verify(p["broken_transforms"], scene=BUNNY, quantity="eye-z", diagnose=True))
+    strip = lambda r: {k: v for k, v in r.items() if k != "seconds"}  # noqa: E731 - wall time differs
+    assert sorted(map(lambda r: json.dumps(strip(r), sort_keys=True), records)) == \
+        sorted(map(lambda r: json.dumps(strip(r), sort_keys=True), cli))
+
+
+def test_a_process_pool_over_a_dataset_agrees_with_the_command(made):
+    import pickle
+    from concurrent.futures import ProcessPoolExecutor
+    import zcheck.dataset
+    _, p = made
+    _, cli, _, _ = verify(made, p["broken_transforms"], "--diagnose")
+    by_index = {r["index"]: r for r in cli}
+    frames = zcheck.dataset.open(p["broken_transforms"], scene=BUNNY, quantity="eye-z")
+    assert len(frames) == FRAMES and frames[3].name == "images/frame_003.png" and frames[3].reading == {"scale": 1000.0}
+    usable = [f for f in frames if f.index != MISSING_DEPTH]
+    with ProcessPoolExecutor(max_workers=2) as pool:
+        for index, camera, report in pool.map(_verify_in_worker, usable):
+            record = by_index[index]
+            assert report.consistent == record["consistent"], index
+            assert report.unexplained == record["unexplained"]["count"], index
+            assert report.to_dict()["pixels"] == record["pixels"], index
+            if not report.consistent:
+                assert report.diagnosis[0]["hypothesis"] == record["diagnosis"][0]["hypothesis"]
+            assert camera == pickle.loads(pickle.dumps(camera))
+    with pytest.raises(zcheck.Error, match="frame_021.png': No such file"):
+        frames[MISSING_DEPTH].load()
+
+
+def test_camera_scene_and_report_pickle_to_equal_values(made):
+    import pickle
+    import numpy as np
+    m, p = made
+    camera = zcheck.Camera.from_file(f"{p['colmap_text']}#frame_007.png", scene=m.scene)
+    again = pickle.loads(pickle.dumps(camera))
+    assert again == camera and hash(again) == hash(camera) and again.notes == camera.notes
+    assert camera != camera.replace(width=321)
+    scene = pickle.loads(pickle.dumps(m.scene))
+    assert scene.triangle_count == m.scene.triangle_count and scene.name == m.scene.name
+    arrays = zcheck.Scene.from_arrays(np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0.0]]), np.array([[0, 1, 2]]), name="tri")
+    assert (pickle.loads(pickle.dumps(arrays)).vertices == arrays.vertices).all()
+    flipped = m.eye_z(7)[::-1]
+    report = m.checker.verify(m.trajectory.camera(7), flipped, "eye-z", diagnose=True)
+    back = pickle.loads(pickle.dumps(report))
+    assert back.to_dict() == report.to_dict() and back.summary() == report.summary()
+    assert back.unexplained == report.unexplained and not back.consistent
+    assert [h["hypothesis"] for h in back.diagnosis] == [h["hypothesis"] for h in report.diagnosis]
+    assert (back.error_over_tolerance == report.error_over_tolerance).all()
+
+
+def test_camera_from_file_reads_every_format_by_reference(made):
+    m, p = made
+    # The same pose through COLMAP, nerfstudio, OpenCV and glTF: the same projection.
+    cameras = [zcheck.Camera.from_file(f"{p['colmap_text']}#frame_007.png", scene=m.scene),
+               zcheck.Camera.from_file(f"{p['transforms']}#frame_007", scene=m.scene),
+               zcheck.Camera.from_file(str(m.opencv_file(7)), scene=m.scene),
+               zcheck.Camera.from_file(f"{p['gltf']}#cam_007", width=320, height=240)]
+    world = np.array([0.01, 0.12, 0.02, 1.0])
+    pixels = []
+    for camera in cameras:
+        clip = camera.matrices()["clip_from_world"] @ world
+        window = camera.matrices()["window_from_ndc"] @ (clip / clip[3])
+        pixels.append((window[0], window[1] if camera.convention != "opengl" else camera.height - window[1]))
+    for pixel in pixels[1:]:
+        assert np.allclose(pixel, pixels[0], atol=1e-6), pixels
+    with pytest.raises(zcheck.Error, match="has no near and far in its file, and there is no scene"):
+        zcheck.Camera.from_file(f"{p['colmap_text']}#frame_007.png")
+    assert zcheck.Camera.from_file(f"{p['colmap_text']}#3", near=0.1, far=10).width == 320

@@ -12,6 +12,7 @@
 // each itself parallel inside. A frame that cannot be run — a missing or malformed depth map, a
 // camera the file refused, a camera that sees nothing — becomes a result with that one-line
 // error; the run goes on. Thread-safe: run() and verify() may be called from several threads.
+#include "zcheck/camera_sources.h"
 #include "zcheck/checker.h"
 #include "zcheck/dataset_source.h"
 #include "zcheck/image_io.h"
@@ -27,6 +28,10 @@
 #include <vector>
 
 namespace zcheck {
+
+// Reads a depth map (image_io.h's readDepthMap, or the command line's plugin of it).
+using DepthMapReader = std::function<DepthMapFile(const std::string& path, const DepthMapReading& reading, int width,
+                                                  int height)>;
 
 struct DatasetRunOptions {
     std::string scene = "builtin:default";  // every frame's, unless its manifest line names one
@@ -44,6 +49,24 @@ struct DatasetRunOptions {
     void parseShard(const std::string& text);
 };
 
+// How one frame is read and its camera made: the frame's own values (a manifest line's) winning
+// over the run's options, which win over what its camera file implies. Throws Error (the
+// frame's error) for a frame the source could not make, or one without a quantity.
+struct FramePlan {
+    std::string quantityName;
+    DepthQuantity quantity = DepthQuantity::EyeZ;
+    DepthMapReading reading;
+    CameraCompletion given;        // near and far
+    std::string scene;
+    std::vector<std::string> notes;  // what the plan assumed (a scale the camera file implies)
+};
+FramePlan planFrame(const DatasetFrame& frame, const DatasetRunOptions& options);
+
+// The frame's camera (completed for `scene` and the map, the run's convention applied) and its
+// map, read with `readDepthMap`. Throws Error.
+CameraForMap frameCameraAndMap(const DatasetFrame& frame, const FramePlan& plan, const Scene& scene,
+                               const DatasetRunOptions& options, const DepthMapReader& readDepthMap);
+
 // The result of one frame.
 struct FrameResult {
     std::size_t index = 0, of = 0;     // the frame's index in the dataset, and the dataset's size
@@ -59,9 +82,6 @@ struct FrameResult {
     bool consistent() const { return verified && report.comparison.consistent(); }
 };
 
-// Reads a depth map (image_io.h's readDepthMap, or the command line's plugin of it).
-using DepthMapReader = std::function<DepthMapFile(const std::string& path, const DepthMapReading& reading, int width,
-                                                  int height)>;
 
 // Scenes loaded and their checkers built once, by name, for any number of runners (thread-safe).
 class SceneCheckers {
