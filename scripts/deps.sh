@@ -5,7 +5,8 @@ packages=(cmake ninja-build g++ pkg-config python3
           libembree-dev libglm-dev libopenimageio-dev openimageio-tools catch2 libtbb-dev
           libcli11-dev nlohmann-json3-dev libpng-dev libhdf5-dev python3-h5py colmap
           pybind11-dev python3-dev python3-numpy python3-pytest
-          libegl-dev libgl1-mesa-dri)  # the last two: the llvmpipe yardstick of `zcheck bench --reference`
+          libegl-dev libgl1-mesa-dri  # the llvmpipe yardstick of `zcheck bench --reference`
+          slurm-wlm munge)            # a local Slurm for the dataset submit test
 missing=()
 for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -289,3 +289,33 @@ def test_camera_from_file_reads_every_format_by_reference(made):
     with pytest.raises(zcheck.Error, match="has no near and far in its file, and there is no scene"):
         zcheck.Camera.from_file(f"{p['colmap_text']}#frame_007.png")
     assert zcheck.Camera.from_file(f"{p['colmap_text']}#3", near=0.1, far=10).width == 320
+
+
+LOCAL_SLURM = Path(__file__).resolve().parents[1] / "slurm" / "local_slurm.sh"
+
+
+@pytest.mark.skipif(os.geteuid() != 0 or not has("sbatch") or not has("munged"),
+                    reason="a local Slurm (slurm-wlm, munge) is started as root")
+def test_a_slurm_job_array_gives_the_single_process_summary(made, tmp_path):
+    import subprocess
+    from helpers import ZCHECK_EXE
+    m, p = made
+    source = p["broken_transforms"]
+    single = m.root / "for_slurm.jsonl"
+    verify(made, source, "--diagnose", results=single)
+    run_cli("dataset", "report", single, "--json", tmp_path / "single.json")
+    state = tmp_path / "slurm"
+    started = subprocess.run(["bash", LOCAL_SLURM, "start", state], capture_output=True, text=True, timeout=120)
+    try:
+        assert started.returncode == 0, started.stderr
+        env = {**os.environ, "SLURM_CONF": str(state / "slurm.conf")}
+        done = subprocess.run([ZCHECK_EXE, "dataset", "submit", source, "--scene", BUNNY, "--quantity", "eye-z", "--diagnose",
+                               "--tasks", "3", "--out", tmp_path / "run", "--wait"], capture_output=True, text=True,
+                              timeout=600, env=env, cwd=m.root)
+        assert done.returncode == 1, done.stdout + done.stderr  # inconsistent frames: the report's status
+        assert "verify job" in done.stdout and "(3 tasks), report job" in done.stdout
+        assert json.loads((tmp_path / "run" / "summary.json").read_text()) == json.loads((tmp_path / "single.json").read_text())
+        assert all((tmp_path / "run" / f"results-{i}.jsonl").exists() for i in range(3))
+        assert "data:image/png;base64," in (tmp_path / "run" / "report.html").read_text()
+    finally:
+        subprocess.run(["bash", LOCAL_SLURM, "stop", state], capture_output=True, timeout=60)
