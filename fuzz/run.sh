@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer harnesses with clang (ASan + UBSan) into ./build-fuzz and runs each
 # for SECONDS (default 60) on a copy of its seed corpus (fuzz/corpus/NAME), two at a time.
-# Usage: fuzz/run.sh [SECONDS] [HARNESS...]   (harnesses: ply obj stl gltf camera depth_map)
+# Usage: fuzz/run.sh [SECONDS] [HARNESS...]   (harnesses: ply obj stl gltf camera camera_import depth_map)
 # Exit status 0 only if no harness found a crash, a hang (> 10 s on one input), a leak or an
 # out-of-memory (> 2 GiB); findings are kept in build-fuzz/findings/NAME/.
 set -euo pipefail
@@ -9,7 +9,7 @@ cd "$(dirname "$0")/.."
 seconds=${1:-60}
 shift || true
 harnesses=("$@")
-((${#harnesses[@]})) || harnesses=(ply obj stl gltf camera depth_map)
+((${#harnesses[@]})) || harnesses=(ply obj stl gltf camera camera_import depth_map)
 
 command -v clang++ > /dev/null || {
     echo "installing clang (libFuzzer)"

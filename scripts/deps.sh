@@ -1,12 +1,17 @@
 #!/usr/bin/env bash
-# Installs zcheck's build and test dependencies from the Debian 12 archive (idempotent).
+# Installs zcheck's build dependencies from the Debian 12 archive (idempotent); with --test, also
+# the real programs the tests start: COLMAP (its model converter writes real models), Blender
+# (headless, its own Z pass), Slurm and munge (a local cluster), h5py (HDF5 maps written by
+# another library).
 set -euo pipefail
 packages=(cmake ninja-build g++ pkg-config python3
           libembree-dev libglm-dev libopenimageio-dev openimageio-tools catch2 libtbb-dev
-          libcli11-dev nlohmann-json3-dev libpng-dev libhdf5-dev python3-h5py colmap
+          libcli11-dev nlohmann-json3-dev libpng-dev libhdf5-dev
           pybind11-dev python3-dev python3-numpy python3-pytest
-          libegl-dev libgl1-mesa-dri  # the llvmpipe yardstick of `zcheck bench --reference`
-          slurm-wlm munge)            # a local Slurm for the dataset submit test
+          libegl-dev libgl1-mesa-dri)  # the llvmpipe yardstick of `zcheck bench --reference`
+if [[ ${1:-} == --test ]]; then
+    packages+=(colmap blender slurm-wlm munge python3-h5py)
+fi
 missing=()
 for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

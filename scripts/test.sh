@@ -7,6 +7,7 @@
 #      tests, which need an uninstrumented build).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+./scripts/deps.sh --test
 ./scripts/build.sh
 (cd build && ctest --output-on-failure --parallel "$(nproc)" --timeout 600)
 fuzz/run.sh "${ZCHECK_FUZZ_SECONDS:-60}"

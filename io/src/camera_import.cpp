@@ -131,7 +131,8 @@ CameraSet readCameraSet(const std::string& path, CameraFormat format)
 {
     switch (format) {
     case CameraFormat::Zcheck: {
-        CameraSet set{path, format, {}};
+        CameraSet set;
+        set.path = path, set.format = format;
         ImportedCamera camera;
         camera.spec = readCameraFile(path);
         camera.hasClipPlanes = true;

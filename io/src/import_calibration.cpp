@@ -311,7 +311,8 @@ private:
             const Matrix tv = shaped(*t, tKey, 3, 1);
             camFromWorld[3] = glm::dvec4(tv.values[0], tv.values[1], tv.values[2], 1.0);
         }
-        CameraSet set{path_, CameraFormat::OpenCv, {}, std::nullopt};
+        CameraSet set;
+        set.path = path_, set.format = CameraFormat::OpenCv;
         const std::size_t slash = path_.find_last_of('/');
         ImportedCamera imported = camera(slash == std::string::npos ? path_ : path_.substr(slash + 1), width, height, intrinsics,
                                          camFromWorld, r ? rKey + ", " + tKey : "pose");
@@ -355,7 +356,8 @@ private:
                     refusal = source() + ": roi." + key + " is " + v->scalar +
                               ": the image is a region of the calibrated one; zcheck reads CameraInfo without a roi";
 
-        CameraSet set{path_, CameraFormat::Ros, {}, std::size_t(0)};
+        CameraSet set;
+        set.path = path_, set.format = CameraFormat::Ros, set.defaultCamera = 0;
         ImportedCamera raw = camera("raw", width, height, intrinsicsOf(K, kKey), glm::dmat4(1.0), "pose");
         std::string model = "plumb_bob";
         if (const Node* m = root_.findIgnoringCase("distortion_model"); m && m->kind == Node::Kind::Scalar && !m->scalar.empty())

@@ -384,7 +384,8 @@ CameraSet readColmapModel(const std::string& path)
     const auto cameras = binary ? readCamerasBinary(folder + "/cameras.bin") : readCamerasText(folder + "/cameras.txt");
     const auto images = binary ? readImagesBinary(folder + "/images.bin") : readImagesText(folder + "/images.txt");
 
-    CameraSet set{path, CameraFormat::Colmap, {}};
+    CameraSet set;
+    set.path = path, set.format = CameraFormat::Colmap;
     const Convention opencv = Convention::preset("opencv");
     for (const ColmapImage& image : images) {
         ImportedCamera camera;

@@ -49,7 +49,8 @@ public:
 
     CameraSet read()
     {
-        CameraSet set{path_, CameraFormat::Nerfstudio, {}};
+        CameraSet set;
+        set.path = path_, set.format = CameraFormat::Nerfstudio;
         const std::vector<std::string> notes = documentNotes();
         if (const json* integer = find(root_, "integer_depth_scale")) {
             if (!integer->is_number() || !(integer->get<double>() > 0) || !std::isfinite(integer->get<double>()))

@@ -20,7 +20,9 @@ CameraSet openCameraSet(const std::string& path, std::optional<CameraFormat> for
 CameraSet readGltfCameras(const std::string& path)
 {
     const LargeVector<char> file = readInputBytes(path, kMeshInput);
-    CameraSet set{path, CameraFormat::Gltf, readGltfCameraNodes(path, std::string_view(file.data(), file.size())), std::nullopt};
+    CameraSet set;
+    set.path = path, set.format = CameraFormat::Gltf;
+    set.cameras = readGltfCameraNodes(path, std::string_view(file.data(), file.size()));
     return set;
 }
 

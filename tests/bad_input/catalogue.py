@@ -17,10 +17,12 @@ path, an option) generated at test time into its own fresh folder, and demands:
      byte-identical, no new file appeared, no 'zcheck-tmp' temporary is left;
   6. stdout holds nothing that looks like a report.
 
-Standard library only (python 3.11). Cases run on 2 worker threads. The cases named in
-EXTRA (variations of the same code paths) run only with --all, to keep the default run
-within ~90 s on 2 cores. -v prints every case's stderr; --keep keeps the case folders.
-Prints per-category counts and ends with the line "N passed, M failed"; exit 0 iff M == 0.
+Standard library only (python 3.11), except that the HDF5 depth-map cases write their files
+with h5py (python3-h5py), imported inside their files= callables. Cases run on 2 worker
+threads. The cases named in EXTRA (variations of the same code paths) run only with --all,
+to keep the default run within ~90 s on 2 cores. -v prints every case's stderr; --keep keeps
+the case folders. Prints per-category counts and ends with the line "N passed, M failed";
+exit 0 iff M == 0.
 """
 
 from __future__ import annotations
@@ -972,6 +974,378 @@ case("nothing-to-compare", "check-camera-looks-away-json", ["check", "--camera",
      files={"away.json": AWAY_CAM})
 
 # --------------------------------------------------------------------------------------
+# Imported cameras: COLMAP models, transforms.json, OpenCV and ROS calibration, FILE#FRAME
+# --------------------------------------------------------------------------------------
+COLMAP_CAMERAS = "# CAMERA_ID MODEL WIDTH HEIGHT PARAMS[]\n1 PINHOLE 64 48 50 50 32 24\n"
+# Two images (each line followed by its POINTS2D line), looking down +z (OpenCV) from z = -3.
+COLMAP_IMAGES = ("# IMAGE_ID QW QX QY QZ TX TY TZ CAMERA_ID NAME\n"
+                 "1 1 0 0 0 0 0 3 1 img_000.png\n\n"
+                 "2 1 0 0 0 0 0 4 1 img_001.png\n\n")
+
+
+def colmap_text(cameras=COLMAP_CAMERAS, images=COLMAP_IMAGES, folder="model"):
+    """The files of a COLMAP text model in `folder` (cameras.txt, images.txt)."""
+    return {f"{folder}/cameras.txt": cameras, f"{folder}/images.txt": images}
+
+
+def colmap_cameras_bin(cameras=((1, 1, 64, 48, (50, 50, 32, 24)),), count=None, cut=0):
+    """cameras.bin: uint64 count; per camera uint32 id, int32 model id, uint64 width, height,
+    float64 params. cut removes bytes from the end."""
+    data = struct.pack("<Q", len(cameras) if count is None else count)
+    for cam_id, model, width, height, params in cameras:
+        data += struct.pack(f"<IiQQ{len(params)}d", cam_id, model, width, height, *params)
+    return data[:len(data) - cut] if cut else data
+
+
+def colmap_images_bin(images=((1, 0.0, 3.0, 1, "img_000.png", 0),), count=None):
+    """images.bin: uint64 count; per image uint32 id, qvec (1, 0, 0, 0), tvec (0, ty, tz),
+    uint32 camera id, NUL-terminated name, uint64 num_points2D and (declared) that many
+    24-byte points, of which none are written when the count is above 4."""
+    data = struct.pack("<Q", len(images) if count is None else count)
+    for image_id, ty, tz, cam_id, name, points in images:
+        data += struct.pack("<I4d3dI", image_id, 1, 0, 0, 0, 0, ty, tz, cam_id) + name.encode() + b"\0"
+        data += struct.pack("<Q", points) + (b"\0" * 24 * points if points <= 4 else b"")
+    return data
+
+
+def colmap_binary(cameras=None, images=None, folder="model"):
+    return {f"{folder}/cameras.bin": cameras if cameras is not None else colmap_cameras_bin(),
+            f"{folder}/images.bin": images if images is not None else colmap_images_bin()}
+
+
+POSE = [[1, 0, 0, 0], [0, 1, 0, 1], [0, 0, 1, 3], [0, 0, 0, 1]]   # at (0, 1, 3) looking down -z (OpenGL)
+
+
+def transforms(frames=None, frame_patch=None, **top):
+    """A nerfstudio transforms.json: 64x48 pinhole intrinsics at the top level and one frame
+    (with a depth map path) unless `frames` is given; frame_patch updates frames[0]."""
+    doc = {"camera_model": "OPENCV", "fl_x": 50, "fl_y": 50, "cx": 32, "cy": 24, "w": 64, "h": 48,
+           "k1": 0, "k2": 0, "p1": 0, "p2": 0}
+    doc.update(top)
+    if frames is None:
+        frames = [{"file_path": "images/frame_000.png", "depth_file_path": "depth/frame_000.npy",
+                   "transform_matrix": POSE}]
+        frames[0].update(frame_patch or {})
+    doc["frames"] = frames
+    return to_json(doc, indent=2)
+
+
+def opencv_yaml(k=(50, 0, 32, 0, 50, 24, 0, 0, 1), drop=()):
+    """OpenCV FileStorage YAML as cv::FileStorage writes it (%YAML:1.0, !!opencv-matrix), K
+    on line 9; drop leaves out top-level keys."""
+    body = [
+        "image_width: 64",
+        "image_height: 48",
+        "camera_matrix: !!opencv-matrix",
+        "   rows: 3",
+        "   cols: 3",
+        "   dt: d",
+        "   data: [ " + ", ".join(str(v) for v in k) + " ]",
+        "distortion_coefficients: !!opencv-matrix",
+        "   rows: 1",
+        "   cols: 5",
+        "   dt: d",
+        "   data: [ 0., 0., 0., 0., 0. ]",
+    ]
+    out, skipping = [], False
+    for line in body:
+        if not line.startswith(" "):
+            skipping = line.split(":")[0] in drop
+        if not skipping:
+            out.append(line)
+    return "%YAML:1.0\n---\n" + "\n".join(out) + "\n"
+
+
+def opencv_xml(body=None, prolog='<?xml version="1.0"?>\n'):
+    body = body if body is not None else (
+        "<image_width>64</image_width>\n<image_height>48</image_height>\n"
+        '<camera_matrix type_id="opencv-matrix">\n  <rows>3</rows>\n  <cols>3</cols>\n  <dt>d</dt>\n'
+        "  <data>\n    50. 0. 32. 0. 50. 24. 0. 0. 1.</data></camera_matrix>\n")
+    return prolog + "<opencv_storage>\n" + body + "</opencv_storage>\n"
+
+
+def ros_yaml(k=(50, 0, 32, 0, 50, 24, 0, 0, 1), extra=()):
+    """A ROS camera_calibration_parsers file (camera_info_manager's YAML)."""
+    return "\n".join([
+        "image_width: 64",
+        "image_height: 48",
+        "camera_name: narrow_stereo",
+        "camera_matrix:",
+        "  rows: 3",
+        "  cols: 3",
+        "  data: [" + ", ".join(str(v) for v in k) + "]",
+        "distortion_model: plumb_bob",
+        "distortion_coefficients:",
+        "  rows: 1",
+        "  cols: 5",
+        "  data: [0, 0, 0, 0, 0]",
+        "projection_matrix:",
+        "  rows: 3",
+        "  cols: 4",
+        "  data: [50, 0, 32, 0, 0, 50, 24, 0, 0, 0, 1, 0]",
+        *extra,
+    ]) + "\n"
+
+
+# A CameraInfo message as `rostopic echo` prints it for a camera that was never calibrated:
+# everything zero (REP 104: K[0] = 0 means uncalibrated).
+ROS_UNCALIBRATED = (
+    "header:\n  seq: 0\n  stamp: {secs: 0, nsecs: 0}\n  frame_id: camera_optical\nheight: 48\nwidth: 64\n"
+    "distortion_model: plumb_bob\nD: [0.0, 0.0, 0.0, 0.0, 0.0]\nK: [" + ", ".join(["0.0"] * 9) + "]\n"
+    "R: [" + ", ".join(["0.0"] * 9) + "]\nP: [" + ", ".join(["0.0"] * 12) + "]\nbinning_x: 0\nbinning_y: 0\n"
+    "roi: {x_offset: 0, y_offset: 0, height: 0, width: 0, do_rectify: False}\n")
+
+CAMERA_USERS = {
+    "camera": lambda ref: ["camera", ref],
+    "check": lambda ref: ["check", "--camera", ref],
+    "matrices": lambda ref: ["matrices", "--camera", ref],
+    "precision": lambda ref: ["precision", "--camera", ref],
+    "unproject": lambda ref: ["unproject", "--camera", ref, "--pixel", "1,1"],
+    "export": lambda ref: ["export", "--camera", ref, "-o", "out.exr"],
+    "verify": lambda ref: ["verify", "--camera", ref, "--depth-map", "map.pfm", "--quantity", "eye-z"],
+}
+
+
+def import_case(name, files, ref, expect, cmd="check", extra=(), limit=20.0, rss=None):
+    """A camera file (or COLMAP model) that one of the commands reads with --camera REF
+    (`zcheck camera REF` for cmd="camera")."""
+    files = dict(files)
+    if cmd == "verify":
+        files["map.pfm"] = GOOD_MAP
+    case("camera-import", f"{cmd}-{name}", CAMERA_USERS[cmd](ref) + list(extra), expect, files=files, limit=limit,
+         max_rss_mb=rss)
+
+
+CT = r"model/cameras\.txt'"
+CB = r"model/cameras\.bin'"
+IB = r"model/images\.bin'"
+TJ = r"'t\.json'"
+BIG = str(2**60)
+
+# COLMAP text
+import_case("colmap-txt-parameter-count", colmap_text("1 PINHOLE 64 48 50 50 32\n"), "model#img_000.png",
+            rf"{CT}.*line 1.*PINHOLE.*takes 4 parameters.*has 3")
+import_case("colmap-txt-unknown-model", colmap_text("1 PINHOLEX 64 48 50 50 32 24\n"), "model#img_000.png",
+            rf"{CT}.*line 1.*unknown camera model 'PINHOLEX'", cmd="camera")
+import_case("colmap-txt-non-numeric-parameter", colmap_text("1 PINHOLE 64 48 50 5O 32 24\n"), "model#img_000.png",
+            rf"{CT}.*line 1.*'5O'.*not a (finite )?number", cmd="matrices")
+import_case("colmap-txt-duplicate-camera-id",
+            colmap_text("1 PINHOLE 64 48 50 50 32 24\n# again\n1 PINHOLE 64 48 60 60 32 24\n"), "model#img_000.png",
+            rf"{CT}.*line 3.*CAMERA_ID 1.*twice")
+import_case("colmap-txt-image-names-missing-camera",
+            colmap_text(images="1 1 0 0 0 0 0 3 1 img_000.png\n\n2 1 0 0 0 0 0 4 7 img_001.png\n\n"),
+            "model#img_000.png", r"images\.txt'? line 3.*CAMERA_ID 7.*not in", cmd="camera")
+import_case("colmap-txt-opencv-distorted", colmap_text("1 OPENCV 64 48 50 50 32 24 0.1 0 0 0\n"),
+            "model#img_000.png", r"images\.txt'? line 2.*OPENCV.*k1 = 0\.1.*(distortion|pinhole)", cmd="camera")
+import_case("colmap-txt-fisheye", colmap_text("1 OPENCV_FISHEYE 64 48 50 50 32 24 0 0 0 0\n"),
+            "model#img_001.png", r"images\.txt'? line 4.*OPENCV_FISHEYE.*(fisheye|not a pinhole)", cmd="export")
+import_case("colmap-txt-width-0", colmap_text("1 PINHOLE 0 48 50 50 32 24\n"), "model#img_000.png",
+            rf"{CT}.*line 1.*WIDTH.*'?0'?.*1\.\.16384")
+import_case("colmap-txt-negative-focal-length", colmap_text("1 PINHOLE 64 48 -50 50 32 24\n"), "model#img_000.png",
+            rf"(cameras\.txt'? line 1|{CT}.*line 1).*(focal|fx|parameter 1).*-50", cmd="camera")
+# COLMAP binary
+import_case("colmap-bin-truncated", colmap_binary(colmap_cameras_bin(cut=12)), "model#img_000.png",
+            rf"{CB}.*byte \d+.*needs 8 bytes.*(cut short|truncat)", limit=HOSTILE)
+import_case("colmap-bin-2^60-cameras", colmap_binary(colmap_cameras_bin(count=2**60)), "model#img_000.png",
+            rf"{CB}.*{BIG} cameras.*more than", limit=HOSTILE, rss=HOSTILE_RSS, cmd="camera")
+import_case("colmap-bin-2^60-images", colmap_binary(images=colmap_images_bin(count=2**60)), "model#img_000.png",
+            rf"{IB}.*{BIG} images.*more than", limit=HOSTILE, rss=HOSTILE_RSS)
+import_case("colmap-bin-unknown-model-id", colmap_binary(colmap_cameras_bin(((1, 99, 64, 48, (50, 50, 32, 24)),))),
+            "model#img_000.png", rf"{CB}.*camera 1.*model id 99", cmd="precision")
+import_case("colmap-bin-2^60-points2D",
+            colmap_binary(images=colmap_images_bin(((1, 0.0, 3.0, 1, "img_000.png", 2**60),))), "model#img_000.png",
+            rf"{IB}.*image record 0.*{BIG} 2-D points.*more than", limit=HOSTILE, rss=HOSTILE_RSS)
+# transforms.json
+import_case("transforms-no-frames", {"t.json": transforms(frames=[])}, "t.json",
+            rf"{TJ}.*(no frames?|no camera|empty)", cmd="camera")
+import_case("transforms-matrix-3-numbers", {"t.json": transforms(frame_patch={"transform_matrix": [1, 0, 0]})},
+            "t.json#0", rf"{TJ}.*'frames\[0\]\.transform_matrix'.*4 rows")
+import_case("transforms-matrix-reflection",
+            {"t.json": transforms(frame_patch={"transform_matrix": [[-1, 0, 0, 0], [0, 1, 0, 1], [0, 0, 1, 3],
+                                                                    [0, 0, 0, 1]]})}, "t.json#0",
+            rf"{TJ}.*frames\[0\]\.transform_matrix.*(reflection|mirror|det|handed)", cmd="verify")
+import_case("transforms-matrix-scaled-rotation",
+            {"t.json": transforms(frame_patch={"transform_matrix": [[2, 0, 0, 0], [0, 2, 0, 1], [0, 0, 2, 3],
+                                                                    [0, 0, 0, 1]]})}, "t.json#0",
+            rf"{TJ}.*frames\[0\]\.transform_matrix.*(scale|rigid|orthonormal|not a rotation)", cmd="unproject")
+import_case("transforms-w-640.5", {"t.json": transforms(w=640.5)}, "t.json#0",
+            rf"{TJ}.*'w'.*whole number.*640\.5")
+import_case("transforms-fisheye-camera-model", {"t.json": transforms(frame_patch={"camera_model": "OPENCV_FISHEYE"})},
+            "t.json#0", rf"{TJ}.*frames\[0\].*OPENCV_FISHEYE.*(fisheye|not a pinhole)", cmd="camera")
+import_case("transforms-nonzero-k1", {"t.json": transforms(k1=0.05)}, "t.json#images/frame_000.png",
+            rf"{TJ}.*frames\[0\].*distortion.*k1 = 0\.05")
+# OpenCV FileStorage YAML and XML
+import_case("opencv-yaml-no-camera-matrix", {"c.yml": opencv_yaml(drop=("camera_matrix",))}, "c.yml",
+            r"'c\.yml'.*no camera matrix")
+import_case("opencv-yaml-skew", {"c.yml": opencv_yaml(k=(50, 7, 32, 0, 50, 24, 0, 0, 1))}, "c.yml",
+            r"'c\.yml'.*camera_matrix.*skew", cmd="camera")
+import_case("opencv-yaml-repeated-key", {"c.yml": opencv_yaml() + "image_width: 640\n"}, "c.yml",
+            r"'c\.yml'.*line 15.*'?image_width'?.*repeated")
+import_case("opencv-yaml-unterminated-flow-sequence",
+            {"c.yml": opencv_yaml().replace("data: [ 50, 0, 32, 0, 50, 24, 0, 0, 1 ]", "data: [ 50, 0, 32, 0, 50,")},
+            "c.yml", r"'c\.yml'.*\bline 9\b.*flow sequence|'c\.yml'.*flow sequence.*\bline 9\b", cmd="camera")
+import_case("opencv-yaml-anchor-alias",
+            {"c.yml": opencv_yaml().replace("camera_matrix: !!opencv-matrix", "camera_matrix: &K !!opencv-matrix")
+             + "new_camera_matrix: *K\n"}, "c.yml", r"'c\.yml'.*line (5|15).*anchor")
+import_case("opencv-yaml-deep-nesting", {"c.yml": "%YAML:1.0\n---\nimage_width: 64\nnest: " + "[" * 100000 +
+                                         "]" * 100000 + "\n"}, "c.yml",
+            r"'c\.yml'.*line 4.*(nested|deeper|depth)", limit=HOSTILE, rss=HOSTILE_RSS)
+import_case("opencv-xml-mismatched-tags", {"c.xml": opencv_xml().replace("<cols>3</cols>", "<cols>3</rows>")}, "c.xml",
+            r"'c\.xml'.*line 7.*</rows>.*closes.*<cols>", cmd="camera")
+import_case("opencv-xml-doctype",
+            {"c.xml": opencv_xml(prolog='<?xml version="1.0"?>\n<!DOCTYPE opencv_storage [<!ENTITY x "50.">]>\n')},
+            "c.xml", r"'c\.xml'.*line 2.*DOCTYPE")
+import_case("opencv-xml-deep-nesting", {"c.xml": opencv_xml("<a>" + "<b>" * 100000 + "</b>" * 100000 + "</a>\n")},
+            "c.xml", r"'c\.xml'.*line 3.*(nested|deeper|depth)", limit=HOSTILE, rss=HOSTILE_RSS, cmd="camera")
+# FileStorage's third form, JSON: the nesting limit of its reader names the file too
+import_case("opencv-json-deep-nesting", {"c.json": '{"camera_matrix": ' + "[" * 100000 + "]" * 100000 + "}\n"},
+            "c.json", r"'c\.json'.*(nested|deeper|depth)", extra=["--camera-format", "opencv"], limit=HOSTILE,
+            rss=HOSTILE_RSS, cmd="camera")
+# ROS CameraInfo
+import_case("ros-k-zero-uncalibrated", {"c.yaml": ROS_UNCALIBRATED}, "c.yaml", r"'c\.yaml'.*K\[0\].*uncalibrated",
+            cmd="camera")
+import_case("ros-binning", {"c.yaml": ros_yaml(extra=("binning_x: 2", "binning_y: 1"))}, "c.yaml",
+            r"'c\.yaml'.*binning_x is 2.*binned")
+# glTF camera nodes (FILE#NODE-NAME)
+
+
+def gltf_camera(node=None, **perspective):
+    """A mutate for gltf(): a perspective camera node 'cam' at (0, 1, 3) added to the scene."""
+    def mutate(doc):
+        lens = {"yfov": 0.8, "znear": 0.1, "zfar": 100, **perspective}
+        doc["cameras"] = [{"type": "perspective", "perspective": lens}]
+        doc["nodes"].append({"name": "cam", "camera": 0, "translation": [0, 1, 3], **(node or {})})
+        doc["scenes"][0]["nodes"].append(len(doc["nodes"]) - 1)
+    return mutate
+
+
+import_case("gltf-yfov-beyond-pi", {"t.gltf": gltf(gltf_camera(yfov=4))}, "t.gltf#cam",
+            r"'t\.gltf'.*cameras\[0\]\.perspective\.yfov.*\b4\b.*pi", cmd="camera")
+case("camera-import", "check-gltf-camera-scaled-to-zero", ["check", "--scene", "t.gltf", "--camera", "t.gltf#cam"],
+     r"'t\.gltf'.*nodes\[1\].*scales its camera to zero", files={"t.gltf": gltf(gltf_camera({"scale": [0, 1, 1]}))})
+# FILE#FRAME, folders, --camera-format
+import_case("frame-unknown", colmap_text(), "model#img_007.png", r"'model'.*no frame 'img_007\.png'", cmd="camera")
+import_case("frame-ambiguous",
+            colmap_text(images="1 1 0 0 0 0 0 3 1 left/img.png\n\n2 1 0 0 0 0 0 4 1 right/img.png\n\n"),
+            "model#img", r"'model'.*frame 'img'.*several cameras")
+import_case("folder-not-a-colmap-model", {"model/cameras.txt": COLMAP_CAMERAS}, "model",
+            r"'model'.*(not a COLMAP model|images\.(txt|bin))")
+import_case("camera-format-unknown", {"c.json": GOOD_CAM}, "c.json", r"camera.format.*'colmap2'.*(expected|colmap, )",
+            extra=["--camera-format", "colmap2"])
+
+# --------------------------------------------------------------------------------------
+# Depth map formats: NumPy .npy, COLMAP dense maps, HDF5
+# --------------------------------------------------------------------------------------
+
+
+def npy(shape=(48, 64), descr="<f4", value=5.0, header=None, length=None, cut=0, data=None):
+    """A NumPy .npy (version 1.0) holding `value` everywhere; `header` replaces the dict,
+    `length` the declared header length, `data` the payload."""
+    head = header if header is not None else (
+        "{'descr': '%s', 'fortran_order': False, 'shape': %s, }" % (descr, repr(tuple(shape))))
+    head += " " * ((64 - (10 + len(head) + 1) % 64) % 64) + "\n"
+    if data is None:
+        count = 1
+        for n in shape:
+            count *= n
+        data = struct.pack("<f", value) * count if count <= 1 << 20 else b""
+    out = b"\x93NUMPY\x01\x00" + struct.pack("<H", len(head) if length is None else length) + head.encode() + data
+    return out[:len(out) - cut] if cut else out
+
+
+def colmap_depth(width=64, height=48, channels=1, value=5.0, header=None, cut=0):
+    """A COLMAP dense map: "W&H&C&" and float32 values (none when the header is huge)."""
+    head = header if header is not None else f"{width}&{height}&{channels}&".encode()
+    n = width * height * channels
+    out = head + (struct.pack("<f", value) * n if n <= 1 << 20 else b"")
+    return out[:len(out) - cut] if cut else out
+
+
+def hdf5_file(build):
+    """A files= callable: an HDF5 file made with h5py (imported here, so that the catalogue
+    itself needs only the standard library); build(h5py_file) fills it."""
+    def make(path):
+        import h5py  # python3-h5py
+        with h5py.File(path, "w") as f:
+            build(f)
+    return make
+
+
+def depth_case(name, files, expect, extra=(), limit=20.0, rss=None, quantity="eye-z"):
+    mapname = next(iter(files))
+    case("depth-format", name, ["verify", "--camera", "cam.json", "--depth-map", mapname, "--quantity", quantity]
+         + list(extra), expect, files={**MAP_CAM, **files}, limit=limit, max_rss_mb=rss)
+
+
+NPY = r"'m\.npy'"
+CDB = r"'m\.bin'"
+H5 = r"'m\.h5'"
+depth_case("npy-dtype-bool", {"m.npy": npy(descr="|b1", data=b"\1" * 3072)},
+           rf"{NPY}.*\|b1.*(not one zcheck reads|dtype)")
+depth_case("npy-1-d-shape", {"m.npy": npy(shape=(3072,))}, rf"{NPY}.*1 dimensions?.*(height, width)")
+depth_case("npy-header-length-beyond-file", {"m.npy": npy(length=60000)}, rf"{NPY}.*header.*60000.*more than the file")
+depth_case("npy-99999999999-rows", {"m.npy": npy(shape=(99999999999, 64))}, rf"{NPY}.*64x99999999999.*64x48",
+           limit=HOSTILE, rss=HOSTILE_RSS)
+depth_case("colmap-3-channels", {"m.bin": colmap_depth(channels=3)}, rf"{CDB}.*3 channels.*(normal map|depth has 1)")
+depth_case("colmap-truncated", {"m.bin": colmap_depth(cut=100)}, rf"{CDB}.*12188 bytes.*12288.*truncated")
+depth_case("colmap-huge-header", {"m.bin": colmap_depth(header=b"9999999999&9999999999&1&")},
+           rf"{CDB}.*9999999999x9999999999.*64x48", limit=HOSTILE, rss=HOSTILE_RSS)
+depth_case("hdf5-signature-then-garbage", {"m.h5": b"\x89HDF\r\n\x1a\n" + garbage(4000)},
+           rf"{H5}.*(malformed|HDF5)", limit=HOSTILE, rss=HOSTILE_RSS)
+depth_case("hdf5-99999999999-rows",
+           {"m.h5": hdf5_file(lambda f: f.create_dataset("depth", shape=(99999999999, 64), dtype="f4",
+                                                         chunks=(1, 64)))},
+           rf"{H5}.*'depth'.*64x99999999999.*(16384|64x48)", limit=HOSTILE, rss=HOSTILE_RSS)
+
+
+def group_only(f):
+    f.create_group("depth").attrs["units"] = "m"
+
+
+depth_case("hdf5-no-dataset", {"m.h5": hdf5_file(group_only)}, rf"{H5}.*no dataset")
+
+# --------------------------------------------------------------------------------------
+# Datasets: dataset verify, report, import, submit
+# --------------------------------------------------------------------------------------
+DS_FILES = {"t.json": transforms()}
+DSV = ["dataset", "verify", "t.json", "--quantity", "eye-z"]
+
+
+def record(index=0, of=1, source="t.json", frame="images/frame_000.png", consistent=True):
+    """One line of a results file (`dataset verify -o`), with the keys `dataset report` needs."""
+    return json.dumps({"frame": frame, "source": source, "scene": "builtin:default", "index": index, "of": of,
+                       "consistent": consistent, "seconds": 0.1}) + "\n"
+
+
+case("dataset", "verify-missing-source", ["dataset", "verify", "nothere.json", "--quantity", "eye-z"],
+     r"^(?!.*COLMAP).*'nothere\.json'.*No such file")
+case("dataset", "verify-camera-file-as-source", ["dataset", "verify", "cam.json", "--quantity", "eye-z"],
+     r"'cam\.json'.*zcheck camera.*(transforms\.json|COLMAP|manifest)", files=dict(MAP_CAM))
+case("dataset", "verify-colmap-without-depth", ["dataset", "verify", "model", "--quantity", "eye-z"],
+     r"'model'.*--depth", files=colmap_text())
+case("dataset", "verify-shard-3-of-3", DSV + ["--shard", "3/3"], r"--shard.*'?3/3'?.*(I < N|0 <= I)",
+     files=dict(DS_FILES))
+case("dataset", "verify-shard-x", DSV + ["--shard", "x"], r"--shard.*'x'.*I/N", files=dict(DS_FILES))
+case("dataset", "verify-results-exist-without-resume", DSV + ["-o", "results.jsonl"],
+     r"'results\.jsonl'.*exists.*--resume", files=dict(DS_FILES), guard=("results.jsonl",))
+case("dataset", "verify-resume-without-output", DSV + ["--resume"], r"--resume.*-o", files=dict(DS_FILES))
+case("dataset", "verify-resume-results-of-another-dataset", DSV + ["-o", "results.jsonl", "--resume"],
+     r"'results\.jsonl' line 1.*'other/t\.json'.*not this run",
+     files={**DS_FILES, "results.jsonl": record(source="other/t.json", of=5)})
+case("dataset", "verify-manifest-without-frames", ["dataset", "verify", "m.jsonl", "--quantity", "eye-z"],
+     r"'m\.jsonl'.*no frames", files={"m.jsonl": "\n  \n\n"})
+case("dataset", "report-malformed-line-not-last", ["dataset", "report", "r.jsonl"],
+     r"'r\.jsonl' line 2.*(JSON|parse)",
+     files={"r.jsonl": record(0, 3) + '{"frame": "images/frame_001.png", "source": \n' + record(2, 3, frame="f2")})
+case("dataset", "report-two-datasets", ["dataset", "report", "a.jsonl", "b.jsonl"],
+     r"'b\.jsonl' line 1.*dataset 'b\.json'.*'a\.json'.*(do not merge|different)",
+     files={"a.jsonl": record(source="a.json", of=2), "b.jsonl": record(1, 2, source="b.json")})
+case("dataset", "import-manifest", ["dataset", "import", "m.jsonl", "-o", "out.jsonl"], r"'m\.jsonl'.*manifest already",
+     files={"m.jsonl": '{"frame": "f0", "camera": "cam.json", "depth": "d.pfm", "quantity": "eye-z"}\n', **MAP_CAM})
+case("dataset", "submit-tasks-0", ["dataset", "submit", "t.json", "--quantity", "eye-z", "--tasks", "0", "--out", "run",
+                                   "--dry-run"], rf"--tasks.*{value_rx('0')}", files=dict(DS_FILES))
+
+# --------------------------------------------------------------------------------------
 # Run only with --all: variations that exercise the same code path as a case above. Every
 # zcheck start costs ~0.3 s of CPU (262 shared libraries), and the default run must fit in
 # ~90 s on 2 cores.
@@ -1020,6 +1394,7 @@ mesh/obj-coordinate-1e19 options/suite-filter-matches-nothing output/unproject-o
 output/export-output-is-directory output/export-png-without-scale output/unproject-output-missing-folder
 output/suite-json-is-directory output/suite-html-same-as-json full-disk/export-exr-with-preview
 depth-map/verify-depth-map-empty-path camera/verify-width-100000 camera/unproject-up-parallel
+camera-import/camera-opencv-xml-deep-nesting camera-import/check-gltf-camera-scaled-to-zero
 """.split())
 
 # --------------------------------------------------------------------------------------

@@ -98,9 +98,13 @@ def write_hdf5(path, **datasets):
 
 
 class Trajectory:
-    """FRAMES cameras on a ring around the scene's bounds, looking at its centre."""
+    """`frames` cameras on a ring around the scene's bounds, looking at its centre; intrinsics
+    FX, FY, CX, CY scaled to a `width` x `height` image."""
 
-    def __init__(self, scene, frames=FRAMES):
+    def __init__(self, scene, frames=FRAMES, width=W, height=H):
+        self.width, self.height = width, height
+        self.fx = FX * width / W
+        self.cx, self.cy = width / 2, height / 2
         lo, hi = scene.bounds
         self.center = (lo + hi) / 2
         radius = np.linalg.norm(hi - lo) / 2
@@ -110,22 +114,23 @@ class Trajectory:
             eye = self.center + radius * np.array([2.2 * math.sin(a), 0.8 + 0.3 * math.sin(3 * a), 2.2 * math.cos(a)])
             self.poses.append(look_at_cam_from_world(eye, self.center))
         self.names = [f"frame_{i:03d}.png" for i in range(frames)]
-        self.k = np.array([[FX, 0, CX - 0.5], [0, FY, CY - 0.5], [0, 0, 1]])  # OpenCV's coordinates
+        self.k = np.array([[self.fx, 0, self.cx - 0.5], [0, self.fx, self.cy - 0.5], [0, 0, 1]])  # OpenCV's coordinates
 
     def camera(self, i, near=None, far=None):
         """The frame's camera as zcheck sees it, near and far hugging the scene (for rendering)."""
-        return zcheck.Camera.from_opencv(self.k, cam_from_world=self.poses[i], width=W, height=H,
+        return zcheck.Camera.from_opencv(self.k, cam_from_world=self.poses[i], width=self.width, height=self.height,
                                          near=near or 0.05, far=far or 100.0)
 
 
 class DatasetMaker:
-    def __init__(self, root, mesh):
+    def __init__(self, root, mesh, frames=FRAMES, width=W, height=H):
         self.root = Path(root)
         self.root.mkdir(parents=True, exist_ok=True)
         self.mesh = str(mesh)
         self.scene = zcheck.Scene.from_file(self.mesh)
         self.checker = zcheck.Checker(self.scene)
-        self.trajectory = Trajectory(self.scene)
+        self.trajectory = Trajectory(self.scene, frames, width, height)
+        self.frames = frames
         self._eye_z = {}
         self._distance = {}
 
@@ -150,16 +155,17 @@ class DatasetMaker:
         point is OpenCV's (W − 1)/2 written where COLMAP's W/2 belongs."""
         folder = self.root / folder
         folder.mkdir(parents=True, exist_ok=True)
-        cameras = [f"1 PINHOLE {W} {H} {FX!r} {FY!r} {CX!r} {CY!r}"]
+        t = self.trajectory
+        cameras = [f"1 PINHOLE {t.width} {t.height} {t.fx!r} {t.fx!r} {t.cx!r} {t.cy!r}"]
         if broken_cx:
-            cameras.append(f"2 PINHOLE {W} {H} {FX!r} {FY!r} {CX - 0.5!r} {CY - 0.5!r}")
+            cameras.append(f"2 PINHOLE {t.width} {t.height} {t.fx!r} {t.fx!r} {t.cx - 0.5!r} {t.cy - 0.5!r}")
         (folder / "cameras.txt").write_text("# Camera list with one line of data per camera:\n"
                                             "#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n"
                                             f"# Number of cameras: {len(cameras)}\n" + "\n".join(cameras) + "\n")
         lines = ["# Image list with two lines of data per image:",
                  "#   IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME",
                  "#   POINTS2D[] as (X, Y, POINT3D_ID)",
-                 f"# Number of images: {FRAMES}, mean observations per image: 0"]
+                 f"# Number of images: {self.frames}, mean observations per image: 0"]
         for i, (pose, name) in enumerate(zip(self.trajectory.poses, self.trajectory.names)):
             q, t = quaternion_of(pose[:3, :3]), pose[:3, 3]
             camera = 2 if i in broken_cx else 1
@@ -208,7 +214,9 @@ class DatasetMaker:
                 write_png16(depth_path, codes)
             frames.append({"file_path": f"images/{image}", "depth_file_path": str(depth_path.relative_to(self.root)),
                            "transform_matrix": matrix.tolist()})
-        document = {"camera_model": "OPENCV", "fl_x": FX, "fl_y": FY, "cx": CX, "cy": CY, "w": float(W), "h": float(H),
+        t = self.trajectory
+        document = {"camera_model": "OPENCV", "fl_x": t.fx, "fl_y": t.fx, "cx": t.cx, "cy": t.cy, "w": float(t.width),
+                    "h": float(t.height),
                     "k1": 0.0, "k2": 0.0, "p1": 0.0, "p2": 0.0, "frames": frames}
         path = self.root / name
         path.write_text(json.dumps(document, indent=1))
@@ -226,7 +234,7 @@ class DatasetMaker:
             data = ", ".join(repr(float(v)) for v in np.ravel(values))
             return f"{name}: !!opencv-matrix\n   rows: {rows}\n   cols: {cols}\n   dt: d\n   data: [ {data} ]\n"
 
-        path.write_text("%YAML:1.0\n---\n" + f"image_width: {W}\nimage_height: {H}\n" + matrix("camera_matrix", 3, 3, k) +
+        path.write_text("%YAML:1.0\n---\n" + f"image_width: {self.trajectory.width}\nimage_height: {self.trajectory.height}\n" + matrix("camera_matrix", 3, 3, k) +
                         matrix("distortion_coefficients", 5, 1, np.zeros(5)) + matrix("R", 3, 3, pose[:3, :3]) +
                         matrix("T", 3, 1, pose[:3, 3]))
         return path
@@ -236,7 +244,7 @@ class DatasetMaker:
         vertices = np.asarray(self.scene.vertices, "<f4")
         triangles = np.asarray(self.scene.triangles, "<u4")
         blob = vertices.tobytes() + triangles.tobytes()
-        yfov = 2 * math.atan(H / 2 / FY)
+        yfov = 2 * math.atan(self.trajectory.height / 2 / self.trajectory.fx)
         nodes = [{"mesh": 0, "name": "mesh"}]
         for i, pose in enumerate(self.trajectory.poses):
             c2w = np.linalg.inv(pose) @ OPENCV_TO_OPENGL
@@ -250,7 +258,8 @@ class DatasetMaker:
                            "min": vertices.min(0).tolist(), "max": vertices.max(0).tolist()},
                           {"bufferView": 1, "componentType": 5125, "count": triangles.size, "type": "SCALAR"}],
             "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
-            "cameras": [{"type": "perspective", "perspective": {"yfov": yfov, "aspectRatio": W / H, "znear": 0.05, "zfar": 100}}],
+            "cameras": [{"type": "perspective", "perspective": {"yfov": yfov, "aspectRatio": self.trajectory.width / self.trajectory.height,
+                                                                "znear": 0.05, "zfar": 100}}],
             "nodes": nodes,
             "scenes": [{"nodes": list(range(len(nodes)))}],
             "scene": 0,

@@ -1,0 +1,174 @@
+#!/usr/bin/env bash
+# Blender end to end: Cycles renders the Stanford bunny on a ground plane through perspective
+# cameras (shifted; HORIZONTAL, VERTICAL and AUTO sensor fit; tall and square pixels; a scaled
+# camera object; an animated one) and an orthographic one (render_and_check.py);
+# zcheck.blender writes the manifest, and `zcheck dataset verify` must find every frame
+# consistent, and exactly the frames broken on purpose inconsistent: a camera's shift_x
+# written with the wrong sign, and a Z pass flipped upside down.
+#
+#   PYTHONPATH=build/python bash tests/blender/test_blender.sh build/cli/zcheck ../shared/data/models
+#
+# Blender runs headless in the background and is stopped by its pid after BLENDER_TIMEOUT
+# seconds (default 600). BLENDER names the executable (default: blender); without one the
+# test is skipped (exit 77). Without PYTHONPATH, build/python beside the executable is used.
+set -euo pipefail
+zcheck=$1
+models=$2
+here=$(cd "$(dirname "$0")" && pwd)
+blender=${BLENDER:-blender}
+timeout_s=${BLENDER_TIMEOUT:-600}
+if ! command -v "$blender" > /dev/null; then
+    echo "test_blender: skipped: no Blender ('$blender') on this machine"
+    exit 77
+fi
+export PYTHONPATH=${PYTHONPATH:-$(cd "$(dirname "$zcheck")/../python" && pwd)}
+
+tmp=$(mktemp -d)
+blender_pid=
+passed=0
+failed=0
+cleanup() {
+    if [[ -n $blender_pid ]] && kill -0 "$blender_pid" 2> /dev/null; then
+        kill "$blender_pid" 2> /dev/null || true
+    fi
+    if [[ $failed -eq 0 ]]; then rm -rf "$tmp"; else echo "test_blender: renders, logs and results kept in $tmp"; fi
+}
+trap cleanup EXIT
+out=$tmp/out
+
+pass() { echo "ok    $1"; passed=$((passed + 1)); }
+fail() { echo "FAIL  $1"; failed=$((failed + 1)); }
+finish() {
+    echo "test_blender: $passed passed, $failed failed"
+    exit $((failed > 0 ? 1 : 0))
+}
+
+# --- render: Blender in the background, stopped by its pid if it overruns ---------------------
+"$blender" -b --factory-startup --python-exit-code 1 -P "$here/render_and_check.py" -- \
+    "$out" "$models/stanford-bunny.obj" > "$tmp/blender.log" 2>&1 &
+blender_pid=$!
+waited=0
+while kill -0 "$blender_pid" 2> /dev/null && [[ $waited -lt $timeout_s ]]; do
+    sleep 1
+    waited=$((waited + 1))
+done
+if kill -0 "$blender_pid" 2> /dev/null; then
+    kill "$blender_pid"
+    sleep 5
+    kill -9 "$blender_pid" 2> /dev/null || true
+    tail -n 20 "$tmp/blender.log"
+    fail "Blender rendered within ${timeout_s} s (stopped: pid $blender_pid)"
+    blender_pid=
+    finish
+fi
+set +e
+wait "$blender_pid"
+status=$?
+set -e
+blender_pid=
+grep "^render_and_check: " "$tmp/blender.log" | sed 's/^/      /'
+if [[ $status -ne 0 || ! -s $out/manifest.jsonl || ! -s $out/checks.json ]]; then
+    tail -n 30 "$tmp/blender.log"
+    fail "Blender rendered the frames and wrote the manifest (exit status $status)"
+    finish
+fi
+pass "Blender rendered 10 frames, exported the scene and wrote the manifest with zcheck.blender"
+
+# --- the second route and Cycles's sample positions (checks.json) ------------------------------
+if python3 - "$out/checks.json" << 'EOF'; then
+import json, sys
+checks = json.load(open(sys.argv[1]))
+worst = max(f["projection"]["max_px"] for f in checks["frames"].values())
+worst_in = max(f["projection"]["max_px_in_image"] for f in checks["frames"].values())
+depth = max(f["projection"]["max_depth_rel"] for f in checks["frames"].values())
+print(f"      world_to_camera_view vs zcheck: {worst:.2e} px at most ({worst_in:.2e} px inside the image), "
+      f"eye depth {depth:.1e} relative")
+assert len(checks["frames"]) == 10 and worst <= 1e-3, worst
+EOF
+    pass "Blender's own projection (world_to_camera_view) agrees with zcheck's camera within 1e-3 px"
+else
+    fail "Blender's own projection (world_to_camera_view) agrees with zcheck's camera within 1e-3 px"
+fi
+if python3 - "$out/checks.json" << 'EOF'; then
+import json, sys
+frames = json.load(open(sys.argv[1]))["frames"]
+offset = max(max(f["samples"]["max_offset_px"]) for f in frames.values())
+beyond = sum(f["samples"]["pixels_beyond_2^-8"] for f in frames.values())
+pixels = sum(f["samples"]["hit_pixels"] for f in frames.values())
+print(f"      Cycles sampled the Z pass up to {offset:.5f} px off the pixel centre; "
+      f"{beyond} of {pixels} pixels beyond 2^-8 px")
+assert beyond == 0
+EOF
+    pass "Cycles took every pixel's depth within 2^-8 px of its centre (Position pass)"
+else
+    fail "Cycles took every pixel's depth within 2^-8 px of its centre (Position pass)"
+fi
+if python3 - "$out/checks.json" << 'EOF'; then
+import json, sys
+refusals = json.load(open(sys.argv[1]))["refusals"]
+assert sorted(refusals) == ["border", "panoramic", "sheared"], refusals
+for case, message in refusals.items():
+    print(f"      {case}: {message}")
+EOF
+    pass "camera_from_object refuses a panoramic camera, a sheared pose and a render border by name"
+else
+    fail "camera_from_object refuses a panoramic camera, a sheared pose and a render border by name"
+fi
+
+# verify MANIFEST RESULTS: `zcheck dataset verify`, its exit status in $verify_status.
+verify() {
+    set +e
+    "$zcheck" dataset verify "$1" --scene "$out/scene.obj" --quantity eye-z --miss '>=1e9' -o "$2" \
+        > "$2.txt" 2>&1
+    verify_status=$?
+    set -e
+    sed 's/^/      /' "$2.txt"
+}
+# inconsistent RESULTS NAMES...: every frame recorded without error, exactly NAMES inconsistent.
+inconsistent() {
+    python3 - "$@" << 'EOF'
+import json, sys
+records = [json.loads(line) for line in open(sys.argv[1])]
+expected = set(sys.argv[2:])
+assert len(records) == 10, len(records)
+assert all(r["error"] is None for r in records), [r["error"] for r in records if r["error"]]
+found = {r["frame"] for r in records if not r["consistent"]}
+assert found == expected, f"inconsistent frames {sorted(found)}, expected {sorted(expected)}"
+EOF
+}
+
+# --- every frame as rendered: consistent -------------------------------------------------------
+verify "$out/manifest.jsonl" "$tmp/results.jsonl"
+if [[ $verify_status -eq 0 ]] && inconsistent "$tmp/results.jsonl"; then
+    pass "zcheck dataset verify: all 10 frames of the Cycles renders consistent"
+else
+    fail "zcheck dataset verify: all 10 frames of the Cycles renders consistent (exit $verify_status)"
+fi
+
+# --- camera B's shift_x with the wrong sign: exactly its frames inconsistent --------------------
+verify "$out/manifest_shift_flipped.jsonl" "$tmp/results_shift.jsonl"
+if [[ $verify_status -eq 1 ]] && inconsistent "$tmp/results_shift.jsonl" tall_0002 square_0002; then
+    pass "a camera's shift_x sign flipped: exactly its frames (tall_0002, square_0002) inconsistent"
+else
+    fail "a camera's shift_x sign flipped: exactly its frames (tall_0002, square_0002) inconsistent (exit $verify_status)"
+fi
+
+# --- one Z pass upside down (the orthographic frame): exactly that frame inconsistent ----------
+oiiotool "$out/tall/depth_0003.exr" --flip -o "$out/tall/depth_0003_flipped.exr"
+python3 - "$out/manifest.jsonl" "$out/manifest_z_flipped.jsonl" << 'EOF'
+import json, sys
+with open(sys.argv[1]) as src, open(sys.argv[2], "w") as dst:
+    for line in src:
+        record = json.loads(line)
+        if record["frame"] == "tall_0003":
+            record["depth"] = "tall/depth_0003_flipped.exr"
+        dst.write(json.dumps(record) + "\n")
+EOF
+verify "$out/manifest_z_flipped.jsonl" "$tmp/results_z.jsonl"
+if [[ $verify_status -eq 1 ]] && inconsistent "$tmp/results_z.jsonl" tall_0003; then
+    pass "one Z pass flipped upside down: exactly that frame (tall_0003) inconsistent"
+else
+    fail "one Z pass flipped upside down: exactly that frame (tall_0003) inconsistent (exit $verify_status)"
+fi
+
+finish
