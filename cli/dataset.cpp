@@ -257,14 +257,14 @@ int runDatasetVerify(const DatasetVerifyOptions& o)
     const auto threadLimit = limitThreads(o.threads);
     const std::string output = o.output.empty() ? "-" : o.output;
     if (o.resume && output == "-") throw Error("--resume completes a results file: give it with -o FILE");
-    if (!o.resume && output != "-" && fileHasContent(output))
-        throw Error("results file '" + output + "' exists: --resume completes it; remove it to start over");
     if (output != "-") {
         OutputFiles check;  // the path rules (a folder, an input, a missing parent) before any work
         check.addInput(o.source);
         check.addInput(o.scene.rfind("builtin:", 0) == 0 ? "" : o.scene);
         check.add(output, "-o");
     }
+    if (!o.resume && output != "-" && fileHasContent(output))
+        throw Error("results file '" + output + "' exists: --resume completes it; remove it to start over");
     const DatasetRunner runner(openSource(o), runOptions(o), [](const std::string& path, const DepthMapReading& reading,
                                                                int width, int height) {
         return images().readDepthMap(path, reading, width, height);

@@ -66,7 +66,7 @@ std::string withoutDotSlash(std::string path)
 // The first bytes of a file (at most `count`), for telling formats apart; "" if unreadable.
 std::string headOf(const std::string& path, std::size_t count)
 {
-    checkInputFile(path, kColmapModelInput);
+    checkInputFile(path, kCameraSetInput);
     const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
     if (fd < 0) return "";
     std::string head(count, '\0');
@@ -106,6 +106,10 @@ std::pair<std::string, std::string> splitCameraReference(const std::string& refe
 CameraFormat detectCameraFormat(const std::string& path)
 {
     if (!importers::colmapModelFolder(path).empty()) return CameraFormat::Colmap;
+    struct stat status {};
+    if (::stat(path.c_str(), &status) == 0 && S_ISDIR(status.st_mode))
+        throw Error("'" + path + "' is a directory but not a COLMAP model: a model holds cameras.txt and images.txt, or "
+                    "cameras.bin and images.bin");
     // The head is enough: every writer puts these keys near the start of the document.
     const std::string head = skipSpaceAndBom(headOf(path, std::size_t(1) << 20));
     if (head.rfind("glTF", 0) == 0) return CameraFormat::Gltf;

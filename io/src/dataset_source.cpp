@@ -82,7 +82,7 @@ public:
     Dataset read()
     {
         Dataset dataset{path_, "manifest", {}};
-        std::istringstream in(readInputFile(path_, kCameraSetInput));
+        std::istringstream in(readInputFile(path_, kManifestInput));
         std::set<std::string> names;
         std::size_t lineNumber = 0;
         for (std::string line; std::getline(in, line);) {

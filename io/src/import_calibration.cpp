@@ -121,7 +121,13 @@ public:
             if (root.name != "opencv_storage") fail("an XML calibration file's root element must be <opencv_storage>");
             root_ = nodeFromXml(root, source());
         } else if (text.compare(start, 1, "{") == 0) {
-            root_ = nodeFromJson(parseJsonStrictly(text, source()));
+            try {
+                root_ = nodeFromJson(parseJsonStrictly(text, source()));
+            } catch (const Error& e) {
+                const std::string what = e.what();
+                if (what.rfind(source(), 0) == 0) throw;
+                fail(what);
+            }
         } else {
             root_ = yaml::parse(text, source());
         }
@@ -344,8 +350,20 @@ private:
         const int width = pixels(*w, wKey), height = pixels(*h, hKey);
         const Matrix K = shaped(*k, kKey, 3, 3);
 
+        // An uncalibrated camera (K[0] = 0, REP 104) has no intrinsics to read: both cameras are
+        // kept with the refusal, before K's form is judged.
+        if (K.at(0, 0) == 0) {
+            CameraSet set;
+            set.path = path_, set.format = CameraFormat::Ros, set.defaultCamera = 0;
+            for (const char* name : {"raw", "rectified"}) {
+                ImportedCamera uncalibrated;
+                uncalibrated.name = name;
+                uncalibrated.refusal = source() + ": " + kKey + "[0] is 0: the camera is uncalibrated (REP 104)";
+                set.cameras.push_back(uncalibrated);
+            }
+            return set;
+        }
         std::string refusal;
-        if (K.at(0, 0) == 0) refusal = source() + ": " + kKey + "[0] is 0: the camera is uncalibrated (REP 104)";
         for (const char* key : {"binning_x", "binning_y"})
             if (const Node* b = root_.findIgnoringCase(key); b && number(*b, key) > 1)
                 refusal = source() + ": " + key + " is " + b->scalar +
@@ -377,7 +395,7 @@ private:
         if (p) {
             const Matrix P = shaped(*p, pKey, 3, 4);
             ImportedCamera rectified;
-            if (P.allZero()) {
+            if (P.allZero() || P.at(0, 0) == 0) {
                 rectified.name = "rectified";
                 rectified.refusal = source() + ": " + pKey + " is all zero: there is no rectified camera";
             } else {

@@ -103,10 +103,26 @@ struct ColmapCamera {
     std::string refusal;  // not a pinhole
 };
 
-// A camera's intrinsics, or why they are not a pinhole's. `where` names the line or record.
+// A camera's intrinsics, or why they are not a pinhole's. `where` names the line or record,
+// which an impossible value (a focal length ≤ 0, a principal point beyond what binary32 rays
+// can hold) is refused with, whichever image uses the camera.
 ColmapCamera cameraOf(const ModelInfo& model, std::int64_t width, std::int64_t height, const std::vector<double>& p,
                       const std::string& where)
 {
+    {
+        const std::size_t f = std::size_t(model.focals);
+        CameraSpec spec;
+        spec.convention = Convention::preset("opencv");
+        spec.width = int(width), spec.height = int(height);
+        spec.view.hasMatrix = true;
+        try {
+            spec.projection = PinholeIntrinsics{p[0], p[f == 1 ? 0 : 1], p[f], p[f + 1], 0.5}.projection(
+                kPlaceholderNear, kPlaceholderFar, "intrinsics");
+            Camera validated(spec);
+        } catch (const Error& e) {
+            throw Error(where + ": " + e.what());
+        }
+    }
     ColmapCamera camera;
     camera.width = width, camera.height = height;
     const std::size_t f = std::size_t(model.focals);
@@ -171,11 +187,12 @@ public:
         if (!parseFiniteNumber(token, value)) fail(i, what + " '" + printableExcerpt(token, 40) + "' is not a finite number");
         return value;
     }
-    std::int64_t integer(std::size_t i, const std::string& token, const std::string& what, std::int64_t max) const
+    std::int64_t integer(std::size_t i, const std::string& token, const std::string& what, std::int64_t max,
+                         std::int64_t min = 0) const
     {
         const double value = number(i, token, what);
-        if (value != std::floor(value) || value < 0 || value > double(max))
-            fail(i, what + " '" + token + "' is not an integer in 0.." + std::to_string(max));
+        if (value != std::floor(value) || value < double(min) || value > double(max))
+            fail(i, what + " '" + token + "' is not an integer in " + std::to_string(min) + ".." + std::to_string(max));
         return std::int64_t(value);
     }
 
@@ -197,7 +214,7 @@ std::map<std::int64_t, ColmapCamera> readCamerasText(const std::string& path)
         const std::int64_t id = file.integer(i, t[0], "CAMERA_ID", 0xFFFFFFFF);
         const ModelInfo* model = modelByName(t[1]);
         if (!model) file.fail(i, "unknown camera model '" + printableExcerpt(t[1], 40) + "' (COLMAP's are " + modelNames() + ")");
-        const std::int64_t width = file.integer(i, t[2], "WIDTH", 16384), height = file.integer(i, t[3], "HEIGHT", 16384);
+        const std::int64_t width = file.integer(i, t[2], "WIDTH", 16384, 1), height = file.integer(i, t[3], "HEIGHT", 16384, 1);
         if (t.size() - 4 != paramCount(*model))
             file.fail(i, std::string("camera model ") + model->name + " takes " + std::to_string(paramCount(*model)) +
                              " parameters, the line has " + std::to_string(t.size() - 4));

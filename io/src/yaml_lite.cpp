@@ -561,7 +561,9 @@ Node Parser::parseFlowSequence(int depth)
             continue;
         }
         if (peek() == ']') break;
-        if (peek() == ':') fail(line_, "a key inside a flow sequence ('[a: b]') is not supported");
+        if (peek() == ':')
+            fail(line_, "a key inside a flow sequence ('[a: b]') is not supported" + opened +
+                            " (is a ']' missing there?)");
         fail(line_, "expected ',' or ']'" + opened + ", found " + restOfLine() + " (a value cannot continue on another line)");
     }
     ++pos_;  // ']'

@@ -10,9 +10,8 @@ anywhere, and the formulas below can be tested without Blender):
     # then: zcheck dataset verify renders/manifest.jsonl --scene mesh.obj --quantity eye-z
 
 Blender's camera model, read from Blender's source and followed here formula by formula:
-`BKE_camera_params_compute_viewplane` (source/blender/blenkernel/intern/camera.c, camera.cc
-since 3.5), which Cycles repeats in `blender_camera_viewplane`
-(intern/cycles/blender/camera.cpp).
+`BKE_camera_params_compute_viewplane` (source/blender/blenkernel/intern/camera.c, later
+camera.cc), which Cycles repeats in `blender_camera_viewplane` (intern/cycles/blender/camera.cpp).
 
   * Pose. `obj.matrix_world` is the camera's pose, world_from_camera (camera-to-world). The
     camera looks down its local -Z with +Y up and +X right: zcheck's "opengl" eye axes.
@@ -25,7 +24,10 @@ since 3.5), which Cycles repeats in `blender_camera_viewplane`
     scale) is refused by zcheck's pose rule, with its message.
   * Image. width = resolution_x * resolution_percentage // 100, likewise height (integer
     division, as Blender sizes the render: `BKE_render_resolution`, Cycles's
-    `render_resolution_x`). Row 0 is the top row of the saved image (Blender's buffers are
+    `render_resolution_x`), and the sensor fit and aspect follow that size, as Cycles's do.
+    (Blender's `world_to_camera_view` takes the aspect of the size before the percentage: where
+    the division truncates, 321x241 at 50 % say, it misses Cycles's pixels by up to 0.07 px;
+    this module does not.) Row 0 is the top row of the saved image (Blender's buffers are
     bottom-up; its image files are not). The centre of pixel (col, row) is the image point
     (col + 0.5, row + 0.5): Cycles samples raster x + a filter offset symmetric about 0.5, so
     an unshifted camera has its principal point at (width/2, height/2), pixel_center 0.5.
@@ -116,12 +118,19 @@ obj:   a camera object (obj.type "CAMERA") whose data is of type "PERSP" or "ORT
 scene: the scene whose render settings size the image: resolution_x/y, resolution_percentage,
        pixel_aspect_x/y (the fit of an AUTO sensor depends on them).
 
-Perspective cameras become pinhole intrinsics (pixels, pixel_center 0.5):
+With ycor = pixel_aspect_y / pixel_aspect_x; the fit horizontal for HORIZONTAL, vertical for
+VERTICAL, and for AUTO horizontal iff width * pixel_aspect_x >= height * pixel_aspect_y;
+viewfac = width (horizontal fit) or ycor * height (vertical); sensor = sensor_height for
+VERTICAL, else sensor_width (AUTO too, whichever way it fits):
+  perspective cameras become pinhole intrinsics (pixels, pixel_center 0.5)
        fx = lens * viewfac / sensor,   fy = fx / ycor,
-       cx = width/2 - shift_x * viewfac,   cy = height/2 + shift_y * viewfac / ycor,
-orthographic ones an orthographic box in camera units; near and far are clip_start and
-clip_end. Convention "opengl" (Blender's camera axes). Raises zcheck.Error for another kind of
-object, a panoramic camera, a render border, multi-view rendering or a scale-0 pose.
+       cx = width/2 - shift_x * viewfac,   cy = height/2 + shift_y * viewfac / ycor;
+  orthographic ones an orthographic box (camera units)
+       right, left = shift_x * ortho_scale +- ortho_scale * width / (2 viewfac),
+       top, bottom = shift_y * ortho_scale +- ortho_scale * ycor * height / (2 viewfac).
+Near and far are clip_start and clip_end; the convention "opengl" (Blender's camera axes).
+Raises zcheck.Error, naming the camera, for another kind of object, a panoramic camera, a render
+border, multi-view rendering, a scale-0 axis or a pose that is sheared or mirrored.
     """
     if getattr(obj, "type", None) != "CAMERA":
         raise Error(f"Blender object '{getattr(obj, 'name', obj)}' is of type {getattr(obj, 'type', None)!r}, "

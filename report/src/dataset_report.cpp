@@ -125,7 +125,7 @@ ResultsFile readResults(const std::string& path)
 {
     ResultsFile out;
     out.path = path;
-    const std::string text = readInputFile(path, kCameraSetInput);
+    const std::string text = readInputFile(path, kResultsInput);
     std::size_t start = 0, line = 0;
     while (start < text.size()) {
         const std::size_t end = text.find('\n', start);

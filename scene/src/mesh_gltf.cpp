@@ -295,6 +295,7 @@ public:
     // The camera nodes alone: no buffer is read.
     std::vector<ImportedCamera> readCameras()
     {
+        camerasOnly_ = true;
         try {
             parseJson(jsonText());
             checkAsset();
@@ -309,7 +310,8 @@ public:
 private:
     [[noreturn]] void fail(const std::string& why) const
     {
-        throw Error("cannot load mesh '" + path_ + "': malformed glTF: " + why);
+        throw Error((camerasOnly_ ? "cannot read the cameras of glTF '" : "cannot load mesh '") + path_ + "': malformed glTF: " +
+                    why);
     }
 
     // ---- container -------------------------------------------------------------------
@@ -1111,6 +1113,7 @@ private:
     }
 
     const std::string& path_;
+    bool camerasOnly_ = false;  // read as a camera file: messages say so
     std::string_view bytes_;
     json root_;
     Bytes bin_;

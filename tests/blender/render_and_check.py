@@ -26,7 +26,8 @@ Writes into OUTDIR:
   manifest.jsonl                both renders' frames (zcheck.blender.write_cameras), named
                                 tall_NNNN and square_NNNN
   manifest_shift_flipped.jsonl  the same, but camera B's shift_x negated while writing it:
-                                exactly frame tall_0002 and square_0002 must be inconsistent
+                                exactly frames tall_0002 and square_0002 must be inconsistent
+  manifest_{tall,square}[_flipped].jsonl   each render's own part of those two
   checks.json                   the second route, the sample positions (below) and the
                                 messages of what camera_from_object refuses: a panoramic
                                 camera, a sheared pose, a render border
@@ -57,8 +58,11 @@ from mathutils import Matrix, Vector
 import zcheck
 import zcheck.blender
 
+# 160x120 rendered. The percentage divides the resolution exactly: world_to_camera_view (the
+# second route) sizes the frame by the resolution before the percentage, Cycles by the rendered
+# size; at 321x241 they differ by up to 0.07 px (Cycles's samples still land on zcheck's centres).
 RESOLUTION = (320, 240)
-PERCENTAGE = 50  # 160x120 rendered
+PERCENTAGE = 50
 PIXEL_ASPECTS = {"tall": (1.0, 1.4), "square": (1.0, 1.0)}
 FRAMES = [1, 2, 3, 4, 5]
 TARGET = (0.0, 0.0, 0.8)
@@ -69,7 +73,8 @@ ALLOWED_SAMPLE_OFFSET_PX = 2.0 ** -8  # zcheck verify's S (README, "zcheck verif
 def arguments():
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
     if len(argv) != 2:
-        raise RuntimeError("usage: blender -b --factory-startup --python-exit-code 1 -P render_and_check.py -- OUTDIR MESH.obj")
+        raise RuntimeError("usage: blender -b --factory-startup --python-exit-code 1 -P render_and_check.py "
+                           "-- OUTDIR MESH.obj")
     return os.path.abspath(argv[0]), os.path.abspath(argv[1])
 
 
@@ -273,7 +278,7 @@ def projection_route(scene, points):
     in_front = blender[:, 2] > obj.data.clip_start
     blender_px = np.c_[blender[:, 0] * w, (1.0 - blender[:, 1]) * h]
     zcheck_px, zcheck_depth = zcheck_pixels(camera, points)
-    visible = in_front & (blender_px[:, 0] >= 0) & (blender_px[:, 0] <= w) & (blender_px[:, 1] >= 0) & (blender_px[:, 1] <= h)
+    visible = in_front & (blender_px >= 0).all(axis=1) & (blender_px[:, 0] <= w) & (blender_px[:, 1] <= h)
     px = np.abs(blender_px - zcheck_px).max(axis=1)
     depth = np.abs(blender[:, 2] - zcheck_depth)
     return {"points": int(in_front.sum()), "max_px": float(px[in_front].max()),
@@ -310,7 +315,8 @@ def refusals(scene):
         except zcheck.Error as error:
             message = str(error)
             if f"'{obj.name}'" not in message or must_say not in message:
-                raise RuntimeError(f"refusal '{case}': the message does not name '{obj.name}' and '{must_say}': {message}")
+                raise RuntimeError(f"refusal '{case}': the message does not name '{obj.name}' and "
+                                   f"'{must_say}': {message}")
             return message
         raise RuntimeError(f"refusal '{case}': camera_from_object accepted camera '{obj.name}'")
 
@@ -386,7 +392,7 @@ def main():
     print(f"render_and_check: largest projection difference {checks['max_projection_px']:.3e} px", flush=True)
     if not checks["max_projection_px"] <= MAX_PROJECTION_DIFFERENCE_PX:
         raise RuntimeError(f"render_and_check: world_to_camera_view and zcheck differ by "
-                         f"{checks['max_projection_px']:.3e} px (> {MAX_PROJECTION_DIFFERENCE_PX} px)")
+                           f"{checks['max_projection_px']:.3e} px (> {MAX_PROJECTION_DIFFERENCE_PX} px)")
 
 
 if __name__ == "__main__":

@@ -37,14 +37,15 @@ trap cleanup EXIT
 out=$tmp/out
 
 pass() { echo "ok    $1"; passed=$((passed + 1)); }
-fail() { echo "FAIL  $1"; failed=$((failed + 1)); }
+fail() { echo "FAIL  $*"; failed=$((failed + 1)); }
 finish() {
     echo "test_blender: $passed passed, $failed failed"
     exit $((failed > 0 ? 1 : 0))
 }
 
 # --- render: Blender in the background, stopped by its pid if it overruns ---------------------
-"$blender" -b --factory-startup --python-exit-code 1 -P "$here/render_and_check.py" -- \
+# TMPDIR: the folder Blender makes for itself (and leaves behind when stopped) goes with ours.
+TMPDIR=$tmp "$blender" -b --factory-startup --python-exit-code 1 -P "$here/render_and_check.py" -- \
     "$out" "$models/stanford-bunny.obj" > "$tmp/blender.log" 2>&1 &
 blender_pid=$!
 waited=0
@@ -150,7 +151,8 @@ verify "$out/manifest_shift_flipped.jsonl" "$tmp/results_shift.jsonl"
 if [[ $verify_status -eq 1 ]] && inconsistent "$tmp/results_shift.jsonl" tall_0002 square_0002; then
     pass "a camera's shift_x sign flipped: exactly its frames (tall_0002, square_0002) inconsistent"
 else
-    fail "a camera's shift_x sign flipped: exactly its frames (tall_0002, square_0002) inconsistent (exit $verify_status)"
+    fail "a camera's shift_x sign flipped: exactly its frames (tall_0002, square_0002) inconsistent" \
+        "(exit $verify_status)"
 fi
 
 # --- one Z pass upside down (the orthographic frame): exactly that frame inconsistent ----------

@@ -23,6 +23,8 @@ inline constexpr InputKind kSidecarInput{"sidecar", std::uint64_t(1) << 20};    
 // few times its size), a COLMAP model's files (images.bin holds every 2-D observation).
 inline constexpr InputKind kCameraSetInput{"camera file", std::uint64_t(512) << 20};       // 512 MiB
 inline constexpr InputKind kColmapModelInput{"COLMAP model file", std::uint64_t(4) << 30};  // 4 GiB
+inline constexpr InputKind kManifestInput{"manifest", std::uint64_t(512) << 20};            // 512 MiB
+inline constexpr InputKind kResultsInput{"results file", std::uint64_t(4) << 30};           // 4 GiB
 
 // Throws Error unless `path` names a readable regular file within the kind's size limit;
 // returns its size in bytes.
