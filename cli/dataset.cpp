@@ -267,7 +267,7 @@ int runDatasetVerify(const DatasetVerifyOptions& o)
         throw Error("results file '" + output + "' exists: --resume completes it; remove it to start over");
     const DatasetRunner runner(openSource(o), runOptions(o), [](const std::string& path, const DepthMapReading& reading,
                                                                int width, int height) {
-        return images().readDepthMap(path, reading, width, height);
+        return readDepthMapFile(path, reading, width, height);
     });
     ResultsSink sink(output);
     std::set<std::size_t> done;
@@ -340,7 +340,7 @@ FramePictures picturesOf(const FrameRecord& r, const std::shared_ptr<SceneChecke
         options.scene = r.scene, options.convention = r.convention;
         const DatasetRunner runner(Dataset{dataset.source, dataset.kind, {frame}}, options,
                                    [](const std::string& path, const DepthMapReading& reading, int width, int height) {
-                                       return images().readDepthMap(path, reading, width, height);
+                                       return readDepthMapFile(path, reading, width, height);
                                    },
                                    checkers);
         VerifiedMap kept;

@@ -52,4 +52,10 @@ const ImageFunctions& images()
     return *functions;
 }
 
+DepthMapFile readDepthMapFile(const std::string& path, const DepthMapReading& reading, int width, int height)
+{
+    if (std::optional<DepthMapFile> native = readDepthMapNatively(path, reading, width, height)) return std::move(*native);
+    return images().readDepthMap(path, reading, width, height);
+}
+
 }  // namespace zcheck::cli

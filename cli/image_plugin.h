@@ -19,6 +19,10 @@ struct ImageFunctions {
 // Loads the plugin once (thread-safe), then returns its functions.
 const ImageFunctions& images();
 
+// A depth map as readDepthMap reads it (image_io.h); the plugin is loaded only for EXR and TIFF,
+// the formats zcheck does not read by itself (readDepthMapNatively).
+DepthMapFile readDepthMapFile(const std::string& path, const DepthMapReading& reading, int width, int height);
+
 }  // namespace zcheck::cli
 
 // The plugin's one entry point.

@@ -52,7 +52,7 @@ int runUnprojectCommand(const UnprojectOptions& o)
         SceneAndCamera input;
         input.camera = o.camera;
         CameraForMap made = cameraAndMapFor(nullptr, input, quantity, [&](int width, int height) {
-            return images().readDepthMap(o.depthMap, o.reading.reading(o.quantity), width, height);
+            return readDepthMapFile(o.depthMap, o.reading.reading(o.quantity), width, height);
         });
         spec = made.spec;
         sized = std::move(made.map);
@@ -103,7 +103,7 @@ int runUnprojectCommand(const UnprojectOptions& o)
     outputs.addInput(o.reading.sidecar);
     outputs.add(o.output, "-o");
     const DepthMapFile map =
-        sized ? std::move(*sized) : images().readDepthMap(o.depthMap, o.reading.reading(o.quantity), camera.width(), camera.height());
+        sized ? std::move(*sized) : readDepthMapFile(o.depthMap, o.reading.reading(o.quantity), camera.width(), camera.height());
     const UnprojectedMap cloud =
         unprojectMap(camera, map.value, quantity, o.space == "eye" ? PointSpace::Eye : PointSpace::World, o.stride);
     outputs.write(o.output, [&](const std::string& temporary) {

@@ -34,7 +34,7 @@ int runVerifyCommand(const VerifyOptions& o)
     Scene scene = loadScene(o.input.scene);
     const DepthMapReading reading = o.reading.reading(o.quantity);
     CameraForMap made = cameraAndMapFor(&scene, o.input, quantity, [&](int width, int height) {
-        return images().readDepthMap(o.depthMap, reading, width, height);
+        return readDepthMapFile(o.depthMap, reading, width, height);
     });
     const Camera camera(made.spec);
     DepthMapFile& file = made.map;

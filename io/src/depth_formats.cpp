@@ -17,20 +17,6 @@ namespace zcheck::depthformats {
 
 namespace {
 
-// The size a header declares against the camera's (image_io.cpp's rule).
-void requireSize(const std::string& path, long long width, long long height, int expectedWidth, int expectedHeight)
-{
-    if (expectedWidth == 0 && expectedHeight == 0) {
-        if (width < 1 || height < 1 || width > 16384 || height > 16384 || width * height > (1LL << 25))
-            throw Error("depth map '" + path + "' is " + std::to_string(width) + "x" + std::to_string(height) +
-                        ", outside the 1..16384 pixels per side (2^25 in all) a camera may have");
-        return;
-    }
-    if (width != expectedWidth || height != expectedHeight)
-        throw Error("depth map '" + path + "' is " + std::to_string(width) + "x" + std::to_string(height) +
-                    " but the camera's image is " + std::to_string(expectedWidth) + "x" + std::to_string(expectedHeight));
-}
-
 // IEEE binary16 to double, exactly (every half is a double).
 double fromHalf(std::uint16_t h)
 {
@@ -203,7 +189,7 @@ DepthMapFile readNpy(const std::string& path, const DepthMapReading& reading, in
         refuse("its shape has " + std::to_string(s.size()) + " dimensions: a depth map is (height, width) or (height, width, channels)");
     const long long height = s[0], width = s[1], channels = s.size() == 3 ? s[2] : 1;
     if (channels < 1 || channels > 64) refuse("its shape has " + std::to_string(channels) + " channels (1..64 are read)");
-    requireSize(path, width, height, expectedWidth, expectedHeight);
+    requireDepthMapSize(path, width, height, expectedWidth, expectedHeight);
     const std::uint64_t need = std::uint64_t(width) * std::uint64_t(height) * std::uint64_t(channels) * std::uint64_t(size);
     const std::uint64_t have = bytes.size() - headerStart - headerLength;
     if (have != need)
@@ -264,7 +250,7 @@ DepthMapFile readColmapDepth(const std::string& path, const DepthMapReading& rea
     const long long width = fields[0], height = fields[1], channels = fields[2];
     if (channels != 1)
         refuse("a COLMAP map of " + std::to_string(channels) + " channels is a normal map, not a depth map (depth has 1)");
-    requireSize(path, width, height, expectedWidth, expectedHeight);
+    requireDepthMapSize(path, width, height, expectedWidth, expectedHeight);
     const std::uint64_t need = std::uint64_t(width) * std::uint64_t(height) * 4;
     if (bytes.size() - at != need)
         refuse("the COLMAP data holds " + std::to_string(bytes.size() - at) + " bytes, but " + std::to_string(width) + "x" +

@@ -16,7 +16,10 @@
 //           (its path, e.g. "depth", "dataset", "group/depth") or as image_io.h chooses a
 //           channel; float or integer of 16 bits or more. Read in a child process: a malformed
 //           file that crashes or hangs the HDF5 library is refused, never fatal.
-#include "zcheck/image_io.h"
+#include "zcheck/depth_map_reading.h"
+#include "zcheck/quantity.h"
+
+#include <vector>
 
 #include <string>
 #include <string_view>

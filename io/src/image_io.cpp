@@ -60,76 +60,6 @@ void writeExr(const std::string& path, int width, int height, const std::vector<
 
 namespace {
 
-// The size a file declares against the camera's; expected 0 × 0 (a camera that takes the map's
-// size) accepts any size a camera may have: 1..16384 per side, 2^25 pixels in all.
-void requireSize(const std::string& path, long long width, long long height, int expectedWidth, int expectedHeight)
-{
-    if (expectedWidth == 0 && expectedHeight == 0) {
-        if (width < 1 || height < 1 || width > 16384 || height > 16384 || width * height > (1LL << 25))
-            throw Error("depth map '" + path + "' is " + std::to_string(width) + "x" + std::to_string(height) +
-                        ", outside the 1..16384 pixels per side (2^25 in all) a camera may have");
-        return;
-    }
-    if (width != expectedWidth || height != expectedHeight)
-        throw Error("depth map '" + path + "' is " + std::to_string(width) + "x" + std::to_string(height) +
-                    " but the camera's image is " + std::to_string(expectedWidth) + "x" + std::to_string(expectedHeight));
-}
-
-// PFM (Paul Debevec's portable float map): "Pf" (1 channel) or "PF" (3), whitespace, width,
-// height, scale (negative: little-endian), one whitespace byte, then float32 rows from the
-// bottom row of the picture to the top. Read here, strictly: the size is compared with the
-// camera's before anything is allocated, and the data must be exactly as long as declared.
-DepthMapFile readPfm(const std::string& path, const std::string& bytes, const DepthMapReading& reading, int expectedWidth,
-                     int expectedHeight)
-{
-    std::size_t at = 2;
-    auto field = [&](const char* what) {
-        while (at < bytes.size() && std::isspace(static_cast<unsigned char>(bytes[at]))) ++at;
-        const std::size_t start = at;
-        while (at < bytes.size() && at - start < 40 && !std::isspace(static_cast<unsigned char>(bytes[at]))) ++at;
-        if (at == start || at >= bytes.size()) refuseDepthMap(path, std::string("malformed PFM header: no ") + what);
-        return bytes.substr(start, at - start);
-    };
-    const int channels = bytes[1] == 'f' ? 1 : 3;
-    const std::string widthText = field("width"), heightText = field("height"), scaleText = field("scale");
-    auto whole = [&](const std::string& text, const char* what) {
-        long long v = -1;
-        const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), v);
-        if (error != std::errc() || end != text.data() + text.size() || v < 1)
-            refuseDepthMap(path, std::string("malformed PFM header: ") + what + " '" + text + "' is not a positive whole number");
-        return v;
-    };
-    const long long width = whole(widthText, "width"), height = whole(heightText, "height");
-    double scale = 0;
-    const auto [end, error] = std::from_chars(scaleText.data(), scaleText.data() + scaleText.size(), scale);
-    if (error != std::errc() || end != scaleText.data() + scaleText.size() || !std::isfinite(scale) || scale == 0)
-        refuseDepthMap(path, "malformed PFM header: scale '" + scaleText + "' must be a nonzero number");
-    ++at;  // the single whitespace byte that ends the header
-    requireSize(path, width, height, expectedWidth, expectedHeight);
-    const std::uint64_t expectedBytes = std::uint64_t(width) * std::uint64_t(height) * std::uint64_t(channels) * 4;
-    if (bytes.size() - at != expectedBytes)
-        refuseDepthMap(path, "the PFM data holds " + std::to_string(bytes.size() - at) + " bytes, but " +
-                            std::to_string(width) + "x" + std::to_string(height) + "x" + std::to_string(channels) +
-                            " float32 values need " + std::to_string(expectedBytes) + (bytes.size() - at < expectedBytes ? " (truncated)" : ""));
-    const std::vector<std::string> names = channels == 1 ? std::vector<std::string>{"Y"} : std::vector<std::string>{"R", "G", "B"};
-    DepthMapFile map;
-    map.width = int(width), map.height = int(height);
-    map.channel = chooseDepthChannel(path, names, reading.channel, reading.quantityChannel);
-    const std::size_t channel = std::size_t(std::find(names.begin(), names.end(), map.channel) - names.begin());
-    map.value.resize(std::size_t(width) * std::size_t(height));
-    const bool bigEndian = scale > 0;
-    for (long long row = 0; row < height; ++row)
-        for (long long col = 0; col < width; ++col) {
-            unsigned char raw[4];
-            std::memcpy(raw, bytes.data() + at + 4 * ((std::size_t(row) * std::size_t(width) + std::size_t(col)) * std::size_t(channels) + channel), 4);
-            if (bigEndian) std::reverse(raw, raw + 4);
-            float v;
-            std::memcpy(&v, raw, 4);
-            map.value[std::size_t(height - 1 - row) * std::size_t(width) + std::size_t(col)] = v;  // stored bottom-up
-        }
-    return map;
-}
-
 // OpenEXR allocates what a header attribute's size field claims (up to 2 GiB for a string)
 // before anything else is checked. The header is walked here first: every attribute must fit
 // in the file, and the data window (the image size) must be the camera's. The layout per the
@@ -180,7 +110,7 @@ void preflightExr(const std::string& path, int expectedWidth, int expectedHeight
                 if (type != "box2i" || size != 16 || at + 16 > head.size()) malformed("dataWindow is not a box2i");
                 std::int32_t box[4];
                 std::memcpy(box, head.data() + at, 16);
-                requireSize(path, std::int64_t(box[2]) - box[0] + 1, std::int64_t(box[3]) - box[1] + 1, expectedWidth,
+                requireDepthMapSize(path, std::int64_t(box[2]) - box[0] + 1, std::int64_t(box[3]) - box[1] + 1, expectedWidth,
                             expectedHeight);
                 sawDataWindow = true;
             }
@@ -197,65 +127,29 @@ void preflightExr(const std::string& path, int expectedWidth, int expectedHeight
 
 DepthMapFile readDepthMap(const std::string& path, const DepthMapReading& reading, int expectedWidth, int expectedHeight)
 {
+    if (std::optional<DepthMapFile> native = readDepthMapNatively(path, reading, expectedWidth, expectedHeight))
+        return std::move(*native);
     const double scale = reading.scale;
-    if (scale != 0 && !(scale > 0 && std::isfinite(scale)))
-        throw Error("--scale must be a positive finite number, got " + formatNumber(scale));
-    if (!std::isfinite(reading.offset)) throw Error("--offset must be a finite number, got " + formatNumber(reading.offset));
-    checkInputFile(path, kDepthMapInput);
-    // The format is decided by the file's first bytes, and only that format's reader sees it:
-    // OpenImageIO would otherwise offer unknown bytes to every plugin it has (video, camera
-    // raw, DICOM, ...). PFM is read by zcheck itself (see readPfm).
-    char head[32] = {};
-    std::streamsize headBytes = 0;
+    // EXR or TIFF (readDepthMapNatively refused anything else): only that format's reader sees
+    // the file — OpenImageIO would otherwise offer unknown bytes to every plugin it has (video,
+    // camera raw, DICOM, ...).
+    unsigned char magic[4] = {0, 0, 0, 0};
     {
         std::ifstream probe(path, std::ios::binary);
-        probe.read(head, sizeof head);
-        headBytes = probe.gcount();
-    }
-    const std::string_view first(head, std::size_t(headBytes));
-    if (depthformats::isNpy(first)) return depthformats::readNpy(path, reading, expectedWidth, expectedHeight);
-    if (depthformats::isHdf5(first)) return depthformats::readHdf5(path, reading, expectedWidth, expectedHeight);
-    if (depthformats::isColmapDepth(first)) return depthformats::readColmapDepth(path, reading, expectedWidth, expectedHeight);
-    const auto* magic = reinterpret_cast<const unsigned char*>(head);
-    if (magic[0] == 'P' && (magic[1] == 'f' || magic[1] == 'F') && std::isspace(magic[2])) {
-        DepthMapFile map = readPfm(path, readInputFile(path, kDepthMapInput), reading, expectedWidth, expectedHeight);
-        for (double& v : map.value) v = reading.depthOf(v, false);
-        return map;
+        probe.read(reinterpret_cast<char*>(magic), 4);
     }
     const char* plugin = magic[0] == 0x76 && magic[1] == 0x2f && magic[2] == 0x31 && magic[3] == 0x01 ? "openexr"
                          : (magic[0] == 'I' && magic[1] == 'I' && magic[2] == 42 && magic[3] == 0) ||
                                    (magic[0] == 'M' && magic[1] == 'M' && magic[2] == 0 && magic[3] == 42)
                              ? "tiff"
-                         : magic[0] == 0x89 && magic[1] == 'P' && magic[2] == 'N' && magic[3] == 'G' ? "png"
                                                                                                       : nullptr;
-    if (!plugin)
-        refuseDepthMap(path, "not an EXR, TIFF, PNG, PFM, NumPy .npy, HDF5 or COLMAP depth map file (judged by its first bytes)");
+    if (!plugin) refuseDepthMap(path, "not an EXR or TIFF file (judged by its first bytes)");
     auto requireScale = [&](const std::string& what) {
         if (!(scale > 0))
             throw Error("depth map '" + path + "' stores integers (" + what +
                         "): give --scale (stored value = depth × scale, e.g. 1000 for millimetres, 5000 for many RGB-D "
                         "sets, 256 for KITTI)");
     };
-    if (plugin == std::string("png")) {
-        // zcheck's own libpng reader (OpenImageIO's leaks on libpng's error path).
-        requireScale("16-bit PNG");
-        Png16 png;
-        try {
-            png = decodePng16(readInputFile(path, kDepthMapInput), [&](long long width, long long height) {
-                requireSize(path, width, height, expectedWidth, expectedHeight);
-            });
-        } catch (const Error& e) {
-            const std::string what = e.what();
-            if (what.rfind("depth map '", 0) == 0) throw;  // the size message names the file already
-            refuseDepthMap(path, what);
-        }
-        DepthMapFile map;
-        map.width = png.width, map.height = png.height, map.valueQuantum = 1.0 / scale;
-        map.channel = chooseDepthChannel(path, {"Y"}, reading.channel, reading.quantityChannel);
-        map.value.resize(png.codes.size());
-        for (std::size_t i = 0; i < png.codes.size(); ++i) map.value[i] = reading.depthOf(png.codes[i], true);
-        return map;
-    }
     if (plugin == std::string("openexr")) preflightExr(path, expectedWidth, expectedHeight);
     auto in = OIIO::ImageInput::create(plugin);
     OIIO::ImageSpec opened;
@@ -269,7 +163,7 @@ DepthMapFile readDepthMap(const std::string& path, const DepthMapReading& readin
     const OIIO::ImageSpec& spec = in->spec();
     if (spec.width < 1 || spec.height < 1 || spec.depth > 1 || spec.nchannels < 1) refuseDepthMap(path, "not a 2-D image");
     // Compared with the camera before a pixel is allocated: a header may declare anything.
-    requireSize(path, spec.width, spec.height, expectedWidth, expectedHeight);
+    requireDepthMapSize(path, spec.width, spec.height, expectedWidth, expectedHeight);
     std::vector<std::string> names;
     for (int c = 0; c < spec.nchannels; ++c)
         names.push_back(c < int(spec.channelnames.size()) && !spec.channelnames[std::size_t(c)].empty()

@@ -4,6 +4,7 @@
 // Python module can check the options without loading the image library (image_io.h reads).
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -53,6 +54,28 @@ struct DepthMapReading {
 // none, is an Error that lists them and asks for --channel.
 std::string chooseDepthChannel(const std::string& path, const std::vector<std::string>& names, const std::string& wanted,
                                const std::string& quantityChannel);
+
+// A depth map read from a file, row 0 at the top as seen (PFM's bottom-to-top rows are flipped).
+struct DepthMapFile {
+    int width = 0, height = 0;
+    std::string channel;          // the channel read
+    std::vector<double> value;    // width·height; NaN where the file marks a miss
+    double valueQuantum = 0;      // the storage step of `value`: 1/scale for integer files, 0 for
+                                  // float files (binary32: the step depends on the value)
+};
+
+// Reads a map in a format zcheck reads by itself — PFM, 16-bit PNG (libpng), NumPy .npy,
+// COLMAP dense maps, HDF5 (depth_formats.h) — told by its first bytes, as `reading` says; or
+// returns nothing for EXR and TIFF, which only image_io.h's readDepthMap (the image library)
+// reads. The rules of readDepthMap (image_io.h) apply: a regular file of at most 2 GiB, its
+// declared size compared with expectedWidth × expectedHeight (0 × 0: any size a camera may
+// have) before any pixel is allocated, 8-bit integers refused. Throws Error naming the file.
+std::optional<DepthMapFile> readDepthMapNatively(const std::string& path, const DepthMapReading& reading, int expectedWidth,
+                                                 int expectedHeight);
+
+// The size a file declares against the camera's (0 × 0: any size a camera may have: 1..16384
+// per side, 2^25 pixels in all); throws Error naming the file and both sizes.
+void requireDepthMapSize(const std::string& path, long long width, long long height, int expectedWidth, int expectedHeight);
 
 // Throws Error "cannot read depth map '<path>': <why>".
 [[noreturn]] void refuseDepthMap(const std::string& path, const std::string& why);

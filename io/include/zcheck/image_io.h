@@ -18,16 +18,6 @@ namespace zcheck {
 void writeExr(const std::string& path, int width, int height, const std::vector<std::string>& names,
               const std::vector<float>& channels);
 
-// A depth map read from a file — EXR, TIFF, PNG or PFM, told apart by their first bytes —
-// row 0 at the top as seen (PFM's bottom-to-top rows are flipped).
-struct DepthMapFile {
-    int width = 0, height = 0;
-    std::string channel;          // the channel read
-    std::vector<double> value;    // width·height; NaN where the file marks a miss
-    double valueQuantum = 0;      // the storage step of `value`: 1/scale for integer files, 0 for
-                                  // float files (binary32: the step depends on the value)
-};
-
 // Reads a map as `reading` says (depth_map_reading.h): its channel, scale, offset and misses.
 // The file must be a regular file of at most 2 GiB, and its declared size must be
 // expectedWidth × expectedHeight (0 × 0: any size a camera may have, for a camera that takes the
