@@ -1,5 +1,6 @@
 #include "xml_lite.h"
 
+#include "text_checks.h"
 #include "zcheck/error.h"
 
 #include <cstdint>
@@ -37,25 +38,6 @@ std::string quoted(std::string_view text)
 // "<name>" for a message, readable whatever the name holds.
 std::string tag(std::string_view name, const char* open = "<") { return open + printableExcerpt(name, 40) + ">"; }
 
-void appendUtf8(std::string& out, std::uint32_t cp)
-{
-    if (cp < 0x80) {
-        out += char(cp);
-    } else if (cp < 0x800) {
-        out += char(0xC0 | (cp >> 6));
-        out += char(0x80 | (cp & 0x3F));
-    } else if (cp < 0x10000) {
-        out += char(0xE0 | (cp >> 12));
-        out += char(0x80 | ((cp >> 6) & 0x3F));
-        out += char(0x80 | (cp & 0x3F));
-    } else {
-        out += char(0xF0 | (cp >> 18));
-        out += char(0x80 | ((cp >> 12) & 0x3F));
-        out += char(0x80 | ((cp >> 6) & 0x3F));
-        out += char(0x80 | (cp & 0x3F));
-    }
-}
-
 // XML 1.0's Char production: what a character reference may name.
 bool isXmlChar(std::uint32_t cp)
 {
@@ -63,68 +45,9 @@ bool isXmlChar(std::uint32_t cp)
            (cp >= 0x10000 && cp <= 0x10FFFF);
 }
 
-// Length of the well-formed UTF-8 sequence at text[i] (no overlong forms, no surrogates,
-// nothing above U+10FFFF), 0 if there is none.
-std::size_t utf8Length(std::string_view text, std::size_t i)
-{
-    const auto byte = [&](std::size_t k) -> unsigned { return i + k < text.size() ? static_cast<unsigned char>(text[i + k]) : 0u; };
-    const auto continuation = [&](std::size_t k) { return (byte(k) & 0xC0) == 0x80; };
-    const unsigned lead = byte(0);
-    if (lead < 0x80) return 1;
-    if (lead >= 0xC2 && lead <= 0xDF) return continuation(1) ? 2 : 0;
-    if (lead >= 0xE0 && lead <= 0xEF) {
-        if (lead == 0xE0 && byte(1) < 0xA0) return 0;
-        if (lead == 0xED && byte(1) > 0x9F) return 0;
-        return continuation(1) && continuation(2) ? 3 : 0;
-    }
-    if (lead >= 0xF0 && lead <= 0xF4) {
-        if (lead == 0xF0 && byte(1) < 0x90) return 0;
-        if (lead == 0xF4 && byte(1) > 0x8F) return 0;
-        return continuation(1) && continuation(2) && continuation(3) ? 4 : 0;
-    }
-    return 0;
-}
-
-[[noreturn]] void failAt(const std::string& source, int line, const std::string& what)
-{
-    throw Error(source + ": line " + std::to_string(line) + ": " + what);
-}
-
-// The text without its BOM, with CRLF and lone CR read as LF (XML's end-of-line handling),
-// after checking that it is UTF-8 without control characters (which XML 1.0 forbids).
-std::string normalizedText(std::string_view text, const std::string& source)
-{
-    if (text.size() > kMaxTextBytes) throw Error(source + ": larger than the 1 MiB this reader accepts");
-    if (text.size() >= 2 && ((text[0] == '\xFE' && text[1] == '\xFF') || (text[0] == '\xFF' && text[1] == '\xFE')))
-        failAt(source, 1, "UTF-16 text; save the file as UTF-8");
-    std::size_t i = text.size() >= 3 && text.substr(0, 3) == "\xEF\xBB\xBF" ? 3 : 0;
-    std::string out;
-    out.reserve(text.size() - i);
-    int line = 1;
-    while (i < text.size()) {
-        const auto c = static_cast<unsigned char>(text[i]);
-        if (c == '\r' || c == '\n') {
-            out += '\n';
-            ++line;
-            i += (c == '\r' && i + 1 < text.size() && text[i + 1] == '\n') ? 2 : 1;
-            continue;
-        }
-        if ((c < 0x20 && c != '\t') || c == 0x7F) {
-            char code[8];
-            std::snprintf(code, sizeof code, "0x%02X", c);
-            failAt(source, line, std::string("control character ") + code + " (only tabs and line breaks may appear)");
-        }
-        const std::size_t length = utf8Length(text, i);
-        if (length == 0) failAt(source, line, "not valid UTF-8");
-        out.append(text.substr(i, length));
-        i += length;
-    }
-    return out;
-}
-
 class Parser {
 public:
-    Parser(std::string_view text, const std::string& source) : text_(normalizedText(text, source)), source_(source) {}
+    Parser(std::string_view text, const std::string& source) : text_(zcheck::text::normalizedText(text, source, kMaxTextBytes)), source_(source) {}
 
     Element parseDocument();
 
@@ -149,7 +72,7 @@ private:
         while (isSpace(peek())) step();
         return pos_ != start;
     }
-    [[noreturn]] void fail(int line, const std::string& what) const { failAt(source_, line, what); }
+    [[noreturn]] void fail(int line, const std::string& what) const { zcheck::text::failAt(source_, line, what); }
     std::string here() const
     {
         std::size_t end = pos_;
@@ -405,7 +328,7 @@ void Parser::readReference(std::string& out)
     }
     if (!valid || !isXmlChar(codePoint))
         fail(line_, "the character reference " + quoted("&" + std::string(body) + ";") + " does not name an XML character");
-    appendUtf8(out, codePoint);
+    zcheck::text::appendUtf8(out, codePoint);
     pos_ = end + 1;
 }
 

@@ -1,5 +1,6 @@
 #include "yaml_lite.h"
 
+#include "text_checks.h"
 #include "zcheck/error.h"
 
 #include <cstdint>
@@ -27,85 +28,6 @@ std::string quoted(std::string_view text)
     return "'" + printableExcerpt(text, kMax) + (text.size() > kMax ? "...'" : "'");
 }
 
-void appendUtf8(std::string& out, std::uint32_t cp)
-{
-    if (cp < 0x80) {
-        out += char(cp);
-    } else if (cp < 0x800) {
-        out += char(0xC0 | (cp >> 6));
-        out += char(0x80 | (cp & 0x3F));
-    } else if (cp < 0x10000) {
-        out += char(0xE0 | (cp >> 12));
-        out += char(0x80 | ((cp >> 6) & 0x3F));
-        out += char(0x80 | (cp & 0x3F));
-    } else {
-        out += char(0xF0 | (cp >> 18));
-        out += char(0x80 | ((cp >> 12) & 0x3F));
-        out += char(0x80 | ((cp >> 6) & 0x3F));
-        out += char(0x80 | (cp & 0x3F));
-    }
-}
-
-// Length of the well-formed UTF-8 sequence at text[i] (no overlong forms, no surrogates,
-// nothing above U+10FFFF), 0 if there is none.
-std::size_t utf8Length(std::string_view text, std::size_t i)
-{
-    const auto byte = [&](std::size_t k) -> unsigned { return i + k < text.size() ? static_cast<unsigned char>(text[i + k]) : 0u; };
-    const auto continuation = [&](std::size_t k) { return (byte(k) & 0xC0) == 0x80; };
-    const unsigned lead = byte(0);
-    if (lead < 0x80) return 1;
-    if (lead >= 0xC2 && lead <= 0xDF) return continuation(1) ? 2 : 0;
-    if (lead >= 0xE0 && lead <= 0xEF) {
-        if (lead == 0xE0 && byte(1) < 0xA0) return 0;
-        if (lead == 0xED && byte(1) > 0x9F) return 0;
-        return continuation(1) && continuation(2) ? 3 : 0;
-    }
-    if (lead >= 0xF0 && lead <= 0xF4) {
-        if (lead == 0xF0 && byte(1) < 0x90) return 0;
-        if (lead == 0xF4 && byte(1) > 0x8F) return 0;
-        return continuation(1) && continuation(2) && continuation(3) ? 4 : 0;
-    }
-    return 0;
-}
-
-[[noreturn]] void failAt(const std::string& source, int line, const std::string& what)
-{
-    throw Error(source + ": line " + std::to_string(line) + ": " + what);
-}
-
-// The text without its BOM, CRLF and lone CR turned into LF (OpenCV on Windows writes CRLF),
-// after checking that it is UTF-8 without control characters. The parser then deals with
-// '\n' alone and may use '\0' as the end.
-std::string normalizedText(std::string_view text, const std::string& source)
-{
-    if (text.size() > kMaxTextBytes) throw Error(source + ": larger than the 1 MiB this reader accepts");
-    if (text.size() >= 2 && ((text[0] == '\xFE' && text[1] == '\xFF') || (text[0] == '\xFF' && text[1] == '\xFE')))
-        failAt(source, 1, "UTF-16 text; save the file as UTF-8");
-    std::size_t i = text.size() >= 3 && text.substr(0, 3) == "\xEF\xBB\xBF" ? 3 : 0;
-    std::string out;
-    out.reserve(text.size() - i);
-    int line = 1;
-    while (i < text.size()) {
-        const auto c = static_cast<unsigned char>(text[i]);
-        if (c == '\r' || c == '\n') {
-            out += '\n';
-            ++line;
-            i += (c == '\r' && i + 1 < text.size() && text[i + 1] == '\n') ? 2 : 1;
-            continue;
-        }
-        if ((c < 0x20 && c != '\t') || c == 0x7F) {
-            char code[8];
-            std::snprintf(code, sizeof code, "0x%02X", c);
-            failAt(source, line, std::string("control character ") + code + " (only tabs and line breaks may appear)");
-        }
-        const std::size_t length = utf8Length(text, i);
-        if (length == 0) failAt(source, line, "not valid UTF-8");
-        out.append(text.substr(i, length));
-        i += length;
-    }
-    return out;
-}
-
 // Where a node sits in block context, which decides what may start there.
 struct Place {
     int parentIndent;  // a node on the lines below must be indented more than this (-1 at the top)
@@ -116,7 +38,7 @@ struct Place {
 
 class Parser {
 public:
-    Parser(std::string_view text, const std::string& source) : text_(normalizedText(text, source)), source_(source) {}
+    Parser(std::string_view text, const std::string& source) : text_(zcheck::text::normalizedText(text, source, kMaxTextBytes)), source_(source) {}
 
     Node parseDocument();
 
@@ -136,7 +58,7 @@ private:
         ++line_;
         lineStart_ = pos_;
     }
-    [[noreturn]] void fail(int line, const std::string& what) const { failAt(source_, line, what); }
+    [[noreturn]] void fail(int line, const std::string& what) const { zcheck::text::failAt(source_, line, what); }
     // The text from `start` to the end of its line, quoted for a message.
     std::string lineFrom(std::size_t start) const
     {
@@ -743,10 +665,10 @@ void Parser::readEscape(std::string& out, int line)
     case 'a': out += '\a'; return;
     case 'v': out += '\v'; return;
     case 'e': out += '\x1B'; return;
-    case 'N': appendUtf8(out, 0x85); return;
-    case '_': appendUtf8(out, 0xA0); return;
-    case 'L': appendUtf8(out, 0x2028); return;
-    case 'P': appendUtf8(out, 0x2029); return;
+    case 'N': zcheck::text::appendUtf8(out, 0x85); return;
+    case '_': zcheck::text::appendUtf8(out, 0xA0); return;
+    case 'L': zcheck::text::appendUtf8(out, 0x2028); return;
+    case 'P': zcheck::text::appendUtf8(out, 0x2029); return;
     case '0': fail(line_, "the escape '\\0' (a NUL inside a value) is not allowed");
     case 'x': digits = 2; break;
     case 'u': digits = 4; break;
@@ -763,7 +685,7 @@ void Parser::readEscape(std::string& out, int line)
     if (codePoint == 0) fail(line_, "the escape for U+0000 (a NUL inside a value) is not allowed");
     if ((codePoint >= 0xD800 && codePoint <= 0xDFFF) || codePoint > 0x10FFFF)
         fail(line_, "an escape for a code point that is not a character (a surrogate or above U+10FFFF)");
-    appendUtf8(out, codePoint);
+    zcheck::text::appendUtf8(out, codePoint);
 }
 
 bool equalIgnoringCase(const std::string& a, const std::string& b)

@@ -109,17 +109,20 @@ class Trajectory:
         self.center = (lo + hi) / 2
         radius = np.linalg.norm(hi - lo) / 2
         self.poses = []  # OpenCV cam_from_world, 4x4
+        self.clip = []   # the renderer's near and far: hugging the scene, as a renderer's would
         for i in range(frames):
             a = 2 * math.pi * i / frames
             eye = self.center + radius * np.array([2.2 * math.sin(a), 0.8 + 0.3 * math.sin(3 * a), 2.2 * math.cos(a)])
             self.poses.append(look_at_cam_from_world(eye, self.center))
+            d = np.linalg.norm(eye - self.center)
+            self.clip.append((0.5 * (d - radius), 1.5 * (d + radius)))
         self.names = [f"frame_{i:03d}.png" for i in range(frames)]
         self.k = np.array([[self.fx, 0, self.cx - 0.5], [0, self.fx, self.cy - 0.5], [0, 0, 1]])  # OpenCV's coordinates
 
     def camera(self, i, near=None, far=None):
         """The frame's camera as zcheck sees it, near and far hugging the scene (for rendering)."""
         return zcheck.Camera.from_opencv(self.k, cam_from_world=self.poses[i], width=self.width, height=self.height,
-                                         near=near or 0.05, far=far or 100.0)
+                                         near=near or self.clip[i][0], far=far or self.clip[i][1])
 
 
 class DatasetMaker:
@@ -259,7 +262,8 @@ class DatasetMaker:
                           {"bufferView": 1, "componentType": 5125, "count": triangles.size, "type": "SCALAR"}],
             "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
             "cameras": [{"type": "perspective", "perspective": {"yfov": yfov, "aspectRatio": self.trajectory.width / self.trajectory.height,
-                                                                "znear": 0.05, "zfar": 100}}],
+                                                                "znear": min(n for n, _ in self.trajectory.clip),
+                                                                "zfar": max(f for _, f in self.trajectory.clip)}}],
             "nodes": nodes,
             "scenes": [{"nodes": list(range(len(nodes)))}],
             "scene": 0,
@@ -268,18 +272,42 @@ class DatasetMaker:
         path.write_text(json.dumps(document))
         return path
 
+    def ros_frame(self, i):
+        """ROS CameraInfo of frame i (the calibration file's form) and, since CameraInfo has no
+        pose — its optical frame is the world — the mesh moved into that frame, as an OBJ."""
+        folder = self.root / "ros"
+        folder.mkdir(parents=True, exist_ok=True)
+        k = self.trajectory.k
+        p = np.hstack([k, np.zeros((3, 1))])
+        data = lambda m: ", ".join(repr(float(v)) for v in np.ravel(m))  # noqa: E731
+        info = folder / f"frame_{i:03d}.yaml"
+        info.write_text(f"image_width: {self.trajectory.width}\nimage_height: {self.trajectory.height}\ncamera_name: cam\n"
+                        f"camera_matrix:\n  rows: 3\n  cols: 3\n  data: [{data(k)}]\n"
+                        "distortion_model: plumb_bob\n"
+                        "distortion_coefficients:\n  rows: 1\n  cols: 5\n  data: [0, 0, 0, 0, 0]\n"
+                        "rectification_matrix:\n  rows: 3\n  cols: 3\n  data: [1, 0, 0, 0, 1, 0, 0, 0, 1]\n"
+                        f"projection_matrix:\n  rows: 3\n  cols: 4\n  data: [{data(p)}]\n")
+        pose = self.trajectory.poses[i]
+        vertices = np.asarray(self.scene.vertices, float) @ pose[:3, :3].T + pose[:3, 3]
+        mesh = folder / f"frame_{i:03d}.obj"
+        with mesh.open("w") as f:
+            f.writelines(f"v {x!r} {y!r} {z!r}\n" for x, y, z in vertices.astype(np.float32).astype(float))
+            f.writelines(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in np.asarray(self.scene.triangles))
+        return info, mesh
+
     def manifest(self, name, colmap_folder, transforms_path, gltf_path, broken_lines=()):
         """A manifest whose frames use every camera format and every depth format:
         COLMAP references with .npy, transforms references with the PNGs, OpenCV files with EXR,
         inline zcheck cameras with HDF5 (BlenderProc's depth and distance), glTF cameras with
-        COLMAP depth maps."""
+        COLMAP depth maps, ROS CameraInfo files with 16-bit PNGs and a scene of their own (the
+        mesh in the camera's frame)."""
         depth_dir = self.root / "manifest_depth"
         depth_dir.mkdir(parents=True, exist_ok=True)
         colmap_depth = self.colmap_depth_maps("manifest_colmap_depth")
         lines = []
         transforms = json.loads(Path(transforms_path).read_text())
         for i, image in enumerate(self.trajectory.names):
-            kind = i % 5
+            kind = i % 6
             line = {"frame": f"f{i:03d}", "quantity": "eye-z"}
             if kind == 0:
                 np.save(depth_dir / f"{i:03d}.npy", self.eye_z(i))
@@ -293,9 +321,14 @@ class DatasetMaker:
                 write_hdf5(depth_dir / f"{i:03d}.h5", depth=self.eye_z(i), distance=self.distance(i))
                 camera = json.loads(self.trajectory.camera(i).to_json())
                 line.update(camera=camera, depth=f"manifest_depth/{i:03d}.h5", channel="depth")
-            else:
+            elif kind == 4:
                 line.update(camera=f"{Path(gltf_path).name}#cam_{i:03d}",
                             depth=str((colmap_depth / f"{image}.geometric.bin").relative_to(self.root)))
+            else:
+                info, mesh = self.ros_frame(i)
+                write_png16(depth_dir / f"{i:03d}.png", self.millimetres(self.eye_z(i)))
+                line.update(camera=str(info.relative_to(self.root)), depth=f"manifest_depth/{i:03d}.png", scale=1000,
+                            scene=str(mesh.relative_to(self.root)))
             lines.append(json.dumps(line))
         for at in sorted(broken_lines, reverse=True):
             lines[at] = lines[at][: len(lines[at]) // 2]  # cut off mid-line: malformed JSON
