@@ -5,8 +5,8 @@ named workloads, against two yardsticks.
     PYTHONPATH=build/python /usr/bin/python3 bench/dataset_bench.py [--build build] [--models DIR]
                                                                      [--frames 96] [--runs 5]
 
-Workloads (640x480, a ring of cameras around the mesh, transforms.json with 16-bit millimetre
-PNGs rendered by the raster route, and a COLMAP model with float32 COLMAP depth maps):
+Workloads (640x480, a ring of cameras around the mesh, transforms.json with 16-bit PNGs rendered
+by the raster route, and a COLMAP model with float32 COLMAP depth maps):
   bunny     the Stanford bunny, 69,451 triangles
   terrain   builtin:terrain?n=709, 1,002,528 triangles
 
@@ -54,15 +54,17 @@ def main():
 
     zcheck = Path(args.build) / "cli" / "zcheck"
     loop = Path(args.build) / "bench" / "dataset_loop"
-    workloads = {"bunny": Path(args.models) / "stanford-bunny.obj", "terrain": "builtin:terrain?n=709"}
+    # (mesh, the PNGs' steps per scene unit: millimetres for the bunny, whose depths are a few
+    # tenths; the terrain's run to ~350 units, so 100 per unit fits 16 bits)
+    workloads = {"bunny": (Path(args.models) / "stanford-bunny.obj", 1000.0), "terrain": ("builtin:terrain?n=709", 100.0)}
     print(f"zcheck dataset verify, {args.frames} frames at 640x480, median of {args.runs} paired runs")
     with tempfile.TemporaryDirectory(prefix="zcheck-dataset-bench-") as root:
-        for name, mesh in workloads.items():
+        for name, (mesh, per_unit) in workloads.items():
             if args.only and name != args.only:
                 continue
             maker = DatasetMaker(Path(root) / name, mesh, frames=args.frames, width=640, height=480)
             made = time.perf_counter()
-            sources = {"transforms (png mm)": (maker.transforms(), []),
+            sources = {f"transforms (16-bit png, {per_unit:g} per unit)": (maker.transforms(per_unit=per_unit), ["--scale", str(per_unit)]),
                        "colmap (float32 maps)": (maker.colmap_text("colmap"),
                                                  ["--depth", str(maker.colmap_depth_maps("colmap_depth")) + "/{name}.geometric.bin"])}
             print(f"\n{name}: {maker.scene.triangle_count:,} triangles; dataset made in {time.perf_counter() - made:.1f} s")

@@ -3,7 +3,7 @@
 // before the clock starts. What `dataset verify` adds over it — reading files, bookkeeping,
 // running frames side by side — is the difference.
 //
-//   dataset_loop SOURCE --scene MESH --quantity Q [--depth PATTERN] [--threads N] [--repeat K]
+//   dataset_loop SOURCE --scene MESH --quantity Q [--depth PATTERN] [--scale S] [--threads N] [--repeat K]
 // prints "loop frames N seconds S frames_per_second F" (the best of K loops).
 #include "zcheck/camera_sources.h"
 #include "zcheck/dataset.h"
@@ -25,11 +25,13 @@ int main(int argc, char** argv)
 {
     std::string source, scene = "builtin:default", quantity = "eye-z", depth;
     int threads = 0, repeat = 3;
+    std::optional<double> scale;
     CLI::App app{"dataset_loop: frames verified by a plain loop, files decoded beforehand"};
     app.add_option("source", source)->required();
     app.add_option("--scene", scene);
     app.add_option("--quantity", quantity);
     app.add_option("--depth", depth);
+    app.add_option("--scale", scale);
     app.add_option("--threads", threads);
     app.add_option("--repeat", repeat);
     CLI11_PARSE(app, argc, argv);
@@ -42,7 +44,7 @@ int main(int argc, char** argv)
             return openCameraSet(path, f);
         });
         DatasetRunOptions options;
-        options.scene = scene, options.quantity = quantity;
+        options.scene = scene, options.quantity = quantity, options.scale = scale;
         const Checker checker(loadScene(scene));
         struct Frame {
             CameraSpec spec;

@@ -5,6 +5,7 @@
 #include "zcheck/camera_import.h"
 #include "zcheck/camera_sources.h"
 #include "zcheck/error.h"
+#include "zcheck/mesh_loader.h"
 #include "zcheck/pose.h"
 
 #include <catch2/catch.hpp>
@@ -14,6 +15,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <string>
 #include <unistd.h>
 
@@ -447,4 +449,76 @@ TEST_CASE("a camera written as COLMAP, nerfstudio, OpenCV or zcheck reads back a
     }
     spec.projection.type = ProjectionType::Orthographic;
     REQUIRE_THROWS_WITH(cameraInFormat(Camera(spec), CameraFormat::Colmap, "x"), Catch::Contains("orthographic projection has no pinhole"));
+}
+
+namespace {
+
+// The eye-z range of the scene's triangles clipped to a perspective camera's view, by brute force
+// in eye space: every triangle, Sutherland–Hodgman against the four side planes through the eye
+// and the near-window edges (left/right/top/bottom at eye-z = near) and the eye plane.
+std::pair<double, double> bruteForceEyeZRange(const Scene& scene, const Camera& camera)
+{
+    const double n = camera.nearDistance();
+    // Planes through the eye, ≥ 0 inside, in (image right, image up, forward) coordinates.
+    auto inside = [&](const glm::dvec3& q, int plane) {
+        switch (plane) {
+        case 0: return q.x * n - camera.left() * q.z;
+        case 1: return camera.right() * q.z - q.x * n;
+        case 2: return q.y * n - camera.bottom() * q.z;
+        case 3: return camera.top() * q.z - q.y * n;
+        default: return q.z;
+        }
+    };
+    const Convention& c = camera.convention();
+    double lo = INFINITY, hi = -INFINITY;
+    for (const glm::uvec3& t : scene.triangles) {
+        std::vector<glm::dvec3> polygon;
+        for (int k = 0; k < 3; ++k) {
+            const glm::dvec3 e(camera.eyeFromWorld * glm::dvec4(glm::dvec3(scene.positions[t[k]]), 1.0));
+            polygon.push_back({e.x, c.eyeUpY * e.y, c.eyeForwardZ * e.z});
+        }
+        for (int plane = 0; plane < 5 && !polygon.empty(); ++plane) {
+            std::vector<glm::dvec3> next;
+            for (std::size_t i = 0; i < polygon.size(); ++i) {
+                const glm::dvec3 a = polygon[i], b = polygon[(i + 1) % polygon.size()];
+                const double fa = inside(a, plane), fb = inside(b, plane);
+                if (fa >= 0) next.push_back(a);
+                if ((fa >= 0) != (fb >= 0)) next.push_back(a + (fa / (fa - fb)) * (b - a));
+            }
+            polygon = next;
+        }
+        for (const glm::dvec3& q : polygon) lo = std::min(lo, q.z), hi = std::max(hi, q.z);
+    }
+    return {lo, hi};
+}
+
+}  // namespace
+
+TEST_CASE("near and far from the scene's triangle chunks equal a clip of every triangle", "[import][clip]")
+{
+    // A terrain seen from random places around and inside its bounds, in several conventions:
+    // the chunk pruning must never change the answer.
+    const Scene scene = loadScene("builtin:terrain?n=90");
+    REQUIRE(scene.chunks);
+    std::mt19937 random(17);
+    std::uniform_real_distribution<double> along(-80, 80), up(2, 60);
+    int seen = 0;
+    for (int i = 0; i < 40; ++i) {
+        CameraSpec spec;
+        spec.convention = Convention::preset(Convention::presetNames()[std::size_t(i) % Convention::presetNames().size()]);
+        spec.width = 160, spec.height = 120;
+        spec.projection = Projection::perspective(30 + i, kPlaceholderNear, kPlaceholderFar);
+        spec.view = View::lookAt({along(random), up(random), along(random)}, {along(random) / 4, 0, along(random) / 4}, {0, 1, 0});
+        const auto [lo, hi] = bruteForceEyeZRange(scene, Camera(spec));
+        if (!(hi > 0)) {
+            REQUIRE_THROWS_WITH(clipPlanesFor(scene, spec), Catch::Contains("sees none of scene"));
+            continue;
+        }
+        ++seen;
+        const ClipPlanes planes = clipPlanesFor(scene, spec);
+        INFO("camera " << i);
+        REQUIRE(planes.far == Approx(hi * 1.01).epsilon(1e-9));
+        REQUIRE(planes.near == Approx(std::max(lo * 0.99, planes.far * 1e-7)).epsilon(1e-9));
+    }
+    REQUIRE(seen > 30);
 }

@@ -78,29 +78,73 @@ bool clippedRange(const ClipVertex (&corner)[3], double& lo, double& hi)
 ClipPlanes clipPlanesFor(const Scene& scene, const CameraSpec& spec)
 {
     const Camera camera(spec);  // its near and far may be placeholders: the side planes do not depend on them
-    std::vector<ClipVertex> vertices(scene.positions.size());
-    for (std::size_t i = 0; i < vertices.size(); ++i) {
-        const glm::dvec4 pEye = camera.eyeFromWorld * glm::dvec4(glm::dvec3(scene.positions[i]), 1.0);
-        const glm::dvec4 pClip = camera.clipFromEye * pEye;
-        vertices[i] = {pClip.x, pClip.y, pClip.w, camera.eyeZOf(glm::dvec3(pEye))};
-    }
+    const glm::dmat4 clipFromWorld = camera.clipFromEye * camera.eyeFromWorld;
+    const glm::dvec4 eyeZRow(camera.eyeFromWorld[0][2] * camera.convention().eyeForwardZ,
+                             camera.eyeFromWorld[1][2] * camera.convention().eyeForwardZ,
+                             camera.eyeFromWorld[2][2] * camera.convention().eyeForwardZ,
+                             camera.eyeFromWorld[3][2] * camera.convention().eyeForwardZ);
+    auto clipVertex = [&](const glm::dvec3& pWorld) {
+        const glm::dvec4 p(pWorld, 1.0);
+        const glm::dvec4 pClip = clipFromWorld * p;
+        return ClipVertex{pClip.x, pClip.y, pClip.w, glm::dot(eyeZRow, p)};
+    };
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (const glm::uvec3& t : scene.triangles) {
-        const ClipVertex corner[3] = {vertices[t[0]], vertices[t[1]], vertices[t[2]]};
+    auto visitTriangle = [&](const glm::uvec3& t) {
+        const ClipVertex corner[3] = {clipVertex(glm::dvec3(scene.positions[t[0]])), clipVertex(glm::dvec3(scene.positions[t[1]])),
+                                      clipVertex(glm::dvec3(scene.positions[t[2]]))};
         int inside = 0;
-        bool outside = false;
-        for (int plane = 0; plane < 5 && !outside; ++plane) {
+        for (int plane = 0; plane < 5; ++plane) {
             int in = 0;
             for (const ClipVertex& v : corner) in += planeValue(v, plane) >= 0;
-            outside = in == 0;
+            if (in == 0) return;  // wholly outside one plane
             inside += in == 3;
         }
-        if (outside) continue;
         if (inside == 5) {
             for (const ClipVertex& v : corner) lo = std::min(lo, v.d), hi = std::max(hi, v.d);
         } else {
             clippedRange(corner, lo, hi);
         }
+    };
+    // Chunks of triangles by their boxes: a chunk wholly outside one plane is skipped; the others
+    // are visited in the order of the nearest eye-z their box allows, until no box can lower the
+    // near end, then in the order of the farthest, until none can raise the far end. The answer
+    // is the one a visit of every triangle gives.
+    const std::shared_ptr<const TriangleChunks> chunks = scene.chunks ? scene.chunks : triangleChunksOf(scene);
+    struct Candidate {
+        std::size_t chunk;
+        double nearest, farthest;
+    };
+    std::vector<Candidate> candidates;
+    for (std::size_t c = 0; c < chunks->lo.size(); ++c) {
+        const glm::dvec3 a(chunks->lo[c]), b(chunks->hi[c]);
+        ClipVertex corners[8];
+        for (int k = 0; k < 8; ++k) corners[k] = clipVertex({k & 1 ? b.x : a.x, k & 2 ? b.y : a.y, k & 4 ? b.z : a.z});
+        bool outside = false;
+        for (int plane = 0; plane < 5 && !outside; ++plane) {
+            outside = true;
+            for (const ClipVertex& v : corners) outside = outside && planeValue(v, plane) < 0;
+        }
+        if (outside) continue;
+        double nearest = INFINITY, farthest = -INFINITY;
+        for (const ClipVertex& v : corners) nearest = std::min(nearest, v.d), farthest = std::max(farthest, v.d);
+        candidates.push_back({c, nearest, farthest});
+    }
+    std::vector<char> visited(chunks->lo.size(), 0);
+    auto visitChunk = [&](std::size_t c) {
+        if (visited[c]) return;
+        visited[c] = 1;
+        const std::size_t end = std::min(scene.triangles.size(), (c + 1) * TriangleChunks::kSize);
+        for (std::size_t t = c * TriangleChunks::kSize; t < end; ++t) visitTriangle(scene.triangles[t]);
+    };
+    std::sort(candidates.begin(), candidates.end(), [](const Candidate& x, const Candidate& y) { return x.nearest < y.nearest; });
+    for (const Candidate& c : candidates) {
+        if (c.nearest >= lo) break;  // no triangle of this box (nor of any later) is nearer
+        visitChunk(c.chunk);
+    }
+    std::sort(candidates.begin(), candidates.end(), [](const Candidate& x, const Candidate& y) { return x.farthest > y.farthest; });
+    for (const Candidate& c : candidates) {
+        if (c.farthest <= hi) break;
+        visitChunk(c.chunk);
     }
     if (!(hi > 0))
         throw Error("the camera sees none of scene '" + scene.name +

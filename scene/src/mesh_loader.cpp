@@ -50,7 +50,11 @@ Scene loadMesh(const std::string& path)
 Scene loadScene(const std::string& nameOrPath)
 {
     if (nameOrPath.empty()) throw Error("the scene name is empty");
-    if (isBuiltinSceneName(nameOrPath)) return builtinScene(nameOrPath);
+    if (isBuiltinSceneName(nameOrPath)) {
+        Scene scene = builtinScene(nameOrPath);
+        scene.chunks = triangleChunksOf(scene);
+        return scene;
+    }
     return loadMesh(nameOrPath);
 }
 

@@ -105,7 +105,25 @@ Scene frameScene(Scene scene, const std::string& what)
     const glm::dvec3 lo = scene.boundsMin(), hi = scene.boundsMax();
     const double radius = std::max(glm::length(hi - lo) / 2, 1e-6);
     scene.defaultCamera = framingCameraSpec((lo + hi) / 2.0, radius);
+    scene.chunks = triangleChunksOf(scene);
     return scene;
+}
+
+std::shared_ptr<const TriangleChunks> triangleChunksOf(const Scene& scene)
+{
+    auto chunks = std::make_shared<TriangleChunks>();
+    const std::size_t count = (scene.triangles.size() + TriangleChunks::kSize - 1) / TriangleChunks::kSize;
+    chunks->lo.assign(count, glm::vec3(INFINITY));
+    chunks->hi.assign(count, glm::vec3(-INFINITY));
+    for (std::size_t t = 0; t < scene.triangles.size(); ++t) {
+        glm::vec3& lo = chunks->lo[t / TriangleChunks::kSize];
+        glm::vec3& hi = chunks->hi[t / TriangleChunks::kSize];
+        for (int k = 0; k < 3; ++k) {
+            const glm::vec3& p = scene.positions[scene.triangles[t][k]];
+            lo = glm::min(lo, p), hi = glm::max(hi, p);
+        }
+    }
+    return chunks;
 }
 
 }  // namespace zcheck

@@ -150,7 +150,9 @@ class DatasetMaker:
 
     @staticmethod
     def millimetres(depth, per_metre=1000.0):
-        return np.where(np.isfinite(depth), np.round(depth * per_metre), 0).astype(np.uint16)
+        codes = np.where(np.isfinite(depth), np.round(depth * per_metre), 0)
+        assert codes.max() <= 65535, f"depth up to {np.nanmax(depth[np.isfinite(depth)])} does not fit 16 bits at {per_metre}"
+        return codes.astype(np.uint16)
 
     # ---- COLMAP ---------------------------------------------------------------------------
     def colmap_text(self, folder, cx=None, broken_cx=()):
@@ -197,7 +199,7 @@ class DatasetMaker:
         return folder
 
     # ---- nerfstudio -------------------------------------------------------------------------
-    def transforms(self, name="transforms.json", broken=None, missing=()):
+    def transforms(self, name="transforms.json", broken=None, missing=(), per_unit=1000.0):
         """transforms.json with 16-bit millimetre PNGs. `broken` maps a frame to how it breaks:
         "y-flip", "inverted-extrinsic", "opencv-axes", "distance", "centimetres"."""
         broken = broken or {}
@@ -209,7 +211,7 @@ class DatasetMaker:
             c2w_gl = np.linalg.inv(pose) @ OPENCV_TO_OPENGL  # camera-to-world, OpenGL camera axes
             matrix = {"inverted-extrinsic": np.linalg.inv(c2w_gl), "opencv-axes": np.linalg.inv(pose)}.get(how, c2w_gl)
             depth = self.distance(i) if how == "distance" else self.eye_z(i)
-            codes = self.millimetres(depth, 100.0 if how == "centimetres" else 1000.0)
+            codes = self.millimetres(depth, per_unit / 10 if how == "centimetres" else per_unit)
             if how == "y-flip":
                 codes = codes[::-1]
             depth_path = depth_dir / image

@@ -319,3 +319,37 @@ def test_a_slurm_job_array_gives_the_single_process_summary(made, tmp_path):
         assert "data:image/png;base64," in (tmp_path / "run" / "report.html").read_text()
     finally:
         subprocess.run(["bash", LOCAL_SLURM, "stop", state], capture_output=True, timeout=60)
+
+
+def test_progress_is_shown_on_a_terminal_and_not_otherwise(made):
+    import shlex
+    import subprocess
+    from helpers import ZCHECK_EXE
+    m, p = made
+    results = m.root / "progress.jsonl"
+    command = shlex.join([ZCHECK_EXE, "dataset", "verify", str(p["transforms"]), "--scene", str(BUNNY), "--quantity",
+                          "eye-z", "-o", str(results)])
+    if results.exists():
+        results.unlink()
+    # `script` gives the command a terminal (util-linux); its output is what the terminal showed.
+    shown = subprocess.run(["script", "-qec", command, "/dev/null"], capture_output=True, text=True, timeout=120)
+    assert shown.returncode == 0, shown.stdout + shown.stderr
+    assert f"frames {FRAMES}/{FRAMES}" in shown.stdout and "frames/s" in shown.stdout and "ETA" in shown.stdout
+    results.unlink()
+    code, records, out, err = verify(made, p["transforms"], results=results)
+    assert "frames/s" not in err and err == ""
+
+
+def test_a_gltf_scene_s_first_camera_is_its_own_and_takes_the_map_s_size(made):
+    m, p = made
+    code, out, err = run_cli("check", "--scene", p["gltf"], "--json")
+    assert code == 0, err
+    report = json.loads(out)
+    assert any("the glTF's first, 'cam_000'" in w for w in report["warnings"])
+    assert (report["camera"]["image"]["width"], report["camera"]["image"]["height"]) == (640, 480)
+    # verify: the camera takes the map's size (320x240), near and far from the file
+    np.save(m.root / "gltf_frame0.npy", m.eye_z(0))
+    code, out, err = run_cli("verify", "--scene", p["gltf"], "--depth-map", m.root / "gltf_frame0.npy", "--quantity",
+                             "eye-z", "--json")
+    assert code == 0, out + err
+    assert json.loads(out)["camera"]["image"] == {"width": 320, "height": 240}

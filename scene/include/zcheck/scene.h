@@ -11,6 +11,7 @@
 #include <glm/glm.hpp>
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,14 @@ struct PolygonPlanarity {
     std::string warning(const std::string& mesh) const;
 };
 
+// Bounding boxes of runs of consecutive triangles (meshes keep neighbours close), so that a
+// question about the whole scene seen from a camera (camera_sources.h's clipPlanesFor) can skip
+// what cannot change its answer. Made once per scene (indexTriangleChunks).
+struct TriangleChunks {
+    static constexpr std::size_t kSize = 1024;  // triangles per chunk; the last may hold fewer
+    std::vector<glm::vec3> lo, hi;              // per chunk, world space
+};
+
 struct Scene {
     std::string name;                     // as addressed: "builtin:default", a file path
     std::vector<glm::vec3> positions;     // world space
@@ -43,6 +52,7 @@ struct Scene {
     PolygonPlanarity planarity;           // of the file's polygons (mesh files; none built in)
     std::vector<ImportedCamera> cameras;  // the file's camera nodes (glTF), in file order; the
                                           // first is the default camera (camera_sources.h)
+    std::shared_ptr<const TriangleChunks> chunks;  // made by indexTriangleChunks; none: made on use
 
     std::size_t triangleCount() const { return triangles.size(); }
     glm::dvec3 boundsMin() const;
@@ -68,6 +78,9 @@ ZCHECK_ALWAYS_INLINE inline void cornersInLanes(const Scene& scene, const std::u
 
 // Throws Error for a scene with no triangles or an index out of range.
 void validateScene(const Scene& scene);
+
+// The scene's TriangleChunks (indices must be valid). loadScene and frameScene make them.
+std::shared_ptr<const TriangleChunks> triangleChunksOf(const Scene& scene);
 
 // Makes a triangle soup a scene to check: validates it (validateScene), refuses it when no
 // triangle has a nonzero area (nothing to draw), and gives it a default camera that frames its
