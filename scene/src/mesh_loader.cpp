@@ -35,9 +35,9 @@ Scene loadMesh(const std::string& path)
     if (bytes.rfind("glTF", 0) == 0 || ext == ".glb" || ext == ".gltf") {
         Scene scene = framed(readGltf(path, bytes));
         if (!scene.cameras.empty()) {  // the file's first camera is the scene's own
-            const ImportedCamera& first = scene.cameras.front();
+            ImportedCamera& first = scene.cameras.front();
+            first.spec.notes.push_back("the camera is the glTF's first, '" + first.name + "'");
             scene.defaultCamera = completeCamera(first, &scene, {});
-            scene.defaultCamera.notes.push_back("the camera is the glTF's first, '" + first.name + "'");
         }
         return scene;
     }
