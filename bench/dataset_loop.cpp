@@ -54,8 +54,7 @@ int main(int argc, char** argv)
         for (const DatasetFrame& frame : dataset.frames) {
             const FramePlan plan = planFrame(frame, options);
             CameraForMap made = frameCameraAndMap(frame, plan, checker.scene(), options, readDepthMap);
-            frames.push_back({made.spec, DepthMap{made.map.width, made.map.height, plan.quantity, std::move(made.map.value),
-                                                  made.map.valueQuantum}});
+            frames.push_back({made.spec, DepthMap::of(std::move(made.map), plan.quantity, plan.reading)});
         }
         double best = 1e300;
         int consistent = 0;

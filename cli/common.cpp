@@ -32,6 +32,15 @@ const CLI::Validator kPositiveFinite(
         return std::string();
     },
     "NUMBER > 0");
+const CLI::Validator kBelowOne(
+    [](std::string& value) {
+        char* end = nullptr;
+        const double v = std::strtod(value.c_str(), &end);
+        if (value.empty() || *end != '\0') return "'" + value + "' is not a number";
+        if (!(v > 0 && v < 1)) return "must be a number in (0, 1), got '" + value + "'";
+        return std::string();
+    },
+    "0 < NUMBER < 1");
 const CLI::Range kThreadRange(1, 1024);
 const CLI::Range kImageSideRange(1, 16384);
 
@@ -174,10 +183,37 @@ void addDepthMapOptions(CLI::App* command, DepthMapOptions& options)
     command->add_option("--miss", options.miss,
                         "the stored value that means 'no surface', or a comparison: 0, 65535, 1e10, nan, inf, '>=1e9'\n"
                         "(default: 0 in integer files; NaN is always a miss)");
+    addAccuracyOptions(command, options.accuracy);
     command->add_option("--sidecar", options.sidecar,
                         "a JSON file describing the map: {\"miss\": 65535 or \">=1e9\", \"scale\": 1000, \"offset\": 0,\n"
-                        "\"channel\": \"Z\"}; other keys are ignored; the options above win over it")
+                        "\"channel\": \"Z\", \"quantum\": 0.001, \"rel_tolerance\": 0, \"abs_tolerance\": 0, \"allow_holes\": false};\n"
+                        "other keys are ignored; the options above win over it")
         ->check(kNonEmptyPath);
+}
+
+void addAccuracyOptions(CLI::App* command, MapAccuracy& accuracy)
+{
+    const char* group = "What the map's producer declares (judged with, never applied to the values)";
+    command->add_option("--quantum", accuracy.quantum,
+                        "the map's values were rounded to multiples of Q (map units, after --scale): each pixel's\n"
+                        "tolerance includes that step (0.001 for millimetres held as float metres). Half floats carry\n"
+                        "their own step without it")
+        ->check(kPositiveFinite)
+        ->group(group);
+    command->add_option("--rel-tolerance", accuracy.relative,
+                        "values are good only to this fraction of themselves (a rasterizer's reconstructed Z pass:\n"
+                        "5e-4); added to every pixel's tolerance")
+        ->check(kBelowOne)
+        ->group(group);
+    command->add_option("--abs-tolerance", accuracy.absolute,
+                        "values are good only to this many map units (a sensor's noise: 0.01 m); added to every\n"
+                        "pixel's tolerance")
+        ->check(kPositiveFinite)
+        ->group(group);
+    command->add_flag("--allow-holes", accuracy.allowHoles,
+                      "a pixel without a value where the surface is hit is a hole (counted and reported), not a\n"
+                      "failure: sensors and some renderers leave them")
+        ->group(group);
 }
 
 DepthMapReading DepthMapOptions::reading(const std::string& quantityName) const
@@ -187,6 +223,7 @@ DepthMapReading DepthMapOptions::reading(const std::string& quantityName) const
     r.quantityChannel = channelNameOf(exportQuantitiesFromList(quantityName).front());
     r.scale = scale, r.offset = offset;
     if (!miss.empty()) r.miss = MissRule::parse(miss);
+    r.accuracy = accuracy;
     return sidecar.empty() ? r : withSidecar(r, sidecar);
 }
 

@@ -97,12 +97,15 @@ void addImageSizeOptions(CLI::App* command, ImageSize& size);
 struct DepthMapOptions {
     std::string channel, miss, sidecar;
     double scale = 0, offset = 0;
+    MapAccuracy accuracy;
     // The reading for a map of quantity `quantityName`: the options, and for those not given,
     // the sidecar's keys ("channel", "miss", "scale", "offset"; others ignored); throws Error
     // naming a bad --miss or sidecar key.
     DepthMapReading reading(const std::string& quantityName) const;
 };
 void addDepthMapOptions(CLI::App* command, DepthMapOptions& options);
+// --quantum, --rel-tolerance, --abs-tolerance, --allow-holes (MapAccuracy), in their own help group.
+void addAccuracyOptions(CLI::App* command, MapAccuracy& accuracy);
 
 // "1,2.5,3" → {1, 2.5, 3}; throws Error naming `option` for anything that is not a number.
 std::vector<double> parseNumberList(const std::string& text, const std::string& option);

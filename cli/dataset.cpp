@@ -35,6 +35,7 @@ namespace {
 struct DatasetVerifyOptions {
     std::string source, scene = "builtin:default", quantity, depthPattern, miss, channel, cameraFormat, convention, shard;
     std::optional<double> scale, offset, near, far;
+    MapAccuracy accuracy;
     std::string output;
     bool resume = false, diagnose = false;
     int threads = 0;
@@ -57,6 +58,7 @@ void addDatasetVerifyOptions(CLI::App* command, DatasetVerifyOptions& o)
     command->add_option("--offset", o.offset, "added to every depth after --scale");
     command->add_option("--miss", o.miss, "the stored value meaning 'no surface': 0, 65535, 1e10, nan, inf, '>=1e9'");
     command->add_option("--channel", o.channel, "the channel or HDF5 dataset to read (depth, distance, Z, ...)");
+    addAccuracyOptions(command, o.accuracy);
     command->add_option("--camera-format", o.cameraFormat, "the source's format when its content should not decide");
     command->add_option("--near", o.near, "near plane of cameras whose file has none (default: from the scene)")
         ->check(kPositiveFinite);
@@ -82,6 +84,7 @@ DatasetRunOptions runOptions(const DatasetVerifyOptions& o)
     DatasetRunOptions options;
     options.scene = o.scene, options.quantity = o.quantity;
     options.scale = o.scale, options.offset = o.offset, options.miss = o.miss, options.channel = o.channel;
+    options.accuracy = o.accuracy;
     options.near = o.near, options.far = o.far, options.convention = o.convention;
     options.diagnose = o.diagnose;
     if (!o.shard.empty()) options.parseShard(o.shard);
@@ -247,6 +250,12 @@ std::vector<std::string> verifyArgumentsOf(const DatasetVerifyOptions& o)
     add("--quantity", o.quantity), add("--depth", o.depthPattern), add("--miss", o.miss), add("--channel", o.channel);
     add("--camera-format", o.cameraFormat), add("--convention", o.convention);
     addNumber("--scale", o.scale), addNumber("--offset", o.offset), addNumber("--near", o.near), addNumber("--far", o.far);
+    auto addDeclared = [&](const char* option, double value) {
+        if (value > 0) addNumber(option, value);
+    };
+    addDeclared("--quantum", o.accuracy.quantum), addDeclared("--rel-tolerance", o.accuracy.relative);
+    addDeclared("--abs-tolerance", o.accuracy.absolute);
+    if (o.accuracy.allowHoles) args.push_back("--allow-holes");
     if (o.diagnose) args.push_back("--diagnose");
     if (o.threads > 0) args.insert(args.end(), {"--threads", std::to_string(o.threads)});
     return args;
@@ -332,6 +341,7 @@ FramePictures picturesOf(const FrameRecord& r, const std::shared_ptr<SceneChecke
         if (r.scale > 0) frame.scale = r.scale;
         frame.offset = r.offset;
         if (!r.miss.empty()) frame.miss = r.miss;
+        frame.accuracy = r.accuracy;
         if (r.projection != "matrix") {  // the camera as it was used: near and far as recorded
             frame.near = r.near;
             if (std::isfinite(r.far)) frame.far = r.far;

@@ -38,7 +38,7 @@ int runVerifyCommand(const VerifyOptions& o)
     });
     const Camera camera(made.spec);
     DepthMapFile& file = made.map;
-    const DepthMap map{file.width, file.height, quantity, file.value, file.valueQuantum};
+    const DepthMap map = DepthMap::of(file, quantity, reading);
     const Checker checker(std::move(scene));
     const VerifyOutcome verified =
         verifyAndReport(checker, camera, map, {o.depthMap, o.quantity, file.channel, reading}, o.diagnose);

@@ -78,6 +78,55 @@ expect_error 2 "\"scale\" must be a positive finite number" verify --depth-map f
 echo '{"miss": 1, "miss": 2}' > twice.json
 expect_error 2 "twice.json" verify --depth-map far_misses.exr --quantity eye-z --sidecar twice.json
 
+# Maps as pipelines and sensors deliver them (issue 36): each accepted with what its reading
+# declares, rejected without it, and the diagnosis names the option.
+# Half floats (an EXR HALF channel) carry their own step: no option needed.
+oiiotool render.exr --ch Z -d half -o half.exr
+"$zcheck" verify --depth-map half.exr --quantity eye-z | grep -q "verdict    CONSISTENT"
+# Millimetre-rounded float metres: --quantum 0.001.
+"$zcheck" export --backend raster --quantity eye-z -o z.pfm > /dev/null
+python3 - <<'PY'
+import struct
+with open("z.pfm", "rb") as f:
+    head = [f.readline() for _ in range(3)]
+    data = f.read()
+n = len(data) // 4
+values = struct.unpack("<%df" % n, data) if float(head[2]) < 0 else struct.unpack(">%df" % n, data)
+rounded = [round(v * 1000) / 1000 if v != float("inf") else v for v in values]
+cycles = [1e10 if v == float("inf") else v for v in values]
+for name, vals in (("mm.pfm", rounded), ("cycles.pfm", cycles)):
+    with open(name, "wb") as f:
+        f.write(head[0] + head[1] + b"-1.0\n" + struct.pack("<%df" % n, *vals))
+PY
+set +e
+"$zcheck" verify --depth-map mm.pfm --quantity eye-z --diagnose > mm.txt
+status=$?
+set -e
+[[ $status -eq 1 ]]
+grep -q "the map's values lie on a 0.001 grid: consistent with --quantum 0.001" mm.txt
+"$zcheck" verify --depth-map mm.pfm --quantity eye-z --quantum 0.001 > mm_ok.txt
+grep -q "verdict    CONSISTENT" mm_ok.txt
+grep -q "declared   values rounded to 0.001 (--quantum 0.001)" mm_ok.txt
+# Cycles' 1e10 where nothing is hit: named, with the rule that reads it.
+set +e
+"$zcheck" verify --depth-map cycles.pfm --quantity eye-z --diagnose > cycles.txt
+set -e
+grep -q "pixels where nothing is hit: its miss value (pass --miss '>=1e9')" cycles.txt
+"$zcheck" verify --depth-map cycles.pfm --quantity eye-z --miss '>=1e9' | grep -q "verdict    CONSISTENT"
+# The same declarations from a sidecar, and --allow-holes counting the holes.
+echo '{"quantum": 0.001, "allow_holes": true}' > declared.json
+"$zcheck" verify --depth-map mm.pfm --quantity eye-z --sidecar declared.json --json | python3 -c "
+import json, sys; d = json.load(sys.stdin)
+assert d['consistent'] and d['depth_map']['declared'] == {'quantum': 0.001, 'rel_tolerance': 0, 'abs_tolerance': 0,
+                                                           'allow_holes': True}, d['depth_map']
+assert d['tolerance']['declared']['quantum'] == 0.001 and d['pixels']['holes'] == 0"
+echo '{"rel_tolerance": 2}' > bad_rel.json
+expect_error 2 "sidecar 'bad_rel.json': \"rel_tolerance\" must be below 1" verify --depth-map mm.pfm --quantity eye-z --sidecar bad_rel.json
+echo '{"allow_holes": "yes"}' > bad_holes.json
+expect_error 2 "\"allow_holes\" must be true or false" verify --depth-map mm.pfm --quantity eye-z --sidecar bad_holes.json
+expect_error 2 "--rel-tolerance" verify --depth-map mm.pfm --quantity eye-z --rel-tolerance 1.5
+expect_error 2 "--quantum" verify --depth-map mm.pfm --quantity eye-z --quantum -1
+
 # Bad input exits 2.
 expect_error 2 "cannot read depth map" verify --depth-map missing.exr
 expect_error 2 "scale" verify --depth-map render_mm.png --quantity eye-z

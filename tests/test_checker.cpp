@@ -551,10 +551,16 @@ TEST_CASE("the comparison's AVX-512 form is bit-identical to its baseline form",
             std::vector<double> quanta(raster.windowDepth.value.size());
             for (std::size_t i = 0; i < quanta.size(); ++i)
                 quanta[i] = storageQuantum(DepthFormat::Float32, raster.windowDepth.value[i]) * double(1 + i % 5);
+            // And a map's declared allowance (verify --rel-tolerance), some pixels' large enough to
+            // turn a depth error into agreement, holes allowed.
+            std::vector<double> allowance(quanta.size());
+            for (std::size_t i = 0; i < allowance.size(); ++i) allowance[i] = quanta[i] * double(i % 7) * double(i % 3 == 0 ? 1000 : 1);
             const std::vector<double>* ownQuanta = &quanta;
-            for (const std::vector<double>* quantum : {ownQuanta, static_cast<const std::vector<double>*>(nullptr)}) {
-                const Comparison b = inForm("baseline", [&] { return compareRoutes(checker.scene(), camera, ray, raster, {}, quantum); });
-                const Comparison c = inForm("auto", [&] { return compareRoutes(checker.scene(), camera, ray, raster, {}, quantum); });
+            const std::vector<DeclaredMap> declarations = {{ownQuanta, nullptr, false}, {nullptr, nullptr, false},
+                                                           {ownQuanta, &allowance, true}, {nullptr, &allowance, false}};
+            for (const DeclaredMap& declared : declarations) {
+                const Comparison b = inForm("baseline", [&] { return compareRoutes(checker.scene(), camera, ray, raster, {}, declared); });
+                const Comparison c = inForm("auto", [&] { return compareRoutes(checker.scene(), camera, ray, raster, {}, declared); });
                 CheckReport byBaseline, byChosen;
                 byBaseline.comparison = b.report, byChosen.comparison = c.report;
                 REQUIRE(checkReportJson(byChosen) == checkReportJson(byBaseline));
@@ -796,7 +802,7 @@ TEST_CASE("a comparison whose sampled floors lie above its percentiles runs agai
     const std::optional<ComparisonReport> unfloored = tileByTile(0.0f);
     REQUIRE(unfloored.has_value());
     REQUIRE(unfloored->p99ErrorQuanta == double(expectedP99));
-    const Comparison full = compareRoutes(judge, routes.ray, routes.raster, &routes.quantum);
+    const Comparison full = compareRoutes(judge, routes.ray, routes.raster, {&routes.quantum});
     REQUIRE(full.report.p99ErrorQuanta == double(expectedP99));
     CheckReport fromRoutes, fromTiles;
     fromRoutes.comparison = full.report, fromTiles.comparison = *unfloored;

@@ -37,6 +37,7 @@ std::string toString(PixelClass pixelClass)
     case PixelClass::AtClipPlane: return "at-clip-plane";
     case PixelClass::RayOnly: return "ray-only";
     case PixelClass::RasterOnly: return "raster-only";
+    case PixelClass::Hole: return "hole";
     }
     return "?";
 }
@@ -186,7 +187,10 @@ double PixelJudge::computeSlope(std::uint32_t primitive) const
     return slopeFrame_.slope(vertex(primitive, 0), vertex(primitive, 1), vertex(primitive, 2));
 }
 
-double PixelJudge::surfaceTolerance(std::uint32_t primitive, double q) const { return toleranceForSlope(slope(primitive), q); }
+double PixelJudge::surfaceTolerance(std::uint32_t primitive, double q, double allowance) const
+{
+    return toleranceForSlope(slope(primitive), q, allowance);
+}
 
 // Does the primitive's plane cross the pixel's ray at the near or far plane, to within
 // binary32 rounding (2^-20 relative) of the distances where the routes clip?
@@ -210,13 +214,14 @@ bool PixelJudge::nearEdge(std::uint32_t primitive, const glm::dvec2& pWindow) co
 }
 
 PixelClass PixelJudge::bothHit(double rayDepth, std::uint32_t rayPrimitive, double rasterDepth,
-                               std::uint32_t rasterPrimitive, double q, const glm::dvec2& pWindow, double& bound) const
+                               std::uint32_t rasterPrimitive, double q, const glm::dvec2& pWindow, double& bound,
+                               double allowance) const
 {
     const double error = std::abs(rasterDepth - rayDepth);
     // Different surfaces: the raster's may legitimately win where the two lie within both
     // tolerances of each other, so the bound is their sum.
     const bool samePrimitive = rayPrimitive == rasterPrimitive;
-    bound = surfaceTolerance(rayPrimitive, q) + (samePrimitive ? 0.0 : surfaceTolerance(rasterPrimitive, q));
+    bound = surfaceTolerance(rayPrimitive, q, allowance) + (samePrimitive ? 0.0 : surfaceTolerance(rasterPrimitive, q));
     if (error <= bound) return PixelClass::Agree;
     if (!samePrimitive && (nearEdge(rayPrimitive, pWindow) || nearEdge(rasterPrimitive, pWindow) ||
                            atClipPlane(rayPrimitive, pWindow) || atClipPlane(rasterPrimitive, pWindow)))
@@ -299,7 +304,7 @@ void merge(TileTally& total, TileTally& tile)
     r.bothHit += b.bothHit, r.bothMiss += b.bothMiss, r.rayOnly += b.rayOnly, r.rasterOnly += b.rasterOnly;
     r.agree += b.agree, r.edgeSurface += b.edgeSurface, r.depthErrors += b.depthErrors;
     r.coverageExplained += b.coverageExplained, r.lostAtClearValue += b.lostAtClearValue;
-    r.atClipPlane += b.atClipPlane, r.coverageUnexplained += b.coverageUnexplained;
+    r.atClipPlane += b.atClipPlane, r.holes += b.holes, r.coverageUnexplained += b.coverageUnexplained;
     r.maxErrorQuanta = std::max(r.maxErrorQuanta, b.maxErrorQuanta);
     r.maxRelativeEyeZError = std::max(r.maxRelativeEyeZError, b.maxRelativeEyeZError);
     r.biasSamples += b.biasSamples;
@@ -392,6 +397,7 @@ struct RowInputs {
     const double* rasterDepth = nullptr;
     const double* slope = nullptr;     // of the triangle both routes hit (where they hit one)
     const double* quantum = nullptr;   // q
+    const double* allowance = nullptr; // a (RoutePixels::allowance; kNoAllowance where it has none)
     const double* relative = nullptr;  // the relative eye-z error
     int n = 0;
     // rowLanesAvx512 only: where these are given, it computes the three arrays above itself
@@ -404,6 +410,9 @@ struct RowInputs {
     PixelClass* pixelClass = nullptr;  // the row's per-pixel results, or null (none kept)
     float* errorOverTolerance = nullptr;
 };
+
+// A row's allowances where the raster side declares none.
+alignas(64) constexpr double kNoAllowance[kLanes] = {};
 
 // What a row's lane pass gives the rest of its tally: the common case's measures (both routes
 // on one triangle: PixelJudge::bothHit's rule for a single surface, one slope, no edge or
@@ -447,13 +456,13 @@ ZCHECK_ALWAYS_INLINE inline void rowLanesBaseline(const RowInputs& in, const Pix
         hit[j] = (in.rayPrimitive[j] != kNoPrimitive) | (in.rasterPrimitive[j] != kNoPrimitive);
     }
     for (int j = 0; j < n; ++j) {
-        const double q = in.quantum[j], m = in.slope[j];
-        out.bound[j] = terms.of(m, q);
+        const double q = in.quantum[j], m = in.slope[j], a = in.allowance[j];
+        out.bound[j] = terms.of(m, q, a);
         const double error = std::abs(in.rasterDepth[j] - in.rayDepth[j]);
         out.signedErrorQuanta[j] = PixelMeasures::signedErrorQuanta(in.rayDepth[j], in.rasterDepth[j], q);
         out.ratio[j] = ratioOf(error, out.bound[j]);
         agree[j] = error <= out.bound[j];
-        bias[j] = common[j] & (terms.S * m <= 0.1 * q);
+        bias[j] = common[j] & (terms.S * m + a <= 0.1 * q);
     }
     if (in.pixelClass) {
         // Without a branch, so that the loop stays SIMD: the class as arithmetic, the ratio's
@@ -580,9 +589,10 @@ ZCHECK_TARGET_AVX512 void rowLanesAvx512(const RowInputs& in, const PixelJudge::
         else
             relative = _mm512_div_pd(_mm512_sub_pd(rayDepth, rasterDepth), _mm512_sub_pd(rasterDepth, relativeA));
         if (in.relativeForm) relative = _mm512_castsi512_pd(_mm512_and_si512(_mm512_castpd_si512(relative), magnitude));
-        // terms.of(m, q) = C·q + S·m + E, in that order.
+        const __m512d allowance = in.allowance == kNoAllowance ? zero : _mm512_maskz_loadu_pd(lanes, in.allowance + j);
+        // terms.of(m, q, a) = C·q + S·m + E + a, in that order.
         const __m512d slopeTerm = _mm512_mul_pd(S, m);
-        const __m512d bound = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(C, q), slopeTerm), E);
+        const __m512d bound = _mm512_add_pd(_mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(C, q), slopeTerm), E), allowance);
         const __m512d difference = _mm512_sub_pd(rasterDepth, rayDepth);
         const __m512d error = _mm512_castsi512_pd(_mm512_and_si512(_mm512_castpd_si512(difference), magnitude));
         const __m512d signedErrorQuanta = _mm512_div_pd(difference, q);
@@ -593,7 +603,7 @@ ZCHECK_TARGET_AVX512 void rowLanesAvx512(const RowInputs& in, const PixelJudge::
         const __m512d ratio =
             _mm512_mask_blend_pd(_mm512_cmp_pd_mask(bound, zero, _CMP_GT_OQ), unbounded, _mm512_div_pd(error, bound));
         const __mmask8 a = _mm512_mask_cmp_pd_mask(lanes, error, bound, _CMP_LE_OQ);
-        const __mmask8 b = _mm512_mask_cmp_pd_mask(c, slopeTerm, _mm512_mul_pd(tenth, q), _CMP_LE_OQ);
+        const __mmask8 b = _mm512_mask_cmp_pd_mask(c, _mm512_add_pd(slopeTerm, allowance), _mm512_mul_pd(tenth, q), _CMP_LE_OQ);
         _mm512_store_pd(out.bound + j, bound);
         _mm512_store_pd(out.signedErrorQuanta + j, signedErrorQuanta);
         _mm512_store_pd(out.errorQuanta + j, errorQuanta);
@@ -775,6 +785,7 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tileBegin
             in.rayPrimitive = rayPrimitives, in.rasterPrimitive = rasterPrimitives, in.surface = surface;
             in.rayDepth = rayDepths, in.rasterDepth = rasterDepths;
             in.slope = slope, in.quantum = quantum, in.relative = relative, in.n = n;
+            in.allowance = raster.allowance ? raster.allowance + b0 : kNoAllowance;
 #ifdef ZCHECK_X86_AVX512
             if constexpr (kAvx512) {
                 const std::uint64_t blockRuns =
@@ -873,7 +884,7 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tileBegin
                     const double error = std::abs(f.rasterWindowDepth - f.rayWindowDepth);
                     double bound = 0;
                     f.pixelClass = judge.bothHit(f.rayWindowDepth, f.rayPrimitive, f.rasterWindowDepth, f.rasterPrimitive, q,
-                                                 pWindow, bound);
+                                                 pWindow, bound, raster.allowance ? raster.allowance[b] : 0.0);
                     f.errorQuanta = std::abs(signedErrorQuantaAt(a, b, q));
                     const double ratio = ratioOf(error, bound);
                     auto withTolerance = [&](PixelFinding& finding) -> PixelFinding& {  // a finding kept
@@ -896,6 +907,7 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tileBegin
                                                 rayHit ? f.rayPrimitive : f.rasterPrimitive, quantumAt(a, b), pWindow);
                     if (f.pixelClass == PixelClass::RayOnlyAtClear) ++r.lostAtClearValue;
                     if (f.pixelClass == PixelClass::AtClipPlane) ++r.atClipPlane;
+                    if (f.pixelClass == PixelClass::RayOnly && raster.holesAllowed) f.pixelClass = PixelClass::Hole, ++r.holes;
                     isUnexplained(f.pixelClass) ? ++r.coverageUnexplained : ++r.coverageExplained;
                 }
                 setClass(i, f.pixelClass);
@@ -1005,19 +1017,20 @@ std::optional<ComparisonReport> TileComparison::finish()
 }
 
 Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderResult& ray,
-                         const RenderResult& raster, const ToleranceModel& tolerance,
-                         const std::vector<double>* rasterQuantum)
+                         const RenderResult& raster, const ToleranceModel& tolerance, const DeclaredMap& declared)
 {
-    return compareRoutes(PixelJudge(scene, camera, tolerance), ray, raster, rasterQuantum);
+    return compareRoutes(PixelJudge(scene, camera, tolerance), ray, raster, declared);
 }
 
 Comparison compareRoutes(const PixelJudge& judge, const RenderResult& ray, const RenderResult& raster,
-                         const std::vector<double>* rasterQuantum)
+                         const DeclaredMap& declared)
 {
     const Camera& camera = judge.camera();
     const int W = camera.width(), H = camera.height();
     RoutePixels rayPixels = RoutePixels::of(ray), rasterPixels = RoutePixels::of(raster);
-    if (rasterQuantum) rasterPixels.quantum = rasterQuantum->data();
+    if (declared.quantum) rasterPixels.quantum = declared.quantum->data();
+    if (declared.allowance) rasterPixels.allowance = declared.allowance->data();
+    rasterPixels.holesAllowed = declared.holesAllowed;
 
     // The keepers' floors, from the single-surface pixels of evenly spaced rows, ~16,000 pixels
     // in all (every 126th row at 1920×1080): the values at their 97th percentile lie below the

@@ -391,15 +391,16 @@ std::vector<Sample> withTolerances(const Scene& scene, const Camera& declared, c
 {
     const Camera departed(departedCameraSpec(declared, d));
     const PixelJudge judge(scene, departed, mapTolerance(), SlopeSource::EachCall);  // ~16,000 samples
-    const double valueQuantum = map.valueQuantum / std::abs(d.valueScale);
     tbb::parallel_for(std::size_t(0), samples.size(), [&](std::size_t k) {
         Sample& s = samples[k];
-        const MapPixel pixel = mapPixelDepth(departed, map.quantity, (s.mapValue - d.valueOffset) / d.valueScale,
-                                             valueQuantum, s.col, s.row, NAN);
+        ValueAccuracy accuracy = map.accuracyAt(std::size_t(s.row) * map.width + s.col);
+        accuracy.step /= std::abs(d.valueScale), accuracy.absolute /= std::abs(d.valueScale);
+        const MapPixel pixel = mapPixelDepth(departed, map.quantity, (s.mapValue - d.valueOffset) / d.valueScale, accuracy,
+                                             s.col, s.row, NAN);
         const glm::dvec2 pWindow = windowFromPixelCentre(departed, s.col, s.row);
         const double z = eyeZFromWindowDepth(departed, pWindow, pixel.depth);
         const double windowSigma = valuePerRelativeEyeZ(departed, pWindow, z, DepthQuantity::Window);
-        s.tolerance = judge.surfaceTolerance(s.primitive, pixel.quantum) / windowSigma;
+        s.tolerance = judge.surfaceTolerance(s.primitive, pixel.quantum, pixel.allowance) / windowSigma;
     });
     samples.erase(std::remove_if(samples.begin(), samples.end(),
                                  [](const Sample& s) { return !(s.tolerance > 0) || !std::isfinite(s.tolerance); }),
@@ -560,7 +561,9 @@ DepthMap departedReading(const Camera& declared, const DepthMap& map, const Depa
                     ? NAN
                     : undone;
         }
-    if (out.valueQuantum > 0) out.valueQuantum /= std::abs(d.valueScale);
+    const double scale = std::abs(d.valueScale);
+    out.valueQuantum /= scale, out.accuracy.quantum /= scale, out.accuracy.absolute /= scale;
+    for (float& step : out.valueStep) step = float(step / scale);
     return out;
 }
 

@@ -97,10 +97,13 @@ Mistake mirrored(std::string name, std::string description, std::string explanat
     mistake.reread = [rows, explanation](const Camera&, const DepthMap& map) {
         DepthMap back = map;
         for (int row = 0; row < map.height; ++row)
-            for (int col = 0; col < map.width; ++col)
-                back.value[std::size_t(row) * map.width + col] =
-                    map.value[rows ? std::size_t(map.height - 1 - row) * map.width + col
-                                   : std::size_t(row) * map.width + (map.width - 1 - col)];
+            for (int col = 0; col < map.width; ++col) {
+                const std::size_t to = std::size_t(row) * map.width + col;
+                const std::size_t from = rows ? std::size_t(map.height - 1 - row) * map.width + col
+                                              : std::size_t(row) * map.width + (map.width - 1 - col);
+                back.value[to] = map.value[from];
+                if (!map.valueStep.empty()) back.valueStep[to] = map.valueStep[from];
+            }
         return Rereadings{{"", explanation, std::nullopt, {}, back}};
     };
     return mistake;

@@ -1,5 +1,6 @@
 #include "zcheck/verify.h"
 
+#include "zcheck/declared_reading.h"
 #include "zcheck/drawn_polygon.h"
 #include "zcheck/error.h"
 #include "zcheck/fit.h"
@@ -103,12 +104,12 @@ MapReader::MapReader(const PixelJudge& judge, const DepthMap& map, const RenderR
 
 MapPixel mapPixelDepth(const Camera& camera, const DepthMap& map, int col, int row, double truthDepth)
 {
-    return mapPixelDepth(camera, map.quantity, map.value[std::size_t(row) * camera.width() + col], map.valueQuantum, col,
-                         row, truthDepth);
+    const std::size_t i = std::size_t(row) * camera.width() + col;
+    return mapPixelDepth(camera, map.quantity, map.value[i], map.accuracyAt(i), col, row, truthDepth);
 }
 
-MapPixel mapPixelDepth(const Camera& camera, DepthQuantity quantity, double value, double valueQuantum, int col, int row,
-                       double truthDepth)
+MapPixel mapPixelDepth(const Camera& camera, DepthQuantity quantity, double value, const ValueAccuracy& accuracy, int col,
+                       int row, double truthDepth)
 {
     MapPixel out;
     WindowDepthAt windowDepthOf(camera, windowFromPixelCentre(camera, col, row), quantity);
@@ -116,17 +117,23 @@ MapPixel mapPixelDepth(const Camera& camera, DepthQuantity quantity, double valu
     const double depth = out.depth;
     // The storage step, carried into window units through the quantity's mapping.
     const double reference = std::isfinite(depth) ? depth : truthDepth;
-    if (quantity == DepthQuantity::Window && valueQuantum == 0) {
+    if (quantity == DepthQuantity::Window && accuracy.step == 0) {
         out.quantum = storageQuantum(camera.depth().format, reference);
     } else if (std::isfinite(depth)) {
-        const double step = valueQuantum > 0 ? valueQuantum
-                                             : double(std::nextafter(float(std::abs(value)), INFINITY)) - std::abs(double(float(value)));
+        const double step = accuracy.step > 0 ? accuracy.step
+                                              : double(std::nextafter(float(std::abs(value)), INFINITY)) - std::abs(double(float(value)));
         const double other = windowDepthOf(value + step);
         out.quantum = std::isfinite(other) ? std::max(std::abs(other - depth), storageQuantum(DepthFormat::Float32, depth))
                                            : storageQuantum(camera.depth().format, depth);
     } else {
         out.quantum = storageQuantum(camera.depth().format, reference);
     }
+    // The declared accuracy, the larger window change of the two sides that are depths.
+    const double declared = accuracy.absolute + accuracy.relative * std::abs(value);
+    if (declared > 0 && std::isfinite(depth))
+        for (const double side : {value - declared, value + declared})
+            if (const double there = windowDepthOf(side); std::isfinite(there))
+                out.allowance = std::max(out.allowance, std::abs(there - depth));
     return out;
 }
 
@@ -148,10 +155,10 @@ MapPixel MapReader::read(int col, int row, bool search) const
     // where a farther one passes (the regression "verify rejected a correct map at a
     // sliver's edge" in tests/test_verify.cpp).
     const std::uint32_t here = truth_.primitiveId[i];
-    const double q = out.quantum;
+    const double q = out.quantum, allowance = out.allowance;
     const double truthDepth = truth_.windowDepth.value[i];
     double bound = 0;
-    if (here != kNoPrimitive && judge_.bothHit(truthDepth, here, depth, here, q, pWindow, bound) == PixelClass::Agree) {
+    if (here != kNoPrimitive && judge_.bothHit(truthDepth, here, depth, here, q, pWindow, bound, allowance) == PixelClass::Agree) {
         out.primitive = here;
         return out;
     }
@@ -168,10 +175,10 @@ MapPixel MapReader::read(int col, int row, bool search) const
         considered.push_back(candidate);
         const double plane = planeWindowDepth(scene_, camera_, candidate, ray);
         if (!std::isfinite(plane)) return;
-        const double tolerance = judge_.surfaceTolerance(candidate, q);
+        const double tolerance = judge_.surfaceTolerance(candidate, q, allowance);
         double lo = plane - tolerance, hi = plane + tolerance;
         if (here != kNoPrimitive) {
-            const double truthTolerance = judge_.surfaceTolerance(here, q);
+            const double truthTolerance = judge_.surfaceTolerance(here, q, allowance);
             lo = std::min(lo, truthDepth - truthTolerance), hi = std::max(hi, truthDepth + truthTolerance);
         }
         const double gap = std::abs(plane - depth);
@@ -180,7 +187,7 @@ MapPixel MapReader::read(int col, int row, bool search) const
         const glm::dvec3 a(scene_.positions[t[0]]), b(scene_.positions[t[1]]), c(scene_.positions[t[2]]);
         if (!insideDrawnTriangle(camera_, a, b, c, pWindow) && !judge_.nearEdge(candidate, pWindow)) return;
         const bool explained = here != kNoPrimitive
-                                   ? judge_.bothHit(truthDepth, here, depth, candidate, q, pWindow, bound) != PixelClass::DepthError
+                                   ? judge_.bothHit(truthDepth, here, depth, candidate, q, pWindow, bound, allowance) != PixelClass::DepthError
                                    : judge_.nearEdge(candidate, pWindow) || judge_.atClipPlane(candidate, pWindow);
         if (explained) closest = gap, primitive = candidate;
     };
@@ -233,19 +240,25 @@ PixelClass MapReader::classify(int col, int row, const MapPixel& pixel) const
     if (truthHit && mapHit) {
         double bound = 0;
         return judge_.bothHit(truth_.windowDepth.value[i], truth_.primitiveId[i], pixel.depth, pixel.primitive,
-                              pixel.quantum, pWindow, bound);
+                              pixel.quantum, pWindow, bound, pixel.allowance);
     }
-    return truthHit ? judge_.oneHit(true, truth_.windowDepth.value[i], truth_.primitiveId[i], pixel.quantum, pWindow)
-                    : judge_.oneHit(false, pixel.depth, pixel.primitive, pixel.quantum, pWindow);
+    if (truthHit) {
+        const PixelClass c = judge_.oneHit(true, truth_.windowDepth.value[i], truth_.primitiveId[i], pixel.quantum, pWindow);
+        return c == PixelClass::RayOnly && map_.accuracy.allowHoles ? PixelClass::Hole : c;
+    }
+    return judge_.oneHit(false, pixel.depth, pixel.primitive, pixel.quantum, pWindow);
 }
 
 RenderResult renderResultFromMap(const PixelJudge& judge, const DepthMap& map, const RenderResult& truth,
-                                 const VertexNeighbours& neighbours, std::vector<double>& quantum)
+                                 const VertexNeighbours& neighbours, std::vector<double>& quantum,
+                                 std::vector<double>& allowance)
 {
     const Camera& camera = judge.camera();
     const int W = camera.width(), H = camera.height();
     RenderResult out = RenderResult::cleared(W, H, camera.clearDepth());
     quantum.assign(std::size_t(W) * H, 0.0);
+    const bool declared = map.accuracy.relative > 0 || map.accuracy.absolute > 0;
+    allowance.assign(declared ? std::size_t(W) * H : 0, 0.0);
     const MapReader reader(judge, map, truth, neighbours);
     // Rows in parallel: each pixel's choice reads only the truth and the map.
     tbb::parallel_for(0, H, [&](int row) {
@@ -253,12 +266,19 @@ RenderResult renderResultFromMap(const PixelJudge& judge, const DepthMap& map, c
             const std::size_t i = std::size_t(row) * W + col;
             const MapPixel pixel = reader.read(col, row);
             quantum[i] = pixel.quantum;
+            if (declared) allowance[i] = pixel.allowance;
             if (pixel.primitive == kNoPrimitive) continue;
             out.windowDepth.value[i] = pixel.depth;
             out.primitiveId[i] = pixel.primitive;
         }
     });
     return out;
+}
+
+DepthMap DepthMap::of(DepthMapFile file, DepthQuantity quantity, const DepthMapReading& reading)
+{
+    return {file.width,           file.height, quantity,      std::move(file.value), file.valueQuantum, std::move(file.valueStep),
+            reading.accuracy, reading.scale, reading.offset};
 }
 
 void requireMapFits(const Camera& camera, const DepthMap& map)
@@ -336,7 +356,8 @@ Probe probeAgreement(const Scene& scene, const RayRenderer& rays, const Camera& 
         ++seen;
         double bound = 0;
         if (primitive != kNoPrimitive && std::isfinite(pixel.depth) && std::isfinite(truthDepth) &&
-            judge.bothHit(truthDepth, primitive, pixel.depth, primitive, pixel.quantum, pWindow, bound) == PixelClass::Agree)
+            judge.bothHit(truthDepth, primitive, pixel.depth, primitive, pixel.quantum, pWindow, bound, pixel.allowance) ==
+                PixelClass::Agree)
             ++agree;
     });
     return {seen == 0 ? 0.0 : double(agree) / double(seen), double(seen) / (kGrid * kGrid)};
@@ -348,14 +369,16 @@ VerifyResult verifyAgainst(const Scene& scene, const Camera& camera, const Depth
     requireMapFits(camera, map);
     VerifyResult run;
     run.truth = std::move(truth);
-    std::vector<double> quantum;
+    std::vector<double> quantum, allowance;
     const PixelJudge judge(scene, camera, mapTolerance());  // reads the map, then compares with the slopes it found
-    run.map = renderResultFromMap(judge, map, run.truth, neighbours, quantum);
+    run.map = renderResultFromMap(judge, map, run.truth, neighbours, quantum, allowance);
     const auto start = std::chrono::steady_clock::now();
-    run.comparison = compareRoutes(judge, run.truth, run.map, &quantum);
+    run.comparison = compareRoutes(judge, run.truth, run.map,
+                                   {&quantum, allowance.empty() ? nullptr : &allowance, map.accuracy.allowHoles});
     run.report.timings.compareMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     run.report.timings.traceMs = run.truth.renderMilliseconds;
     run.report.describeInputs(scene, camera, mapTolerance());
+    run.report.declared = map.accuracy;
     run.report.comparison = run.comparison.report;
     return run;
 }
@@ -515,6 +538,37 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
                      "average)"
                    : "consistent except at edges";
         out.insert(out.begin(), std::move(asDeclared));  // before readings that only rename the same values
+    }
+    // What the reading should have declared (declared_reading.h): each finding alone, and all
+    // of them together, judged as any hypothesis.
+    ReadingFindings findings = findReading(camera, map, truth);
+    std::vector<std::string> found;
+    if (findings.missValue) found.push_back("miss");
+    if (findings.grid > 0) found.push_back("grid");
+    {  // holes: the pixels left unexplained where only the truth hits, once the miss value is read as one
+        const VerifyResult run = verifyAgainst(scene_, camera, declaredReading(map, findings, found), truth, neighbours());
+        findings.holes = std::count(run.comparison.pixelClass.begin(), run.comparison.pixelClass.end(), PixelClass::RayOnly);
+        if (findings.holes > 0 && !map.accuracy.allowHoles) found.push_back("holes");
+    }
+    auto findingName = [](const std::string& use) {
+        return use == "miss" ? std::string("miss-value") : use == "grid" ? std::string("quantum") : use;
+    };
+    auto judgeReading = [&](const std::vector<std::string>& use, const DepthMap& read, const std::string& extra) {
+        std::string name;
+        for (const std::string& u : use) name += (name.empty() ? "" : " + ") + findingName(u);
+        std::string because = describeFindings(findings, use);
+        if (!extra.empty()) because += (because.empty() ? "" : "; ") + extra;
+        return judgeAgainst(hypothesis(name, "", "consistent if read as declared: " + because), camera, read, truth);
+    };
+    {
+        std::vector<std::vector<std::string>> readings;
+        for (const std::string& use : found) readings.push_back({use});
+        if (found.size() > 1) readings.push_back(found);
+        std::vector<Hypothesis> judged(readings.size());
+        tbb::parallel_for(std::size_t(0), readings.size(), [&](std::size_t k) {
+            judged[k] = judgeReading(readings[k], declaredReading(map, findings, readings[k]), "");
+        });
+        out.insert(out.end(), judged.begin(), judged.end());
     }
     // The continuous families, fitted side by side, each confirmed by a full comparison; not
     // needed where a mistake of the catalogue explains the map whole.
@@ -681,6 +735,34 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
                 const Candidate& reading = candidates[std::size_t(closest - residual.begin())];
                 fitEach(*reading.reading.map, &reading);
             }
+        }
+    }
+    // A stated accuracy, last, and only where no convention explains the map (a uniform offset,
+    // which the depth-scale fit measures, may be the map's stated accuracy): the tolerance that
+    // would accept the map as read with the findings above.
+    if (std::none_of(out.begin(), out.end(), [](const Hypothesis& h) {
+            return (h.consistent || h.consistentExceptEdges()) && h.name != "depth-scale";
+        })) {
+        const DepthMap read = declaredReading(map, findings, found);
+        if (const std::optional<MapAccuracy> accuracy = toleranceFinding(camera, read, truth)) {
+            DepthMap declared = read;
+            declared.accuracy = *accuracy;
+            const std::string option = accuracy->relative > map.accuracy.relative
+                                           ? "--rel-tolerance " + formatNumber(accuracy->relative)
+                                           : "--abs-tolerance " + formatNumber(accuracy->absolute);
+            const std::string within = accuracy->relative > map.accuracy.relative
+                                           ? "±" + formatNumber(accuracy->relative) + " of the truth (relative)"
+                                           : "±" + formatNumber(accuracy->absolute) + " of the truth";
+            std::vector<std::string> use = found;
+            Hypothesis h = judgeReading(use, declared,
+                                        "its values lie within " + within + " everywhere: pass " + option +
+                                            " if your renderer or sensor is good only to that (a tolerance is for "
+                                            "accuracy, never for a convention mistake)");
+            h.name = h.name.empty() ? "tolerance" : h.name + " + tolerance";
+            h.fitted.push_back({accuracy->relative > map.accuracy.relative ? "rel_tolerance" : "abs_tolerance",
+                                accuracy->relative > map.accuracy.relative ? accuracy->relative : accuracy->absolute,
+                                accuracy->relative > map.accuracy.relative ? map.accuracy.relative : map.accuracy.absolute});
+            out.push_back(std::move(h));
         }
     }
     // A map with no surface at all, as read, is evidence for nothing: say so first.

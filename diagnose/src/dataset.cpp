@@ -45,6 +45,7 @@ DatasetRunner::DatasetRunner(Dataset dataset, DatasetRunOptions options, DepthMa
     if (options_.shards < 1 || options_.shard >= options_.shards) throw Error("the shard must be I/N with 0 <= I < N");
     if (!options_.quantity.empty()) depthQuantityFromName(options_.quantity);  // a bad --quantity is the run's error
     if (!options_.miss.empty()) MissRule::parse(options_.miss);
+    options_.accuracy.require("the run's options");
     if (!options_.convention.empty()) Convention::preset(options_.convention);
     (*checkers_)(options_.scene);
 }
@@ -73,6 +74,7 @@ FramePlan planFrame(const DatasetFrame& frame, const DatasetRunOptions& options)
     reading.offset = frame.offset.value_or(options.offset.value_or(0.0));
     const std::string miss = frame.miss.value_or(options.miss);
     if (!miss.empty()) reading.miss = MissRule::parse(miss);
+    reading.accuracy = frame.accuracy.over(options.accuracy);
     plan.given.near = frame.near ? frame.near : options.near;
     plan.given.far = frame.far ? frame.far : options.far;
     plan.scene = frame.scene.value_or(options.scene);
@@ -109,7 +111,7 @@ FrameResult DatasetRunner::verify(std::size_t index, VerifiedMap* keep) const
         CameraForMap made = frameCameraAndMap(frame, plan, checker.scene(), options_, readDepthMap_);
         const Camera camera(made.spec);
         result.map.channel = made.map.channel;
-        const DepthMap map{made.map.width, made.map.height, plan.quantity, std::move(made.map.value), made.map.valueQuantum};
+        const DepthMap map = DepthMap::of(std::move(made.map), plan.quantity, plan.reading);
         VerifiedMap verified = verifyMap(checker, camera, map, options_.diagnose);
         result.verified = true;
         result.report = verified.run.report;

@@ -115,7 +115,8 @@ private:
         const nlohmann::json object = parseJsonStrictly(line, where);
         if (!object.is_object()) throw Error(where + ": a frame is a JSON object");
         static const std::set<std::string> known = {"frame", "camera", "depth", "quantity", "scale", "offset",
-                                                    "miss", "channel", "scene", "near", "far"};
+                                                    "miss", "channel", "scene", "near", "far", "quantum",
+                                                    "rel_tolerance", "abs_tolerance", "allow_holes"};
         for (const auto& item : object.items())
             if (!known.count(item.key())) throw Error(where + ": unknown key '" + printableExcerpt(item.key(), 40) + "'");
         auto text = [&](const char* key) -> std::optional<std::string> {
@@ -143,6 +144,7 @@ private:
         frame.near = number_("near"), frame.far = number_("far");
         if ((frame.near && !(*frame.near > 0)) || (frame.far && !(*frame.far > 0)))
             throw Error(where + ": 'near' and 'far' must be > 0");
+        frame.accuracy = accuracyFromJson(object, where);
         if (object.contains("miss") && !object["miss"].is_null()) {
             const nlohmann::json& miss = object["miss"];
             if (miss.is_number()) frame.miss = formatNumber(miss.get<double>());
@@ -232,6 +234,10 @@ std::string manifestLine(const DatasetFrame& frame, const std::string& cameraRef
     if (frame.scene) line["scene"] = relativeTo(*frame.scene, manifestPath);
     if (frame.near) line["near"] = *frame.near;
     if (frame.far) line["far"] = *frame.far;
+    if (frame.accuracy.quantum > 0) line["quantum"] = frame.accuracy.quantum;
+    if (frame.accuracy.relative > 0) line["rel_tolerance"] = frame.accuracy.relative;
+    if (frame.accuracy.absolute > 0) line["abs_tolerance"] = frame.accuracy.absolute;
+    if (frame.accuracy.allowHoles) line["allow_holes"] = true;
     return line.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 

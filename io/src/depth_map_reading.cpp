@@ -100,6 +100,75 @@ std::string chooseDepthChannel(const std::string& path, const std::vector<std::s
     refuseDepthMap(path, "several of its channels are named as depth (" + listed(depth) + "); name the one to read with --channel");
 }
 
+void MapAccuracy::require(const std::string& where) const
+{
+    auto check = [&](const char* name, double v) {
+        if (!(v >= 0) || !std::isfinite(v))
+            throw Error(where + ": " + name + " must be a finite number >= 0 (got " + formatNumber(v) + ")");
+    };
+    check("quantum", quantum), check("relative tolerance", relative), check("absolute tolerance", absolute);
+    if (relative >= 1) throw Error(where + ": relative tolerance must be below 1 (got " + formatNumber(relative) + ")");
+}
+
+std::string MapAccuracy::options() const
+{
+    std::string out;
+    auto add = [&](const std::string& option) { out += (out.empty() ? "" : " ") + option; };
+    if (quantum > 0) add("--quantum " + formatNumber(quantum));
+    if (relative > 0) add("--rel-tolerance " + formatNumber(relative));
+    if (absolute > 0) add("--abs-tolerance " + formatNumber(absolute));
+    if (allowHoles) add("--allow-holes");
+    return out;
+}
+
+MapAccuracy MapAccuracy::over(const MapAccuracy& fallback) const
+{
+    MapAccuracy out = *this;
+    if (!(out.quantum > 0)) out.quantum = fallback.quantum;
+    if (!(out.relative > 0)) out.relative = fallback.relative;
+    if (!(out.absolute > 0)) out.absolute = fallback.absolute;
+    out.allowHoles = out.allowHoles || fallback.allowHoles;
+    return out;
+}
+
+MapAccuracy accuracyFromJson(const nlohmann::json& object, const std::string& where)
+{
+    MapAccuracy out;
+    auto given = [&](const char* key) { return object.contains(key) && !object[key].is_null(); };
+    auto number = [&](const char* key, double& field) {
+        if (!given(key)) return;
+        const nlohmann::json& v = object[key];
+        if (!v.is_number() || !(v.get<double>() >= 0) || !std::isfinite(v.get<double>()))
+            throw Error(where + ": \"" + key + "\" must be a finite number >= 0");
+        field = v.get<double>();
+    };
+    number("quantum", out.quantum);
+    number("rel_tolerance", out.relative);
+    number("abs_tolerance", out.absolute);
+    if (out.relative >= 1) throw Error(where + ": \"rel_tolerance\" must be below 1");
+    if (given("allow_holes")) {
+        if (!object["allow_holes"].is_boolean()) throw Error(where + ": \"allow_holes\" must be true or false");
+        out.allowHoles = object["allow_holes"].get<bool>();
+    }
+    return out;
+}
+
+nlohmann::json toJson(const MapAccuracy& accuracy)
+{
+    return {{"quantum", accuracy.quantum},
+            {"rel_tolerance", accuracy.relative},
+            {"abs_tolerance", accuracy.absolute},
+            {"allow_holes", accuracy.allowHoles}};
+}
+
+double binary16Step(double stored)
+{
+    const double magnitude = std::abs(stored);
+    if (!std::isfinite(magnitude)) return 0;
+    const int exponent = magnitude < std::ldexp(1.0, -14) ? -14 : std::ilogb(magnitude);
+    return std::ldexp(1.0, exponent - 10);
+}
+
 DepthMapReading withSidecar(DepthMapReading r, const std::string& sidecar)
 {
     const nlohmann::json doc = parseJsonStrictly(readInputFile(sidecar, kSidecarInput), sidecar);
@@ -119,6 +188,7 @@ DepthMapReading withSidecar(DepthMapReading r, const std::string& sidecar)
         if (!doc["offset"].is_number() || !std::isfinite(doc["offset"].get<double>())) throw bad("offset", "must be a finite number");
         r.offset = doc["offset"].get<double>();
     }
+    r.accuracy = r.accuracy.over(accuracyFromJson(doc, "sidecar '" + sidecar + "'"));
     if (given("miss") && !r.miss.given()) {
         const nlohmann::json& m = doc["miss"];
         if (m.is_number()) {

@@ -30,10 +30,21 @@ ExportQuantity exportOf(DepthQuantity q);
 // At most N worker threads for one call (TBB's limit is process-wide while it lives); none: all.
 std::unique_ptr<tbb::global_control> threadLimit(std::optional<int> threads);
 
-// The keyword arguments miss=, scale= and offset= as a reading (depth_map_reading.h), checked
-// as the command line checks --miss, --scale and --offset. `miss` is None, a number, or a
-// string ("65535", "nan", ">=1e9").
-DepthMapReading readingOf(const py::object& miss, std::optional<double> scale, std::optional<double> offset);
+// A keyword argument that must be None or a real number (a Python int or float, a NumPy scalar):
+// anything else — a bool, a string, a list — is a zcheck.Error naming `name`.
+std::optional<double> numberArgument(const py::object& value, const char* name);
+
+// The keyword arguments a map is read with, as a reading (depth_map_reading.h), checked as the
+// command line checks --miss, --scale, --offset, --quantum, --rel-tolerance, --abs-tolerance and
+// --allow-holes; a wrong type or value is a zcheck.Error naming the argument. `miss` is None, a
+// number, or a string ("65535", "nan", ">=1e9").
+struct ReadingArguments {
+    py::object miss = py::none(), scale = py::none(), offset = py::none();
+    py::object quantum = py::none(), relTolerance = py::none(), absTolerance = py::none(), allowHoles = py::none();
+};
+DepthMapReading readingOf(const ReadingArguments& arguments);
+// The quantity argument: a required depth quantity's name (a zcheck.Error when None or not one).
+DepthQuantity quantityArgument(const py::object& quantity, std::string& name);
 
 // zcheck.Report: the result of Checker.check, Checker.verify or Checker.verify_file.
 struct PyReport {

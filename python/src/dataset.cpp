@@ -29,9 +29,13 @@ struct PyDataset {
 DatasetRunOptions runOptions(const std::string& scene, std::optional<std::string> quantity, std::optional<double> scale,
                              std::optional<double> offset, const py::object& miss, std::optional<std::string> channel,
                              std::optional<double> near, std::optional<double> far, std::optional<std::string> convention,
-                             bool diagnose, std::optional<std::string> shard)
+                             bool diagnose, std::optional<std::string> shard, const py::dict& declared)
 {
     DatasetRunOptions o;
+    ReadingArguments arguments;
+    arguments.quantum = declared["quantum"], arguments.relTolerance = declared["rel_tolerance"];
+    arguments.absTolerance = declared["abs_tolerance"], arguments.allowHoles = declared["allow_holes"];
+    o.accuracy = readingOf(arguments).accuracy;
     o.scene = scene;
     o.quantity = quantity.value_or("");
     if (scale && !(*scale > 0 && std::isfinite(*scale))) fail("scale must be a positive finite number, got " + formatNumber(*scale));
@@ -57,6 +61,11 @@ py::dict frameDict(const PyDataset& d, std::size_t index)
         if (plan.reading.scale > 0) reading["scale"] = plan.reading.scale;
         if (plan.reading.offset != 0) reading["offset"] = plan.reading.offset;
         if (plan.reading.miss.given()) reading["miss"] = plan.reading.miss.text();
+        const MapAccuracy& declared = plan.reading.accuracy;
+        if (declared.quantum > 0) reading["quantum"] = declared.quantum;
+        if (declared.relative > 0) reading["rel_tolerance"] = declared.relative;
+        if (declared.absolute > 0) reading["abs_tolerance"] = declared.absolute;
+        if (declared.allowHoles) reading["allow_holes"] = true;
         out["quantity"] = plan.quantityName, out["reading"] = reading, out["scene"] = plan.scene;
         out["notes"] = plan.notes;
     } catch (const Error& e) {
@@ -76,10 +85,10 @@ void bindDatasets(py::module_& m)
                          std::optional<std::string> depth, std::optional<std::string> cameraFormat, std::optional<double> scale,
                          std::optional<double> offset, const py::object& miss, std::optional<std::string> channel,
                          std::optional<double> near, std::optional<double> far, std::optional<std::string> convention,
-                         bool diagnose, std::optional<std::string> shard) {
+                         bool diagnose, std::optional<std::string> shard, const py::dict& declared) {
                  auto d = std::make_shared<PyDataset>();
                  DatasetRunOptions options =
-                     runOptions(scene, quantity, scale, offset, miss, channel, near, far, convention, diagnose, shard);
+                     runOptions(scene, quantity, scale, offset, miss, channel, near, far, convention, diagnose, shard, declared);
                  DatasetSourceOptions sourceOptions;
                  sourceOptions.depthPattern = depth.value_or("");
                  if (cameraFormat) sourceOptions.cameraFormat = cameraFormatFromName(*cameraFormat);
@@ -92,7 +101,7 @@ void bindDatasets(py::module_& m)
              }),
              py::arg("source"), py::arg("scene"), py::arg("quantity"), py::arg("depth"), py::arg("camera_format"),
              py::arg("scale"), py::arg("offset"), py::arg("miss"), py::arg("channel"), py::arg("near"), py::arg("far"),
-             py::arg("convention"), py::arg("diagnose"), py::arg("shard"))
+             py::arg("convention"), py::arg("diagnose"), py::arg("shard"), py::arg("declared"))
         .def("__len__", [](const PyDataset& d) { return d.dataset().frames.size(); })
         .def_property_readonly("source", [](const PyDataset& d) { return d.dataset().source; })
         .def_property_readonly("kind", [](const PyDataset& d) { return d.dataset().kind; })

@@ -20,13 +20,16 @@ PYBIND11_MODULE(_zcheck_files, m)
     bindDatasets(m);
     m.def(
         "verify_file",
-        [](const Checker& checker, const Camera& camera, const std::string& path, const std::string& quantityName,
-           std::optional<std::string> channel, const py::object& miss, std::optional<double> scale,
-           std::optional<double> offset, std::optional<std::string> sidecar, bool diagnose, std::optional<int> threads) {
+        [](const Checker& checker, const Camera& camera, const std::string& path, const py::object& quantityArg,
+           std::optional<std::string> channel, const py::object& miss, const py::object& scale, const py::object& offset,
+           std::optional<std::string> sidecar, const py::object& quantum, const py::object& relTolerance,
+           const py::object& absTolerance, const py::object& allowHoles, bool diagnose, std::optional<int> threads) {
             // Exactly `zcheck verify --depth-map PATH --quantity Q [--channel C] [--scale S]
-            // [--offset O] [--miss M] [--diagnose]` (cli/verify.cpp).
-            const DepthQuantity quantity = depthQuantityFromName(quantityName);
-            DepthMapReading reading = readingOf(miss, scale, offset);
+            // [--offset O] [--miss M] [--quantum Q] [--rel-tolerance R] [--abs-tolerance A]
+            // [--allow-holes] [--diagnose]` (cli/verify.cpp).
+            std::string quantityName;
+            const DepthQuantity quantity = quantityArgument(quantityArg, quantityName);
+            DepthMapReading reading = readingOf({miss, scale, offset, quantum, relTolerance, absTolerance, allowHoles});
             reading.channel = channel ? *channel : "";
             reading.quantityChannel = channelNameOf(exportOf(quantity));
             if (sidecar) reading = withSidecar(reading, *sidecar);
@@ -36,23 +39,27 @@ PYBIND11_MODULE(_zcheck_files, m)
                 py::gil_scoped_release release;
                 const auto limit = threadLimit(threads);
                 const DepthMapFile file = readDepthMap(path, reading, camera.width(), camera.height());
-                const DepthMap map{file.width, file.height, quantity, file.value, file.valueQuantum};
+                const DepthMap map = DepthMap::of(file, quantity, reading);
                 fillVerification(*r, verifyAndReport(checker, camera, map, {path, quantityName, file.channel, reading}, diagnose));
             }
             return r;
         },
-        py::arg("checker"), py::arg("camera"), py::arg("path"), py::arg("quantity"), py::kw_only(),
+        py::arg("checker"), py::arg("camera"), py::arg("path"), py::arg("quantity") = py::none(), py::kw_only(),
         py::arg("channel") = py::none(), py::arg("miss") = py::none(), py::arg("scale") = py::none(),
-        py::arg("offset") = py::none(), py::arg("sidecar") = py::none(), py::arg("diagnose") = false,
+        py::arg("offset") = py::none(), py::arg("sidecar") = py::none(), py::arg("quantum") = py::none(),
+        py::arg("rel_tolerance") = py::none(), py::arg("abs_tolerance") = py::none(), py::arg("allow_holes") = py::none(),
+        py::arg("diagnose") = false,
         py::arg("threads") = py::none(), R"doc(See zcheck.Checker.verify_file.)doc");
 
     m.def(
         "read_depth_map",
         [](const std::string& path, const Camera& camera, std::optional<std::string> quantity,
-           std::optional<std::string> channel, const py::object& miss, std::optional<double> scale,
-           std::optional<double> offset, std::optional<std::string> sidecar) {
+           std::optional<std::string> channel, const py::object& miss, const py::object& scale, const py::object& offset,
+           std::optional<std::string> sidecar) {
             if (quantity && channel) fail("read_depth_map: give quantity or channel, not both");
-            DepthMapReading reading = readingOf(miss, scale, offset);
+            ReadingArguments arguments;
+            arguments.miss = miss, arguments.scale = scale, arguments.offset = offset;
+            DepthMapReading reading = readingOf(arguments);
             reading.channel = channel ? *channel : "";
             if (quantity) reading.quantityChannel = channelNameOf(exportOf(depthQuantityFromName(*quantity)));
             if (sidecar) reading = withSidecar(reading, *sidecar);

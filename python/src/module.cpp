@@ -450,14 +450,10 @@ std::string cameraRepr(const Camera& c)
 // ---------------------------------------------------------------------------------------------
 // depth maps given as arrays
 
-struct MapInput {
-    std::vector<double> values;
-    double quantum = 0;  // 1/scale for integer maps; 0: binary32
-};
-
-// `depth` (height × width, any float or integer dtype) → values as verify and unproject take
-// them, converted as a file's are (DepthMapReading::depthOf): integer maps need a scale.
-MapInput mapFromArray(py::handle depth, const Camera& camera, const DepthMapReading& reading)
+// `depth` (height × width, any float or integer dtype) → the map verify and unproject take,
+// its values converted as a file's are (DepthMapReading::depthOf): integer maps need a scale,
+// and step 1/scale; float16 maps carry each value's own step (binary16Step), as a file's do.
+DepthMap mapFromArray(py::handle depth, const Camera& camera, const DepthMapReading& reading, DepthQuantity quantity)
 {
     const py::array a = numericArray(depth, "depth");
     if (a.ndim() != 2 || a.shape(0) != camera.height() || a.shape(1) != camera.width())
@@ -468,10 +464,17 @@ MapInput mapFromArray(py::handle depth, const Camera& camera, const DepthMapRead
         fail("depth is an integer array (" + dtypeText(a) +
              "): give scale= (stored value = depth × scale, e.g. 1000 for millimetres; 0 = miss)");
     const DoubleArray d = asDoubles(a);
-    MapInput out;
-    out.values.assign(d.data(), d.data() + d.size());
-    for (double& v : out.values) v = reading.depthOf(v, integer);
-    out.quantum = integer ? 1.0 / reading.scale : 0.0;
+    DepthMap out;
+    out.width = camera.width(), out.height = camera.height(), out.quantity = quantity;
+    out.value.assign(d.data(), d.data() + d.size());
+    if (!integer && a.dtype().itemsize() == 2) {
+        out.valueStep.resize(out.value.size());
+        for (std::size_t i = 0; i < out.value.size(); ++i) out.valueStep[i] = float(reading.depthStepOf(binary16Step(out.value[i])));
+    }
+    for (double& v : out.value) v = reading.depthOf(v, integer);
+    out.valueQuantum = integer ? 1.0 / reading.scale : 0.0;
+    out.accuracy = reading.accuracy;
+    out.scale = reading.scale, out.offset = reading.offset;
     return out;
 }
 
@@ -843,11 +846,10 @@ verdict, and per-pixel images. to_dict() is the document `zcheck check --json` (
         .def_property_readonly(
             "diagnosis",
             [](const PyReport& r) -> py::object {
-                if (!r.diagnosis) return py::none();
-                return diagnosisList(*r.diagnosis);
+                return r.diagnosis ? diagnosisList(*r.diagnosis) : py::list();
             },
             "verify(..., diagnose=True) on an inconsistent map: the hypotheses, as Checker.diagnose returns "
-            "them; else None.")
+            "them; else an empty list (nothing was diagnosed).")
         .def(
             "to_json", [](const PyReport& r) { return r.json; },
             "The JSON text `zcheck check --json` / `zcheck verify --json` prints.")
@@ -947,25 +949,27 @@ Misses hold the quantity's miss value: the clear value (window), NDC z of the fa
 +inf (eye-z, distance), NaN (positions, normals), 0xFFFFFFFF (primitive-id).)doc")
         .def(
             "verify",
-            [](const Checker& checker, const Camera& camera, py::object depth, const std::string& quantityName,
-               const py::object& miss, std::optional<double> scale, std::optional<double> offset, bool diagnose,
+            [](const Checker& checker, const Camera& camera, py::object depth, const py::object& quantityArg,
+               const py::object& miss, const py::object& scale, const py::object& offset, const py::object& quantum,
+               const py::object& relTolerance, const py::object& absTolerance, const py::object& allowHoles, bool diagnose,
                std::optional<int> threads) {
-                const DepthQuantity quantity = depthQuantityFromName(quantityName);
-                const DepthMapReading reading = readingOf(miss, scale, offset);
-                MapInput input = mapFromArray(depth, camera, reading);
+                std::string quantityName;
+                const DepthQuantity quantity = quantityArgument(quantityArg, quantityName);
+                const DepthMapReading reading = readingOf({miss, scale, offset, quantum, relTolerance, absTolerance, allowHoles});
+                const DepthMap map = mapFromArray(depth, camera, reading, quantity);
                 auto r = std::make_unique<PyReport>();
                 r->verify = true;
                 {
                     py::gil_scoped_release release;
                     const auto limit = threadLimit(threads);
-                    const DepthMap map{camera.width(), camera.height(), quantity, std::move(input.values), input.quantum};
                     fillVerification(*r, verifyAndReport(checker, camera, map, {"<array>", quantityName, "", reading}, diagnose));
                 }
                 return r;
             },
-            py::arg("camera"), py::arg("depth"), py::arg("quantity"), py::kw_only(), py::arg("miss") = py::none(),
-            py::arg("scale") = py::none(), py::arg("offset") = py::none(), py::arg("diagnose") = false,
-            py::arg("threads") = py::none(),
+            py::arg("camera"), py::arg("depth"), py::arg("quantity") = py::none(), py::kw_only(), py::arg("miss") = py::none(),
+            py::arg("scale") = py::none(), py::arg("offset") = py::none(), py::arg("quantum") = py::none(),
+            py::arg("rel_tolerance") = py::none(), py::arg("abs_tolerance") = py::none(), py::arg("allow_holes") = py::none(),
+            py::arg("diagnose") = false, py::arg("threads") = py::none(),
             R"doc(A depth map rendered elsewhere against the ray route's ground truth: what `zcheck verify` does.
 
 depth:    (camera.height, camera.width) array, row 0 at the top, any float or integer dtype.
@@ -978,26 +982,38 @@ miss:     the stored value that marks "no surface" (0, 65535, 1e10, float("inf")
 scale:    stored value = (depth - offset) x scale. Integer arrays need it (quantum 1/scale, like a
           16-bit PNG); float arrays are divided by it.
 offset:   added to every depth after scale (default 0).
+quantum:  the values were rounded to multiples of this (map units, after scale): 0.001 for
+          millimetres held as float metres (`cv2.imread(p, -1) / 1000.0`). float16 arrays carry
+          their own step without it.
+rel_tolerance, abs_tolerance: the map is good only to ±(abs + rel·|value|) (map units): a
+          rasterizer's reconstructed Z pass, a sensor; added to every pixel's tolerance.
+allow_holes: a pixel without a value where the surface is hit is a hole, counted in
+          report.to_dict()["pixels"]["holes"], not a failure.
 diagnose: when inconsistent, also run diagnose() and put it in the report (`--diagnose`).
 Returns a Report whose to_dict() is `zcheck verify --json`'s document (depth_map.file "<array>").)doc")
         .def(
             "diagnose",
-            [](const Checker& checker, const Camera& camera, py::object depth, const std::string& quantityName,
-               const py::object& miss, std::optional<double> scale, std::optional<double> offset,
+            [](const Checker& checker, const Camera& camera, py::object depth, const py::object& quantityArg,
+               const py::object& miss, const py::object& scale, const py::object& offset, const py::object& quantum,
+               const py::object& relTolerance, const py::object& absTolerance, const py::object& allowHoles,
                std::optional<int> threads) {
-                const DepthQuantity quantity = depthQuantityFromName(quantityName);
-                MapInput input = mapFromArray(depth, camera, readingOf(miss, scale, offset));
+                std::string quantityName;
+                const DepthQuantity quantity = quantityArgument(quantityArg, quantityName);
+                const DepthMap map = mapFromArray(depth, camera,
+                                                  readingOf({miss, scale, offset, quantum, relTolerance, absTolerance, allowHoles}),
+                                                  quantity);
                 std::vector<Hypothesis> hypotheses;
                 {
                     py::gil_scoped_release release;
                     const auto limit = threadLimit(threads);
-                    const DepthMap map{camera.width(), camera.height(), quantity, std::move(input.values), input.quantum};
                     hypotheses = checker.diagnose(camera, map);
                 }
                 return diagnosisList(hypotheses);
             },
-            py::arg("camera"), py::arg("depth"), py::arg("quantity"), py::kw_only(), py::arg("miss") = py::none(),
-            py::arg("scale") = py::none(), py::arg("offset") = py::none(), py::arg("threads") = py::none(),
+            py::arg("camera"), py::arg("depth"), py::arg("quantity") = py::none(), py::kw_only(), py::arg("miss") = py::none(),
+            py::arg("scale") = py::none(), py::arg("offset") = py::none(), py::arg("quantum") = py::none(),
+            py::arg("rel_tolerance") = py::none(), py::arg("abs_tolerance") = py::none(), py::arg("allow_holes") = py::none(),
+            py::arg("threads") = py::none(),
             R"doc(Every hypothesis of the mistake catalogue that applies to this camera and map, then every
 fitted family (sample-offset, field-of-view, near-far, depth-scale, intrinsics, pose), ranked:
 consistent ones first, then by unexplained pixels. Dicts {hypothesis, variant, explanation,
@@ -1015,15 +1031,17 @@ Arguments as for verify().)doc")
     m.def(
         "unproject",
         [](const Camera& camera, py::object depth, const std::string& quantityName, const std::string& space,
-           int stride, const py::object& miss, std::optional<double> scale, std::optional<double> offset) {
+           int stride, const py::object& miss, const py::object& scale, const py::object& offset) {
             if (space != "eye" && space != "world") fail("space must be eye or world, got '" + space + "'");
             if (stride < 1 || stride > 16384) fail("stride must be in 1..16384, got " + std::to_string(stride));
             const DepthQuantity quantity = depthQuantityFromName(quantityName);
-            MapInput input = mapFromArray(depth, camera, readingOf(miss, scale, offset));
+            ReadingArguments arguments;
+            arguments.miss = miss, arguments.scale = scale, arguments.offset = offset;
+            const DepthMap input = mapFromArray(depth, camera, readingOf(arguments), quantity);
             UnprojectedMap cloud;
             {
                 py::gil_scoped_release release;
-                cloud = unprojectMap(camera, input.values, quantity, space == "eye" ? PointSpace::Eye : PointSpace::World,
+                cloud = unprojectMap(camera, input.value, quantity, space == "eye" ? PointSpace::Eye : PointSpace::World,
                                      stride);
             }
             const py::ssize_t n = py::ssize_t(cloud.points.size());

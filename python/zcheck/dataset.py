@@ -33,7 +33,9 @@ def _files():
     return _zcheck_files
 
 
-_OPTIONS = ("quantity", "depth", "camera_format", "scale", "offset", "miss", "channel", "near", "far", "convention")
+_OPTIONS = ("quantity", "depth", "camera_format", "scale", "offset", "miss", "channel", "near", "far", "convention",
+            "quantum", "rel_tolerance", "abs_tolerance", "allow_holes")
+_DECLARED = ("quantum", "rel_tolerance", "abs_tolerance", "allow_holes")
 
 
 class Frame:
@@ -44,7 +46,8 @@ class Frame:
     depth        the depth map's path
     quantity     "window", "ndc", "eye-z" or "distance"
     reading      the keyword arguments Checker.verify_file and read_depth_map take for it
-                 (channel, scale, offset, miss), as the frame reads its map
+                 (channel, scale, offset, miss, and what the map declares: quantum, rel_tolerance,
+                 abs_tolerance, allow_holes), as the frame reads its map
     scene        the scene's name or path
     error        why the frame cannot be verified ("" when it can): a camera the file refused,
                  a malformed manifest line
@@ -109,7 +112,8 @@ class Dataset:
         self._native = _files()._Dataset(str(source), str(scene), values["quantity"], values["depth"],
                                          values["camera_format"], values["scale"], values["offset"], values["miss"],
                                          values["channel"], values["near"], values["far"], values["convention"],
-                                         bool(options.get("diagnose", False)), options.get("shard"))
+                                         bool(options.get("diagnose", False)), options.get("shard"),
+                                         {name: values[name] for name in _DECLARED})
         self.source = self._native.source
         self.kind = self._native.kind
 
@@ -157,6 +161,8 @@ quantity:      what the maps hold, unless a line says: "window", "ndc", "eye-z",
 depth:         COLMAP: each image's depth map, "{name}" the image name, "{stem}" without extension
 camera_format: the source's format when its content should not decide
 scale, offset, miss, channel: how maps are read (as `zcheck verify`'s options)
+quantum, rel_tolerance, abs_tolerance, allow_holes: what the maps declare (as Checker.verify's),
+               unless a manifest line says
 near, far:     the clip planes of cameras whose file has none
 convention:    replaces every camera's convention
 """

@@ -83,6 +83,7 @@ FrameRecord recordFrom(const json& j, const std::string& where)
         r.depth = text("file"), r.quantity = text("quantity"), r.channel = text("channel"), r.miss = text("miss");
         if (m.contains("scale") && m["scale"].is_number()) r.scale = m["scale"].get<double>();
         if (m.contains("offset") && m["offset"].is_number()) r.offset = m["offset"].get<double>();
+        if (m.contains("declared") && m["declared"].is_object()) r.accuracy = accuracyFromJson(m["declared"], where);
     }
     if (j.contains("camera") && j["camera"].is_object()) {
         const json& c = j["camera"];

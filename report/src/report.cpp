@@ -1,5 +1,7 @@
 #include "zcheck/report.h"
 
+#include "zcheck/error.h"
+
 #include "camera_json.h"
 #include "report_json.h"
 #include "zcheck/png_file.h"
@@ -55,6 +57,7 @@ nlohmann::json pixelsJson(const ComparisonReport& c)
             {"coverage_explained", c.coverageExplained},
             {"lost_at_clear_value", c.lostAtClearValue},
             {"at_clip_plane", c.atClipPlane},
+            {"holes", c.holes},
             {"coverage_unexplained", c.coverageUnexplained}};
 }
 
@@ -96,7 +99,8 @@ nlohmann::json depthMapJson(const DepthMapSource& source)
             {"channel", source.channel},
             {"scale", r.scale},
             {"offset", r.offset},
-            {"miss", r.miss.given() ? nlohmann::json(r.miss.text()) : nlohmann::json(nullptr)}};
+            {"miss", r.miss.given() ? nlohmann::json(r.miss.text()) : nlohmann::json(nullptr)},
+            {"declared", toJson(r.accuracy)}};
 }
 
 nlohmann::json hypothesisJson(const Hypothesis& h)
@@ -128,6 +132,7 @@ nlohmann::json toJson(const CheckReport& report)
          {{"subpixel_bits", report.tolerance.subpixelBits},
           {"constant_quanta", ToleranceModel::constantQuanta(report.camera.depth)},
           {"slope_credit", report.tolerance.slopeCredit == SlopeCredit::SampleOffset ? "sample-offset" : "vertex-snapping"},
+          {"declared", toJson(report.declared)},
           {"rule", report.tolerance.slopeCredit == SlopeCredit::SampleOffset
                        ? "|d_map - d_ray| <= C*q + S*m, m = |dd/dx| + |dd/dy| (sum over both surfaces when they differ)"
                        : "|d_raster - d_ray| <= C*q + S*m, m = max(|dd/dx|, |dd/dy|) (sum over both surfaces when they differ)"}}},
@@ -165,7 +170,17 @@ std::string formatSummary(const CheckReport& report, const std::string& comparin
     std::snprintf(line, sizeof line, "depth      %s%s, range [%g, %g]; tolerance C = %g q, S = 2^-%d px\n",
                   toString(cam.depth.format).c_str(), cam.depth.reversed ? ", reversed-Z" : "", cam.depth.rangeMin,
                   cam.depth.rangeMax, ToleranceModel::constantQuanta(cam.depth), report.tolerance.subpixelBits);
-    out << line << "\npixels                             count\n";
+    out << line;
+    if (const MapAccuracy& d = report.declared; d.any()) {
+        std::string declared;
+        auto add = [&](const std::string& part) { declared += (declared.empty() ? "" : "; ") + part; };
+        if (d.quantum > 0) add("values rounded to " + formatNumber(d.quantum));
+        if (d.relative > 0 || d.absolute > 0)
+            add("good to ±(" + formatNumber(d.absolute) + " + " + formatNumber(d.relative) + "·|value|), added to each tolerance");
+        if (d.allowHoles) add("holes allowed");
+        out << "declared   " << declared << " (" << d.options() << ")\n";
+    }
+    out << "\npixels                             count\n";
     auto row = [&](const char* label, std::int64_t n, std::int64_t of) {
         std::snprintf(line, sizeof line, "  %-28s %9lld  %s\n", label, static_cast<long long>(n), percent(n, of).c_str());
         out << line;
@@ -177,9 +192,10 @@ std::string formatSummary(const CheckReport& report, const std::string& comparin
     row("both miss", c.bothMiss, total);
     row("ray only", c.rayOnly, total);
     row("raster only", c.rasterOnly, total);
-    row("  explained (at an edge)", c.coverageExplained - c.lostAtClearValue - c.atClipPlane, total);
+    row("  explained (at an edge)", c.coverageExplained - c.lostAtClearValue - c.atClipPlane - c.holes, total);
     row("  explained (at clear value)", c.lostAtClearValue, total);
     row("  explained (on near/far)", c.atClipPlane, total);
+    if (report.declared.allowHoles) row("  holes (allowed)", c.holes, total);
     row("  UNEXPLAINED", c.coverageUnexplained, total);
 
     out << "\ndepth error over compared pixels (both hit, same surface or within tolerance)\n";

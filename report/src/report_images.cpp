@@ -23,6 +23,7 @@ Rgb classColour(PixelClass c)
     case PixelClass::AtClipPlane: return {150, 110, 60};
     case PixelClass::RayOnly: return {255, 0, 255};
     case PixelClass::RasterOnly: return {255, 140, 0};
+    case PixelClass::Hole: return {90, 90, 90};
     }
     return {255, 255, 255};
 }

@@ -93,7 +93,8 @@ def test_quantity_and_route_names(tmp_path, default_checker, small_camera, small
         default_checker.render(small_camera, "eye-z", "gpu")
     with pytest.raises(zcheck.Error, match="dtype must be float32 or float64, got int32"):
         default_checker.render(small_camera, "eye-z", dtype=np.int32)
-    with pytest.raises(TypeError):  # the quantity is required: mixing them up is what zcheck catches
+    # the quantity is required (mixing them up is what zcheck catches): a zcheck.Error, not pybind11's TypeError
+    with pytest.raises(zcheck.Error, match="^quantity is required"):
         default_checker.verify(small_camera, z)
 
 

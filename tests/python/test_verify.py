@@ -18,12 +18,13 @@ def test_ray_render_verifies_and_its_flip_does_not(default_checker, small_camera
     assert report.consistent and report.unexplained == 0 and report.both_hit > 0.5 * W * H
     doc = report.to_dict()
     assert doc["depth_map"] == {"file": "<array>", "quantity": "eye-z", "channel": "", "scale": 0.0, "offset": 0.0,
-                                "miss": None}
+                                "miss": None, "declared": {"quantum": 0.0, "rel_tolerance": 0.0, "abs_tolerance": 0.0,
+                                                           "allow_holes": False}}
     assert "diagnosis" not in doc
 
     flipped = z[::-1]
     bad = default_checker.verify(small_camera, flipped, "eye-z")
-    assert not bad.consistent and bad.unexplained > 1000 and bad.diagnosis is None
+    assert not bad.consistent and bad.unexplained > 1000 and bad.diagnosis == []
     hypotheses = default_checker.diagnose(small_camera, flipped, "eye-z")
     assert consistent_names(hypotheses)[0] == "y-flip"
     assert set(hypotheses[0]) == {"hypothesis", "variant", "explanation", "consistent", "unexplained",
@@ -37,7 +38,7 @@ def test_ray_render_verifies_and_its_flip_does_not(default_checker, small_camera
     assert diagnosed.summary().rstrip().endswith("diagnosis  " + next(h["explanation"] for h in hypotheses
                                                                            if h["consistent"]))
     # the unflipped map needs no diagnosis, even when asked for one
-    assert default_checker.verify(small_camera, z, "eye-z", diagnose=True).diagnosis is None
+    assert default_checker.verify(small_camera, z, "eye-z", diagnose=True).diagnosis == []
 
 
 def test_every_quantity_round_trips_and_the_wrong_one_is_named(default_checker, small_camera):
@@ -196,3 +197,47 @@ def test_sidecar_describes_the_file(tmp_path, default_checker, small_camera, sma
     sidecar.write_text('{"scale": "a thousand"}')
     with pytest.raises(zcheck.Error, match=r"\"scale\" must be a positive finite number"):
         zcheck.read_depth_map(path, small_camera, quantity="eye-z", sidecar=sidecar)
+
+
+def test_declared_reading_accepts_real_world_maps_and_the_diagnosis_names_the_option(default_checker, small_camera):
+    """Issue 36: millimetre-rounded floats (cv2.imread(p, -1) / 1000.0), float16, a miss value, holes."""
+    z = default_checker.render(small_camera, "eye-z", dtype="float64")
+    hit = np.isfinite(z)
+    mm = np.where(hit, np.round(z * 1000) / 1000, np.inf).astype(np.float32)
+    assert not default_checker.verify(small_camera, mm, "eye-z").consistent
+    assert consistent_names(default_checker.diagnose(small_camera, mm, "eye-z"))[0] == "quantum"
+    report = default_checker.verify(small_camera, mm, "eye-z", quantum=0.001)
+    assert report.consistent and report.to_dict()["depth_map"]["declared"]["quantum"] == 0.001
+    assert default_checker.verify(small_camera, z.astype(np.float16), "eye-z").consistent
+
+    cycles = np.where(hit, z, 1e10)
+    best = default_checker.diagnose(small_camera, cycles, "eye-z")[0]
+    assert best["consistent"] and best["hypothesis"] == "miss-value" and "--miss '>=1e9'" in best["explanation"]
+    assert default_checker.verify(small_camera, cycles, "eye-z", miss=">=1e9").consistent
+
+    holed = z.copy()
+    holed[::7, ::5] = np.nan
+    assert not default_checker.verify(small_camera, holed, "eye-z").consistent
+    allowed = default_checker.verify(small_camera, holed, "eye-z", allow_holes=True)
+    assert allowed.consistent and allowed.to_dict()["pixels"]["holes"] > 0.9 * np.isnan(holed[hit]).sum()
+
+    short = z * (1 - 4e-4)
+    assert default_checker.verify(small_camera, short, "eye-z", rel_tolerance=5e-4).consistent
+    assert not default_checker.verify(small_camera, short, "eye-z", rel_tolerance=2e-4).consistent
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda c, cam, z: c.verify(cam, z), "quantity is required"),
+    (lambda c, cam, z: c.verify(cam, z, 3), "quantity must be a string"),
+    (lambda c, cam, z: c.verify(cam, z, "eye-z", miss=[0, 65535]), "miss must be a number or a rule"),
+    (lambda c, cam, z: c.verify(cam, z, "eye-z", scale="1000"), "scale must be a number, got str"),
+    (lambda c, cam, z: c.verify(cam, z, "eye-z", quantum=-1), "quantum must be a finite number >= 0"),
+    (lambda c, cam, z: c.verify(cam, z, "eye-z", rel_tolerance=1.5), "rel_tolerance must be a finite number >= 0 and below 1"),
+    (lambda c, cam, z: c.verify(cam, z, "eye-z", allow_holes=1), "allow_holes must be True or False"),
+    (lambda c, cam, z: c.diagnose(cam, z), "quantity is required"),
+])
+def test_wrong_arguments_raise_one_line_naming_the_argument(default_checker, small_camera, call, message):
+    z = default_checker.render(small_camera, "eye-z")
+    with pytest.raises(zcheck.Error) as caught:
+        call(default_checker, small_camera, z)
+    assert message in str(caught.value) and "\n" not in str(caught.value)

@@ -20,6 +20,7 @@
 // Thread-safety: a Checker is immutable after construction; every member function is const
 // and may be called from several threads at once. Each call allocates its own results.
 #include "zcheck/compare.h"
+#include "zcheck/depth_map_reading.h"
 #include "zcheck/quantity.h"
 #include "zcheck/raster_renderer.h"
 #include "zcheck/ray_renderer.h"
@@ -63,6 +64,7 @@ struct CheckReport {
     ComparisonReport comparison;
     Timings timings;
     std::vector<std::string> warnings;  // about the inputs (PolygonPlanarity::warning), in the report
+    MapAccuracy declared;               // verify: what the map declared (DepthMap::accuracy); check: nothing
 
     // Fills what the report says of its inputs: the scene (name, triangles, warnings), the
     // camera and the tolerance. Checker::check and verify share it.
@@ -86,6 +88,14 @@ struct CheckOptions {
     bool keepPixels = true;
 };
 
+// How one value of a map is judged (value units): the step it was stored or rounded with (0:
+// binary32's own spacing at the value), and the accuracy its producer declares, ± (absolute +
+// relative·|value|).
+struct ValueAccuracy {
+    double step = 0;
+    double relative = 0, absolute = 0;
+};
+
 // A depth map rendered elsewhere, as read: values per pixel in one depth quantity.
 struct DepthMap {
     int width = 0, height = 0;
@@ -93,6 +103,20 @@ struct DepthMap {
     std::vector<double> value;   // row 0 at the top; misses as eyePointFromDepth defines them
                                  // (non-finite; the clear value for window and ndc; ≤ 0 for eye-z, distance)
     double valueQuantum = 0;     // the storage step of `value` (1/scale for integer files); 0: binary32
+    std::vector<float> valueStep;  // each value's own step (binary16 files), overriding valueQuantum; or empty
+    MapAccuracy accuracy;        // what its producer declares (depth_map_reading.h)
+    double scale = 0, offset = 0;  // how stored values became `value`: stored / scale + offset (scale 0: 1)
+
+    // A map of `quantity` as a file was read `reading`'s way, with what the reading declares.
+    static DepthMap of(DepthMapFile file, DepthQuantity quantity, const DepthMapReading& reading);
+    // A value as the file stored it (before scale and offset).
+    double storedOf(double v) const { return (v - offset) * (scale > 0 ? scale : 1.0); }
+    // Value i's: its step (its own, the file's, at least the declared quantum) and the declared accuracy.
+    ValueAccuracy accuracyAt(std::size_t i) const
+    {
+        const double own = valueStep.empty() ? valueQuantum : double(valueStep[i]);
+        return {std::max(own, accuracy.quantum), accuracy.relative, accuracy.absolute};
+    }
 };
 
 struct VerifyResult {

@@ -66,6 +66,8 @@ enum class PixelClass : std::uint8_t {
                          // within binary32 rounding of where the routes clip: explained
     RayOnly,             // only the ray hits, unexplained
     RasterOnly,          // only the raster hits, unexplained
+    Hole,                // only the ray hits, and the raster side is a map that declared it leaves
+                         // holes (DeclaredMap::holesAllowed): counted, explained
 };
 std::string toString(PixelClass pixelClass);
 // DepthError, RayOnly and RasterOnly: the classes no tolerance explains.
@@ -119,6 +121,7 @@ struct ComparisonReport {
     std::int64_t coverageExplained = 0;    // pixel centre within S of an edge, or depth at the clear value
     std::int64_t lostAtClearValue = 0;     // of those: ray-only surfaces whose depth quantizes to the clear value
     std::int64_t atClipPlane = 0;          // of those: a surface on the near or far plane
+    std::int64_t holes = 0;                // of those: holes of a map that declared it leaves them
     std::int64_t coverageUnexplained = 0;  // anything else
     // Over the both-hit pixels compared on depth (agree + depthErrors):
     double maxErrorQuanta = 0;      // max |d_raster − d_ray| / q
@@ -187,21 +190,25 @@ public:
                SlopeSource slopes = SlopeSource::TableOfSeen);
 
     // One surface's tolerance at depth-storage quantum q, in window-depth units:
-    // C·q + S·m + E (m = 0 for kUnknownPrimitive, which earns no slope credit).
-    double surfaceTolerance(std::uint32_t primitive, double q) const;
+    // C·q + S·m + E + a (m = 0 for kUnknownPrimitive, which earns no slope credit; a, the
+    // allowance, is what a map rendered elsewhere declares of its accuracy — DeclaredMap — and
+    // 0 for zcheck's own routes).
+    double surfaceTolerance(std::uint32_t primitive, double q, double allowance = 0) const;
     // The same for a surface whose slope m = slope(primitive) is known already.
-    double toleranceForSlope(double m, double q) const { return terms_.of(m, q); }
+    double toleranceForSlope(double m, double q, double allowance = 0) const { return terms_.of(m, q, allowance); }
     // Its terms, for a kernel that computes it several lanes at a time (the same operations
     // in the same order as of()).
     struct ToleranceTerms {
         double C, S, E;
-        double of(double m, double q) const { return C * q + S * m + E; }
+        double of(double m, double q, double a = 0) const { return C * q + S * m + E + a; }
     };
     const ToleranceTerms& toleranceTerms() const { return terms_; }
     // Both routes hit: d_ray on `rayPrimitive`, d_raster on `rasterPrimitive`, at window point
     // pWindow. Returns Agree, EdgeSurface or DepthError; `bound` receives the tolerance used.
+    // `allowance`: the raster side's declared accuracy there (surfaceTolerance), added once.
     PixelClass bothHit(double rayDepth, std::uint32_t rayPrimitive, double rasterDepth,
-                       std::uint32_t rasterPrimitive, double q, const glm::dvec2& pWindow, double& bound) const;
+                       std::uint32_t rasterPrimitive, double q, const glm::dvec2& pWindow, double& bound,
+                       double allowance = 0) const;
     // Only one route hits, on `primitive` (`rayHit`: the ray's hit, at window depth `depth`):
     // RayOnlyEdge/RasterOnlyEdge, RayOnlyAtClear, AtClipPlane, or RayOnly/RasterOnly.
     PixelClass oneHit(bool rayHit, double depth, std::uint32_t primitive, double q, const glm::dvec2& pWindow) const;
@@ -327,6 +334,8 @@ struct RoutePixels {
     const std::uint32_t* primitive = nullptr;  // kNoPrimitive where nothing was hit
     const glm::dvec3* pEye = nullptr;          // ray route, optional: exact hit points in eye space
     const double* quantum = nullptr;           // optional: each pixel's storage quantum (compareRoutes)
+    const double* allowance = nullptr;         // optional: each pixel's declared allowance (DeclaredMap)
+    bool holesAllowed = false;                 // DeclaredMap::holesAllowed
     int col0 = 0, row0 = 0;                    // the rectangle's first pixel
     std::size_t stride = 0;                    // entries from one row to the next
 
@@ -384,13 +393,25 @@ private:
 // A raster primitive id that is not a triangle of the scene (kUnknownPrimitive) marks a hit
 // whose surface is unknown: it earns no edge or clip-plane explanation and no slope credit.
 constexpr std::uint32_t kUnknownPrimitive = 0xFFFFFFFEu;
+// What a map rendered elsewhere, compared as the raster side (verify), says of itself beyond its
+// depths: per pixel (width·height entries, row by row), its storage quantum in window units, and
+// the allowance its declared accuracy adds to the tolerance (window units, ≥ 0); and whether a
+// pixel it leaves empty where the ray hits is a hole (PixelClass::Hole, counted in
+// ComparisonReport::holes, explained) rather than unexplained. Absent arrays: the camera's
+// depth format's quantum, no allowance.
+struct DeclaredMap {
+    const std::vector<double>* quantum = nullptr;
+    const std::vector<double>* allowance = nullptr;
+    bool holesAllowed = false;
+};
+
 Comparison compareRoutes(const Scene& scene, const Camera& camera, const RenderResult& ray,
                          const RenderResult& raster, const ToleranceModel& tolerance = {},
-                         const std::vector<double>* rasterQuantum = nullptr);
+                         const DeclaredMap& declared = {});
 // The same through a judge of the caller's (its scene, camera and tolerance; TableOfSeen, or
 // every slope is computed per pixel): `verify` reads a map with the judge it then compares with.
 Comparison compareRoutes(const PixelJudge& judge, const RenderResult& ray, const RenderResult& raster,
-                         const std::vector<double>* rasterQuantum = nullptr);
+                         const DeclaredMap& declared = {});
 
 // The same for one triangle (DepthSlopeFrame::slope).
 double windowDepthSlope(const Camera& camera, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c);

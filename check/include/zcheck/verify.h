@@ -71,16 +71,20 @@ inline ToleranceModel mapTolerance()
 struct MapPixel {
     double depth = NAN;                        // window depth, NaN for a miss
     double quantum = 0;                        // the storage step there, in window units
+    double allowance = 0;                      // the declared accuracy there, in window units (DeclaredMap)
     std::uint32_t primitive = kNoPrimitive;    // the surface chosen (above); kNoPrimitive for a miss
 };
 
-// The pixel's window depth and storage step as the comparison reads them (its surface left
-// kNoPrimitive); `truthDepth` is the truth's window depth there, the reference for a miss.
+// The pixel's window depth, storage step and allowance as the comparison reads them (its
+// surface left kNoPrimitive); `truthDepth` is the truth's window depth there, the reference for
+// a miss. The value's step and declared accuracy are carried into window units through the
+// quantity's mapping at the pixel: the larger window change of value ± step (at least binary32's
+// spacing at the window depth), and of value ± (absolute + relative·|value|).
 MapPixel mapPixelDepth(const Camera& camera, const DepthMap& map, int col, int row, double truthDepth);
-// The same for one value of `quantity` stored with step `valueQuantum` (DepthMap's meaning: 0
-// for binary32, or for a window map the camera's depth format).
-MapPixel mapPixelDepth(const Camera& camera, DepthQuantity quantity, double value, double valueQuantum, int col, int row,
-                       double truthDepth);
+// The same for one value of `quantity` judged by `accuracy` (a step of 0: binary32, or for a
+// window map the camera's depth format).
+MapPixel mapPixelDepth(const Camera& camera, DepthQuantity quantity, double value, const ValueAccuracy& accuracy, int col,
+                       int row, double truthDepth);
 
 // Reads a map pixel by pixel against an already rendered truth: the per-pixel rule of
 // renderResultFromMap, and the comparison's class for one pixel, so that a diagnosis can
@@ -112,11 +116,13 @@ private:
 };
 
 // The map as the raster side of a comparison (window depth per pixel, a hit where the value is
-// not a miss, the surface chosen as above). `quantum` receives each pixel's storage step in
-// window units. `judge` as MapReader's; the comparison of the result may then use it too
-// (compareRoutes), finding the slopes it computed.
+// not a miss, the surface chosen as above). `quantum` and `allowance` receive each pixel's
+// storage step and declared accuracy in window units (allowance left empty where the map
+// declares none), for the comparison's DeclaredMap. `judge` as MapReader's; the comparison of
+// the result may then use it too (compareRoutes), finding the slopes it computed.
 RenderResult renderResultFromMap(const PixelJudge& judge, const DepthMap& map, const RenderResult& truth,
-                                 const VertexNeighbours& neighbours, std::vector<double>& quantum);
+                                 const VertexNeighbours& neighbours, std::vector<double>& quantum,
+                                 std::vector<double>& allowance);
 
 // Throws Error unless `map` is camera.width() × camera.height() with a value per pixel.
 void requireMapFits(const Camera& camera, const DepthMap& map);

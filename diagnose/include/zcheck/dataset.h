@@ -40,6 +40,7 @@ struct DatasetRunOptions {
     // implies, such as nerfstudio's millimetres).
     std::optional<double> scale, offset;
     std::string miss, channel;
+    MapAccuracy accuracy;       // --quantum, --rel-tolerance, --abs-tolerance, --allow-holes (a manifest line's win)
     std::optional<double> near, far;        // the clip planes of cameras whose file has none
     std::string convention;                 // replaces every camera's convention ("" keeps it)
     bool diagnose = false;                  // diagnose the inconsistent frames

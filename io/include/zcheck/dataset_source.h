@@ -13,7 +13,8 @@
 //   manifest         JSON Lines (.jsonl), one frame a line, blank lines skipped:
 //                      {"frame": "f003", "camera": "sparse/0#img_003.png", "depth": "d/003.png",
 //                       "quantity": "eye-z", "scale": 1000, "offset": 0, "miss": ">=1e9",
-//                       "channel": "Z", "scene": "mesh.ply", "near": 0.1, "far": 50}
+//                       "channel": "Z", "scene": "mesh.ply", "near": 0.1, "far": 50,
+//                       "quantum": 0.001, "rel_tolerance": 0, "abs_tolerance": 0.005, "allow_holes": true}
 //                    "camera" is a reference FILE#FRAME to any camera file (camera_import.h) or
 //                    an inline zcheck camera (the camera file's JSON object); "frame" (default:
 //                    the line number) and "depth" are required, the rest optional. Paths are
@@ -21,6 +22,7 @@
 //                    whose `error` says why: the run records it and goes on.
 // The index of a frame is its position in the source (file order), the unit of --shard.
 #include "zcheck/camera_import.h"
+#include "zcheck/depth_map_reading.h"
 
 #include <cstddef>
 #include <optional>
@@ -38,6 +40,8 @@ struct DatasetFrame {
     std::optional<std::string> quantity, miss, channel, scene;
     std::optional<double> scale, offset;    // as a manifest line gives them: they win over the run's options
     std::optional<double> near, far;        // likewise (for cameras whose file has none)
+    MapAccuracy accuracy;                   // what the line declares (depth_map_reading.h): its fields
+                                            // win over the run's options
     std::optional<double> impliedScale;     // what the camera file implies (nerfstudio's millimetres): the
                                             // run's --scale wins over it
     std::string impliedScaleNote;           // the sentence a report prints when it is used

@@ -29,6 +29,30 @@ private:
     std::string written_;
 };
 
+// What a map's producer declares of its values, beyond how to read them: judged with, never
+// applied to the values (a map is never "fixed"). Nothing declared: every value is exact to its
+// storage (binary32, binary16, or an integer file's step) and every pixel where the surface is
+// hit holds a value.
+struct MapAccuracy {
+    double quantum = 0;    // values rounded to multiples of this (map units, after scale); 0: none
+    double relative = 0;   // values good to ± (absolute + relative·|value|) (map units) ...
+    double absolute = 0;
+    bool allowHoles = false;  // ... and a missing value where the surface is hit is a hole, not a failure
+
+    bool any() const { return quantum > 0 || relative > 0 || absolute > 0 || allowHoles; }
+    // Throws Error naming `where` and the field unless every number is finite and ≥ 0 (and
+    // relative < 1).
+    void require(const std::string& where) const;
+    // The options that declare this ("--quantum 0.001 --allow-holes"), "" for none.
+    std::string options() const;
+    // The fields declared here (non-zero, true), the others from `fallback`.
+    MapAccuracy over(const MapAccuracy& fallback) const;
+    bool operator==(const MapAccuracy& o) const
+    {
+        return quantum == o.quantum && relative == o.relative && absolute == o.absolute && allowHoles == o.allowHoles;
+    }
+};
+
 // How to read a depth map. The depth of a stored value v is v / scale + offset (scale 1 and
 // offset 0 when not given); integer files need a scale.
 struct DepthMapReading {
@@ -38,6 +62,7 @@ struct DepthMapReading {
     double scale = 0;             // 0: not given
     double offset = 0;
     MissRule miss;                // not given: integer files' 0 is a miss; NaN always is
+    MapAccuracy accuracy;         // what the producer declares (judged with, not applied)
 
     // The depth of a value as the file stores it: NaN for a miss, else stored / scale + offset.
     double depthOf(double stored, bool integerFile) const
@@ -45,6 +70,8 @@ struct DepthMapReading {
         if (std::isnan(stored) || (miss.given() ? miss.matches(stored) : integerFile && stored == 0)) return NAN;
         return (scale > 0 ? stored / scale : stored) + offset;
     }
+    // A step between stored values as a step between depths.
+    double depthStepOf(double storedStep) const { return scale > 0 ? storedStep / scale : storedStep; }
 };
 
 // The channel of a file with channels `names` that holds depth: `wanted` when given (Error
@@ -62,6 +89,8 @@ struct DepthMapFile {
     std::vector<double> value;    // width·height; NaN where the file marks a miss
     double valueQuantum = 0;      // the storage step of `value`: 1/scale for integer files, 0 for
                                   // float files (binary32: the step depends on the value)
+    std::vector<float> valueStep; // binary16 files (EXR HALF, .npy float16): each value's own step
+                                  // (its binary16 spacing, after scale); empty otherwise
 };
 
 // Reads a map in a format zcheck reads by itself — PFM, 16-bit PNG (libpng), NumPy .npy,
@@ -80,10 +109,15 @@ void requireDepthMapSize(const std::string& path, long long width, long long hei
 // Throws Error "cannot read depth map '<path>': <why>".
 [[noreturn]] void refuseDepthMap(const std::string& path, const std::string& why);
 
-// The reading with the fields not given (an empty channel, scale 0, offset 0, no miss rule)
-// taken from a sidecar: a JSON object whose "channel", "miss" (a number, or a rule such as
-// ">=1e9", "nan", "inf"), "scale" and "offset" keys describe the map; other keys are ignored
-// and null is absent. Throws Error naming the sidecar and the key that breaks its rule.
+// The spacing of binary16 values around `stored` (the step of its exponent's range; a
+// subnormal's for the smallest): what a half-float map's value may have been rounded by.
+double binary16Step(double stored);
+
+// The reading with the fields not given (an empty channel, scale 0, offset 0, no miss rule,
+// nothing declared) taken from a sidecar: a JSON object whose "channel", "miss" (a number, or a
+// rule such as ">=1e9", "nan", "inf"), "scale", "offset", "quantum", "rel_tolerance",
+// "abs_tolerance" and "allow_holes" keys describe the map; other keys are ignored and null is
+// absent. Throws Error naming the sidecar and the key that breaks its rule.
 DepthMapReading withSidecar(DepthMapReading reading, const std::string& sidecar);
 
 }  // namespace zcheck

@@ -8,7 +8,7 @@
 //   consistent              true only for a verified, consistent frame
 //   error                   null, or the one-line message of a frame that could not be verified
 //   seconds                 the frame's wall time (reading, verifying, diagnosing)
-//   depth_map               file, quantity, channel, scale, offset, miss (as `verify --json`)
+//   depth_map               file, quantity, channel, scale, offset, miss, declared (as `verify --json`)
 //   pixels, depth_error     as `verify --json`
 //   unexplained             count and bounding_box (no samples)
 //   camera                  convention, type, width, height, near, far of the camera used
@@ -35,6 +35,7 @@ struct FrameRecord {
     std::string frame, source, scene, depth, quantity;
     std::string channel, miss;                // the reading, as recorded (scale 0: none)
     double scale = 0, offset = 0;
+    MapAccuracy accuracy;                     // what the reading declared
     std::string convention, projection;       // the camera used
     double near = 0, far = 0;
     bool consistent = false;

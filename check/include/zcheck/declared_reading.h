@@ -1,0 +1,57 @@
+#pragma once
+// What a rejected map's values say its reading should have declared — the options of `verify`
+// that would have accepted it (a miss value, a rounding grid, holes, a stated accuracy) —
+// measured against the ground truth, so that a correct map read without them is named as such
+// instead of being blamed on a convention. Checker::diagnose judges each finding (and all of
+// them together) with a full comparison, like every hypothesis: nothing here accepts a map by
+// itself.
+//
+//   miss value  one finite value holds ≥ 90 % of the pixels where the truth sees nothing, at
+//               least 16 of them, and at most 1 % of its pixels are where the truth hits: the
+//               renderer's "no surface" (Cycles' 1e10, Eevee's 65504, a PNG's 65535, 0, the far
+//               plane). Suggested as a rule on stored values: ">=1e9" from 1e9 up, else the value.
+//   grid        ≥ 99 % of the values where the truth hits lie within 1/1000 of a step (or four
+//               binary32 spacings) of a multiple of Q, for the largest Q of 1, 2 or 5 × 10^k
+//               (k = −6..0) or 2^−k (k = 1..24) at least 16 binary32 spacings of the largest
+//               value: values rounded to a grid coarser than their storage.
+//   holes       pixels without a value where the truth hits (after the miss value above).
+//   tolerance   only where no convention explains the map (Checker::diagnose asks last): an
+//               eye-z or distance map whose values where both see a surface lie within a small
+//               relative (≤ 1 %) or absolute error of the truth; the more uniform of the two
+//               (largest over median) is suggested, rounded up to one significant digit.
+#include "zcheck/checker.h"
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace zcheck {
+
+struct ReadingFindings {
+    // The miss value as the map holds it (value units) and as a rule on stored values, and
+    // on how many pixels where nothing is hit.
+    std::optional<double> missValue;
+    std::string missRule;
+    std::int64_t missPixels = 0;
+    double grid = 0;               // the rounding grid (value units); 0: none
+    std::int64_t holes = 0;        // truth hits, map has no value (after the miss value)
+    std::int64_t truthHits = 0;    // pixels where the truth sees a surface
+};
+
+// The findings of a map against the declared camera's ground truth (already rendered).
+ReadingFindings findReading(const Camera& camera, const DepthMap& map, const RenderResult& truth);
+
+// The map as it reads with the findings declared: the miss value read as "no surface", the
+// grid as its quantum, holes allowed (each only when `use` names it: "miss", "grid", "holes").
+DepthMap declaredReading(const DepthMap& map, const ReadingFindings& findings, const std::vector<std::string>& use);
+
+// A stated accuracy that would accept `map` (relative or absolute, the other 0), or nothing:
+// see above. `truth` is the declared camera's.
+std::optional<MapAccuracy> toleranceFinding(const Camera& camera, const DepthMap& map, const RenderResult& truth);
+
+// "the map holds 1e10 at all 54,155 pixels where nothing is hit: its miss value (pass --miss '>=1e9')",
+// and likewise for the grid and holes: one clause per finding `use` names.
+std::string describeFindings(const ReadingFindings& findings, const std::vector<std::string>& use);
+
+}  // namespace zcheck

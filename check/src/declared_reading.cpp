@@ -1,0 +1,177 @@
+#include "zcheck/declared_reading.h"
+
+#include "zcheck/error.h"
+#include "zcheck/inverse_projection.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+namespace zcheck {
+
+namespace {
+
+bool holdsSurface(const Camera& camera, const DepthMap& map, int col, int row)
+{
+    return eyePointFromDepth(camera, windowFromPixelCentre(camera, col, row), map.value[std::size_t(row) * map.width + col],
+                             map.quantity)
+        .has_value();
+}
+
+// binary32's spacing at v.
+double binary32Spacing(double v)
+{
+    const float f = float(std::abs(v));
+    return double(std::nextafter(f, INFINITY)) - double(f);
+}
+
+// "54,155".
+std::string grouped(std::int64_t n)
+{
+    std::string digits = std::to_string(n), out;
+    for (std::size_t k = 0; k < digits.size(); ++k) {
+        if (k > 0 && (digits.size() - k) % 3 == 0) out += ',';
+        out += digits[k];
+    }
+    return out;
+}
+
+// The smallest of 1, 2, 5 × 10^k not below x (one significant digit, rounded up).
+double roundedUp(double x)
+{
+    const double decade = std::pow(10.0, std::floor(std::log10(x)));
+    for (const double m : {1.0, 2.0, 5.0, 10.0})
+        if (m * decade >= x * (1 - 1e-12)) return m * decade;
+    return 10 * decade;
+}
+
+}  // namespace
+
+ReadingFindings findReading(const Camera& camera, const DepthMap& map, const RenderResult& truth)
+{
+    ReadingFindings out;
+    const int W = map.width, H = map.height;
+    // The values where the truth sees nothing, and where it hits.
+    std::map<double, std::int64_t> atMisses;
+    std::int64_t truthMisses = 0;
+    std::vector<double> hitValues;
+    for (int row = 0; row < H; ++row)
+        for (int col = 0; col < W; ++col) {
+            const std::size_t i = std::size_t(row) * W + col;
+            const double v = map.value[i];
+            if (!truth.hit(i)) {
+                ++truthMisses;
+                if (std::isfinite(v)) ++atMisses[v];
+            } else {
+                ++out.truthHits;
+                if (holdsSurface(camera, map, col, row)) hitValues.push_back(v);
+            }
+        }
+    // The miss value.
+    if (!atMisses.empty()) {
+        const auto most = std::max_element(atMisses.begin(), atMisses.end(),
+                                           [](const auto& a, const auto& b) { return a.second < b.second; });
+        const std::int64_t alsoAtHits = std::count(hitValues.begin(), hitValues.end(), most->first);
+        if (most->second >= 16 && most->second * 10 >= truthMisses * 9 && alsoAtHits * 100 <= most->second) {
+            out.missValue = most->first;
+            out.missPixels = most->second;
+            const double stored = map.storedOf(most->first);
+            out.missRule = stored >= 1e9 ? ">=1e9" : formatNumber(stored);
+        }
+    }
+    // Holes: the truth hits, the map holds nothing (its miss value read as nothing too).
+    for (int row = 0; row < H; ++row)
+        for (int col = 0; col < W; ++col) {
+            const std::size_t i = std::size_t(row) * W + col;
+            if (truth.hit(i) && !holdsSurface(camera, map, col, row)) ++out.holes;
+        }
+    // The grid: the largest step of the candidates that ≥ 99 % of the values lie on.
+    if (hitValues.size() >= 16) {
+        double largest = 0;
+        for (double v : hitValues) largest = std::max(largest, std::abs(v));
+        const double finest = 16 * binary32Spacing(largest);
+        std::vector<double> candidates;
+        for (int k = -6; k <= 0; ++k)
+            for (const double m : {1.0, 2.0, 5.0}) candidates.push_back(m * std::pow(10.0, k));
+        for (int k = 1; k <= 24; ++k) candidates.push_back(std::ldexp(1.0, -k));
+        std::sort(candidates.rbegin(), candidates.rend());
+        const std::size_t stride = std::max<std::size_t>(1, hitValues.size() / 20000);  // a sample suffices
+        for (const double q : candidates) {
+            if (q < finest || q < map.accuracy.quantum * 1.5 || q <= map.valueQuantum * 1.5) continue;
+            std::size_t on = 0, of = 0;
+            for (std::size_t k = 0; k < hitValues.size(); k += stride) {
+                const double v = hitValues[k];
+                const double off = std::abs(v / q - std::round(v / q)) * q;
+                on += off <= std::max(1e-3 * q, 4 * binary32Spacing(v)) ? 1 : 0;
+                ++of;
+            }
+            if (on * 100 >= of * 99) {
+                out.grid = q;
+                break;
+            }
+        }
+    }
+    return out;
+}
+
+DepthMap declaredReading(const DepthMap& map, const ReadingFindings& findings, const std::vector<std::string>& use)
+{
+    auto uses = [&](const char* name) { return std::find(use.begin(), use.end(), name) != use.end(); };
+    DepthMap out = map;
+    if (uses("miss") && findings.missValue)
+        for (double& v : out.value)
+            if (v == *findings.missValue) v = NAN;
+    if (uses("grid") && findings.grid > 0) out.accuracy.quantum = findings.grid;
+    if (uses("holes")) out.accuracy.allowHoles = true;
+    return out;
+}
+
+std::optional<MapAccuracy> toleranceFinding(const Camera& camera, const DepthMap& map, const RenderResult& truth)
+{
+    if (map.quantity != DepthQuantity::EyeZ && map.quantity != DepthQuantity::Distance) return std::nullopt;
+    const int W = map.width, H = map.height;
+    std::vector<double> absolute, relative;
+    for (int row = 0; row < H; ++row)
+        for (int col = 0; col < W; ++col) {
+            const std::size_t i = std::size_t(row) * W + col;
+            if (!truth.hit(i) || !holdsSurface(camera, map, col, row)) continue;
+            const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
+            const double eyeZ = eyeZFromWindowDepth(camera, pWindow, truth.windowDepth.value[i]);
+            const double expected = map.quantity == DepthQuantity::EyeZ ? eyeZ : distanceFromEyeZ(camera, pWindow, eyeZ);
+            const double error = std::abs(map.value[i] - expected);
+            absolute.push_back(error), relative.push_back(error / expected);
+        }
+    if (absolute.size() < 16) return std::nullopt;
+    auto largestOverMedian = [](std::vector<double> v, double& largest) {
+        largest = *std::max_element(v.begin(), v.end());
+        std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
+        return largest / std::max(v[v.size() / 2], 1e-300);
+    };
+    double largestAbsolute = 0, largestRelative = 0;
+    const double spreadAbsolute = largestOverMedian(absolute, largestAbsolute);
+    const double spreadRelative = largestOverMedian(relative, largestRelative);
+    // A convention mistake is not a tolerance: only small errors qualify.
+    if (!(largestRelative <= 0.01) || largestAbsolute == 0) return std::nullopt;
+    MapAccuracy out = map.accuracy;
+    if (spreadRelative <= spreadAbsolute) out.relative = roundedUp(largestRelative * 1.05);
+    else out.absolute = roundedUp(largestAbsolute * 1.05);
+    return out;
+}
+
+std::string describeFindings(const ReadingFindings& f, const std::vector<std::string>& use)
+{
+    auto uses = [&](const char* name) { return std::find(use.begin(), use.end(), name) != use.end(); };
+    std::string out;
+    auto add = [&](const std::string& clause) { out += (out.empty() ? "" : "; ") + clause; };
+    if (uses("miss") && f.missValue)
+        add("the map holds " + formatNumber(*f.missValue) + " at " + grouped(f.missPixels) +
+            " pixels where nothing is hit: its miss value (pass --miss '" + f.missRule + "')");
+    if (uses("grid") && f.grid > 0)
+        add("the map's values lie on a " + formatNumber(f.grid) + " grid: consistent with --quantum " + formatNumber(f.grid));
+    if (uses("holes") && f.holes > 0)
+        add(grouped(f.holes) + " pixels have no depth where the surface is hit: holes (pass --allow-holes if your sensor "
+                               "or renderer leaves them)");
+    return out;
+}
+
+}  // namespace zcheck

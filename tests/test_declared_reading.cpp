@@ -1,0 +1,239 @@
+// Maps as pipelines and sensors deliver them: what their reading declares (a rounding quantum,
+// half floats' own steps, a stated accuracy, holes) accepts them; without it they are rejected
+// and the diagnosis names the option; and declared accuracy does not hide a convention mistake.
+#include "zcheck/declared_reading.h"
+#include "zcheck/verify.h"
+
+#include "zcheck/inverse_projection.h"
+
+#include "diagnosis_helpers.h"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <random>
+
+using namespace zcheck;
+using testing::mapOf;
+
+namespace {
+
+// The builtin scene shrunk ten times (0.36 .. 3.7 m from the eye): a room an RGB-D sensor sees.
+struct Room {
+    Scene scene = builtinScene("builtin:default");
+    CameraSpec spec;
+    explicit Room(const std::string& convention = "opengl")
+    {
+        for (glm::vec3& p : scene.positions) p *= 0.1f;
+        spec = scene.defaultCamera;
+        spec.view.eye *= 0.1, spec.view.target *= 0.1;
+        spec.projection.near *= 0.1, spec.projection.far *= 0.1;
+        spec.width = 200, spec.height = 150;
+        spec.convention = Convention::preset(convention);
+    }
+};
+
+// The truth's eye-z (or distance) map, exact to binary32 (misses: +inf).
+DepthMap truthMap(const Checker& checker, const Camera& camera, ExportQuantity quantity)
+{
+    return mapOf(checker.scene(), camera, checker.renderRay(camera), quantity);
+}
+
+bool consistent(const Checker& checker, const Camera& camera, const DepthMap& map)
+{
+    return checker.verify(camera, map).comparison.report.consistent();
+}
+
+// The first consistent hypothesis's name, "" for none.
+std::string bestConsistent(const Checker& checker, const Camera& camera, const DepthMap& map)
+{
+    for (const Hypothesis& h : checker.diagnose(camera, map))
+        if (h.consistent) return h.name;
+    return "";
+}
+
+// A Kinect-like sensor's map (σ = 1.2 mm + 1.9 mm·(z − 0.4 m)², rounded to millimetres,
+// silhouettes eroded by a pixel, `holeShare` of the pixels dropped), misses as 0.
+DepthMap kinectLike(const DepthMap& exact, double holeShare, unsigned seed)
+{
+    std::mt19937 random(seed);
+    std::normal_distribution<double> normal;
+    std::uniform_real_distribution<double> uniform;
+    DepthMap out = exact;
+    const int W = exact.width, H = exact.height;
+    auto hit = [&](int col, int row) {
+        return col >= 0 && col < W && row >= 0 && row < H && std::isfinite(exact.value[std::size_t(row) * W + col]);
+    };
+    for (int row = 0; row < H; ++row)
+        for (int col = 0; col < W; ++col) {
+            double& v = out.value[std::size_t(row) * W + col];
+            const bool inside = hit(col, row) && hit(col - 1, row) && hit(col + 1, row) && hit(col, row - 1) && hit(col, row + 1);
+            if (!inside || uniform(random) < holeShare) {
+                v = NAN;
+                continue;
+            }
+            const double z = exact.value[std::size_t(row) * W + col];
+            const double sigma = 0.0012 + 0.0019 * (z - 0.4) * (z - 0.4);
+            v = std::round((z + sigma * normal(random)) * 1000) / 1000;
+        }
+    return out;
+}
+
+}  // namespace
+
+TEST_CASE("millimetre-rounded floats are accepted with --quantum 0.001, rejected and named without", "[declared]")
+{
+    for (const char* convention : {"opengl", "opencv", "direct3d"})
+        for (ExportQuantity q : {ExportQuantity::EyeZ, ExportQuantity::Distance}) {
+            const Room room(convention);
+            const Checker checker(room.scene);
+            const Camera camera(room.spec);
+            DepthMap map = truthMap(checker, camera, q);
+            for (double& v : map.value)
+                if (std::isfinite(v)) v = double(float(std::round(v * 1000) / 1000));
+            INFO(convention << " " << toString(q));
+            REQUIRE_FALSE(consistent(checker, camera, map));
+            REQUIRE(bestConsistent(checker, camera, map) == "quantum");
+            DepthMap declared = map;
+            declared.accuracy.quantum = 0.001;
+            REQUIRE(consistent(checker, camera, declared));
+        }
+}
+
+TEST_CASE("half floats carry their own step: a float16 map verifies without options", "[declared]")
+{
+    const Room room;
+    const Checker checker(room.scene);
+    const Camera camera(room.spec);
+    DepthMap map = truthMap(checker, camera, ExportQuantity::EyeZ);
+    DepthMap asBinary32 = map;
+    map.valueStep.assign(map.value.size(), 0.0f);
+    for (std::size_t i = 0; i < map.value.size(); ++i) {
+        // binary16 rounding of the value: to a multiple of its spacing.
+        const double step = binary16Step(map.value[i]);
+        if (std::isfinite(map.value[i])) map.value[i] = asBinary32.value[i] = std::round(map.value[i] / step) * step;
+        map.valueStep[i] = float(step);
+    }
+    REQUIRE(binary16Step(1.0) == std::ldexp(1.0, -10));
+    REQUIRE(binary16Step(3.0) == std::ldexp(1.0, -9));
+    REQUIRE(binary16Step(1e-6) == std::ldexp(1.0, -24));
+    REQUIRE(consistent(checker, camera, map));
+    REQUIRE_FALSE(consistent(checker, camera, asBinary32));  // the same values read as binary32
+}
+
+TEST_CASE("a miss value where nothing is hit is named with the --miss rule that reads it", "[declared]")
+{
+    const Room room;
+    const Checker checker(room.scene);
+    const Camera camera(room.spec);
+    const DepthMap exact = truthMap(checker, camera, ExportQuantity::EyeZ);
+    for (const double sentinel : {1e10, 65504.0}) {
+        DepthMap map = exact;
+        std::int64_t misses = 0;
+        for (double& v : map.value)
+            if (!std::isfinite(v)) v = sentinel, ++misses;
+        REQUIRE(misses > 1000);
+        REQUIRE_FALSE(consistent(checker, camera, map));
+        const RenderResult truth = checker.renderRay(camera);
+        const ReadingFindings found = findReading(camera, map, truth);
+        REQUIRE(found.missValue == sentinel);
+        REQUIRE(found.missPixels == misses);
+        REQUIRE(found.missRule == (sentinel >= 1e9 ? ">=1e9" : "65504"));
+        REQUIRE(bestConsistent(checker, camera, map) == "miss-value");
+        const std::vector<Hypothesis> diagnosis = checker.diagnose(camera, map);
+        REQUIRE(diagnosis.front().explanation.find("pass --miss") != std::string::npos);
+    }
+}
+
+TEST_CASE("holes are failures unless allowed; allowed, they are counted and a flipped map still fails", "[declared]")
+{
+    const Room room;
+    const Checker checker(room.scene);
+    const Camera camera(room.spec);
+    const DepthMap exact = truthMap(checker, camera, ExportQuantity::EyeZ);
+    DepthMap map = exact;
+    std::mt19937 random(3);
+    std::int64_t holes = 0;
+    for (double& v : map.value)
+        if (std::isfinite(v) && random() % 20 == 0) v = NAN, ++holes;
+    REQUIRE_FALSE(consistent(checker, camera, map));
+    REQUIRE(bestConsistent(checker, camera, map) == "holes");
+    map.accuracy.allowHoles = true;
+    const VerifyResult run = checker.verify(camera, map);
+    const ComparisonReport& r = run.comparison.report;
+    REQUIRE(r.consistent());
+    // Every hole is a pixel only the truth sees; those at an edge are explained there already.
+    REQUIRE(r.rayOnly == holes);
+    REQUIRE(r.holes <= holes);
+    REQUIRE(r.holes >= holes * 98 / 100);
+    // Holes allowed do not make a y-flipped map pass.
+    DepthMap flipped = map;
+    for (int row = 0; row < map.height; ++row)
+        for (int col = 0; col < map.width; ++col)
+            flipped.value[std::size_t(row) * map.width + col] = map.value[std::size_t(map.height - 1 - row) * map.width + col];
+    REQUIRE_FALSE(consistent(checker, camera, flipped));
+    REQUIRE(bestConsistent(checker, camera, flipped) == "y-flip");
+}
+
+TEST_CASE("a map good only to a stated accuracy: accepted with it, and its option is named", "[declared]")
+{
+    const Room room;
+    const Checker checker(room.scene);
+    const Camera camera(room.spec);
+    DepthMap map = truthMap(checker, camera, ExportQuantity::EyeZ);
+    for (double& v : map.value) v *= 1 - 4e-4;  // Eevee's Z pass: 4·10⁻⁴ short everywhere
+    REQUIRE_FALSE(consistent(checker, camera, map));
+    bool named = false;
+    for (const Hypothesis& h : checker.diagnose(camera, map))
+        named |= h.consistent && h.name == "tolerance" && h.explanation.find("--rel-tolerance 0.0005") != std::string::npos;
+    REQUIRE(named);
+    DepthMap declared = map;
+    declared.accuracy.relative = 5e-4;
+    REQUIRE(consistent(checker, camera, declared));
+    declared.accuracy.relative = 3e-4;  // less than the map's error
+    REQUIRE_FALSE(consistent(checker, camera, declared));
+    DepthMap absolute = map;
+    absolute.accuracy.absolute = 0.002;  // 4e-4 × 3.7 m = 1.5 mm at the farthest
+    REQUIRE(consistent(checker, camera, absolute));
+}
+
+TEST_CASE("a noisy, quantized, holed RGB-D map: accepted with its options; flipped, distance or moved: rejected and named",
+          "[declared]")
+{
+    for (const char* convention : {"opencv", "opengl"}) {
+        const Room room(convention);
+        const Checker checker(room.scene);
+        const Camera camera(room.spec);
+        const DepthMap exact = truthMap(checker, camera, ExportQuantity::EyeZ);
+        MapAccuracy sensor;  // what its user knows of it: millimetres, holes, and 6σ of its noise, relative
+        sensor.quantum = 0.001, sensor.allowHoles = true;
+        for (double z : exact.value)
+            if (std::isfinite(z)) sensor.relative = std::max(sensor.relative, 6 * (0.0012 + 0.0019 * (z - 0.4) * (z - 0.4)) / z);
+        REQUIRE(sensor.relative < 0.05);
+        DepthMap map = kinectLike(exact, 0.03, 11);
+        INFO(convention);
+        REQUIRE_FALSE(consistent(checker, camera, map));
+        map.accuracy = sensor;
+        REQUIRE(consistent(checker, camera, map));
+        // Flipped rows.
+        DepthMap flipped = map;
+        for (int row = 0; row < map.height; ++row)
+            for (int col = 0; col < map.width; ++col)
+                flipped.value[std::size_t(row) * map.width + col] = map.value[std::size_t(map.height - 1 - row) * map.width + col];
+        REQUIRE_FALSE(consistent(checker, camera, flipped));
+        REQUIRE(bestConsistent(checker, camera, flipped) == "y-flip");
+        // Distance stored where eye-z was declared.
+        DepthMap distance = kinectLike(truthMap(checker, camera, ExportQuantity::Distance), 0.03, 12);
+        distance.accuracy = sensor;
+        distance.quantity = DepthQuantity::EyeZ;  // declared eye-z, holds distance
+        REQUIRE_FALSE(consistent(checker, camera, distance));
+        REQUIRE(bestConsistent(checker, camera, distance) == "distance-as-eye-z");
+        // Seen from an eye 5 cm to the side.
+        CameraSpec moved = room.spec;
+        moved.view.eye.x += 0.05, moved.view.target.x += 0.05;
+        const Camera movedCamera(moved);
+        DepthMap fromElsewhere = kinectLike(truthMap(checker, movedCamera, ExportQuantity::EyeZ), 0.03, 13);
+        fromElsewhere.accuracy = sensor;
+        REQUIRE_FALSE(consistent(checker, camera, fromElsewhere));
+    }
+}
