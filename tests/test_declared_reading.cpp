@@ -10,6 +10,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -50,6 +51,16 @@ std::string bestConsistent(const Checker& checker, const Camera& camera, const D
     for (const Hypothesis& h : checker.diagnose(camera, map))
         if (h.consistent) return h.name;
     return "";
+}
+
+// The map upside down (a y-flip).
+DepthMap flippedRows(const DepthMap& map)
+{
+    DepthMap out = map;
+    for (int row = 0; row < map.height; ++row)
+        std::copy_n(map.value.begin() + std::ptrdiff_t(map.height - 1 - row) * map.width, map.width,
+                    out.value.begin() + std::ptrdiff_t(row) * map.width);
+    return out;
 }
 
 // A Kinect-like sensor's map (σ = 1.2 mm + 1.9 mm·(z − 0.4 m)², rounded to millimetres,
@@ -167,10 +178,7 @@ TEST_CASE("holes are failures unless allowed; allowed, they are counted and a fl
     REQUIRE(r.holes <= holes);
     REQUIRE(r.holes >= holes * 98 / 100);
     // Holes allowed do not make a y-flipped map pass.
-    DepthMap flipped = map;
-    for (int row = 0; row < map.height; ++row)
-        for (int col = 0; col < map.width; ++col)
-            flipped.value[std::size_t(row) * map.width + col] = map.value[std::size_t(map.height - 1 - row) * map.width + col];
+    const DepthMap flipped = flippedRows(map);
     REQUIRE_FALSE(consistent(checker, camera, flipped));
     REQUIRE(bestConsistent(checker, camera, flipped) == "y-flip");
 }
@@ -216,10 +224,7 @@ TEST_CASE("a noisy, quantized, holed RGB-D map: accepted with its options; flipp
         map.accuracy = sensor;
         REQUIRE(consistent(checker, camera, map));
         // Flipped rows.
-        DepthMap flipped = map;
-        for (int row = 0; row < map.height; ++row)
-            for (int col = 0; col < map.width; ++col)
-                flipped.value[std::size_t(row) * map.width + col] = map.value[std::size_t(map.height - 1 - row) * map.width + col];
+        const DepthMap flipped = flippedRows(map);
         REQUIRE_FALSE(consistent(checker, camera, flipped));
         REQUIRE(bestConsistent(checker, camera, flipped) == "y-flip");
         // Distance stored where eye-z was declared.
