@@ -158,7 +158,7 @@ const std::vector<std::string>& depthQuantityNames()
     return names;
 }
 
-constexpr int kPixelClassCount = int(PixelClass::RasterOnly) + 1;
+constexpr int kPixelClassCount = int(PixelClass::Hole) + 1;  // the last class (compare.h)
 
 // ---------------------------------------------------------------------------------------------
 // threads: at most N worker threads for one call (TBB's limit is process-wide while it lives)

@@ -220,6 +220,8 @@ def test_declared_reading_accepts_real_world_maps_and_the_diagnosis_names_the_op
     assert not default_checker.verify(small_camera, holed, "eye-z").consistent
     allowed = default_checker.verify(small_camera, holed, "eye-z", allow_holes=True)
     assert allowed.consistent and allowed.to_dict()["pixels"]["holes"] > 0.9 * np.isnan(holed[hit]).sum()
+    hole = zcheck.pixel_classes.index("hole")
+    assert (allowed.pixel_classes == hole).sum() == allowed.to_dict()["pixels"]["holes"]
 
     short = z * (1 - 4e-4)
     assert default_checker.verify(small_camera, short, "eye-z", rel_tolerance=5e-4).consistent
