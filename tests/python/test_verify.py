@@ -243,3 +243,10 @@ def test_wrong_arguments_raise_one_line_naming_the_argument(default_checker, sma
     with pytest.raises(zcheck.Error) as caught:
         call(default_checker, small_camera, z)
     assert message in str(caught.value) and "\n" not in str(caught.value)
+
+
+def test_regression_pixel_classes_named_only_up_to_raster_only():
+    """zcheck.pixel_classes stopped at a hard-coded last class, so a class added after it (hole)
+    had an index in Report.pixel_classes but no name."""
+    assert zcheck.pixel_classes[-1] == "hole" and len(set(zcheck.pixel_classes)) == len(zcheck.pixel_classes)
+    assert {"ray-only", "raster-only", "hole"} <= set(zcheck.pixel_classes)
