@@ -230,14 +230,14 @@ PixelClass PixelJudge::bothHit(double rayDepth, std::uint32_t rayPrimitive, doub
 }
 
 PixelClass PixelJudge::oneHit(bool rayHit, double depth, std::uint32_t primitive, double q,
-                              const glm::dvec2& pWindow) const
+                              const glm::dvec2& pWindow, bool holesAllowed) const
 {
     // Explained at an edge of its triangle, (ray route only) at the clear value, or on the
     // near/far plane.
     if (nearEdge(primitive, pWindow)) return rayHit ? PixelClass::RayOnlyEdge : PixelClass::RasterOnlyEdge;
     if (rayHit && std::abs(depth - camera_.clearDepth()) <= surfaceTolerance(primitive, q)) return PixelClass::RayOnlyAtClear;
     if (atClipPlane(primitive, pWindow)) return PixelClass::AtClipPlane;
-    return rayHit ? PixelClass::RayOnly : PixelClass::RasterOnly;
+    return !rayHit ? PixelClass::RasterOnly : holesAllowed ? PixelClass::Hole : PixelClass::RayOnly;
 }
 
 bool isUnexplained(PixelClass c)
@@ -904,10 +904,11 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tileBegin
                     // Coverage mismatch: only one route sees a surface (PixelJudge::oneHit).
                     rayHit ? ++r.rayOnly : ++r.rasterOnly;
                     f.pixelClass = judge.oneHit(rayHit, rayHit ? f.rayWindowDepth : f.rasterWindowDepth,
-                                                rayHit ? f.rayPrimitive : f.rasterPrimitive, quantumAt(a, b), pWindow);
+                                                rayHit ? f.rayPrimitive : f.rasterPrimitive, quantumAt(a, b), pWindow,
+                                                raster.holesAllowed);
                     if (f.pixelClass == PixelClass::RayOnlyAtClear) ++r.lostAtClearValue;
                     if (f.pixelClass == PixelClass::AtClipPlane) ++r.atClipPlane;
-                    if (f.pixelClass == PixelClass::RayOnly && raster.holesAllowed) f.pixelClass = PixelClass::Hole, ++r.holes;
+                    if (f.pixelClass == PixelClass::Hole) ++r.holes;
                     isUnexplained(f.pixelClass) ? ++r.coverageUnexplained : ++r.coverageExplained;
                 }
                 setClass(i, f.pixelClass);

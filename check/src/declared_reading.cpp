@@ -62,9 +62,8 @@ ReadingFindings findReading(const Camera& camera, const DepthMap& map, const Ren
             if (!truth.hit(i)) {
                 ++truthMisses;
                 if (std::isfinite(v)) ++atMisses[v];
-            } else {
-                ++out.truthHits;
-                if (holdsSurface(camera, map, col, row)) hitValues.push_back(v);
+            } else if (holdsSurface(camera, map, col, row)) {
+                hitValues.push_back(v);
             }
         }
     // The miss value.
@@ -79,12 +78,6 @@ ReadingFindings findReading(const Camera& camera, const DepthMap& map, const Ren
             out.missRule = stored >= 1e9 ? ">=1e9" : formatNumber(stored);
         }
     }
-    // Holes: the truth hits, the map holds nothing (its miss value read as nothing too).
-    for (int row = 0; row < H; ++row)
-        for (int col = 0; col < W; ++col) {
-            const std::size_t i = std::size_t(row) * W + col;
-            if (truth.hit(i) && !holdsSurface(camera, map, col, row)) ++out.holes;
-        }
     // The grid: the largest step of the candidates that ≥ 99 % of the values lie on.
     if (hitValues.size() >= 16) {
         double largest = 0;
@@ -114,15 +107,22 @@ ReadingFindings findReading(const Camera& camera, const DepthMap& map, const Ren
     return out;
 }
 
-DepthMap declaredReading(const DepthMap& map, const ReadingFindings& findings, const std::vector<std::string>& use)
+std::string Declared::name() const
 {
-    auto uses = [&](const char* name) { return std::find(use.begin(), use.end(), name) != use.end(); };
+    std::string out;
+    for (const auto& [declared, part] : {std::pair{missValue, "miss-value"}, std::pair{grid, "quantum"}, std::pair{holes, "holes"}})
+        if (declared) out += (out.empty() ? "" : " + ") + std::string(part);
+    return out;
+}
+
+DepthMap declaredReading(const DepthMap& map, const ReadingFindings& findings, const Declared& use)
+{
     DepthMap out = map;
-    if (uses("miss") && findings.missValue)
+    if (use.missValue && findings.missValue)
         for (double& v : out.value)
             if (v == *findings.missValue) v = NAN;
-    if (uses("grid") && findings.grid > 0) out.accuracy.quantum = findings.grid;
-    if (uses("holes")) out.accuracy.allowHoles = true;
+    if (use.grid && findings.grid > 0) out.accuracy.quantum = findings.grid;
+    if (use.holes) out.accuracy.allowHoles = true;
     return out;
 }
 
@@ -136,8 +136,8 @@ std::optional<MapAccuracy> toleranceFinding(const Camera& camera, const DepthMap
             const std::size_t i = std::size_t(row) * W + col;
             if (!truth.hit(i) || !holdsSurface(camera, map, col, row)) continue;
             const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
-            const double eyeZ = eyeZFromWindowDepth(camera, pWindow, truth.windowDepth.value[i]);
-            const double expected = map.quantity == DepthQuantity::EyeZ ? eyeZ : distanceFromEyeZ(camera, pWindow, eyeZ);
+            const double expected = depthValueFromEyeZ(
+                camera, pWindow, eyeZFromWindowDepth(camera, pWindow, truth.windowDepth.value[i]), map.quantity);
             const double error = std::abs(map.value[i] - expected);
             absolute.push_back(error), relative.push_back(error / expected);
         }
@@ -158,17 +158,16 @@ std::optional<MapAccuracy> toleranceFinding(const Camera& camera, const DepthMap
     return out;
 }
 
-std::string describeFindings(const ReadingFindings& f, const std::vector<std::string>& use)
+std::string describeFindings(const ReadingFindings& f, const Declared& use)
 {
-    auto uses = [&](const char* name) { return std::find(use.begin(), use.end(), name) != use.end(); };
     std::string out;
     auto add = [&](const std::string& clause) { out += (out.empty() ? "" : "; ") + clause; };
-    if (uses("miss") && f.missValue)
+    if (use.missValue && f.missValue)
         add("the map holds " + formatNumber(*f.missValue) + " at " + grouped(f.missPixels) +
             " pixels where nothing is hit: its miss value (pass --miss '" + f.missRule + "')");
-    if (uses("grid") && f.grid > 0)
+    if (use.grid && f.grid > 0)
         add("the map's values lie on a " + formatNumber(f.grid) + " grid: consistent with --quantum " + formatNumber(f.grid));
-    if (uses("holes") && f.holes > 0)
+    if (use.holes && f.holes > 0)
         add(grouped(f.holes) + " pixels have no depth where the surface is hit: holes (pass --allow-holes if your sensor "
                                "or renderer leaves them)");
     return out;

@@ -30,22 +30,11 @@ double valueOfEyePoint(const Camera& camera, const glm::dvec3& pEye, DepthQuanti
     return NAN;
 }
 
-double valueOfEyeZ(const Camera& camera, const glm::dvec2& pWindow, double eyeZ, DepthQuantity quantity)
-{
-    switch (quantity) {
-    case DepthQuantity::Window: return windowDepthFromEyeZ(camera, pWindow, eyeZ);
-    case DepthQuantity::Ndc: return camera.ndcZFromWindowDepth(windowDepthFromEyeZ(camera, pWindow, eyeZ));
-    case DepthQuantity::EyeZ: return eyeZ;
-    case DepthQuantity::Distance: return distanceFromEyeZ(camera, pWindow, eyeZ);
-    }
-    return NAN;
-}
-
 // The value's change, as `quantity`, for a relative eye-z change at eye depth z (forward
 // difference of 1e-6).
 double valuePerRelativeEyeZ(const Camera& camera, const glm::dvec2& pWindow, double z, DepthQuantity quantity)
 {
-    return std::abs(valueOfEyeZ(camera, pWindow, z * (1 + 1e-6), quantity) - valueOfEyeZ(camera, pWindow, z, quantity)) / 1e-6;
+    return std::abs(depthValueFromEyeZ(camera, pWindow, z * (1 + 1e-6), quantity) - depthValueFromEyeZ(camera, pWindow, z, quantity)) / 1e-6;
 }
 
 bool isMissValue(const Camera& camera, const glm::dvec2& pWindow, double value, DepthQuantity quantity)

@@ -242,11 +242,9 @@ PixelClass MapReader::classify(int col, int row, const MapPixel& pixel) const
         return judge_.bothHit(truth_.windowDepth.value[i], truth_.primitiveId[i], pixel.depth, pixel.primitive,
                               pixel.quantum, pWindow, bound, pixel.allowance);
     }
-    if (truthHit) {
-        const PixelClass c = judge_.oneHit(true, truth_.windowDepth.value[i], truth_.primitiveId[i], pixel.quantum, pWindow);
-        return c == PixelClass::RayOnly && map_.accuracy.allowHoles ? PixelClass::Hole : c;
-    }
-    return judge_.oneHit(false, pixel.depth, pixel.primitive, pixel.quantum, pWindow);
+    return truthHit ? judge_.oneHit(true, truth_.windowDepth.value[i], truth_.primitiveId[i], pixel.quantum, pWindow,
+                                    map_.accuracy.allowHoles)
+                    : judge_.oneHit(false, pixel.depth, pixel.primitive, pixel.quantum, pWindow);
 }
 
 RenderResult renderResultFromMap(const PixelJudge& judge, const DepthMap& map, const RenderResult& truth,
@@ -542,28 +540,27 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
     // What the reading should have declared (declared_reading.h): each finding alone, and all
     // of them together, judged as any hypothesis.
     ReadingFindings findings = findReading(camera, map, truth);
-    std::vector<std::string> found;
-    if (findings.missValue) found.push_back("miss");
-    if (findings.grid > 0) found.push_back("grid");
+    Declared found;
+    found.missValue = findings.missValue.has_value(), found.grid = findings.grid > 0;
     {  // holes: the pixels left unexplained where only the truth hits, once the miss value is read as one
         const VerifyResult run = verifyAgainst(scene_, camera, declaredReading(map, findings, found), truth, neighbours());
         findings.holes = std::count(run.comparison.pixelClass.begin(), run.comparison.pixelClass.end(), PixelClass::RayOnly);
-        if (findings.holes > 0 && !map.accuracy.allowHoles) found.push_back("holes");
+        found.holes = findings.holes > 0 && !map.accuracy.allowHoles;
     }
-    auto findingName = [](const std::string& use) {
-        return use == "miss" ? std::string("miss-value") : use == "grid" ? std::string("quantum") : use;
-    };
-    auto judgeReading = [&](const std::vector<std::string>& use, const DepthMap& read, const std::string& extra) {
-        std::string name;
-        for (const std::string& u : use) name += (name.empty() ? "" : " + ") + findingName(u);
+    auto judgeReading = [&](const Declared& use, const DepthMap& read, const std::string& extra) {
         std::string because = describeFindings(findings, use);
         if (!extra.empty()) because += (because.empty() ? "" : "; ") + extra;
-        return judgeAgainst(hypothesis(name, "", "consistent if read as declared: " + because), camera, read, truth);
+        return judgeAgainst(hypothesis(use.name(), "", "consistent if read as declared: " + because), camera, read, truth);
     };
     {
-        std::vector<std::vector<std::string>> readings;
-        for (const std::string& use : found) readings.push_back({use});
-        if (found.size() > 1) readings.push_back(found);
+        std::vector<Declared> readings;  // each finding alone, then all of them
+        for (const auto member : {&Declared::missValue, &Declared::grid, &Declared::holes})
+            if (found.*member) {
+                Declared alone;
+                alone.*member = true;
+                readings.push_back(alone);
+            }
+        if (readings.size() > 1) readings.push_back(found);
         std::vector<Hypothesis> judged(readings.size());
         tbb::parallel_for(std::size_t(0), readings.size(), [&](std::size_t k) {
             judged[k] = judgeReading(readings[k], declaredReading(map, findings, readings[k]), "");
@@ -747,21 +744,17 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
         if (const std::optional<MapAccuracy> accuracy = toleranceFinding(camera, read, truth)) {
             DepthMap declared = read;
             declared.accuracy = *accuracy;
-            const std::string option = accuracy->relative > map.accuracy.relative
-                                           ? "--rel-tolerance " + formatNumber(accuracy->relative)
-                                           : "--abs-tolerance " + formatNumber(accuracy->absolute);
-            const std::string within = accuracy->relative > map.accuracy.relative
-                                           ? "±" + formatNumber(accuracy->relative) + " of the truth (relative)"
-                                           : "±" + formatNumber(accuracy->absolute) + " of the truth";
-            std::vector<std::string> use = found;
-            Hypothesis h = judgeReading(use, declared,
+            const bool relative = accuracy->relative > map.accuracy.relative;  // else absolute (toleranceFinding)
+            const double value = relative ? accuracy->relative : accuracy->absolute;
+            const std::string option = std::string(relative ? "--rel-tolerance " : "--abs-tolerance ") + formatNumber(value);
+            const std::string within = "±" + formatNumber(value) + " of the truth" + (relative ? " (relative)" : "");
+            Hypothesis h = judgeReading(found, declared,
                                         "its values lie within " + within + " everywhere: pass " + option +
                                             " if your renderer or sensor is good only to that (a tolerance is for "
                                             "accuracy, never for a convention mistake)");
             h.name = h.name.empty() ? "tolerance" : h.name + " + tolerance";
-            h.fitted.push_back({accuracy->relative > map.accuracy.relative ? "rel_tolerance" : "abs_tolerance",
-                                accuracy->relative > map.accuracy.relative ? accuracy->relative : accuracy->absolute,
-                                accuracy->relative > map.accuracy.relative ? map.accuracy.relative : map.accuracy.absolute});
+            h.fitted.push_back({relative ? "rel_tolerance" : "abs_tolerance", value,
+                                relative ? map.accuracy.relative : map.accuracy.absolute});
             out.push_back(std::move(h));
         }
     }

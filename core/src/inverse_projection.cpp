@@ -105,6 +105,17 @@ double distanceFromEyeZ(const Camera& camera, const glm::dvec2& pWindow, double 
     return distanceOfEyePoint(camera, eyePointAtEyeZ(camera, pWindow, eyeZ));
 }
 
+double depthValueFromEyeZ(const Camera& camera, const glm::dvec2& pWindow, double eyeZ, DepthQuantity quantity)
+{
+    switch (quantity) {
+    case DepthQuantity::Window: return windowDepthFromEyeZ(camera, pWindow, eyeZ);
+    case DepthQuantity::Ndc: return camera.ndcZFromWindowDepth(windowDepthFromEyeZ(camera, pWindow, eyeZ));
+    case DepthQuantity::EyeZ: return eyeZ;
+    case DepthQuantity::Distance: return distanceFromEyeZ(camera, pWindow, eyeZ);
+    }
+    return NAN;
+}
+
 double eyeZFromDistance(const Camera& camera, const glm::dvec2& pWindow, double distance)
 {
     const EyePlaneRay ray = eyePlaneRayFrom(eyeRayThroughWindow(camera, pWindow));

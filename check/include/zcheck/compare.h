@@ -210,8 +210,10 @@ public:
                        std::uint32_t rasterPrimitive, double q, const glm::dvec2& pWindow, double& bound,
                        double allowance = 0) const;
     // Only one route hits, on `primitive` (`rayHit`: the ray's hit, at window depth `depth`):
-    // RayOnlyEdge/RasterOnlyEdge, RayOnlyAtClear, AtClipPlane, or RayOnly/RasterOnly.
-    PixelClass oneHit(bool rayHit, double depth, std::uint32_t primitive, double q, const glm::dvec2& pWindow) const;
+    // RayOnlyEdge/RasterOnlyEdge, RayOnlyAtClear, AtClipPlane, or RayOnly/RasterOnly — or Hole
+    // for a ray-only pixel none of those explains when the raster side allows holes (DeclaredMap).
+    PixelClass oneHit(bool rayHit, double depth, std::uint32_t primitive, double q, const glm::dvec2& pWindow,
+                      bool holesAllowed = false) const;
     // Whether pWindow lies within S pixels of the primitive's edge as drawn.
     bool nearEdge(std::uint32_t primitive, const glm::dvec2& pWindow) const;
     // Whether the primitive's plane meets the pixel's ray on the near or far plane.

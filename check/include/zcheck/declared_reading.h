@@ -14,7 +14,8 @@
 //               binary32 spacings) of a multiple of Q, for the largest Q of 1, 2 or 5 × 10^k
 //               (k = −6..0) or 2^−k (k = 1..24) at least 16 binary32 spacings of the largest
 //               value: values rounded to a grid coarser than their storage.
-//   holes       pixels without a value where the truth hits (after the miss value above).
+//   holes       pixels without a value where the truth hits that the comparison leaves
+//               unexplained once the miss value above is read as one (Checker::diagnose counts them).
 //   tolerance   only where no convention explains the map (Checker::diagnose asks last): an
 //               eye-z or distance map whose values where both see a surface lie within a small
 //               relative (≤ 1 %) or absolute error of the truth; the more uniform of the two
@@ -35,16 +36,23 @@ struct ReadingFindings {
     std::string missRule;
     std::int64_t missPixels = 0;
     double grid = 0;               // the rounding grid (value units); 0: none
-    std::int64_t holes = 0;        // truth hits, map has no value (after the miss value)
-    std::int64_t truthHits = 0;    // pixels where the truth sees a surface
+    std::int64_t holes = 0;        // unexplained holes (above); findReading leaves it 0
+};
+
+// Which findings a reading declares.
+struct Declared {
+    bool missValue = false, grid = false, holes = false;
+    bool any() const { return missValue || grid || holes; }
+    // "miss-value", "quantum", "holes", joined by " + " ("" for none): the hypothesis's name.
+    std::string name() const;
 };
 
 // The findings of a map against the declared camera's ground truth (already rendered).
 ReadingFindings findReading(const Camera& camera, const DepthMap& map, const RenderResult& truth);
 
-// The map as it reads with the findings declared: the miss value read as "no surface", the
-// grid as its quantum, holes allowed (each only when `use` names it: "miss", "grid", "holes").
-DepthMap declaredReading(const DepthMap& map, const ReadingFindings& findings, const std::vector<std::string>& use);
+// The map as it reads with the findings `use` declares: the miss value read as "no surface",
+// the grid as its quantum, holes allowed.
+DepthMap declaredReading(const DepthMap& map, const ReadingFindings& findings, const Declared& use);
 
 // A stated accuracy that would accept `map` (relative or absolute, the other 0), or nothing:
 // see above. `truth` is the declared camera's.
@@ -52,6 +60,6 @@ std::optional<MapAccuracy> toleranceFinding(const Camera& camera, const DepthMap
 
 // "the map holds 1e10 at all 54,155 pixels where nothing is hit: its miss value (pass --miss '>=1e9')",
 // and likewise for the grid and holes: one clause per finding `use` names.
-std::string describeFindings(const ReadingFindings& findings, const std::vector<std::string>& use);
+std::string describeFindings(const ReadingFindings& findings, const Declared& use);
 
 }  // namespace zcheck

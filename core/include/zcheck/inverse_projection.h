@@ -72,6 +72,8 @@ double eyeZFromWindowDepth(const Camera& camera, const glm::dvec2& pWindow, doub
 double windowDepthFromEyeZ(const Camera& camera, const glm::dvec2& pWindow, double eyeZ);
 double distanceFromEyeZ(const Camera& camera, const glm::dvec2& pWindow, double eyeZ);
 double eyeZFromDistance(const Camera& camera, const glm::dvec2& pWindow, double distance);
+// The depth value, as `quantity`, of the point at eye depth eyeZ on the ray through (x, y).
+double depthValueFromEyeZ(const Camera& camera, const glm::dvec2& pWindow, double eyeZ, DepthQuantity quantity);
 
 // The eye-space point at window point (x, y) whose depth, as `quantity`, is `value`
 // (window: depth-buffer value; ndc: z_ndc; eye-z; distance). Empty for a miss: a value that
