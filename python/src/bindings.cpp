@@ -41,19 +41,29 @@ void fillVerification(PyReport& r, VerifyOutcome verified)
     fillComparison(r, verified.run.comparison, verified.run.truth, verified.run.map);
 }
 
+namespace {
+
+// A Python int or float or a NumPy scalar, not a bool, a string or an array.
+bool isRealNumber(const py::object& value)
+{
+    return !py::isinstance<py::bool_>(value) && !py::isinstance<py::str>(value) && !py::isinstance<py::array>(value) &&
+           (py::isinstance<py::float_>(value) || py::isinstance<py::int_>(value) || py::hasattr(value, "__float__"));
+}
+
+std::string typeName(const py::object& value) { return py::str(py::type::of(value).attr("__name__")); }
+
+}  // namespace
+
 std::optional<double> numberArgument(const py::object& value, const char* name)
 {
     if (value.is_none()) return std::nullopt;
-    const bool number = !py::isinstance<py::bool_>(value) && !py::isinstance<py::str>(value) &&
-                        (py::isinstance<py::float_>(value) || py::isinstance<py::int_>(value) ||
-                         py::hasattr(value, "__float__"));
-    if (number && !py::isinstance<py::array>(value)) {
+    if (isRealNumber(value)) {
         try {
             return py::float_(value).cast<double>();
         } catch (const py::error_already_set&) {
         }
     }
-    fail(std::string(name) + " must be a number, got " + std::string(py::str(py::type::of(value).attr("__name__"))));
+    fail(std::string(name) + " must be a number, got " + typeName(value));
 }
 
 DepthMapReading readingOf(const ReadingArguments& a)
@@ -68,30 +78,26 @@ DepthMapReading readingOf(const ReadingArguments& a)
     if (py::isinstance<py::str>(a.miss)) {
         reading.miss = MissRule::parse(a.miss.cast<std::string>());
     } else if (!a.miss.is_none()) {
-        if (py::isinstance<py::bool_>(a.miss) || !(py::isinstance<py::float_>(a.miss) || py::isinstance<py::int_>(a.miss) ||
-                                                   py::hasattr(a.miss, "__float__")))
-            fail("miss must be a number or a rule such as '>=1e9', got " +
-                 std::string(py::str(py::type::of(a.miss).attr("__name__"))) + " (one miss value or rule per map)");
+        if (!isRealNumber(a.miss))
+            fail("miss must be a number or a rule such as '>=1e9', got " + typeName(a.miss) +
+                 " (one miss value or rule per map)");
         reading.miss = MissRule::parse(formatNumber(*numberArgument(a.miss, "miss")));
     }
+    // What the map declares: finite, >= 0 (MapAccuracy::require's rule, each named as its argument).
+    auto declared = [](const py::object& value, const char* name, bool belowOne) {
+        const double v = numberArgument(value, name).value_or(0.0);
+        if (!(v >= 0) || !std::isfinite(v) || (belowOne && v >= 1))
+            fail(std::string(name) + " must be a finite number >= 0" + (belowOne ? " and below 1" : "") + ", got " +
+                 formatNumber(v));
+        return v;
+    };
     MapAccuracy& d = reading.accuracy;
-    d.quantum = numberArgument(a.quantum, "quantum").value_or(0.0);
-    d.relative = numberArgument(a.relTolerance, "rel_tolerance").value_or(0.0);
-    d.absolute = numberArgument(a.absTolerance, "abs_tolerance").value_or(0.0);
+    d.quantum = declared(a.quantum, "quantum", false);
+    d.relative = declared(a.relTolerance, "rel_tolerance", true);
+    d.absolute = declared(a.absTolerance, "abs_tolerance", false);
     if (!a.allowHoles.is_none()) {
         if (!py::isinstance<py::bool_>(a.allowHoles)) fail("allow_holes must be True or False");
         d.allowHoles = a.allowHoles.cast<bool>();
-    }
-    try {
-        d.require("the declared accuracy");
-    } catch (const Error&) {
-        auto bad = [](const char* name, double v) {
-            fail(std::string(name) + " must be a finite number >= 0" + (std::string(name) == "rel_tolerance" ? " and below 1" : "") +
-                 ", got " + formatNumber(v));
-        };
-        if (!(d.quantum >= 0) || !std::isfinite(d.quantum)) bad("quantum", d.quantum);
-        if (!(d.absolute >= 0) || !std::isfinite(d.absolute)) bad("abs_tolerance", d.absolute);
-        bad("rel_tolerance", d.relative);
     }
     return reading;
 }
