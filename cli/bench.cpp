@@ -144,7 +144,7 @@ WholeCheck wholeCheckInChild(const std::string& sceneName, const Camera& camera,
 }
 
 struct BenchOptions {
-    SceneAndCamera input{kWorkloadScene, "", ""};
+    SceneAndCamera input{kWorkloadScene, {}};
     ImageSize imageSize;
     int repeat = 5;
     int threads = 0;

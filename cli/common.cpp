@@ -105,7 +105,8 @@ CameraSpec withConvention(CameraSpec spec, const std::string& convention)
 
 CameraCompletion completionOf(const CameraOptions& o, std::optional<std::pair<int, int>> size)
 {
-    CameraCompletion given{o.near, o.far, std::nullopt, std::nullopt};
+    CameraCompletion given;
+    given.near = o.near, given.far = o.far;
     if (size) given.width = size->first, given.height = size->second;
     return given;
 }

@@ -29,16 +29,26 @@ std::string toString(CameraFormat format)
     return "?";
 }
 
+namespace {
+
+constexpr CameraFormat kAllCameraFormats[] = {CameraFormat::Zcheck, CameraFormat::Colmap, CameraFormat::Nerfstudio,
+                                              CameraFormat::OpenCv, CameraFormat::Ros,    CameraFormat::Gltf};
+
+}  // namespace
+
 const std::vector<std::string>& cameraFormatNames()
 {
-    static const std::vector<std::string> names = {"zcheck", "colmap", "nerfstudio", "opencv", "ros", "gltf"};
+    static const std::vector<std::string> names = [] {
+        std::vector<std::string> all;
+        for (CameraFormat f : kAllCameraFormats) all.push_back(toString(f));
+        return all;
+    }();
     return names;
 }
 
 CameraFormat cameraFormatFromName(const std::string& name)
 {
-    for (CameraFormat f : {CameraFormat::Zcheck, CameraFormat::Colmap, CameraFormat::Nerfstudio, CameraFormat::OpenCv,
-                           CameraFormat::Ros, CameraFormat::Gltf})
+    for (CameraFormat f : kAllCameraFormats)
         if (toString(f) == name) return f;
     if (name == "instant-ngp") return CameraFormat::Nerfstudio;
     throw Error("unknown camera format '" + name + "' (expected zcheck, colmap, nerfstudio, instant-ngp, opencv, ros or gltf)");

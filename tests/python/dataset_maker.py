@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 import zcheck
+from helpers import gl_look_at
 
 W, H = 320, 240
 FX = FY = 300.0
@@ -30,17 +31,9 @@ OPENCV_TO_OPENGL = np.diag([1.0, -1.0, -1.0, 1.0])  # flips y and z: one camera 
 
 
 def look_at_cam_from_world(eye, target, up=(0.0, 1.0, 0.0)):
-    """OpenCV's [R | t] (x right, y down, z forward) of a camera at `eye` looking at `target`."""
-    eye, target, up = (np.asarray(v, float) for v in (eye, target, up))
-    forward = target - eye
-    forward /= np.linalg.norm(forward)
-    right = np.cross(forward, up)
-    right /= np.linalg.norm(right)
-    down = np.cross(forward, right)
-    m = np.eye(4)
-    m[:3, :3] = np.stack([right, down, forward])
-    m[:3, 3] = -m[:3, :3] @ eye
-    return m
+    """OpenCV's [R | t] (x right, y down, z forward) of a camera at `eye` looking at `target`:
+    gluLookAt's OpenGL eye space with y and z flipped."""
+    return OPENCV_TO_OPENGL @ gl_look_at(eye, target, up)
 
 
 def quaternion_of(r):
