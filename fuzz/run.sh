@@ -25,7 +25,7 @@ run_one() {
     rm -rf "$work" "$findings" && mkdir -p "$work" "$findings"
     cp fuzz/corpus/"$name"/* "$work"/ 2> /dev/null || true
     # -timeout: one input over 10 s is a hang; -rss_limit_mb: memory over 2 GiB is a finding.
-    if ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
+    if ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1:intercept_tls_get_addr=0 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
         build-fuzz/fuzz/fuzz_"$name" "$work" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
         -max_len=262144 -artifact_prefix="$findings"/ -print_final_stats=1 > build-fuzz/fuzz_"$name".log 2>&1; then
         echo "fuzz_$name: $(grep -E '^stat::number_of_executed_units' build-fuzz/fuzz_"$name".log | awk '{print $2}') executions in ${seconds} s, 0 findings"
