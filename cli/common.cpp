@@ -3,6 +3,7 @@
 #include "zcheck/camera_file.h"
 #include "zcheck/camera_sources.h"
 #include "zcheck/error.h"
+#include "zcheck/inverse_projection.h"
 
 #include <cmath>
 #include <cstdio>
@@ -215,6 +216,33 @@ void addAccuracyOptions(CLI::App* command, MapAccuracy& accuracy)
                       "a pixel without a value where the surface is hit is a hole (counted and reported), not a\n"
                       "failure: sensors and some renderers leave them")
         ->group(group);
+}
+
+std::string takeFromSidecar(const DepthMapOptions& reading, CameraOptions& camera, std::string& quantity)
+{
+    std::string compareWith;
+    if (!reading.sidecar.empty()) {
+        const SidecarSubject subject = sidecarSubject(reading.sidecar);
+        if (subject.hasCamera) {
+            if (camera.reference.empty()) camera.reference = reading.sidecar;
+            else compareWith = reading.sidecar;
+        }
+        if (quantity.empty())
+            quantity = subject.quantityOf(reading.sidecar, reading.channel).value_or("");
+    }
+    if (quantity.empty()) quantity = "window";
+    return compareWith;
+}
+
+void requireSidecarCameraAgrees(const CameraSpec& used, const CameraOptions& camera, const std::string& sidecar,
+                                DepthQuantity quantity)
+{
+    if (sidecar.empty()) return;
+    const bool depthMapping = quantity == DepthQuantity::Window || quantity == DepthQuantity::Ndc;
+    const std::string difference = howCamerasDiffer(Camera(used), Camera(readCameraFile(sidecar)), depthMapping);
+    if (!difference.empty())
+        throw Error("--camera '" + camera.reference + "' and the camera in sidecar '" + sidecar + "' (the one that rendered "
+                    "the map) differ in " + difference + ": give the map's own camera, or leave --camera out");
 }
 
 DepthMapReading DepthMapOptions::reading(const std::string& quantityName) const

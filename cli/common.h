@@ -104,6 +104,15 @@ struct DepthMapOptions {
     DepthMapReading reading(const std::string& quantityName) const;
 };
 void addDepthMapOptions(CLI::App* command, DepthMapOptions& options);
+// What --sidecar says the map is where the command line is silent. zcheck's export sidecar
+// names the camera that rendered the map — used when --camera is absent — and each channel's
+// quantity — used when `quantity` is "" (not given); else "window". Returns the sidecar when it
+// holds a camera and --camera was given too, for requireSidecarCameraAgrees; "" otherwise.
+std::string takeFromSidecar(const DepthMapOptions& reading, CameraOptions& camera, std::string& quantity);
+// Refuses (Error naming both) a --camera that images the world otherwise than the camera in
+// `sidecar` (for window and ndc maps, maps depth otherwise too). "" : nothing to compare.
+void requireSidecarCameraAgrees(const CameraSpec& used, const CameraOptions& camera, const std::string& sidecar,
+                                DepthQuantity quantity);
 // --quantum, --rel-tolerance, --abs-tolerance, --allow-holes (MapAccuracy), in their own help group.
 void addAccuracyOptions(CLI::App* command, MapAccuracy& accuracy);
 

@@ -20,7 +20,7 @@ namespace {
 
 struct UnprojectOptions {
     CameraOptions camera;
-    std::string pixel, depthMap, quantity = "window", output, space = "world";
+    std::string pixel, depthMap, quantity, output, space = "world";  // quantity "": the sidecar's, else window
     std::optional<double> depth;
     DepthMapOptions reading;
     int stride = 1;
@@ -43,21 +43,27 @@ nlohmann::json vec3Json(const glm::dvec3& v) { return nlohmann::json::array({v.x
 int runUnprojectCommand(const UnprojectOptions& o)
 {
     if (o.space != "eye" && o.space != "world") throw Error("--space must be eye or world, got '" + o.space + "'");
-    const DepthQuantity quantity = depthQuantityFromName(o.quantity);
+    CameraOptions cameraOptions = o.camera;
+    std::string quantityName = o.quantity;
+    const std::string compareWith = takeFromSidecar(o.reading, cameraOptions, quantityName);
+    const DepthQuantity quantity = depthQuantityFromName(quantityName);
+    if (cameraOptions.reference.empty())
+        throw Error("unproject needs --camera FILE (or the --sidecar zcheck's export wrote, which names the camera)");
     // With a map: the camera and the map made together (a camera file without an image size takes
     // the map's; near and far, when the file has none, cover the map's depths).
     std::optional<DepthMapFile> sized;
     CameraSpec spec;
     if (!o.depthMap.empty()) {
         SceneAndCamera input;
-        input.camera = o.camera;
+        input.camera = cameraOptions;
         CameraForMap made = cameraAndMapFor(nullptr, input, quantity, [&](int width, int height) {
-            return readDepthMapFile(o.depthMap, o.reading.reading(o.quantity), width, height);
+            return readDepthMapFile(o.depthMap, o.reading.reading(quantityName), width, height);
         });
+        requireSidecarCameraAgrees(made.spec, cameraOptions, compareWith, quantity);
         spec = made.spec;
         sized = std::move(made.map);
     } else {
-        spec = cameraSpecFrom(o.camera);
+        spec = cameraSpecFrom(cameraOptions);
     }
     const Camera camera(spec);
     auto toWorld = [&](const glm::dvec3& pEye) { return glm::dvec3(camera.worldFromEye * glm::dvec4(pEye, 1.0)); };
@@ -87,7 +93,7 @@ int runUnprojectCommand(const UnprojectOptions& o)
         } else {
             requireDepthValue(camera, quantity, *o.depth, "--depth");
             const auto pEye = eyePointFromDepth(camera, pWindow, *o.depth, quantity);
-            if (!pEye) throw Error("--depth " + formatNumber(*o.depth) + " is a miss for quantity " + o.quantity);
+            if (!pEye) throw Error("--depth " + formatNumber(*o.depth) + " is a miss for quantity " + quantityName);
             out["point"] = {{"eye", vec3Json(*pEye)}, {"world", vec3Json(toWorld(*pEye))},
                             {"eye_z", camera.eyeZOf(*pEye)}, {"distance", distanceOfEyePoint(camera, *pEye)}};
         }
@@ -98,24 +104,36 @@ int runUnprojectCommand(const UnprojectOptions& o)
     if (o.depthMap.empty()) throw Error("unproject needs --pixel COL,ROW or --depth-map FILE");
     if (o.output.empty()) throw Error("--depth-map needs -o FILE.ply");
     OutputFiles outputs;
-    outputs.addInput(cameraInputPath(o.camera));
+    outputs.addInput(cameraInputPath(cameraOptions));
     outputs.addInput(o.depthMap);
     outputs.addInput(o.reading.sidecar);
     outputs.add(o.output, "-o");
     const DepthMapFile map =
-        sized ? std::move(*sized) : readDepthMapFile(o.depthMap, o.reading.reading(o.quantity), camera.width(), camera.height());
+        sized ? std::move(*sized) : readDepthMapFile(o.depthMap, o.reading.reading(quantityName), camera.width(), camera.height());
     const UnprojectedMap cloud =
         unprojectMap(camera, map.value, quantity, o.space == "eye" ? PointSpace::Eye : PointSpace::World, o.stride);
+    std::string outOfRange;  // values the quantity cannot hold: never dropped silently
+    if (cloud.outOfRange > 0) {
+        const glm::ivec2 at = cloud.firstOutOfRange;
+        outOfRange = std::to_string(cloud.outOfRange) + " value" + (cloud.outOfRange == 1 ? "" : "s") + " of '" +
+                     o.depthMap + "' lie outside what a " + quantityName + " map holds, " +
+                     depthValueRange(camera, quantity) + " (e.g. " +
+                     formatNumber(map.value[std::size_t(at.y) * camera.width() + at.x]) + " at pixel (" +
+                     std::to_string(at.x) + ", " + std::to_string(at.y) + "))";
+        if (cloud.points.empty()) throw Error(outOfRange + ", and the rest are misses: is --quantity right?");
+    }
     outputs.write(o.output, [&](const std::string& temporary) {
         writePointCloudPly(temporary, cloud.points, !o.ascii,
                            {"zcheck unproject of " + std::filesystem::path(o.depthMap).filename().string() + " (" +
-                                o.quantity + ", channel " + map.channel + ")",
+                                quantityName + ", channel " + map.channel + ")",
                             std::string("space ") + o.space +
                                 (o.space == "eye" ? " (" + camera.convention().name + " eye axes)" : "")});
     });
     outputs.commit();
-    std::cout << prettyJson({{"points", cloud.points.size()}, {"misses", cloud.misses}, {"channel", map.channel},
-                             {"quantity", o.quantity}, {"space", o.space}, {"output", o.output}})
+    if (!outOfRange.empty()) std::cerr << "zcheck: warning: " << outOfRange << ": no point written for them\n";
+    std::cout << prettyJson({{"points", cloud.points.size()}, {"misses", cloud.misses},
+                             {"out_of_range", cloud.outOfRange}, {"channel", map.channel},
+                             {"quantity", quantityName}, {"space", o.space}, {"output", o.output}})
               << "\n";
     return kExitConsistent;
 }
@@ -129,11 +147,11 @@ Command addUnprojectCommand(CLI::App& app)
         "unproject", "The inverse projection: the ray through a pixel centre, the point at a depth value, or a\n"
                      "whole depth map (EXR, PFM, TIFF, 16-bit PNG with --scale) as a PLY point cloud, misses skipped.");
     addCameraOptions(command, o->camera, kCameraFileHelp);
-    command->get_option("--camera")->required();
     command->add_option("--pixel", o->pixel, "COL,ROW (row 0 at the top): print the ray through its centre");
     command->add_option("--depth", o->depth, "with --pixel: print the point at this depth value");
-    command->add_option("--quantity", o->quantity, "what --depth / the map holds: window | ndc | eye-z | distance")
-        ->capture_default_str();
+    command->add_option("--quantity", o->quantity,
+                        "what --depth / the map holds: window | ndc | eye-z | distance (default: as zcheck's export\n"
+                        "sidecar given with --sidecar says, else window)");
     command->add_option("--depth-map", o->depthMap, "a depth map to turn into a point cloud")->check(kNonEmptyPath);
     addDepthMapOptions(command, o->reading);
     command->add_option("-o,--output", o->output, "the PLY file to write (atomically)")->check(kNonEmptyPath);

@@ -14,7 +14,7 @@ namespace {
 
 struct VerifyOptions {
     SceneAndCamera input;
-    std::string depthMap, quantity = "window", outDir;
+    std::string depthMap, quantity, outDir;  // quantity "": the sidecar's, else window
     DepthMapOptions reading;
     bool diagnose = false, json = false;
     int threads = 0;
@@ -22,29 +22,33 @@ struct VerifyOptions {
 
 int runVerifyCommand(const VerifyOptions& o)
 {
-    const DepthQuantity quantity = depthQuantityFromName(o.quantity);
+    SceneAndCamera input = o.input;
+    std::string quantityName = o.quantity;
+    const std::string compareWith = takeFromSidecar(o.reading, input.camera, quantityName);
+    const DepthQuantity quantity = depthQuantityFromName(quantityName);
     const auto threadLimit = limitThreads(o.threads);
     OutputFiles outputs;
-    outputs.addInput(o.input.scene);
-    outputs.addInput(cameraInputPath(o.input.camera));
+    outputs.addInput(input.scene);
+    outputs.addInput(cameraInputPath(input.camera));
     outputs.addInput(o.depthMap);
     outputs.addInput(o.reading.sidecar);
-    const RunFolder folder{o.outDir, "map_depth.exr"};
+    const RunFolder folder{o.outDir, "map_depth.exr", true};
     if (!o.outDir.empty()) folder.plan(outputs);
     Scene scene = loadScene(o.input.scene);
-    const DepthMapReading reading = o.reading.reading(o.quantity);
-    CameraForMap made = cameraAndMapFor(&scene, o.input, quantity, [&](int width, int height) {
+    const DepthMapReading reading = o.reading.reading(quantityName);
+    CameraForMap made = cameraAndMapFor(&scene, input, quantity, [&](int width, int height) {
         return readDepthMapFile(o.depthMap, reading, width, height);
     });
+    requireSidecarCameraAgrees(made.spec, input.camera, compareWith, quantity);
     const Camera camera(made.spec);
     DepthMapFile& file = made.map;
     const DepthMap map = DepthMap::of(file, quantity, reading);
     const Checker checker(std::move(scene));
     const VerifyOutcome verified =
-        verifyAndReport(checker, camera, map, {o.depthMap, o.quantity, file.channel, reading}, o.diagnose);
+        verifyAndReport(checker, camera, map, {o.depthMap, quantityName, file.channel, reading}, o.diagnose);
     const VerifyResult& run = verified.run;
     if (!o.outDir.empty()) {
-        folder.write(outputs, run.truth, run.map, run.comparison, verified.json);
+        folder.write(outputs, run.truth, run.map, run.comparison, verified.json, run.mapError);
         outputs.commit();
     }
     std::cout << (o.json ? verified.json : verified.summary) << (o.json ? "\n" : "");
@@ -64,8 +68,9 @@ Command addVerifyCommand(CLI::App& app)
     command->add_option("--depth-map", o->depthMap, "EXR (multi-layer too), PFM, TIFF, or 16-bit PNG with --scale")
         ->required()
         ->check(kNonEmptyPath);
-    command->add_option("--quantity", o->quantity, "what the map holds: window | ndc | eye-z | distance")
-        ->capture_default_str();
+    command->add_option("--quantity", o->quantity,
+                        "what the map holds: window | ndc | eye-z | distance (default: as zcheck's export sidecar\n"
+                        "given with --sidecar says, else window)");
     addDepthMapOptions(command, o->reading);
     command->add_flag("--diagnose", o->diagnose, "when inconsistent, test the classic hypotheses and name the one that fits");
     command->add_option("--out", o->outDir, "write truth and map depth EXRs, heatmap, classes and report.json")

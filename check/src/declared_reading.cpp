@@ -11,11 +11,10 @@ namespace zcheck {
 
 namespace {
 
+// Not a miss: a depth, or a value its quantity cannot hold (still something the map holds there).
 bool holdsSurface(const Camera& camera, const DepthMap& map, int col, int row)
 {
-    return eyePointFromDepth(camera, windowFromPixelCentre(camera, col, row), map.value[std::size_t(row) * map.width + col],
-                             map.quantity)
-        .has_value();
+    return kindOfDepthValue(camera, map.quantity, map.value[std::size_t(row) * map.width + col]) != DepthValueKind::Miss;
 }
 
 // binary32's spacing at v.

@@ -37,9 +37,9 @@ double valuePerRelativeEyeZ(const Camera& camera, const glm::dvec2& pWindow, dou
     return std::abs(depthValueFromEyeZ(camera, pWindow, z * (1 + 1e-6), quantity) - depthValueFromEyeZ(camera, pWindow, z, quantity)) / 1e-6;
 }
 
-bool isMissValue(const Camera& camera, const glm::dvec2& pWindow, double value, DepthQuantity quantity)
+bool isMissValue(const Camera& camera, const glm::dvec2&, double value, DepthQuantity quantity)
 {
-    return !eyePointFromDepth(camera, pWindow, value, quantity);
+    return kindOfDepthValue(camera, quantity, value) == DepthValueKind::Miss;
 }
 
 // One sample pixel: the plane the truth shows there, the map's value and the value's scale.
@@ -588,6 +588,54 @@ double medianResidual(const Scene& scene, const Camera& camera, const DepthMap& 
     return medianAbsolute(problem.residuals({}, false));
 }
 
+glm::dvec2 wholeImageShift(const Camera& camera, const DepthMap& map, const RenderResult& truth)
+{
+    const int W = camera.width(), H = camera.height();
+    // Each pixel's depth as a number both sides share: the distance for a distance map, else
+    // eye-z (window and NDC values turned into it); NaN where nothing is seen.
+    const bool distance = map.quantity == DepthQuantity::Distance;
+    std::vector<double> mine(std::size_t(W) * H, NAN), theirs(std::size_t(W) * H, NAN);
+    for (int row = 0; row < H; ++row)
+        for (int col = 0; col < W; ++col) {
+            const std::size_t i = std::size_t(row) * W + col;
+            const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
+            if (truth.hit(i)) {
+                const double z = eyeZFromWindowDepth(camera, pWindow, truth.windowDepth.value[i]);
+                theirs[i] = distance ? distanceFromEyeZ(camera, pWindow, z) : z;
+            }
+            if (const auto p = eyePointFromDepth(camera, pWindow, map.value[i], map.quantity))
+                mine[i] = distance ? map.value[i] : camera.eyeZOf(*p);
+        }
+    // A grid of about 4096 sample pixels; a shift's score is how many of them hold the truth's
+    // depth of the pixel it moves them to, within 0.2 %.
+    const int stride = std::max(1, int(std::sqrt(double(W) * H / 4096.0)));
+    auto score = [&](int sx, int sy) {
+        int agree = 0;
+        for (int row = stride / 2; row < H; row += stride)
+            for (int col = stride / 2; col < W; col += stride) {
+                const int c = col + sx, r = row + sy;
+                if (c < 0 || c >= W || r < 0 || r >= H) continue;
+                const double m = mine[std::size_t(row) * W + col], t = theirs[std::size_t(r) * W + c];
+                agree += std::abs(m - t) <= 2e-3 * std::abs(t) ? 1 : 0;
+            }
+        return agree;
+    };
+    int seen = 0;
+    for (int row = stride / 2; row < H; row += stride)
+        for (int col = stride / 2; col < W; col += stride) seen += std::isfinite(mine[std::size_t(row) * W + col]) ? 1 : 0;
+    const int declared = score(0, 0);
+    glm::ivec2 best{0, 0};
+    int bestScore = declared;
+    for (int sx = -W / 3; sx <= W / 3; ++sx)
+        if (const int s = sx == 0 ? 0 : score(sx, 0); s > bestScore) bestScore = s, best = {sx, 0};
+    for (int sy = -H / 3; sy <= H / 3; ++sy)
+        if (const int s = sy == 0 ? 0 : score(0, sy); s > bestScore) bestScore = s, best = {0, sy};
+    // Clearly better than the declared sampling, and agreeing at a third of the map at least (a
+    // shift moves part of the image out of it).
+    if (best == glm::ivec2(0) || bestScore < 2 * declared || 3 * bestScore < seen) return glm::dvec2(0.0);
+    return glm::dvec2(best);
+}
+
 FitResult fitDeparture(const Scene& scene, const Camera& camera, const DepthMap& map, const RenderResult& truth,
                        FitFamily family, const TruthRender& render)
 {
@@ -595,6 +643,19 @@ FitResult fitDeparture(const Scene& scene, const Camera& camera, const DepthMap&
     out.family = family;
     Departure d;
     std::optional<RenderResult> rendered;  // the truth through the departed camera, from round 2
+    // An image shifted by many pixels (a principal point far off) starts there, with its own truth.
+    bool shiftedStart = false;
+    if (family == FitFamily::SampleOffset)
+        if (const glm::dvec2 shift = wholeImageShift(camera, map, truth); shift != glm::dvec2(0.0)) {
+            try {
+                d.sampleOffset = shift;
+                rendered = render(Camera(departedCameraSpec(camera, d)), RayFaults{});
+                out.initialResidual = medianResidual(scene, camera, map, truth);
+                shiftedStart = true;
+            } catch (const Error&) {
+                d = Departure{}, rendered.reset();
+            }
+        }
     double previous = 0;                   // the last round's residual
     std::unique_ptr<Problem> last;         // the last round's
     for (int round = 0; round < 3; ++round) {
@@ -608,7 +669,7 @@ FitResult fitDeparture(const Scene& scene, const Camera& camera, const DepthMap&
         std::vector<double> z;
         for (const Sample& s : problem.samples) z.push_back(std::abs(departed.eyeZOf(eyePointOnPlane(departed, s))));
         problem.sceneDepth = std::max(medianOf(z), 1e-12);
-        if (round == 0) out.initialResidual = medianAbsolute(problem.residuals(d, false));
+        if (round == 0 && !shiftedStart) out.initialResidual = medianAbsolute(problem.residuals(d, false));
         if (family == FitFamily::SampleOffset && round == 0) {
             // Whole-pixel shifts first: the best of the offsets within two pixels.
             double best = INFINITY;
@@ -616,7 +677,7 @@ FitResult fitDeparture(const Scene& scene, const Camera& camera, const DepthMap&
             for (int dy = -2; dy <= 2; ++dy)
                 for (int dx = -2; dx <= 2; ++dx) {
                     Departure trial = d;
-                    trial.sampleOffset = glm::dvec2(dx, dy);
+                    trial.sampleOffset = d.sampleOffset + glm::dvec2(dx, dy);
                     const std::vector<double> r = problem.residuals(trial, false);
                     const double cost = robustCost(r, 1e-3);
                     if (cost < best) best = cost, start = trial;
@@ -627,7 +688,7 @@ FitResult fitDeparture(const Scene& scene, const Camera& camera, const DepthMap&
         const Departure next = levenbergMarquardt(problem);
         out.samples = problem.samples.size();
         out.residual = medianAbsolute(problem.residuals(next, false));
-        const bool moved = glm::length(next.sampleOffset - d.sampleOffset) > 1e-4 ||
+        const bool moved = (shiftedStart && round == 0) || glm::length(next.sampleOffset - d.sampleOffset) > 1e-4 ||
                            glm::length(next.focalScale - d.focalScale) > 1e-6 ||
                            glm::length(next.principalShift - d.principalShift) > 1e-4 ||
                            glm::length(next.eyeShift - d.eyeShift) > 1e-6 * problem.sceneDepth ||
@@ -759,6 +820,10 @@ std::string describeFit(const Camera& camera, const DepthMap& map, const FitResu
         if (whole != glm::dvec2(0.0))
             text += (within == glm::dvec2(0.0) ? "" : ",") + std::string(" the image shifted by (") +
                     signedNumber(whole.x) + ", " + signedNumber(whole.y) + ") px";
+        if (std::max(std::abs(d.sampleOffset.x), std::abs(d.sampleOffset.y)) >= 2)
+            text += ": the principal point off by (" + signedNumber(-d.sampleOffset.x, 4) + ", " +
+                    signedNumber(-d.sampleOffset.y, 4) + ") px (x right, y down) — cx or cy, or Blender's shift_x or "
+                    "shift_y (in units of the larger sensor side) with the wrong sign";
         return text;
     }
     case FitFamily::FieldOfView: {

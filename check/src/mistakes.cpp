@@ -1,7 +1,11 @@
 #include "zcheck/mistakes.h"
 
 #include "zcheck/fit.h"
+#include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
+#include "zcheck/pose.h"
+
+#include <glm/gtc/matrix_transform.hpp>
 
 #include <cmath>
 #include <cstdio>
@@ -148,6 +152,52 @@ glm::dmat4 nearFarSwapped(const Camera& camera)
     return m;
 }
 
+// The view in OpenCV's camera axes (x right, y down, z forward), as COLMAP, OpenCV and TUM-style
+// trajectories store a pose: cvFromEye · eyeFromWorld, and back.
+glm::dmat4 cvFromEye(const Camera& camera)
+{
+    glm::dmat4 f(1.0);
+    f[1][1] = -camera.convention().eyeUpY, f[2][2] = camera.convention().eyeForwardZ;
+    return f;  // its own inverse
+}
+
+// Views a renderer may have used instead of the declared one, each a variant with its
+// explanation; a mistake of the diagnosis only (inject empty: the suite's catalogue of injected
+// mistakes is the renderer's chain, not the files it was given). A variant equal to the declared
+// view, or no valid camera, is left out.
+struct ViewVariant {
+    std::string variant, explanation;
+    glm::dmat4 eyeFromWorld;
+};
+Mistake otherViews(std::string name, std::string description,
+                   std::function<std::vector<ViewVariant>(const Camera&)> build)
+{
+    Mistake mistake{std::move(name), std::move(description), Route::Raster, {}, {}};
+    mistake.reread = [build](const Camera& camera, const DepthMap&) {
+        Rereadings out;
+        for (const ViewVariant& v : build(camera)) {
+            if (!differ(v.eyeFromWorld, camera.eyeFromWorld)) continue;
+            CameraSpec spec = camera.spec();
+            spec.view.hasMatrix = true;
+            spec.view.eyeFromWorld = v.eyeFromWorld;
+            out.push_back({v.variant, v.explanation, spec, {}, {}});
+        }
+        return out;
+    };
+    return mistake;
+}
+
+// [R | t] of a rigid view, and the view made of a rotation and a translation.
+glm::dmat3 rotationOf(const glm::dmat4& m) { return glm::dmat3(m); }
+glm::dmat4 viewOf(const glm::dmat3& r, const glm::dvec3& t)
+{
+    glm::dmat4 m(r);
+    m[3] = glm::dvec4(t, 1.0);
+    return m;
+}
+
+std::string factorText(double k) { return k >= 1 ? "× " + formatNumber(k) : "/ " + formatNumber(1 / k); }
+
 std::vector<Mistake> buildCatalogue()
 {
     std::vector<Mistake> all;
@@ -200,6 +250,133 @@ std::vector<Mistake> buildCatalogue()
                                 m = turn * camera.eyeFromWorld;
                                 return true;
                             }));
+
+    // Poses as files store them (COLMAP, OpenCV, TUM-style trajectories): in OpenCV axes,
+    // world-to-camera [R | t] or camera-to-world [Rᵀ | C].
+    all.push_back(otherViews(
+        "transposed-rotation", "the pose's rotation transposed (R used as Rᵀ: a row- vs column-major 3×3, or a "
+                               "camera-to-world rotation used as world-to-camera)",
+        [](const Camera& camera) {
+            const glm::dmat4 f = cvFromEye(camera), cv = f * camera.eyeFromWorld;
+            const glm::dmat3 r = rotationOf(cv);
+            const glm::dvec3 t(cv[3]), eye = -glm::transpose(r) * t;
+            const glm::dmat3 rt = glm::transpose(r);
+            return std::vector<ViewVariant>{
+                {"translation kept", "consistent if the pose's rotation is transposed (R used as Rᵀ) and t kept: a "
+                                     "row- vs column-major rotation", f * viewOf(rt, t)},
+                {"eye kept", "consistent if the pose's rotation is transposed (R used as Rᵀ) with the eye where it "
+                             "is: a camera-to-world rotation used as world-to-camera", f * viewOf(rt, -rt * eye)}};
+        }));
+    all.push_back(otherViews(
+        "quaternion-order", "a pose's quaternion read in the other component order (x y z w as w x y z, or the reverse)",
+        [](const Camera& camera) {
+            const glm::dmat4 f = cvFromEye(camera), cv = f * camera.eyeFromWorld;
+            const glm::dmat3 r = rotationOf(cv);
+            const glm::dvec3 t(cv[3]), eye = -glm::transpose(r) * t;
+            std::vector<ViewVariant> out;
+            for (const bool worldToCamera : {true, false})
+                for (const bool xyzwAsWxyz : {true, false}) {
+                    const glm::dmat3 stored = worldToCamera ? r : glm::transpose(r);
+                    const glm::dvec4 q = quaternionFromRotation(stored);  // w x y z in q[0..3]
+                    // Stored x y z w and read as w x y z (w' = x, x' = y, y' = z, z' = w), or stored
+                    // w x y z and read as x y z w (w' = z, x' = w, y' = x, z' = y): each undoes the
+                    // other, so a camera file misread either way is covered too.
+                    const glm::dmat3 used = xyzwAsWxyz ? rotationFromQuaternion(q[1], q[2], q[3], q[0], "quaternion")
+                                                       : rotationFromQuaternion(q[3], q[0], q[1], q[2], "quaternion");
+                    const glm::dmat3 rUsed = worldToCamera ? used : glm::transpose(used);
+                    const std::string order = xyzwAsWxyz ? "x y z w read as w x y z" : "w x y z read as x y z w";
+                    const std::string pose = worldToCamera ? "world-to-camera" : "camera-to-world";
+                    out.push_back({pose + ", " + order,
+                                   "consistent if the " + pose + (worldToCamera ? " (COLMAP-style)" : " (TUM-style)") +
+                                       " quaternion was read in the other order (" + order + ")",
+                                   f * (worldToCamera ? viewOf(rUsed, t) : viewOf(rUsed, -rUsed * eye))});
+                }
+            return out;
+        }));
+    all.push_back(otherViews(
+        "pose-units", "the pose's translation in other units than the scene (millimetres or centimetres for metres)",
+        [](const Camera& camera) {
+            const glm::dmat4 f = cvFromEye(camera), cv = f * camera.eyeFromWorld;
+            const glm::dmat3 r = rotationOf(cv);
+            const glm::dvec3 t(cv[3]), eye = -glm::transpose(r) * t;
+            std::vector<ViewVariant> out;
+            for (const double k : {1000.0, 0.001, 100.0, 0.01}) {
+                out.push_back({"t " + factorText(k), "consistent if the world-to-camera translation t is " + factorText(k) +
+                                                         " (another unit than the scene's)", f * viewOf(r, k * t)});
+                out.push_back({"eye " + factorText(k), "consistent if the eye position (a camera-to-world translation) is " +
+                                                           factorText(k) + " (another unit than the scene's)",
+                               f * viewOf(r, -r * (k * eye))});
+            }
+            return out;
+        }));
+    all.push_back(otherViews(
+        "mesh-up-axis", "the mesh turned between Y-up and Z-up (Blender's OBJ import turns it −90° about x)",
+        [](const Camera& camera) {
+            std::vector<ViewVariant> out;
+            for (const double degrees : {-90.0, 90.0}) {
+                // The renderer drew the mesh turned by T: eye = V·T·p, the truth through V·T.
+                const glm::dmat4 turned = glm::rotate(glm::dmat4(1.0), glm::radians(degrees), glm::dvec3(1, 0, 0));
+                const std::string by = (degrees < 0 ? "−" : "+") + formatNumber(std::abs(degrees)) + "° about x";
+                out.push_back({by, "consistent if the renderer's mesh was turned " + by +
+                                       (degrees < 0 ? " (Y-up read as Z-up, as Blender's OBJ import does)" : " (Z-up read as Y-up)"),
+                               camera.eyeFromWorld * turned});
+            }
+            return out;
+        }));
+
+    // The mesh in other units: the renderer drew k·p through the view [R | t]. Its eye points are
+    // k × those of p through [R | t/k], seen along the same rays by a perspective camera, and
+    // clipped by near and far where p's are by near/k and far/k: the truth through that camera,
+    // and the map's eye-z and distance / k (window depth, a function of z/near and z/far, stays).
+    Mistake meshUnits{"mesh-units", "the mesh in other units than the camera (millimetres or centimetres for metres)",
+                      Route::Raster, {}, {}};
+    meshUnits.reread = [](const Camera& camera, const DepthMap& map) {
+        Rereadings out;
+        if (!camera.spec().projection.isPerspective() || isRawMatrix(camera)) return out;
+        // An eye at the world's origin sees a scaled mesh as the same picture with scaled depths:
+        // the depth-scale fit's finding, which says more (any scale, and an offset).
+        if (glm::length(glm::dvec3(camera.worldFromEye[3])) < 1e-3 * camera.nearDistance()) return out;
+        for (const double k : {1000.0, 0.001, 100.0, 0.01}) {
+            CameraSpec spec = camera.spec();
+            spec.view.hasMatrix = true;
+            spec.view.eyeFromWorld = camera.eyeFromWorld;
+            spec.view.eyeFromWorld[3] = glm::dvec4(glm::dvec3(camera.eyeFromWorld[3]) / k, 1.0);
+            Projection& p = spec.projection;
+            p.near /= k, p.far /= k;  // an infinite far stays infinite
+            if (p.type == ProjectionType::Frustum) p.left /= k, p.right /= k, p.bottom /= k, p.top /= k;
+            DepthMap read = map;
+            if (map.quantity == DepthQuantity::EyeZ || map.quantity == DepthQuantity::Distance) {
+                for (double& v : read.value) v /= k;
+                read.valueQuantum /= k;
+                for (float& step : read.valueStep) step = float(step / k);
+                read.accuracy.quantum /= k, read.accuracy.absolute /= k;  // declared in the map's units
+            }
+            out.push_back({factorText(k), "consistent if the renderer's mesh was " + factorText(k) +
+                                              " (in other units than the camera's pose)",
+                           spec, {}, read});
+        }
+        return out;
+    };
+    all.push_back(meshUnits);
+    // The principal point's coordinates exchanged (cx for cy).
+    Mistake swappedPrincipal{"cx-cy-swapped", "the principal point's coordinates exchanged (cx used for cy and cy for cx)",
+                             Route::Raster, {}, {}};
+    swappedPrincipal.reread = [](const Camera& camera, const DepthMap&) {
+        Rereadings out;
+        // Where the optical axis meets the image (x right, y down from the top-left corner).
+        const glm::dvec3 axis = windowFromEye(camera, glm::dvec3(0, 0, camera.convention().eyeForwardZ));
+        const glm::dvec2 principal{axis.x, camera.imageYFromWindowY(axis.y)};
+        const glm::dvec2 swapped{principal.y, principal.x};
+        if (!(glm::length(swapped - principal) > 0.25)) return out;
+        Departure moved;
+        moved.principalShift = swapped - principal;
+        out.push_back({"", "consistent if the principal point's coordinates are exchanged: (" + formatNumber(swapped.x) +
+                               ", " + formatNumber(swapped.y) + ") px instead of (" + formatNumber(principal.x) + ", " +
+                               formatNumber(principal.y) + ")",
+                       departedCameraSpec(camera, moved), {}, {}});
+        return out;
+    };
+    all.push_back(swappedPrincipal);
 
     // The projection matrix.
     all.push_back(wrongProjection(

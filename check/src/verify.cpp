@@ -361,6 +361,29 @@ Probe probeAgreement(const Scene& scene, const RayRenderer& rays, const Camera& 
     return {seen == 0 ? 0.0 : double(agree) / double(seen), double(seen) / (kGrid * kGrid)};
 }
 
+void countOutOfRange(const Camera& camera, const DepthMap& map, ComparisonReport& report)
+{
+    const int W = camera.width();
+    for (std::size_t i = 0; i < map.value.size(); ++i)
+        if (kindOfDepthValue(camera, map.quantity, map.value[i]) == DepthValueKind::OutOfRange && report.outOfRange++ == 0) {
+            report.outOfRangeCol = int(i % W), report.outOfRangeRow = int(i / W);
+            report.outOfRangeValue = map.storedOf(map.value[i]);
+        }
+}
+
+void requireDepthsInRange(const Camera& camera, const DepthMap& map, const std::string& name)
+{
+    ComparisonReport count;
+    countOutOfRange(camera, map, count);
+    if (count.outOfRange == 0) return;
+    for (const double v : map.value)
+        if (kindOfDepthValue(camera, map.quantity, v) == DepthValueKind::Depth) return;
+    throw Error(name + ": it holds no " + toString(map.quantity) + " depth — " + std::to_string(count.outOfRange) +
+                " values lie outside " + depthValueRange(camera, map.quantity) +
+                " (e.g. " + formatNumber(count.outOfRangeValue) + " at pixel (" + std::to_string(count.outOfRangeCol) +
+                ", " + std::to_string(count.outOfRangeRow) + ")), the rest are misses: is the quantity right?");
+}
+
 VerifyResult verifyAgainst(const Scene& scene, const Camera& camera, const DepthMap& map, RenderResult truth,
                            const VertexNeighbours& neighbours)
 {
@@ -377,14 +400,66 @@ VerifyResult verifyAgainst(const Scene& scene, const Camera& camera, const Depth
     run.report.timings.traceMs = run.truth.renderMilliseconds;
     run.report.describeInputs(scene, camera, mapTolerance());
     run.report.declared = map.accuracy;
+    run.report.secondRoute = "map";
+    run.report.outOfRangeRule = toString(map.quantity) + " map holds values in " + depthValueRange(camera, map.quantity);
+    countOutOfRange(camera, map, run.comparison.report);
     run.report.comparison = run.comparison.report;
     return run;
+}
+
+namespace {
+
+// The value at rank ⌈q·n⌉ − 1 of `values` (reordered), 0 for none.
+double quantileOf(std::vector<double>& values, double q)
+{
+    if (values.empty()) return 0;
+    const std::size_t rank = std::size_t(std::max(0.0, std::ceil(q * double(values.size())) - 1));
+    std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(rank), values.end());
+    return values[rank];
+}
+
+}  // namespace
+
+void measureMapErrors(const Camera& camera, const DepthMap& map, VerifyResult& run)
+{
+    const int W = camera.width(), H = camera.height();
+    MapErrors& e = run.report.mapErrors;
+    e = MapErrors{};
+    const bool linear = map.quantity == DepthQuantity::EyeZ || map.quantity == DepthQuantity::Distance;
+    e.quantity = linear ? toString(map.quantity) : "eye-z";
+    e.eyeZEquivalent = !linear;
+    run.mapError.assign(std::size_t(W) * H, NAN);
+    std::vector<double> absolute, relative;
+    for (int row = 0; row < H; ++row)
+        for (int col = 0; col < W; ++col) {
+            const std::size_t i = std::size_t(row) * W + col;
+            const PixelClass c = run.comparison.pixelClass[i];
+            if (c != PixelClass::Agree && c != PixelClass::DepthError) continue;
+            const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
+            const double trueEyeZ = eyeZFromWindowDepth(camera, pWindow, run.truth.windowDepth.value[i]);
+            const double truth = linear ? depthValueFromEyeZ(camera, pWindow, trueEyeZ, map.quantity) : trueEyeZ;
+            const double mine = linear ? map.value[i] : eyeZFromWindowDepth(camera, pWindow, run.map.windowDepth.value[i]);
+            const double error = mine - truth;
+            if (!std::isfinite(error)) continue;
+            run.mapError[i] = float(error);
+            absolute.push_back(std::abs(error));
+            relative.push_back(truth != 0 ? std::abs(error / truth) : 0.0);
+            if (std::abs(error) > e.maxAbs || e.worstCol < 0) {
+                e.maxAbs = std::abs(error);
+                e.worstCol = col, e.worstRow = row, e.worstMap = mine, e.worstTrue = truth;
+            }
+        }
+    e.compared = std::int64_t(absolute.size());
+    e.p99Abs = quantileOf(absolute, 0.99), e.medianAbs = quantileOf(absolute, 0.5);
+    e.p99Rel = quantileOf(relative, 0.99), e.medianRel = quantileOf(relative, 0.5);
+    e.maxRel = relative.empty() ? 0 : *std::max_element(relative.begin(), relative.end());
 }
 
 VerifyResult Checker::verify(const Camera& camera, const DepthMap& map) const
 {
     VerifyResult run = verifyAgainst(scene_, camera, map, renderRay(camera), neighbours());
     run.report.timings.bvhBuildMs = bvhBuildMilliseconds();
+    measureMapErrors(camera, map, run);
     return run;
 }
 
@@ -762,8 +837,7 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
     const bool anySurface = !explained && [&] {
         for (int row = 0; row < map.height; ++row)
             for (int col = 0; col < map.width; ++col)
-                if (eyePointFromDepth(camera, windowFromPixelCentre(camera, col, row), map.value[std::size_t(row) * map.width + col],
-                                      map.quantity))
+                if (kindOfDepthValue(camera, map.quantity, map.value[std::size_t(row) * map.width + col]) != DepthValueKind::Miss)
                     return true;
         return false;
     }();

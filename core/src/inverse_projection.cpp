@@ -2,7 +2,9 @@
 
 #include "zcheck/error.h"
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace zcheck {
 
@@ -122,20 +124,49 @@ double eyeZFromDistance(const Camera& camera, const glm::dvec2& pWindow, double 
     return camera.eyeZOf(ray.origin + distance * ray.direction);
 }
 
+namespace {
+// The closed interval of window or NDC depths; eye-z and distance: [0, inf].
+std::pair<double, double> depthValueBounds(const Camera& camera, DepthQuantity quantity)
+{
+    switch (quantity) {
+    case DepthQuantity::Window: return {camera.depth().rangeMin, camera.depth().rangeMax};
+    case DepthQuantity::Ndc: return {camera.convention().ndcZMin(), 1.0};
+    case DepthQuantity::EyeZ:
+    case DepthQuantity::Distance: break;
+    }
+    return {0.0, INFINITY};
+}
+}  // namespace
+
+DepthValueKind kindOfDepthValue(const Camera& camera, DepthQuantity quantity, double value)
+{
+    if (!std::isfinite(value)) return DepthValueKind::Miss;
+    const bool linear = quantity == DepthQuantity::EyeZ || quantity == DepthQuantity::Distance;
+    if (linear) return value > 0 ? DepthValueKind::Depth : value == 0 ? DepthValueKind::Miss : DepthValueKind::OutOfRange;
+    const auto [lo, hi] = depthValueBounds(camera, quantity);
+    const double slack = 0x1p-23 * std::max({1.0, std::abs(lo), std::abs(hi)});  // one binary32 step
+    if (!(value >= lo - slack && value <= hi + slack)) return DepthValueKind::OutOfRange;
+    const double window = quantity == DepthQuantity::Ndc ? camera.windowDepthFromNdcZ(value) : value;
+    return window == camera.clearDepth() || window == camera.windowDepthFar() ? DepthValueKind::Miss : DepthValueKind::Depth;
+}
+
+std::string depthValueRange(const Camera& camera, DepthQuantity quantity)
+{
+    if (quantity == DepthQuantity::EyeZ || quantity == DepthQuantity::Distance) return "> 0 (0 means no depth)";
+    const auto [lo, hi] = depthValueBounds(camera, quantity);
+    return "[" + formatNumber(lo) + ", " + formatNumber(hi) + "], the camera's " +
+           (quantity == DepthQuantity::Window ? "depth range" : "NDC depth range");
+}
+
 std::optional<glm::dvec3> eyePointFromDepth(const Camera& camera, const glm::dvec2& pWindow, double value,
                                             DepthQuantity quantity)
 {
-    if (!std::isfinite(value)) return std::nullopt;
+    if (kindOfDepthValue(camera, quantity, value) != DepthValueKind::Depth) return std::nullopt;
     switch (quantity) {
     case DepthQuantity::Ndc: value = camera.windowDepthFromNdcZ(value); [[fallthrough]];
-    case DepthQuantity::Window:
-        if (value == camera.clearDepth() || value == camera.windowDepthFar()) return std::nullopt;
-        return eyeFromWindow(camera, {pWindow, value});
-    case DepthQuantity::EyeZ:
-        if (!(value > 0)) return std::nullopt;
-        return eyePointAtEyeZ(camera, pWindow, value);
+    case DepthQuantity::Window: return eyeFromWindow(camera, {pWindow, value});
+    case DepthQuantity::EyeZ: return eyePointAtEyeZ(camera, pWindow, value);
     case DepthQuantity::Distance: {
-        if (!(value > 0)) return std::nullopt;
         const EyePlaneRay ray = eyePlaneRayFrom(eyeRayThroughWindow(camera, pWindow));
         return ray.origin + value * ray.direction;
     }
@@ -158,12 +189,8 @@ void requireDepthValue(const Camera& camera, DepthQuantity quantity, double valu
         if (!(value > 0)) throw Error(given + " must be > 0: the point must lie in front of the eye");
         return;
     }
-    const bool window = quantity == DepthQuantity::Window;
-    const double lo = window ? camera.depth().rangeMin : camera.convention().ndcZMin();
-    const double hi = window ? camera.depth().rangeMax : 1.0;
-    if (!(value >= lo && value <= hi))
-        throw Error(given + " must lie in [" + formatNumber(lo) + ", " + formatNumber(hi) + "], the camera's " +
-                    (window ? "depth range" : "NDC depth range"));
+    const auto [lo, hi] = depthValueBounds(camera, quantity);
+    if (!(value >= lo && value <= hi)) throw Error(given + " must lie in " + depthValueRange(camera, quantity));
 }
 
 UnprojectedMap unprojectMap(const Camera& camera, const std::vector<double>& values, DepthQuantity quantity,
@@ -177,16 +204,52 @@ UnprojectedMap unprojectMap(const Camera& camera, const std::vector<double>& val
     UnprojectedMap out;
     for (int row = 0; row < H; row += stride)
         for (int col = 0; col < W; col += stride) {
-            const auto pEye = eyePointFromDepth(camera, windowFromPixelCentre(camera, col, row),
-                                                values[std::size_t(row) * W + col], quantity);
+            const double value = values[std::size_t(row) * W + col];
+            const auto pEye = eyePointFromDepth(camera, windowFromPixelCentre(camera, col, row), value, quantity);
             if (!pEye) {
-                ++out.misses;
+                if (kindOfDepthValue(camera, quantity, value) == DepthValueKind::OutOfRange) {
+                    if (out.outOfRange++ == 0) out.firstOutOfRange = {col, row};
+                } else {
+                    ++out.misses;
+                }
                 continue;
             }
             out.points.push_back(space == PointSpace::Eye ? *pEye : glm::dvec3(camera.worldFromEye * glm::dvec4(*pEye, 1.0)));
             out.pixels.emplace_back(col, row);
         }
     return out;
+}
+
+std::string howCamerasDiffer(const Camera& a, const Camera& b, bool depthMapping)
+{
+    if (a.width() != b.width() || a.height() != b.height())
+        return "image sizes " + std::to_string(a.width()) + "x" + std::to_string(a.height()) + " and " +
+               std::to_string(b.width()) + "x" + std::to_string(b.height());
+    // Points `a` sees at nine pixels, at two depths inside its clip range, as `b` sees them.
+    const double nearZ = a.nearDistance(), farZ = std::isinf(a.farDistance()) ? nearZ * 100 : a.farDistance();
+    for (const double t : {0.25, 0.75})
+        for (const double u : {0.0, 0.5, 1.0})
+            for (const double v : {0.0, 0.5, 1.0}) {
+                const glm::dvec2 pImage{u * a.width(), v * a.height()};  // x right, y down from the top-left
+                const glm::dvec2 pWindow{pImage.x, a.windowYFromImageY(pImage.y)};
+                const double eyeZ = nearZ + t * (farZ - nearZ);
+                const glm::dvec3 pEyeA = eyePointAtEyeZ(a, pWindow, eyeZ);
+                const glm::dvec3 pWorld = glm::dvec3(a.worldFromEye * glm::dvec4(pEyeA, 1.0));
+                const glm::dvec3 pEyeB = glm::dvec3(b.eyeFromWorld * glm::dvec4(pWorld, 1.0));
+                const glm::dvec3 inB = windowFromEye(b, pEyeB);
+                const glm::dvec2 imageB{inB.x, b.imageYFromWindowY(inB.y)};
+                const double eyeZB = b.eyeZOf(pEyeB);
+                if (!(std::abs(imageB.x - pImage.x) <= 1e-3 && std::abs(imageB.y - pImage.y) <= 1e-3 && eyeZB > 0))
+                    return "the pose or the projection: the point the first sees at image point (" + formatNumber(pImage.x) +
+                           ", " + formatNumber(pImage.y) + ") the second sees at (" + formatNumber(imageB.x) + ", " +
+                           formatNumber(imageB.y) + ")";
+                if (!(std::abs(eyeZB - eyeZ) <= 1e-6 * eyeZ))
+                    return "the eye-z of a point: " + formatNumber(eyeZ) + " and " + formatNumber(eyeZB);
+                if (depthMapping && !(std::abs(inB.z - windowDepthFromEyeZ(a, pWindow, eyeZ)) <= 1e-7))
+                    return "the depth mapping (near, far, depth range or reversed-Z): window depth " +
+                           formatNumber(windowDepthFromEyeZ(a, pWindow, eyeZ)) + " and " + formatNumber(inB.z);
+            }
+    return "";
 }
 
 }  // namespace zcheck

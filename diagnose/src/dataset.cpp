@@ -112,7 +112,7 @@ FrameResult DatasetRunner::verify(std::size_t index, VerifiedMap* keep) const
         const Camera camera(made.spec);
         result.map.channel = made.map.channel;
         const DepthMap map = DepthMap::of(std::move(made.map), plan.quantity, plan.reading);
-        VerifiedMap verified = verifyMap(checker, camera, map, options_.diagnose);
+        VerifiedMap verified = verifyMap(checker, camera, map, options_.diagnose, "depth map '" + frame.depth + "'");
         result.verified = true;
         result.report = verified.run.report;
         result.diagnosed = verified.diagnosed;

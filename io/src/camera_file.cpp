@@ -331,7 +331,15 @@ json parseJsonStrictly(const std::string& text, const std::string& source)
 CameraSpec readCameraFile(const std::string& path)
 {
     const std::string text = readInputFile(path, kCameraInput);
-    return cameraSpecFromJson(parseJsonStrictly(text, "camera file '" + path + "'"), "camera file '" + path + "'");
+    const json document = parseJsonStrictly(text, "camera file '" + path + "'");
+    if (isExportSidecar(document)) return cameraSpecFromJson(document["camera"], "sidecar '" + path + "' camera");
+    return cameraSpecFromJson(document, "camera file '" + path + "'");
+}
+
+bool isExportSidecar(const json& document)
+{
+    return document.is_object() && document.contains("zcheck_version") && document.contains("camera") &&
+           document["camera"].is_object();
 }
 
 namespace {

@@ -11,6 +11,9 @@
 namespace zcheck {
 
 CameraSpec cameraSpecFromJson(const nlohmann::json& document, const std::string& source);
+// A sidecar zcheck's export wrote: an object with "zcheck_version" and a "camera" object (a
+// camera file's), which readCameraFile reads as the camera.
+bool isExportSidecar(const nlohmann::json& document);
 // JSON text parsed strictly: a syntax error or a key repeated within one object throws Error
 // beginning with `source` (e.g. "camera file 'c.json'").
 nlohmann::json parseJsonStrictly(const std::string& text, const std::string& source);

@@ -5,6 +5,7 @@
 #include "zcheck/camera_file.h"
 #include "zcheck/error.h"
 #include "zcheck/input_file.h"
+#include "zcheck/inverse_projection.h"
 
 #include <filesystem>
 #include <map>
@@ -112,11 +113,12 @@ private:
     void readLine(const std::string& line, std::size_t number, DatasetFrame& frame)
     {
         const std::string where = "manifest '" + path_ + "' line " + std::to_string(number);
+        sidecarCamera_.reset();
         const nlohmann::json object = parseJsonStrictly(line, where);
         if (!object.is_object()) throw Error(where + ": a frame is a JSON object");
         static const std::set<std::string> known = {"frame", "camera", "depth", "quantity", "scale", "offset",
                                                     "miss", "channel", "scene", "near", "far", "quantum",
-                                                    "rel_tolerance", "abs_tolerance", "allow_holes"};
+                                                    "rel_tolerance", "abs_tolerance", "allow_holes", "sidecar"};
         for (const auto& item : object.items())
             if (!known.count(item.key())) throw Error(where + ": unknown key '" + printableExcerpt(item.key(), 40) + "'");
         auto text = [&](const char* key) -> std::optional<std::string> {
@@ -151,7 +153,10 @@ private:
             else if (miss.is_string()) frame.miss = miss.get<std::string>();
             else throw Error(where + ": 'miss' must be a number or a rule such as \">=1e9\"");
         }
-        if (!object.contains("camera") || object["camera"].is_null()) throw Error(where + ": 'camera' is missing");
+        if (const auto sidecar = text("sidecar")) takeFromSidecar(importers::pathBeside(path_, *sidecar), object, where, frame);
+        if (frame.camera && (!object.contains("camera") || object["camera"].is_null())) return;
+        if (!object.contains("camera") || object["camera"].is_null())
+            throw Error(where + ": 'camera' is missing (nor does a 'sidecar' of zcheck's export name one)");
         const nlohmann::json& camera = object["camera"];
         if (camera.is_object()) {
             ImportedCamera inline_;
@@ -167,6 +172,43 @@ private:
             frame.impliedScaleNote = set.depthScaleNote;
         } else {
             throw Error(where + ": 'camera' must be a camera reference \"FILE#FRAME\" or a zcheck camera object");
+        }
+        if (sidecarCamera_ && frame.camera->hasImageSize) {
+            const std::string difference = howCamerasDiffer(Camera(frame.camera->spec), Camera(*sidecarCamera_), false);
+            if (!difference.empty())
+                throw Error(where + ": its 'camera' and the camera in its 'sidecar' (the one that rendered the map) differ in " +
+                            difference + ": give the map's own camera, or leave 'camera' out");
+        }
+    }
+
+    // A line's "sidecar": what zcheck's export (or another producer) wrote beside the map. Its reading
+    // keys and quantity apply where the line is silent; its camera is the frame's when the line has
+    // none, and is compared with the line's otherwise.
+    void takeFromSidecar(const std::string& sidecar, const nlohmann::json& object, const std::string& where,
+                         DatasetFrame& frame)
+    {
+        sidecarCamera_.reset();
+        try {
+            const DepthMapReading reading = withSidecar(DepthMapReading{}, sidecar);
+            if (!frame.channel && !reading.channel.empty()) frame.channel = reading.channel;
+            if (!frame.scale && reading.scale > 0) frame.scale = reading.scale;
+            if (!frame.offset && reading.offset != 0) frame.offset = reading.offset;
+            if (!frame.miss && reading.miss.given()) frame.miss = reading.miss.text();
+            frame.accuracy = frame.accuracy.over(reading.accuracy);
+            const SidecarSubject subject = sidecarSubject(sidecar);
+            if (!frame.quantity) frame.quantity = subject.quantityOf(sidecar, frame.channel.value_or(""));
+            if (subject.hasCamera) {
+                sidecarCamera_ = readCameraFile(sidecar);
+                if (!object.contains("camera") || object["camera"].is_null()) {
+                    ImportedCamera camera;
+                    camera.name = frame.name;
+                    camera.spec = *sidecarCamera_;
+                    camera.hasClipPlanes = true;
+                    frame.camera = camera;
+                }
+            }
+        } catch (const Error& e) {
+            throw Error(where + ": " + e.what());
         }
     }
 
@@ -192,6 +234,7 @@ private:
         std::string error;
     };
     std::string path_;
+    std::optional<CameraSpec> sidecarCamera_;  // the current line's sidecar's camera
     CameraSetReader readCameras_;
     std::map<std::string, Entry> sets_;
 };

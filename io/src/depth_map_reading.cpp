@@ -208,4 +208,35 @@ DepthMapReading withSidecar(DepthMapReading r, const std::string& sidecar)
     return r;
 }
 
+SidecarSubject sidecarSubject(const std::string& sidecar)
+{
+    const nlohmann::json doc = parseJsonStrictly(readInputFile(sidecar, kSidecarInput), sidecar);
+    SidecarSubject out;
+    if (!doc.is_object()) return out;
+    out.hasCamera = isExportSidecar(doc);
+    if (!doc.contains("channels") || !doc["channels"].is_array()) return out;
+    for (const nlohmann::json& channel : doc["channels"]) {
+        if (!channel.is_object() || !channel.contains("name") || !channel.contains("quantity")) continue;
+        if (!channel["name"].is_string() || !channel["quantity"].is_string()) continue;
+        const std::string quantity = channel["quantity"].get<std::string>();
+        if (quantity == "window" || quantity == "ndc" || quantity == "eye-z" || quantity == "distance")
+            out.channelQuantities.emplace_back(channel["name"].get<std::string>(), quantity);
+    }
+    return out;
+}
+
+std::optional<std::string> SidecarSubject::quantityOf(const std::string& sidecar, const std::string& channel) const
+{
+    if (channelQuantities.empty()) return std::nullopt;
+    std::string listed;
+    for (const auto& [name, quantity] : channelQuantities) {
+        if (!channel.empty() && name == channel) return quantity;
+        listed += (listed.empty() ? "" : ", ") + name + " (" + quantity + ")";
+    }
+    if (channel.empty() && channelQuantities.size() == 1) return channelQuantities.front().second;
+    if (!channel.empty()) return std::nullopt;
+    throw Error("sidecar '" + sidecar + "' lists several depth channels — " + listed +
+                ": give --channel or --quantity");
+}
+
 }  // namespace zcheck

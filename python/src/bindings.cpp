@@ -66,6 +66,15 @@ std::optional<double> numberArgument(const py::object& value, const char* name)
     fail(std::string(name) + " must be a number, got " + typeName(value));
 }
 
+std::optional<int> sizeArgument(const py::object& value, const char* name)
+{
+    const std::optional<double> v = numberArgument(value, name);
+    if (!v) return std::nullopt;
+    if (!(*v == std::floor(*v)) || !(std::abs(*v) <= 1e9))
+        fail(std::string(name) + " must be a whole number of pixels, got " + formatNumber(*v));
+    return int(*v);
+}
+
 DepthMapReading readingOf(const ReadingArguments& a)
 {
     DepthMapReading reading;

@@ -33,6 +33,9 @@ std::unique_ptr<tbb::global_control> threadLimit(std::optional<int> threads);
 // A keyword argument that must be None or a real number (a Python int or float, a NumPy scalar):
 // anything else — a bool, a string, a list — is a zcheck.Error naming `name`.
 std::optional<double> numberArgument(const py::object& value, const char* name);
+// A keyword argument that must be None or a whole number of pixels: an int, or a float that is
+// integral (instant-ngp writes "w": 640.0); 640.5, a bool or a string is a zcheck.Error naming `name`.
+std::optional<int> sizeArgument(const py::object& value, const char* name);
 
 // The keyword arguments a map is read with, as a reading (depth_map_reading.h), checked as the
 // command line checks --miss, --scale, --offset, --quantum, --rel-tolerance, --abs-tolerance and

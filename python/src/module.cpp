@@ -36,6 +36,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace py = pybind11;
@@ -258,22 +259,25 @@ Convention conventionNamed(const std::string& name, const std::string& where)
     }
 }
 
-void requireImageSize(const std::optional<int>& width, const std::optional<int>& height, const std::string& where)
+// width= and height=, both required: whole numbers of pixels (640 or 640.0).
+std::pair<int, int> requireImageSize(const py::object& width, const py::object& height, const std::string& where)
 {
-    if (!width || !height) fail(where + ": width and height (the image size in pixels) are required");
+    const std::optional<int> w = sizeArgument(width, (where + ": width").c_str());
+    const std::optional<int> h = sizeArgument(height, (where + ": height").c_str());
+    if (!w || !h) fail(where + ": width and height (the image size in pixels) are required");
+    return {*w, *h};
 }
 
-Camera cameraFromOpencv(py::object K, py::object R, py::object t, std::optional<int> width, std::optional<int> height,
+Camera cameraFromOpencv(py::object K, py::object R, py::object t, py::object width, py::object height,
                         py::object camFromWorld, py::object worldFromCam, double near, double far, double pixelCenter,
                         const std::string& convention, const std::string& depthFormat, bool reversed,
                         std::pair<double, double> depthRange)
 {
     const std::string where = "Camera.from_opencv";
     const std::string at = where + ": ";
-    requireImageSize(width, height, where);
     CameraSpec spec;
+    std::tie(spec.width, spec.height) = requireImageSize(width, height, where);
     spec.convention = conventionNamed(convention, where);
-    spec.width = *width, spec.height = *height;
     spec.depth = depthSettings(depthFormat, reversed, depthRange, where);
 
     // Intrinsics: [[fx, 0, cx], [0, fy, cy], [0, 0, 1]], by the pose rule's reading (pose.h).
@@ -329,14 +333,14 @@ Camera cameraFromOpencv(py::object K, py::object R, py::object t, std::optional<
     return makeCamera(spec, where);
 }
 
-Camera cameraFromMatrices(py::object clipFromEye, py::object eyeFromWorld, std::optional<int> width,
-                          std::optional<int> height, py::object worldFromEye, const std::string& convention,
+Camera cameraFromMatrices(py::object clipFromEye, py::object eyeFromWorld, py::object width, py::object height,
+                          py::object worldFromEye, const std::string& convention,
                           const std::string& vectors, const std::string& depthFormat, bool reversed,
                           std::pair<double, double> depthRange)
 {
     const std::string where = "Camera.from_matrices";
     const std::string at = where + ": ";
-    requireImageSize(width, height, where);
+    const auto [imageWidth, imageHeight] = requireImageSize(width, height, where);
     if (vectors != "column" && vectors != "row")
         fail(at + "vectors must be \"column\" (p' = M·p) or \"row\" (p' = p·M, Direct3D style), got '" + vectors + "'");
     auto read = [&](py::handle object, const std::string& name) {
@@ -345,7 +349,7 @@ Camera cameraFromMatrices(py::object clipFromEye, py::object eyeFromWorld, std::
     };
     CameraSpec spec;
     spec.convention = conventionNamed(convention, where);
-    spec.width = *width, spec.height = *height;
+    spec.width = imageWidth, spec.height = imageHeight;
     spec.depth = depthSettings(depthFormat, reversed, depthRange, where);
     spec.projection.type = ProjectionType::Matrix;
     spec.projection.clipFromEye = read(clipFromEye, "clip_from_eye");
@@ -358,15 +362,15 @@ Camera cameraFromMatrices(py::object clipFromEye, py::object eyeFromWorld, std::
     return makeCamera(spec, where);
 }
 
-Camera cameraReplaced(const Camera& camera, const std::optional<std::string>& convention, std::optional<int> width,
-                      std::optional<int> height, const std::optional<std::string>& depthFormat,
+Camera cameraReplaced(const Camera& camera, const std::optional<std::string>& convention, const py::object& width,
+                      const py::object& height, const std::optional<std::string>& depthFormat,
                       std::optional<bool> reversed, std::optional<std::pair<double, double>> depthRange)
 {
     const std::string where = "Camera.replace";
     CameraSpec spec = camera.spec();
     if (convention) spec.convention = conventionNamed(*convention, where);
-    if (width) spec.width = *width;
-    if (height) spec.height = *height;
+    if (const auto w = sizeArgument(width, "Camera.replace: width")) spec.width = *w;
+    if (const auto h = sizeArgument(height, "Camera.replace: height")) spec.height = *h;
     if (depthFormat) spec.depth.format = depthSettings(*depthFormat, false, {0, 1}, where).format;
     if (reversed) spec.depth.reversed = *reversed;
     if (depthRange) spec.depth.rangeMin = depthRange->first, spec.depth.rangeMax = depthRange->second;
@@ -646,10 +650,12 @@ parameter.)doc")
         .def_static(
             "from_file",
             [](const std::string& reference, std::optional<std::string> format, const Scene* scene,
-               std::optional<double> near, std::optional<double> far, std::optional<int> width, std::optional<int> height) {
+               std::optional<double> near, std::optional<double> far, const py::object& width, const py::object& height) {
                 const ImportedCamera imported =
                     importCamera(reference, format ? std::optional<CameraFormat>(cameraFormatFromName(*format)) : std::nullopt);
-                return makeCamera(completeCamera(imported, scene, {near, far, width, height, std::nullopt}), "Camera.from_file");
+                return makeCamera(completeCamera(imported, scene, {near, far, sizeArgument(width, "Camera.from_file: width"),
+                                                                  sizeArgument(height, "Camera.from_file: height"), std::nullopt}),
+                                  "Camera.from_file");
             },
             py::arg("path"), py::kw_only(), py::arg("format") = py::none(), py::arg("scene") = py::none(),
             py::arg("near") = py::none(), py::arg("far") = py::none(), py::arg("width") = py::none(),
@@ -785,6 +791,11 @@ verdict, and per-pixel images. to_dict() is the document `zcheck check --json` (
         .def_property_readonly("ray_only", [](const PyReport& r) { return r.report.comparison.rayOnly; })
         .def_property_readonly("raster_only", [](const PyReport& r) { return r.report.comparison.rasterOnly; },
                                "Pixels only the raster route (or the verified map) covers.")
+        .def_property_readonly("map_only", [](const PyReport& r) { return r.report.comparison.rasterOnly; },
+                               "Pixels only the verified map covers (verify's name for raster_only).")
+        .def_property_readonly("out_of_range", [](const PyReport& r) { return r.report.comparison.outOfRange; },
+                               "Pixels of a verified map holding values its quantity cannot hold (window 2, a "
+                               "negative eye-z): errors.")
         .def_property_readonly("agree", [](const PyReport& r) { return r.report.comparison.agree; })
         .def_property_readonly("edge_surface", [](const PyReport& r) { return r.report.comparison.edgeSurface; })
         .def_property_readonly("depth_errors", [](const PyReport& r) { return r.report.comparison.depthErrors; })

@@ -5,6 +5,7 @@
 #include "zcheck/error.h"
 #include "zcheck/input_file.h"
 #include "zcheck/png_file.h"
+#include "zcheck/report.h"
 #include "zcheck/report_images.h"
 
 #include <algorithm>
@@ -29,14 +30,15 @@ std::string frameRecordJson(const FrameResult& r)
                    {"consistent", r.consistent()}, {"error", r.error.empty() ? json(nullptr) : json(r.error)},
                    {"seconds", r.seconds}, {"depth_map", reportjson::depthMapJson(r.map)}};
     if (r.verified) {
-        const ComparisonReport& c = r.report.comparison;
         const CameraSpec& camera = r.report.camera;
         record["camera"] = {{"convention", camera.convention.name}, {"type", toString(camera.projection.type)},
                             {"width", camera.width}, {"height", camera.height}, {"near", camera.projection.near},
                             {"far", std::isinf(camera.projection.far) ? json("inf") : json(camera.projection.far)}};
-        record["pixels"] = reportjson::pixelsJson(c);
-        record["depth_error"] = reportjson::depthErrorJson(c);
-        record["unexplained"] = reportjson::unexplainedJson(c, false);
+        record["pixels"] = reportjson::pixelsJson(r.report);
+        record["depth_error"] = reportjson::depthErrorJson(r.report);
+        record["map_errors"] = reportjson::mapErrorsJson(r.report);
+        record["out_of_range"] = reportjson::outOfRangeJson(r.report);
+        record["unexplained"] = reportjson::unexplainedJson(r.report, false);
         record["warnings"] = r.report.warnings;
     }
     if (r.diagnosed) {
@@ -44,7 +46,8 @@ std::string frameRecordJson(const FrameResult& r)
         for (const Hypothesis& h : r.diagnosis)
             if (explains(h)) list.push_back(reportjson::hypothesisJson(h));
         record["diagnosis"] = list;
-        if (list.empty() && !r.diagnosis.empty()) {
+        const ComparisonReport& c = r.report.comparison;
+        if (list.empty() && !r.diagnosis.empty() && comesClose(r.diagnosis.front(), c.bothHit + c.rayOnly + c.rasterOnly)) {
             const Hypothesis& best = r.diagnosis.front();
             record["closest"] = {{"hypothesis", best.name}, {"variant", best.variant}, {"unexplained", best.unexplained}};
         }
@@ -99,7 +102,9 @@ FrameRecord recordFrom(const json& j, const std::string& where)
     if (j.contains("pixels")) {
         const json& p = j["pixels"];
         r.depthErrors = std::int64_t(number(p, "depth_errors"));
-        r.compared = std::int64_t(number(p, "both_hit") + number(p, "ray_only") + number(p, "raster_only"));
+        // "raster_only": results written before verify called the map "map".
+        r.compared = std::int64_t(number(p, "both_hit") + number(p, "ray_only") + number(p, "map_only") +
+                                  number(p, "raster_only"));
     }
     if (j.contains("depth_error")) {
         const json& e = j["depth_error"];

@@ -16,19 +16,27 @@ namespace zcheck {
 
 namespace {
 
-nlohmann::json toJson(const PixelFinding& f)
+// A pixel class's name as a report says it: "raster-only" is "map-only" in verify's.
+std::string className(PixelClass c, const std::string& second)
+{
+    std::string name = toString(c);
+    if (const std::size_t at = name.find("raster"); at != std::string::npos) name.replace(at, 6, second);
+    return name;
+}
+
+nlohmann::json toJson(const PixelFinding& f, const std::string& second)
 {
     auto depthOrNull = [](double d) { return std::isfinite(d) ? nlohmann::json(d) : nlohmann::json(nullptr); };
     return {
         {"col", f.col},
         {"row", f.row},
-        {"class", toString(f.pixelClass)},
+        {"class", className(f.pixelClass, second)},
         {"ray_window_depth", depthOrNull(f.rayWindowDepth)},
-        {"raster_window_depth", depthOrNull(f.rasterWindowDepth)},
+        {second + "_window_depth", depthOrNull(f.rasterWindowDepth)},
         {"error_quanta", depthOrNull(f.errorQuanta)},
         {"tolerance_quanta", depthOrNull(f.toleranceQuanta)},
         {"ray_primitive", f.rayPrimitive == kNoPrimitive ? nlohmann::json(nullptr) : nlohmann::json(f.rayPrimitive)},
-        {"raster_primitive",
+        {second + "_primitive",
          f.rasterPrimitive == kNoPrimitive ? nlohmann::json(nullptr) : nlohmann::json(f.rasterPrimitive)},
     };
 }
@@ -44,13 +52,14 @@ std::string percent(std::int64_t part, std::int64_t whole)
 
 namespace reportjson {
 
-nlohmann::json pixelsJson(const ComparisonReport& c)
+nlohmann::json pixelsJson(const CheckReport& r)
 {
+    const ComparisonReport& c = r.comparison;
     return {{"total", std::int64_t(c.width) * c.height},
             {"both_hit", c.bothHit},
             {"both_miss", c.bothMiss},
             {"ray_only", c.rayOnly},
-            {"raster_only", c.rasterOnly},
+            {r.secondRoute + "_only", c.rasterOnly},
             {"agree", c.agree},
             {"edge_surface", c.edgeSurface},
             {"depth_errors", c.depthErrors},
@@ -58,11 +67,13 @@ nlohmann::json pixelsJson(const ComparisonReport& c)
             {"lost_at_clear_value", c.lostAtClearValue},
             {"at_clip_plane", c.atClipPlane},
             {"holes", c.holes},
-            {"coverage_unexplained", c.coverageUnexplained}};
+            {"coverage_unexplained", c.coverageUnexplained},
+            {"out_of_range", c.outOfRange}};
 }
 
-nlohmann::json depthErrorJson(const ComparisonReport& c)
+nlohmann::json depthErrorJson(const CheckReport& r)
 {
+    const ComparisonReport& c = r.comparison;
     return {{"max_quanta", c.maxErrorQuanta},
             {"p99_quanta", c.p99ErrorQuanta},
             {"max_over_tolerance", c.maxErrorOverTolerance},
@@ -71,11 +82,12 @@ nlohmann::json depthErrorJson(const ComparisonReport& c)
             {"bias_samples", c.biasSamples},
             {"mean_signed_error_quanta", c.meanSignedErrorQuanta},
             {"depth_bias", c.depthBias},
-            {"worst_pixel", toJson(c.worst)}};
+            {"worst_pixel", toJson(c.worst, r.secondRoute)}};
 }
 
-nlohmann::json unexplainedJson(const ComparisonReport& c, bool samples)
+nlohmann::json unexplainedJson(const CheckReport& r, bool samples)
 {
+    const ComparisonReport& c = r.comparison;
     nlohmann::json box = nullptr;
     if (c.unexplainedMaxCol >= 0)
         box = {{"min_col", c.unexplainedMinCol},
@@ -85,10 +97,35 @@ nlohmann::json unexplainedJson(const ComparisonReport& c, bool samples)
     nlohmann::json out = {{"count", c.unexplained()}, {"bounding_box", box}};
     if (samples) {
         nlohmann::json list = nlohmann::json::array();
-        for (const auto& f : c.unexplainedSamples) list.push_back(toJson(f));
+        for (const auto& f : c.unexplainedSamples) list.push_back(toJson(f, r.secondRoute));
         out["samples"] = list;
     }
     return out;
+}
+
+nlohmann::json mapErrorsJson(const CheckReport& r)
+{
+    const MapErrors& e = r.mapErrors;
+    if (e.compared == 0) return nullptr;
+    return {{"quantity", e.quantity},
+            {"eye_z_equivalent", e.eyeZEquivalent},
+            {"units", e.eyeZEquivalent ? "scene units" : "the map's units (after scale and offset)"},
+            {"compared", e.compared},
+            {"max_abs", e.maxAbs},
+            {"p99_abs", e.p99Abs},
+            {"median_abs", e.medianAbs},
+            {"max_rel", e.maxRel},
+            {"p99_rel", e.p99Rel},
+            {"median_rel", e.medianRel},
+            {"worst_pixel", {{"col", e.worstCol}, {"row", e.worstRow}, {"map", e.worstMap}, {"true", e.worstTrue}}}};
+}
+
+nlohmann::json outOfRangeJson(const CheckReport& r)
+{
+    const ComparisonReport& c = r.comparison;
+    nlohmann::json first = nullptr;
+    if (c.outOfRange > 0) first = {{"col", c.outOfRangeCol}, {"row", c.outOfRangeRow}, {"stored", c.outOfRangeValue}};
+    return {{"count", c.outOfRange}, {"first", first}};
 }
 
 nlohmann::json depthMapJson(const DepthMapSource& source)
@@ -122,7 +159,7 @@ using namespace reportjson;
 nlohmann::json toJson(const CheckReport& report)
 {
     const ComparisonReport& c = report.comparison;
-    return {
+    nlohmann::json document = {
         {"zcheck_version", kVersion},
         {"scene", report.scene},
         {"triangles", report.triangles},
@@ -136,9 +173,9 @@ nlohmann::json toJson(const CheckReport& report)
           {"rule", report.tolerance.slopeCredit == SlopeCredit::SampleOffset
                        ? "|d_map - d_ray| <= C*q + S*m, m = |dd/dx| + |dd/dy| (sum over both surfaces when they differ)"
                        : "|d_raster - d_ray| <= C*q + S*m, m = max(|dd/dx|, |dd/dy|) (sum over both surfaces when they differ)"}}},
-        {"pixels", pixelsJson(c)},
-        {"depth_error", depthErrorJson(c)},
-        {"unexplained", unexplainedJson(c, true)},
+        {"pixels", pixelsJson(report)},
+        {"depth_error", depthErrorJson(report)},
+        {"unexplained", unexplainedJson(report, true)},
         {"timings_ms",
          {{"bvh_build", report.timings.bvhBuildMs},
           {"trace", report.timings.traceMs},
@@ -147,6 +184,13 @@ nlohmann::json toJson(const CheckReport& report)
           {"tile_by_tile", report.timings.tileByTile}}},
         {"consistent", c.consistent()},
     };
+    if (report.secondRoute == "map") {  // verify: no raster was drawn; the map's errors in its units
+        document["timings_ms"].erase("raster");
+        document["timings_ms"].erase("tile_by_tile");
+        document["map_errors"] = mapErrorsJson(report);
+        document["out_of_range"] = outOfRangeJson(report);
+    }
+    return document;
 }
 
 }  // namespace
@@ -190,13 +234,20 @@ std::string formatSummary(const CheckReport& report, const std::string& comparin
     row("  other surface at edge", c.edgeSurface, total);
     row("  DEPTH ERROR", c.depthErrors, total);
     row("both miss", c.bothMiss, total);
+    const std::string second = report.secondRoute;
     row("ray only", c.rayOnly, total);
-    row("raster only", c.rasterOnly, total);
+    row((second + " only").c_str(), c.rasterOnly, total);
     row("  explained (at an edge)", c.coverageExplained - c.lostAtClearValue - c.atClipPlane - c.holes, total);
     row("  explained (at clear value)", c.lostAtClearValue, total);
     row("  explained (on near/far)", c.atClipPlane, total);
     if (report.declared.allowHoles) row("  holes (allowed)", c.holes, total);
     row("  UNEXPLAINED", c.coverageUnexplained, total);
+    if (c.outOfRange > 0) {
+        row("OUT OF RANGE (errors)", c.outOfRange, total);
+        out << "  values the map's quantity cannot hold (a " << report.outOfRangeRule << "), e.g. "
+            << formatNumber(c.outOfRangeValue) << " stored at (" << c.outOfRangeCol << ", " << c.outOfRangeRow
+            << "); counted above by what the comparison made of them\n";
+    }
 
     out << "\ndepth error over compared pixels (both hit, same surface or within tolerance)\n";
     std::snprintf(line, sizeof line, "  max %.3g q, p99 %.3g q; max / tolerance %.3g\n", c.maxErrorQuanta,
@@ -212,9 +263,20 @@ std::string formatSummary(const CheckReport& report, const std::string& comparin
         out << line;
     }
     if (c.agree + c.depthErrors > 0) {
-        std::snprintf(line, sizeof line, "  worst pixel (%d, %d): ray %.10g, raster %.10g, %.3g q (tolerance %.3g q)\n",
-                      c.worst.col, c.worst.row, c.worst.rayWindowDepth, c.worst.rasterWindowDepth,
+        std::snprintf(line, sizeof line, "  worst pixel (%d, %d): ray %.10g, %s %.10g, %.3g q (tolerance %.3g q)\n",
+                      c.worst.col, c.worst.row, c.worst.rayWindowDepth, second.c_str(), c.worst.rasterWindowDepth,
                       c.worst.errorQuanta, c.worst.toleranceQuanta);
+        out << line;
+    }
+    if (const MapErrors& e = report.mapErrors; e.compared > 0) {
+        out << "\nmap - truth " << (e.eyeZEquivalent ? "as eye-z, in scene units" : "(" + e.quantity + "), in the map's units")
+            << ", over the " << e.compared << " pixels compared on depth\n";
+        std::snprintf(line, sizeof line, "  |error|   max %.4g, p99 %.4g, median %.4g\n", e.maxAbs, e.p99Abs, e.medianAbs);
+        out << line;
+        std::snprintf(line, sizeof line, "  relative  max %.3g, p99 %.3g, median %.3g\n", e.maxRel, e.p99Rel, e.medianRel);
+        out << line;
+        std::snprintf(line, sizeof line, "  worst pixel (%d, %d): map %.10g, true %.10g\n", e.worstCol, e.worstRow,
+                      e.worstMap, e.worstTrue);
         out << line;
     }
     if (c.unexplained() > 0) {
@@ -224,8 +286,8 @@ std::string formatSummary(const CheckReport& report, const std::string& comparin
         out << line;
         for (std::size_t k = 0; k < c.unexplainedSamples.size() && k < 5; ++k) {
             const auto& f = c.unexplainedSamples[k];
-            std::snprintf(line, sizeof line, "  (%d, %d) %-12s ray %.10g, raster %.10g\n", f.col, f.row,
-                          toString(f.pixelClass).c_str(), f.rayWindowDepth, f.rasterWindowDepth);
+            std::snprintf(line, sizeof line, "  (%d, %d) %-12s ray %.10g, %s %.10g\n", f.col, f.row,
+                          className(f.pixelClass, second).c_str(), f.rayWindowDepth, second.c_str(), f.rasterWindowDepth);
             out << line;
         }
     }
@@ -236,9 +298,13 @@ std::string formatSummary(const CheckReport& report, const std::string& comparin
                       static_cast<long long>(c.lostAtClearValue), toString(cam.depth.format).c_str());
         out << line;
     }
-    std::snprintf(line, sizeof line, "\ntimings    BVH build %.1f ms, trace %.1f ms, raster %.1f ms, compare %.1f ms%s\n",
-                  report.timings.bvhBuildMs, report.timings.traceMs, report.timings.rasterMs,
-                  report.timings.compareMs, report.timings.tileByTile ? " (tile by tile, interleaved)" : "");
+    if (second == "raster")
+        std::snprintf(line, sizeof line, "\ntimings    BVH build %.1f ms, trace %.1f ms, raster %.1f ms, compare %.1f ms%s\n",
+                      report.timings.bvhBuildMs, report.timings.traceMs, report.timings.rasterMs,
+                      report.timings.compareMs, report.timings.tileByTile ? " (tile by tile, interleaved)" : "");
+    else
+        std::snprintf(line, sizeof line, "\ntimings    BVH build %.1f ms, trace %.1f ms, compare %.1f ms\n",
+                      report.timings.bvhBuildMs, report.timings.traceMs, report.timings.compareMs);
     out << line;
     out << "verdict    " << (c.consistent() ? "CONSISTENT" : "INCONSISTENT") << "\n";
     return out.str();
@@ -261,18 +327,21 @@ VerifyOutcome verifyAndReport(const Checker& checker, const Camera& camera, cons
                               const DepthMapSource& source, bool diagnose)
 {
     VerifyOutcome out;
-    VerifiedMap verified = verifyMap(checker, camera, map, diagnose);
+    VerifiedMap verified = verifyMap(checker, camera, map, diagnose, "depth map '" + source.file + "'");
     out.run = std::move(verified.run);
     out.diagnosed = verified.diagnosed;
     out.diagnosis = std::move(verified.diagnosis);
     out.json = verifyReportJson(out.run.report, source, out.diagnosed ? &out.diagnosis : nullptr);
     out.summary = formatSummary(out.run.report, "ground truth (Embree) vs depth map '" + source.file + "' channel '" +
                                                     source.channel + "' (" + source.quantity + ")");
-    if (out.diagnosed) out.summary += "\n" + formatDiagnosis(out.diagnosis);
+    if (out.diagnosed) {
+        const ComparisonReport& c = out.run.comparison.report;
+        out.summary += "\n" + formatDiagnosis(out.diagnosis, c.bothHit + c.rayOnly + c.rasterOnly);
+    }
     return out;
 }
 
-std::string formatDiagnosis(const std::vector<Hypothesis>& hypotheses)
+std::string formatDiagnosis(const std::vector<Hypothesis>& hypotheses, std::int64_t compared)
 {
     // Ranked (Checker::diagnose): the consistent ones first, then those failing only at edges.
     if (hypotheses.empty()) return "diagnosis  no hypothesis applies to this camera and map\n";
@@ -291,10 +360,22 @@ std::string formatDiagnosis(const std::vector<Hypothesis>& hypotheses)
                 out += "  also     " + hypotheses[k].name + ": " + named(hypotheses[k]) + "\n";
         return out;
     }
-    return "diagnosis  none of the " + std::to_string(hypotheses.size()) +
-           " hypotheses makes the map consistent (closest: " + best.name +
-           (best.variant.empty() ? "" : " " + best.variant) + ", " + (best.estimated ? "about " : "") +
-           std::to_string(best.unexplained) + " unexplained pixels)\n";
+    const std::string none = "diagnosis  none of the " + std::to_string(hypotheses.size()) + " hypotheses makes the map consistent";
+    if (compared < kFewestToDiagnose)
+        return none + ": only " + std::to_string(compared) + " pixel" + (compared == 1 ? "" : "s") +
+               " were compared (the map or the truth sees almost nothing), too few to tell them apart\n";
+    // A best that still leaves most compared pixels unexplained explains nothing: naming it would
+    // point the user at a mistake the map does not show.
+    if (!comesClose(best, compared))
+        return none + ", and none comes close: the best (" + best.name + (best.variant.empty() ? "" : " " + best.variant) +
+               ") still leaves " + (best.estimated ? "about " : "") + std::to_string(best.unexplained) + " of the " +
+               std::to_string(compared) + " compared pixels unexplained\n";
+    if (best.unexplained == 0)
+        return none + " (closest: " + best.name + (best.variant.empty() ? "" : " " + best.variant) +
+               ", which explains every pixel but leaves a systematic bias or values out of range)\n";
+    return none + " (closest: " + best.name + (best.variant.empty() ? "" : " " + best.variant) + ", " +
+           (best.estimated ? "about " : "") + std::to_string(best.unexplained) + " of the " + std::to_string(compared) +
+           " compared pixels unexplained)\n";
 }
 
 namespace {

@@ -9,9 +9,13 @@
 
 namespace zcheck::reportjson {
 
-nlohmann::json pixelsJson(const ComparisonReport& c);                      // "pixels": the classes' counts
-nlohmann::json depthErrorJson(const ComparisonReport& c);                  // "depth_error"
-nlohmann::json unexplainedJson(const ComparisonReport& c, bool samples);  // "unexplained": count, box[, samples]
+// Each names the truth's partner as the report does (CheckReport::secondRoute): "raster_only",
+// "raster_window_depth" in check's; "map_only", "map_window_depth" in verify's.
+nlohmann::json pixelsJson(const CheckReport& r);                      // "pixels": the classes' counts
+nlohmann::json depthErrorJson(const CheckReport& r);                  // "depth_error"
+nlohmann::json unexplainedJson(const CheckReport& r, bool samples);  // "unexplained": count, box[, samples]
+nlohmann::json mapErrorsJson(const CheckReport& r);                   // "map_errors" (verify; null: nothing compared)
+nlohmann::json outOfRangeJson(const CheckReport& r);                  // "out_of_range" (verify)
 nlohmann::json depthMapJson(const DepthMapSource& source);                 // "depth_map"
 nlohmann::json hypothesisJson(const Hypothesis& h);                        // one entry of "diagnosis"
 

@@ -197,3 +197,27 @@ def test_errors_are_one_line():
     assert isinstance(caught.value, ValueError)
     with pytest.raises(zcheck.Error, match="^threads must be in 1..1024, got 2000"):
         zcheck.Checker(quad_scene(1)).render(quad_camera(), "eye-z", threads=2000)
+
+
+def test_regression_integral_float_image_sizes_were_refused_by_pybind11(tmp_path):
+    """instant-ngp writes "w": 640.0: an integral float is a size; 640.5, a string or a bool is a
+    zcheck.Error naming the argument (pybind11's own TypeError never reaches the user)."""
+    K = np.array([[100.0, 0, 79.5], [0, 100, 59.5], [0, 0, 1]])
+    R, t = np.eye(3), np.array([0.0, 0, 5])
+    by_int = zcheck.Camera.from_opencv(K, R, t, W, H)
+    by_float = zcheck.Camera.from_opencv(K, R, t, float(W), np.float32(H))
+    assert (by_float.width, by_float.height) == (W, H)
+    assert np.array_equal(by_int.matrices()["clip_from_world"], by_float.matrices()["clip_from_world"])
+    P = np.array([[1.0, 0, 0, 0], [0, 1, 0, 0], [0, 0, -1.002, -0.2002], [0, 0, -1, 0]])
+    assert zcheck.Camera.from_matrices(P, np.eye(4), width=float(W), height=float(H)).width == W
+    assert by_int.replace(width=2.0 * W).width == 2 * W
+    path = tmp_path / "camera.json"
+    path.write_text(json.dumps(GOOD))
+    assert zcheck.Camera.from_file(str(path), width=float(W), height=float(H)).height == H
+    for value, message in [(W + 0.5, f"width must be a whole number of pixels, got {W + 0.5}"),
+                           ("160", "width must be a number, got str"),
+                           (True, "width must be a number, got bool")]:
+        with pytest.raises(zcheck.Error, match="^Camera.from_opencv: " + message):
+            zcheck.Camera.from_opencv(K, R, t, value, H)
+        with pytest.raises(zcheck.Error, match="^Camera.replace: " + message):
+            by_int.replace(width=value)

@@ -250,3 +250,27 @@ def test_regression_pixel_classes_named_only_up_to_raster_only():
     had an index in Report.pixel_classes but no name."""
     assert zcheck.pixel_classes[-1] == "hole" and len(set(zcheck.pixel_classes)) == len(zcheck.pixel_classes)
     assert {"ray-only", "raster-only", "hole"} <= set(zcheck.pixel_classes)
+
+
+def test_verify_reports_the_map_in_its_units_and_counts_values_out_of_range(default_checker, small_camera):
+    z = default_checker.render(small_camera, "eye-z").astype(np.float64)
+    far = z * 1.002  # 0.2 % too far everywhere
+    report = default_checker.verify(small_camera, far, "eye-z")
+    doc = report.to_dict()
+    errors = doc["map_errors"]
+    assert errors["quantity"] == "eye-z" and not errors["eye_z_equivalent"]
+    assert errors["median_rel"] == pytest.approx(0.002, rel=1e-4) and errors["max_rel"] == pytest.approx(0.002, rel=1e-4)
+    worst = errors["worst_pixel"]
+    assert worst["map"] == far[worst["row"], worst["col"]]
+    assert worst["true"] == pytest.approx(z[worst["row"], worst["col"]], rel=1e-6)
+    assert errors["max_abs"] == pytest.approx(np.nanmax(np.where(np.isfinite(z), 0.002 * z, np.nan)), rel=1e-5)
+    assert "map_only" in doc["pixels"] and "raster_only" not in doc["pixels"] and report.map_only == report.raster_only
+    assert "map - truth (eye-z), in the map's units" in report.summary()
+    # a negative eye-z is no miss: counted, named, and the map rejected
+    holed = z.copy()
+    holed[10:14, 20:30] = -1.0
+    bad = default_checker.verify(small_camera, holed, "eye-z")
+    assert not bad.consistent and bad.out_of_range == 40
+    assert bad.to_dict()["out_of_range"]["first"] == {"col": 20, "row": 10, "stored": -1.0}
+    with pytest.raises(zcheck.Error, match="it holds no eye-z depth"):
+        default_checker.verify(small_camera, np.full_like(z, -2.0), "eye-z")

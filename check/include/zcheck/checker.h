@@ -55,6 +55,20 @@ struct Timings {
     bool tileByTile = false;
 };
 
+// A verified map's errors as its user reads them, over the pixels compared on depth (both hit
+// the same surface: agree + depth errors), error = map − truth. Eye-z and distance maps: in the
+// map's own units (after scale and offset: metres, mostly). Window and ndc maps: their eye-z
+// equivalents, in scene units (the quanta stay the comparison's measure).
+struct MapErrors {
+    std::string quantity;           // "eye-z" or "distance": what the values below measure
+    bool eyeZEquivalent = false;    // a window or ndc map's errors, as eye-z
+    std::int64_t compared = 0;      // 0: nothing compared (and everything below 0)
+    double maxAbs = 0, p99Abs = 0, medianAbs = 0;  // |error|
+    double maxRel = 0, p99Rel = 0, medianRel = 0;  // |error| / true value
+    int worstCol = -1, worstRow = -1;              // the largest |error|: where, the map's value, the true one
+    double worstMap = 0, worstTrue = 0;
+};
+
 // What was compared, how long it took, what was found (report.h prints it).
 struct CheckReport {
     std::string scene;              // scene name as addressed
@@ -65,6 +79,11 @@ struct CheckReport {
     Timings timings;
     std::vector<std::string> warnings;  // about the inputs (PolygonPlanarity::warning), in the report
     MapAccuracy declared;               // verify: what the map declared (DepthMap::accuracy); check: nothing
+    std::string secondRoute = "raster"; // what the truth is compared with: "raster" (check) or "map" (verify),
+                                        // as the report and its JSON keys name it
+    MapErrors mapErrors;                // verify: the map's errors in its units; check: nothing compared
+    std::string outOfRangeRule;         // verify: what the map's quantity holds ("window map holds values
+                                        // in [0, 1], the camera's depth range"), for values out of range
 
     // Fills what the report says of its inputs: the scene (name, triangles, warnings), the
     // camera and the tolerance. Checker::check and verify share it.
@@ -100,8 +119,8 @@ struct ValueAccuracy {
 struct DepthMap {
     int width = 0, height = 0;
     DepthQuantity quantity = DepthQuantity::Window;
-    std::vector<double> value;   // row 0 at the top; misses as eyePointFromDepth defines them
-                                 // (non-finite; the clear value for window and ndc; ≤ 0 for eye-z, distance)
+    std::vector<double> value;   // row 0 at the top; misses and values out of range as
+                                 // kindOfDepthValue (inverse_projection.h) defines them
     double valueQuantum = 0;     // the storage step of `value` (1/scale for integer files); 0: binary32
     std::vector<float> valueStep;  // each value's own step (binary16 files), overriding valueQuantum; or empty
     MapAccuracy accuracy;        // what its producer declares (depth_map_reading.h)
@@ -124,6 +143,8 @@ struct VerifyResult {
     RenderResult map;         // the map as a render result (see verify.h for the surface it saw)
     Comparison comparison;
     CheckReport report;
+    std::vector<float> mapError;  // Checker::verify: per pixel map − truth in report.mapErrors' units,
+                                  // NaN where not compared on depth; empty otherwise
 };
 
 // A parameter a diagnosis measured: "fovy_deg", "sample_dx_px", "near", "value_scale", ...

@@ -140,8 +140,15 @@ struct ComparisonReport {
     double meanSignedErrorQuanta = 0;      // mean of (d_raster − d_ray) / q over them
     bool depthBias = false;                // a systematic rounding bias was found
 
+    // A verified map's pixels whose values its quantity cannot hold (kindOfDepthValue: window 2,
+    // a negative eye-z): errors whatever the classes above say of them; the first in scan order
+    // and its value as stored. A route's render has none.
+    std::int64_t outOfRange = 0;
+    int outOfRangeCol = -1, outOfRangeRow = -1;
+    double outOfRangeValue = 0;
+
     std::int64_t unexplained() const { return depthErrors + coverageUnexplained; }
-    bool consistent() const { return unexplained() == 0 && !depthBias; }
+    bool consistent() const { return unexplained() == 0 && !depthBias && outOfRange == 0; }
 };
 
 struct Comparison {

@@ -126,6 +126,12 @@ RenderResult renderResultFromMap(const PixelJudge& judge, const DepthMap& map, c
 
 // Throws Error unless `map` is camera.width() × camera.height() with a value per pixel.
 void requireMapFits(const Camera& camera, const DepthMap& map);
+// The map's values its quantity cannot hold (kindOfDepthValue), counted into `report`
+// (outOfRange, the first one and its stored value); verifyAgainst does it for every reading.
+void countOutOfRange(const Camera& camera, const DepthMap& map, ComparisonReport& report);
+// Refuses (Error beginning with `name`) a map whose values are all misses or out of range with
+// at least one out of range: it holds nothing of its quantity (a wrong --quantity, mostly).
+void requireDepthsInRange(const Camera& camera, const DepthMap& map, const std::string& name);
 
 // Whether `map` certainly cannot be consistent with `truth`, judged on a sample: the pixels
 // that do not simply agree with the truth's own surface are looked for on every fourth row
@@ -169,6 +175,10 @@ struct EdgeTally {
     std::int64_t atEdges = 0, blends = 0;
 };
 EdgeTally tallyEdges(const Camera& camera, const RenderResult& truth, const RenderResult& map, const Comparison& comparison);
+
+// The map's errors in its own units (report.mapErrors, mapError per pixel), from a comparison
+// of it: Checker::verify's last step (a diagnosis's readings skip it).
+void measureMapErrors(const Camera& camera, const DepthMap& map, VerifyResult& run);
 
 // The comparison of `map` against an already rendered ground truth `truth` (one BVH, one
 // truth render, many readings of the map).

@@ -75,15 +75,25 @@ double eyeZFromDistance(const Camera& camera, const glm::dvec2& pWindow, double 
 // The depth value, as `quantity`, of the point at eye depth eyeZ on the ray through (x, y).
 double depthValueFromEyeZ(const Camera& camera, const glm::dvec2& pWindow, double eyeZ, DepthQuantity quantity);
 
+// What a stored value is to a map of `quantity` made by `camera`. A miss: not finite, the clear
+// value (window, ndc), or 0 (eye-z, distance: "no depth"). Out of range — a value the quantity
+// cannot hold, an error and never a miss: window depth outside the depth range, z_ndc outside
+// the convention's NDC depth range (each with one binary32 step of slack), a negative eye-z or
+// distance. Otherwise a depth.
+enum class DepthValueKind { Depth, Miss, OutOfRange };
+DepthValueKind kindOfDepthValue(const Camera& camera, DepthQuantity quantity, double value);
+// The interval a quantity's depths lie in, as text: "[0, 1], the camera's depth range", "> 0".
+std::string depthValueRange(const Camera& camera, DepthQuantity quantity);
+
 // The eye-space point at window point (x, y) whose depth, as `quantity`, is `value`
-// (window: depth-buffer value; ndc: z_ndc; eye-z; distance). Empty for a miss: a value that
-// is not finite, the clear value (window, ndc), or not positive (eye-z, distance).
+// (window: depth-buffer value; ndc: z_ndc; eye-z; distance). Empty unless kindOfDepthValue
+// says Depth.
 std::optional<glm::dvec3> eyePointFromDepth(const Camera& camera, const glm::dvec2& pWindow, double value,
                                             DepthQuantity quantity);
 
 // Refuses (throws Error) a depth value the camera cannot produce: window depth outside the
 // depth range, z_ndc outside the convention's NDC range, eye-z or distance not in front of
-// the eye, or anything not finite. `name` begins the message ("--depth 2 (window) must lie in
+// the eye, or anything not finite (stricter than kindOfDepthValue: no slack). `name` begins the message ("--depth 2 (window) must lie in
 // [0, 1], the camera's depth range").
 void requireDepthValue(const Camera& camera, DepthQuantity quantity, double value, const std::string& name);
 
@@ -97,11 +107,19 @@ struct UnprojectedMap {
     std::vector<glm::dvec3> points;   // eye or world space, as asked
     std::vector<glm::ivec2> pixels;   // (col, row) of each point
     std::size_t misses = 0;
+    std::size_t outOfRange = 0;       // values the quantity cannot hold (kindOfDepthValue): no point
+    glm::ivec2 firstOutOfRange{-1, -1};  // the first of them in scan order, (col, row)
 };
 enum class PointSpace { Eye, World };
 // Throws Error if values.size() is not width·height or stride < 1.
 UnprojectedMap unprojectMap(const Camera& camera, const std::vector<double>& values, DepthQuantity quantity,
                             PointSpace space = PointSpace::World, int stride = 1);
+
+// How two cameras image the world differently, in one phrase ("" when alike): their image
+// sizes; a point seen at a pixel of `a` seen elsewhere by `b` (pose, field of view, principal
+// point, y direction), or at another eye-z; with `depthMapping`, another depth-buffer value
+// (near, far, depth range, reversed-Z). Conventions that image the world alike are alike.
+std::string howCamerasDiffer(const Camera& a, const Camera& b, bool depthMapping);
 
 // Range of an eye-space point from the centre of projection (or from the eye plane, along
 // the viewing ray, for parallel projections).

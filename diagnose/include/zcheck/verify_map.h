@@ -27,8 +27,11 @@ struct VerifiedMap {
     std::vector<Hypothesis> diagnosis;  // Checker::diagnose's ranking
 };
 
-// Checker::verify; then a comparison with nothing in it is refused (Error "nothing to compare",
-// requireSomethingCompared); then, when `diagnose` and the map is inconsistent, Checker::diagnose.
-VerifiedMap verifyMap(const Checker& checker, const Camera& camera, const DepthMap& map, bool diagnose);
+// A map holding no value of its quantity, only misses and values it cannot hold, is refused
+// (Error beginning with `name`, requireDepthsInRange); then Checker::verify; then a comparison
+// with nothing in it is refused (Error "nothing to compare", requireSomethingCompared); then,
+// when `diagnose` and the map is inconsistent, Checker::diagnose.
+VerifiedMap verifyMap(const Checker& checker, const Camera& camera, const DepthMap& map, bool diagnose,
+                      const std::string& name = "the depth map");
 
 }  // namespace zcheck

@@ -19,7 +19,8 @@
 
 namespace zcheck {
 
-// The file must be a regular file of at most 1 MiB (input_file.h).
+// The file must be a regular file of at most 1 MiB (input_file.h). The sidecar zcheck's export
+// writes beside a map is a camera file too: its "camera" object is read.
 CameraSpec readCameraFile(const std::string& path);
 // The same from JSON text; `source` begins every message ("camera file 'c.json'", "dict").
 // A syntax error or a key repeated within one object is an Error too.

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace zcheck {
@@ -119,5 +120,17 @@ double binary16Step(double stored);
 // "abs_tolerance" and "allow_holes" keys describe the map; other keys are ignored and null is
 // absent. Throws Error naming the sidecar and the key that breaks its rule.
 DepthMapReading withSidecar(DepthMapReading reading, const std::string& sidecar);
+
+// What a sidecar says the map is, beyond how to read it. zcheck's export writes the camera that
+// rendered the map ("camera", with "zcheck_version") and each channel's quantity ("channels":
+// [{"name": "Z", "quantity": "eye-z"}, ...]); other producers' sidecars may have neither.
+struct SidecarSubject {
+    bool hasCamera = false;  // readCameraFile(sidecar) reads it
+    std::vector<std::pair<std::string, std::string>> channelQuantities;  // {channel, quantity}, depth quantities only
+    // The quantity of `channel` ("" : the sidecar's only depth channel); nothing when the sidecar
+    // does not say. Throws Error naming the sidecar when several channels leave it open.
+    std::optional<std::string> quantityOf(const std::string& sidecar, const std::string& channel) const;
+};
+SidecarSubject sidecarSubject(const std::string& sidecar);
 
 }  // namespace zcheck

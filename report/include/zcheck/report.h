@@ -9,6 +9,7 @@
 #include "zcheck/suite.h"
 #include "zcheck/verify_map.h"
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -36,8 +37,17 @@ VerifyOutcome verifyAndReport(const Checker& checker, const Camera& camera, cons
                               const DepthMapSource& source, bool diagnose);
 
 // The diagnosis lines for people: the best hypothesis (and up to three more that also explain
-// the map, or all of it but a handful of edge pixels), or the closest one.
-std::string formatDiagnosis(const std::vector<Hypothesis>& hypotheses);
+// the map, or all of it but a handful of edge pixels), or the closest one — unless it leaves at
+// least half of the `compared` pixels (where either side sees a surface, as the map was read)
+// unexplained ("none comes close"), or fewer than kFewestToDiagnose pixels were compared.
+inline constexpr std::int64_t kFewestToDiagnose = 100;
+// Whether an inconsistent best hypothesis may be offered as the closest: enough compared pixels,
+// and it leaves fewer than half of them unexplained.
+inline bool comesClose(const Hypothesis& best, std::int64_t compared)
+{
+    return compared >= kFewestToDiagnose && 2 * best.unexplained < compared;
+}
+std::string formatDiagnosis(const std::vector<Hypothesis>& hypotheses, std::int64_t compared);
 
 // The suite: the detection table, and the whole run as JSON and as self-contained HTML (with
 // images of every kept failure).
