@@ -239,3 +239,26 @@ TEST_CASE("ZCHECK_RAY_KERNEL takes auto or baseline and nothing else", "[ray][ke
     REQUIRE_THROWS_WITH(renderWith("avx2"),
                         Catch::Contains("ZCHECK_RAY_KERNEL=avx2") && Catch::Contains("'auto' or 'baseline'"));
 }
+
+TEST_CASE("regression: a raw matrix whose near plane crosses the eye plane gave Embree a negative tnear", "[rays][regression]")
+{
+    // The diagnosis builds such cameras (a tilted depth row) and probes them with single rays;
+    // Embree's assertion `ray.tnear() >= 0` aborted zcheck. The camera sees nothing behind its eye
+    // plane: both the probe and a full render start there.
+    const Scene scene = builtinScene("builtin:default");
+    const RayRenderer rays(scene);
+    CameraSpec spec = scene.defaultCamera;
+    spec.width = 64, spec.height = 48;
+    const Camera straight(spec);
+    spec.projection.type = ProjectionType::Matrix;
+    spec.projection.clipFromEye = straight.clipFromEye;
+    spec.projection.clipFromEye[0][2] += 3.0 * straight.clipFromEye[3][2];  // depth tilted with eye x
+    const Camera tilted(spec);
+    bool behind = false;
+    for (int col = 0; col < 64; ++col)
+        behind = behind || worldEyePlaneRayThroughWindow(tilted, windowFromPixelCentre(tilted, col, 24)).tNear < 0;
+    REQUIRE(behind);
+    const RenderResult render = rays.render(tilted);
+    REQUIRE(render.primitiveId.size() == 64u * 48u);
+    for (int col = 0; col < 64; ++col) (void)rays.primitiveAt(tilted, windowFromPixelCentre(tilted, col, 24));
+}

@@ -1116,3 +1116,48 @@ TEST_CASE("a tile compared a few rows at a time, tiles interleaved, reports what
         REQUIRE(testing::sameBits(bands.errorOverTolerance, whole.errorOverTolerance));
     }
 }
+
+TEST_CASE("regression: a best hypothesis that left almost every pixel unexplained was offered as the closest",
+          "[diagnose][report][regression]")
+{
+    // A map of noise on the default scene: no hypothesis explains it, and none is named as if it
+    // nearly did ("closest: field-of-view" pointed the user at a mistake the map does not show).
+    const Checker checker(builtinScene("builtin:default"));
+    const Camera camera(smallCamera(checker.scene()));
+    DepthMap noise{camera.width(), camera.height(), DepthQuantity::EyeZ, {}, 0};
+    std::uint32_t state = 12345;
+    for (int i = 0; i < camera.width() * camera.height(); ++i) {
+        state = state * 1664525u + 1013904223u;
+        noise.value.push_back(1.0 + 9.0 * (state >> 8) / double(1u << 24));
+    }
+    const VerifyResult run = checker.verify(camera, noise);
+    const ComparisonReport& c = run.comparison.report;
+    const std::vector<Hypothesis> diagnosis = checker.diagnose(camera, noise);
+    REQUIRE_FALSE(diagnosis.front().consistent);
+    const std::string text = formatDiagnosis(diagnosis, c.bothHit + c.rayOnly + c.rasterOnly);
+    INFO(text);
+    REQUIRE(text.find("none comes close") != std::string::npos);
+    REQUIRE(text.find("closest") == std::string::npos);
+    // A best that leaves under half the compared pixels unexplained is still offered.
+    Hypothesis near;
+    near.name = "pose", near.unexplained = 1204;
+    REQUIRE(formatDiagnosis({near}, 41887).find("(closest: pose, 1204 of the 41887 compared pixels unexplained)") !=
+            std::string::npos);
+}
+
+TEST_CASE("regression: 'about 0 unexplained pixels' stood beside 'none makes the map consistent'",
+          "[diagnose][report][regression]")
+{
+    // A nearly empty comparison: too few pixels to tell hypotheses apart, and the report says so.
+    Hypothesis best;
+    best.name = "y-flip", best.unexplained = 0, best.estimated = true;
+    const std::string few = formatDiagnosis({best}, 12);
+    INFO(few);
+    REQUIRE(few.find("only 12 pixels were compared") != std::string::npos);
+    REQUIRE(few.find("about 0") == std::string::npos);
+    // Enough compared, none unexplained, yet not consistent (a bias): said as such, not "about 0".
+    const std::string biased = formatDiagnosis({best}, 5000);
+    INFO(biased);
+    REQUIRE(biased.find("explains every pixel but leaves a systematic bias or values out of range") != std::string::npos);
+    REQUIRE(biased.find("about 0") == std::string::npos);
+}

@@ -606,33 +606,45 @@ glm::dvec2 wholeImageShift(const Camera& camera, const DepthMap& map, const Rend
             if (const auto p = eyePointFromDepth(camera, pWindow, map.value[i], map.quantity))
                 mine[i] = distance ? map.value[i] : camera.eyeZOf(*p);
         }
-    // A grid of about 4096 sample pixels; a shift's score is how many of them hold the truth's
-    // depth of the pixel it moves them to, within 0.2 %.
+    // A grid of about 4096 sample pixels. A sample agrees under a shift when its depth lies within
+    // 0.2 % of the range of the truth's at the pixel it moves to and that pixel's two neighbours
+    // along the shift (a fractional shift falls between them).
     const int stride = std::max(1, int(std::sqrt(double(W) * H / 4096.0)));
-    auto score = [&](int sx, int sy) {
-        int agree = 0;
-        for (int row = stride / 2; row < H; row += stride)
-            for (int col = stride / 2; col < W; col += stride) {
-                const int c = col + sx, r = row + sy;
-                if (c < 0 || c >= W || r < 0 || r >= H) continue;
-                const double m = mine[std::size_t(row) * W + col], t = theirs[std::size_t(r) * W + c];
-                agree += std::abs(m - t) <= 2e-3 * std::abs(t) ? 1 : 0;
-            }
-        return agree;
-    };
-    int seen = 0;
+    std::vector<glm::ivec2> samples;
     for (int row = stride / 2; row < H; row += stride)
-        for (int col = stride / 2; col < W; col += stride) seen += std::isfinite(mine[std::size_t(row) * W + col]) ? 1 : 0;
-    const int declared = score(0, 0);
+        for (int col = stride / 2; col < W; col += stride)
+            if (std::isfinite(mine[std::size_t(row) * W + col])) samples.emplace_back(col, row);
+    auto agrees = [&](const glm::ivec2& at, int sx, int sy) {
+        const double m = mine[std::size_t(at.y) * W + at.x];
+        double lo = INFINITY, hi = -INFINITY;
+        for (int k = -1; k <= 1; ++k) {
+            const int c = at.x + sx + (sx != 0 ? k : 0), r = at.y + sy + (sy != 0 ? k : 0);
+            if (c < 0 || c >= W || r < 0 || r >= H) continue;
+            const double t = theirs[std::size_t(r) * W + c];
+            if (std::isfinite(t)) lo = std::min(lo, t), hi = std::max(hi, t);
+            if (sx == 0 && sy == 0) break;
+        }
+        return lo <= hi && m >= lo * (1 - 2e-3) && m <= hi * (1 + 2e-3);
+    };
+    // The samples the declared sampling leaves unexplained; a shift gains those it explains and
+    // loses those it breaks (a ground plane seen without roll agrees at every shift along x).
+    std::vector<char> declared(samples.size());
+    std::size_t suspects = 0;
+    for (std::size_t k = 0; k < samples.size(); ++k) suspects += (declared[k] = agrees(samples[k], 0, 0)) ? 0 : 1;
     glm::ivec2 best{0, 0};
-    int bestScore = declared;
+    long bestGain = 0;
+    auto consider = [&](int sx, int sy) {
+        long gain = 0;
+        for (std::size_t k = 0; k < samples.size(); ++k) gain += (agrees(samples[k], sx, sy) ? 1 : 0) - (declared[k] ? 1 : 0);
+        if (gain > bestGain) bestGain = gain, best = {sx, sy};
+    };
     for (int sx = -W / 3; sx <= W / 3; ++sx)
-        if (const int s = sx == 0 ? 0 : score(sx, 0); s > bestScore) bestScore = s, best = {sx, 0};
+        if (std::abs(sx) > 1) consider(sx, 0);
     for (int sy = -H / 3; sy <= H / 3; ++sy)
-        if (const int s = sy == 0 ? 0 : score(0, sy); s > bestScore) bestScore = s, best = {0, sy};
-    // Clearly better than the declared sampling, and agreeing at a third of the map at least (a
-    // shift moves part of the image out of it).
-    if (best == glm::ivec2(0) || bestScore < 2 * declared || 3 * bestScore < seen) return glm::dvec2(0.0);
+        if (std::abs(sy) > 1) consider(0, sy);
+    // It must explain most of what the declared sampling does not (shifts of a pixel or two are
+    // the local fit's).
+    if (suspects < 16 || 2 * bestGain < long(suspects)) return glm::dvec2(0.0);
     return glm::dvec2(best);
 }
 
@@ -661,6 +673,24 @@ FitResult fitDeparture(const Scene& scene, const Camera& camera, const DepthMap&
     for (int round = 0; round < 3; ++round) {
         const Camera departed(departedCameraSpec(camera, d));
         Problem problem{camera, map, family, d, 1, 1, samplesOf(scene, camera, departed, map, rendered ? *rendered : truth)};
+        if (shiftedStart) {
+            // Along a long shift only surfaces whose depth changes along it tell one shift from the
+            // next; where most do not (a ground plane seen without roll, along x), their near-zero
+            // residuals would set the robust scale and leave the telling ones out as outliers.
+            const glm::dvec2 along = windowFromImageOffset(camera, d.sampleOffset.x != 0 ? glm::dvec2(1, 0) : glm::dvec2(0, 1));
+            std::vector<Sample> telling;
+            for (const Sample& sample : problem.samples) {
+                const glm::dvec2 centre = windowFromPixelCentre(departed, sample.col, sample.row);
+                auto eyeZAt = [&](const glm::dvec2& pWindow) {
+                    const EyePlaneRay ray = worldEyePlaneRayThroughWindow(departed, pWindow);
+                    const double t = (sample.offset - glm::dot(sample.normal, ray.origin)) / glm::dot(sample.normal, ray.direction);
+                    return departed.eyeZOf(glm::dvec3(departed.eyeFromWorld * glm::dvec4(ray.origin + t * ray.direction, 1.0)));
+                };
+                const double before = eyeZAt(centre - 0.5 * along), after = eyeZAt(centre + 0.5 * along);
+                if (std::abs(after - before) > 1e-3 * std::abs(after + before) / 2) telling.push_back(sample);
+            }
+            if (telling.size() >= 64) problem.samples = std::move(telling);
+        }
         if (problem.samples.size() < 16) break;
         std::vector<double> values;
         for (const Sample& s : problem.samples) values.push_back(std::abs(s.mapValue));

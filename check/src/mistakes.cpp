@@ -414,18 +414,41 @@ std::vector<Mistake> buildCatalogue()
                                       m = camera.clipFromEye * mirror;
                                       return true;
                                   }));
-    all.push_back(wrongProjection("principal-point-mirrored",
-                                  "an off-centre principal point mirrored about the image centre (cx for W - 1 - cx, a "
-                                  "frustum's left for -right), as a y-up vs y-down or sign slip does",
-                                  "consistent if the principal point is mirrored about the image centre",
-                                  [](const Camera& camera, glm::dmat4& m) {
-                                      // The image offset lives in the z column (perspective) or the
-                                      // w column (parallel) of the x and y rows: negate it.
-                                      m = camera.clipFromEye;
-                                      for (int c : {2, 3})
-                                          for (int r : {0, 1}) m[c][r] = -m[c][r];
-                                      return differ(m, camera.clipFromEye);
-                                  }));
+    // The image offset lives in the z column (perspective) or the w column (parallel) of the x
+    // and y rows: negated in `rows`, the principal point is mirrored about the image centre there.
+    auto principalMirrored = [](const Camera& camera, glm::dmat4& m, std::initializer_list<int> rows) {
+        m = camera.clipFromEye;
+        for (int c : {2, 3})
+            for (int r : rows) m[c][r] = -m[c][r];
+        return differ(m, camera.clipFromEye);
+    };
+    Mistake mirroredPrincipal = wrongProjection(
+        "principal-point-mirrored",
+        "an off-centre principal point mirrored about the image centre (cx for W - 1 - cx, a frustum's left for "
+        "-right), as a y-up vs y-down or sign slip does",
+        "consistent if the principal point is mirrored about the image centre",
+        [principalMirrored](const Camera& camera, glm::dmat4& m) { return principalMirrored(camera, m, {0, 1}); });
+    // ... or in one axis only: a sign slip in cx or cy alone (Blender's shift_x or shift_y read
+    // with the wrong sign), a diagnosis of its own.
+    mirroredPrincipal.reread = [both = mirroredPrincipal.reread, principalMirrored](const Camera& camera, const DepthMap& map) {
+        Rereadings out = both(camera, map);
+        for (const auto& [row, axis] : {std::pair{0, "x"}, std::pair{1, "y"}}) {
+            glm::dmat4 m;
+            glm::dmat4 other;
+            if (!principalMirrored(camera, m, {row}) || !principalMirrored(camera, other, {1 - row})) continue;
+            CameraSpec spec = camera.spec();
+            spec.projection.type = ProjectionType::Matrix;
+            spec.projection.clipFromEye = m;
+            const std::string c = row == 0 ? "cx" : "cy", shift = row == 0 ? "shift_x" : "shift_y";
+            out.push_back({std::string(axis) + " only",
+                           "consistent if the principal point is mirrored about the image centre in " + std::string(axis) +
+                               " only (" + c + " for " + (row == 0 ? "W" : "H") + " - 1 - " + c + ": a sign slip in " + c +
+                               ", or Blender's " + shift + " read with the wrong sign)",
+                           spec, {}, {}});
+        }
+        return out;
+    };
+    all.push_back(mirroredPrincipal);
     all.push_back(wrongProjection("transposed", "the projection matrix transposed (row- vs column-major confusion)",
                                   "consistent if the projection matrix is transposed (row- vs column-major)",
                                   [](const Camera& camera, glm::dmat4& m) {

@@ -198,7 +198,7 @@ std::uint32_t RayRenderer::primitiveAt(const Camera& camera, const glm::dvec2& p
     hit.ray.org_y = float(r.origin.y - embree_->frameOrigin.y);
     hit.ray.org_z = float(r.origin.z - embree_->frameOrigin.z);
     hit.ray.dir_x = float(r.direction.x), hit.ray.dir_y = float(r.direction.y), hit.ray.dir_z = float(r.direction.z);
-    hit.ray.tnear = float(r.tNear);
+    hit.ray.tnear = float(std::max(0.0, r.tNear));  // see traceRect
     hit.ray.tfar = std::isinf(r.tFar) ? INFINITY : float(r.tFar);
     hit.ray.mask = 0xFFFFFFFFu;
     hit.hit.geomID = hit.hit.primID = RTC_INVALID_GEOMETRY_ID;
@@ -331,7 +331,10 @@ ZCHECK_ALWAYS_INLINE inline void traceRectBody(RTCScene rtcScene, const glm::dve
             for (int k = 0; k < kPacketRays; ++k) {
                 const EyePlaneRay r = cameraRays.worldRay(p.pImage(k));
                 for (int c = 0; c < 3; ++c) p.lane[c][k] = r.origin[c], p.lane[3 + c][k] = r.direction[c];
-                ray.tnear[k] = float(r.tNear), ray.tfar[k] = std::isinf(r.tFar) ? INFINITY : float(r.tFar);
+                // A raw matrix whose near plane crosses the eye plane puts it behind the eye at
+                // some pixels: the camera sees nothing behind its eye plane (and Embree takes no
+                // negative tnear).
+                ray.tnear[k] = float(std::max(0.0, r.tNear)), ray.tfar[k] = std::isinf(r.tFar) ? INFINITY : float(r.tFar);
             }
         }
         for (int k = 0; k < kPacketRays; ++k) {

@@ -31,7 +31,7 @@ cleanup() {
     if [[ -n $blender_pid ]] && kill -0 "$blender_pid" 2> /dev/null; then
         kill "$blender_pid" 2> /dev/null || true
     fi
-    if [[ $failed -eq 0 ]]; then rm -rf "$tmp"; else echo "test_blender: renders, logs and results kept in $tmp"; fi
+    if [[ $failed -eq 0 && -z ${KEEP:-} ]]; then rm -rf "$tmp"; else echo "test_blender: renders, logs and results kept in $tmp"; fi
 }
 trap cleanup EXIT
 out=$tmp/out
@@ -153,6 +153,37 @@ if [[ $verify_status -eq 1 ]] && inconsistent "$tmp/results_shift.jsonl" tall_00
 else
     fail "a camera's shift_x sign flipped: exactly its frames (tall_0002, square_0002) inconsistent" \
         "(exit $verify_status)"
+fi
+
+# --- and --diagnose names the mistake ----------------------------------------------------------
+# The shift moved cx by 2 · 0.05 · viewfac px (12 px with square pixels, 16.8 with tall ones) to
+# W - cx: the principal point mirrored in x.
+set +e
+"$zcheck" dataset verify "$out/manifest_shift_flipped.jsonl" --scene "$out/scene.obj" --quantity eye-z --miss '>=1e9' \
+    --diagnose -o "$tmp/results_shift_diagnosed.jsonl" > /dev/null 2>&1
+set -e
+if python3 - "$out/manifest.jsonl" "$out/manifest_shift_flipped.jsonl" "$tmp/results_shift_diagnosed.jsonl" << 'EOF'; then
+import json, sys
+true_cams = {r["frame"]: r["camera"] for r in map(json.loads, open(sys.argv[1]))}
+declared = {r["frame"]: r["camera"] for r in map(json.loads, open(sys.argv[2]))}
+records = {r["frame"]: r for r in map(json.loads, open(sys.argv[3]))}
+for frame in ("tall_0002", "square_0002"):
+    moved = true_cams[frame]["projection"]["cx"] - declared[frame]["projection"]["cx"]
+    diagnosis = records[frame].get("diagnosis", [])
+    names = [(h["hypothesis"], h["variant"]) for h in diagnosis if h["consistent"]]
+    print(f"      {frame}: principal point moved {moved:+.3f} px; consistent: {names}")
+    # Named as what it is: cx mirrored about the centre, a shift_x sign slip ...
+    assert names and names[0] == ("principal-point-mirrored", "x only"), (frame, names, records[frame].get("closest"))
+    assert "shift_x read with the wrong sign" in diagnosis[0]["explanation"], diagnosis[0]["explanation"]
+    # ... and, where the fit runs too, measured: the image moved by the principal point's move.
+    for h in diagnosis:
+        if h["hypothesis"] == "sample-offset" and h["consistent"]:
+            fitted = {v["name"]: v["value"] for v in h["fitted"]}
+            assert abs(fitted["sample_dx_px"] + moved) < 0.02 and abs(fitted["sample_dy_px"]) < 0.02, fitted
+EOF
+    pass "--diagnose names the flipped shift_x: the principal point mirrored in x only, on Cycles's Z passes"
+else
+    fail "--diagnose names the flipped shift_x: the principal point mirrored in x only, on Cycles's Z passes"
 fi
 
 # --- one Z pass upside down (the orthographic frame): exactly that frame inconsistent ----------

@@ -97,8 +97,8 @@ double medianResidual(const Scene& scene, const Camera& camera, const DepthMap& 
 // The whole-pixel shift of the image along one axis alone (up to a third of the image) under
 // which the map's depths best match the truth's at the pixels they move to: a principal point
 // off by many pixels (Blender's shift_y with the wrong sign) shifts the whole picture, too far
-// for a local fit. (0, 0) unless it agrees at twice as many pixels as the declared sampling and
-// at a third of the map's. The sample-offset fit starts there.
+// for a local fit. (0, 0) unless, of the sample pixels the declared sampling leaves unexplained,
+// it explains at least half more than it breaks of the others. The sample-offset fit starts there.
 glm::dvec2 wholeImageShift(const Camera& camera, const DepthMap& map, const RenderResult& truth);
 
 // Fits one family. `truth` is the declared camera's ground truth (the first round's planes).
