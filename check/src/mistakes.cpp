@@ -173,6 +173,7 @@ Mistake otherViews(std::string name, std::string description,
                    std::function<std::vector<ViewVariant>(const Camera&)> build)
 {
     Mistake mistake{std::move(name), std::move(description), Route::Raster, {}, {}};
+    mistake.alone = true;
     mistake.reread = [build](const Camera& camera, const DepthMap&) {
         Rereadings out;
         for (const ViewVariant& v : build(camera)) {
@@ -330,6 +331,7 @@ std::vector<Mistake> buildCatalogue()
     // and the map's eye-z and distance / k (window depth, a function of z/near and z/far, stays).
     Mistake meshUnits{"mesh-units", "the mesh in other units than the camera (millimetres or centimetres for metres)",
                       Route::Raster, {}, {}};
+    meshUnits.alone = true;
     meshUnits.reread = [](const Camera& camera, const DepthMap& map) {
         Rereadings out;
         if (!camera.spec().projection.isPerspective() || isRawMatrix(camera)) return out;
@@ -361,6 +363,7 @@ std::vector<Mistake> buildCatalogue()
     // The principal point's coordinates exchanged (cx for cy).
     Mistake swappedPrincipal{"cx-cy-swapped", "the principal point's coordinates exchanged (cx used for cy and cy for cx)",
                              Route::Raster, {}, {}};
+    swappedPrincipal.alone = true;
     swappedPrincipal.reread = [](const Camera& camera, const DepthMap&) {
         Rereadings out;
         // Where the optical axis meets the image (x right, y down from the top-left corner).

@@ -429,26 +429,30 @@ void measureMapErrors(const Camera& camera, const DepthMap& map, VerifyResult& r
     e.quantity = linear ? toString(map.quantity) : "eye-z";
     e.eyeZEquivalent = !linear;
     run.mapError.assign(std::size_t(W) * H, NAN);
-    std::vector<double> absolute, relative;
-    for (int row = 0; row < H; ++row)
+    std::vector<double> truthOf(std::size_t(W) * H, NAN), mineOf(std::size_t(W) * H, NAN);
+    tbb::parallel_for(0, H, [&](int row) {
         for (int col = 0; col < W; ++col) {
             const std::size_t i = std::size_t(row) * W + col;
             const PixelClass c = run.comparison.pixelClass[i];
             if (c != PixelClass::Agree && c != PixelClass::DepthError) continue;
             const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
             const double trueEyeZ = eyeZFromWindowDepth(camera, pWindow, run.truth.windowDepth.value[i]);
-            const double truth = linear ? depthValueFromEyeZ(camera, pWindow, trueEyeZ, map.quantity) : trueEyeZ;
-            const double mine = linear ? map.value[i] : eyeZFromWindowDepth(camera, pWindow, run.map.windowDepth.value[i]);
-            const double error = mine - truth;
-            if (!std::isfinite(error)) continue;
-            run.mapError[i] = float(error);
-            absolute.push_back(std::abs(error));
-            relative.push_back(truth != 0 ? std::abs(error / truth) : 0.0);
-            if (std::abs(error) > e.maxAbs || e.worstCol < 0) {
-                e.maxAbs = std::abs(error);
-                e.worstCol = col, e.worstRow = row, e.worstMap = mine, e.worstTrue = truth;
-            }
+            truthOf[i] = linear ? depthValueFromEyeZ(camera, pWindow, trueEyeZ, map.quantity) : trueEyeZ;
+            mineOf[i] = linear ? map.value[i] : eyeZFromWindowDepth(camera, pWindow, run.map.windowDepth.value[i]);
         }
+    });
+    std::vector<double> absolute, relative;
+    for (std::size_t i = 0; i < truthOf.size(); ++i) {
+        const double error = mineOf[i] - truthOf[i];
+        if (!std::isfinite(error)) continue;
+        run.mapError[i] = float(error);
+        absolute.push_back(std::abs(error));
+        relative.push_back(truthOf[i] != 0 ? std::abs(error / truthOf[i]) : 0.0);
+        if (std::abs(error) > e.maxAbs || e.worstCol < 0) {
+            e.maxAbs = std::abs(error);
+            e.worstCol = int(i % W), e.worstRow = int(i / W), e.worstMap = mineOf[i], e.worstTrue = truthOf[i];
+        }
+    }
     e.compared = std::int64_t(absolute.size());
     e.p99Abs = quantileOf(absolute, 0.99), e.medianAbs = quantileOf(absolute, 0.5);
     e.p99Rel = quantileOf(relative, 0.99), e.medianRel = quantileOf(relative, 0.5);
@@ -690,7 +694,9 @@ std::vector<Hypothesis> Checker::diagnose(const Camera& camera, const DepthMap& 
         for (std::size_t a = 0; a < candidates.size(); ++a)
             for (std::size_t b = 0; b < candidates.size(); ++b) {
                 const Candidate &first = candidates[a], &second = candidates[b];
-                if (!first.camera || !second.camera || first.mistake == second.mistake || !first.readsMapOnly()) continue;
+                if (!first.camera || !second.camera || first.mistake == second.mistake || !first.readsMapOnly() ||
+                    first.mistake->alone || second.mistake->alone)
+                    continue;
                 if (second.readsMapOnly() && (b <= a || (changesQuantity(first) && changesQuantity(second)))) continue;
                 pairs.emplace_back(a, b);
             }

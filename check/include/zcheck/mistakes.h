@@ -43,6 +43,9 @@ struct Mistake {
     std::function<bool(const Camera&, RouteFaults&)> inject;
     // The ways to re-read `map` under the mistake; empty where it has no meaning.
     std::function<std::vector<Rereading>(const Camera&, const DepthMap&)> reread;
+    // The diagnosis tries it alone, never paired with another: a mistake made with the files a
+    // renderer was given (a pose's rotation, its units, the mesh's axes), not in its chain.
+    bool alone = false;
 };
 
 const std::vector<Mistake>& mistakeCatalogue();
