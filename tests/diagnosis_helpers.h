@@ -38,8 +38,8 @@ inline DepthMap mapOf(const Scene& scene, const Camera& camera, const RenderResu
 // The window depth of `render`, stored as a float32 file stores it.
 inline DepthMap windowMapOf(const Camera& camera, const RenderResult& render)
 {
-    DepthMap map{camera.width(), camera.height(), DepthQuantity::Window,
-                 {render.windowDepth.value.begin(), render.windowDepth.value.end()}, 0};
+    DepthMap map = DepthMap::exact(camera.width(), camera.height(), DepthQuantity::Window,
+                                   {render.windowDepth.value.begin(), render.windowDepth.value.end()});
     for (double& v : map.value) v = double(float(v));
     return map;
 }

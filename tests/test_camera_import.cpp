@@ -410,7 +410,7 @@ TEST_CASE("near and far hug the scene as the camera sees it", "[import][clip]")
     const CameraSpec completed = completeCamera(imported, &scene, {});
     REQUIRE(completed.projection.near == Approx(3.96));
     REQUIRE_THAT(completed.notes.back(), Catch::Contains("near and far are not in the camera file"));
-    const CameraSpec given = completeCamera(imported, &scene, {1.0, 50.0, std::nullopt, std::nullopt});
+    const CameraSpec given = completeCamera(imported, &scene, {1.0, 50.0, std::nullopt, std::nullopt, std::nullopt});
     REQUIRE(given.projection.near == 1.0);
     REQUIRE(given.projection.far == 50.0);
 

@@ -73,7 +73,7 @@ TEST_CASE("one Checker used from several threads at once gives each the same ans
     std::vector<CheckResult> results(4);
     std::vector<VerifyResult> verified(4);
     const LargeVector<double>& drawn = alone.raster.windowDepth.value;
-    DepthMap map{camera.width(), camera.height(), DepthQuantity::Window, {drawn.begin(), drawn.end()}, 0};
+    DepthMap map = DepthMap::exact(camera.width(), camera.height(), DepthQuantity::Window, {drawn.begin(), drawn.end()});
     std::vector<std::thread> threads;
     for (std::size_t k = 0; k < results.size(); ++k)
         threads.emplace_back([&, k] {
@@ -153,7 +153,7 @@ TEST_CASE("verify refuses a map whose size is not the camera's", "[checker]")
 {
     const Checker checker(builtinScene("builtin:default"));
     const Camera camera(smallCamera(checker.scene()));
-    const DepthMap map{10, 10, DepthQuantity::EyeZ, std::vector<double>(100, 1.0), 0};
+    const DepthMap map = DepthMap::exact(10, 10, DepthQuantity::EyeZ, std::vector<double>(100, 1.0));
     REQUIRE_THROWS_WITH(checker.verify(camera, map), Catch::Contains("10x10") && Catch::Contains("160x120"));
 }
 
@@ -465,8 +465,8 @@ TEST_CASE("a map with no surface is explained by no hypothesis (a view that sees
 {
     const Checker checker(builtinScene("builtin:default"));
     const Camera camera(smallCamera(checker.scene()));
-    const DepthMap empty{camera.width(), camera.height(), DepthQuantity::Window,
-                         std::vector<double>(std::size_t(camera.width()) * camera.height(), camera.clearDepth()), 0};
+    const DepthMap empty = DepthMap::exact(camera.width(), camera.height(), DepthQuantity::Window,
+                                           std::vector<double>(std::size_t(camera.width()) * camera.height(), camera.clearDepth()));
     const std::vector<Hypothesis> diagnosis = checker.diagnose(camera, empty);
     for (const Hypothesis& h : diagnosis) {
         INFO(h.name << " " << h.variant);
@@ -1124,7 +1124,7 @@ TEST_CASE("regression: a best hypothesis that left almost every pixel unexplaine
     // nearly did ("closest: field-of-view" pointed the user at a mistake the map does not show).
     const Checker checker(builtinScene("builtin:default"));
     const Camera camera(smallCamera(checker.scene()));
-    DepthMap noise{camera.width(), camera.height(), DepthQuantity::EyeZ, {}, 0};
+    DepthMap noise = DepthMap::exact(camera.width(), camera.height(), DepthQuantity::EyeZ, {});
     std::uint32_t state = 12345;
     for (int i = 0; i < camera.width() * camera.height(); ++i) {
         state = state * 1664525u + 1013904223u;

@@ -271,8 +271,8 @@ TEST_CASE("a resolved multisample depth map is named anti-aliased, consistent ex
     forEachSetup([](const Bench& b) {
         if (b.quantity != ExportQuantity::Window) return;
         const Camera& camera = b.camera;
-        DepthMap map{camera.width(), camera.height(), DepthQuantity::Window,
-                     std::vector<double>(std::size_t(camera.width()) * camera.height(), 0.0), 0};
+        DepthMap map = DepthMap::exact(camera.width(), camera.height(), DepthQuantity::Window,
+                                       std::vector<double>(std::size_t(camera.width()) * camera.height(), 0.0));
         for (const glm::dvec2 sample : {glm::dvec2(-2, -6), glm::dvec2(6, -2), glm::dvec2(-6, 2), glm::dvec2(2, 6)}) {
             Departure d;
             d.sampleOffset = sample / 16.0;

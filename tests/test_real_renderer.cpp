@@ -74,8 +74,10 @@ DepthMap glDepthMap(const Scene& scene, const Camera& camera, GlDepth setup, int
     if (samplePositions) *samplePositions = drawn.samplePositions;
     INFO("OpenGL renderer: " << drawn.renderer);
     REQUIRE(drawn.depth.size() == std::size_t(camera.width()) * camera.height());
-    return DepthMap{camera.width(), camera.height(), DepthQuantity::Window,
-                    std::vector<double>(drawn.depth.begin(), drawn.depth.end()), 0};
+    DepthMap map;
+    map.width = camera.width(), map.height = camera.height(), map.quantity = DepthQuantity::Window;
+    map.value.assign(drawn.depth.begin(), drawn.depth.end());
+    return map;
 }
 
 // The map verified through the camera: consistent, with enough surface compared to mean it.

@@ -252,7 +252,7 @@ TEST_CASE("every swap of the four quantities is diagnosed by its own name", "[ve
             for (const auto& [unused, declared] : quantities) {
                 if (deliveredQuantity == declared) continue;
                 const QuantityImage image = quantityImage(s.scene, camera, drawn, delivered);
-                DepthMap map{image.width, image.height, declared, image.value, 0.0};
+                DepthMap map = DepthMap::exact(image.width, image.height, declared, image.value);
                 for (double& v : map.value) v = double(float(v));  // as stored in a float32 file
                 const std::string name = toString(deliveredQuantity) + "-as-" + toString(declared);
                 INFO(convention << ": " << name);

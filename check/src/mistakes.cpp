@@ -199,6 +199,30 @@ glm::dmat4 viewOf(const glm::dmat3& r, const glm::dvec3& t)
 
 std::string factorText(double k) { return k >= 1 ? "× " + formatNumber(k) : "/ " + formatNumber(1 / k); }
 
+// A camera's pose as files store it: world-to-camera [R | t] in OpenCV axes, the eye at −Rᵀt;
+// and views back in the camera's own axes from such a rotation with a translation or an eye.
+struct FilePose {
+    glm::dmat4 cvFromEyeAxes;
+    glm::dmat3 r;
+    glm::dvec3 t, eye;
+    static FilePose of(const Camera& camera)
+    {
+        FilePose out;
+        out.cvFromEyeAxes = cvFromEye(camera);
+        const glm::dmat4 cv = out.cvFromEyeAxes * camera.eyeFromWorld;
+        out.r = rotationOf(cv), out.t = glm::dvec3(cv[3]), out.eye = -(glm::transpose(out.r) * out.t);
+        return out;
+    }
+    glm::dmat4 withT(const glm::dmat3& rotation, const glm::dvec3& translation) const
+    {
+        return cvFromEyeAxes * viewOf(rotation, translation);
+    }
+    glm::dmat4 withEye(const glm::dmat3& rotation, const glm::dvec3& position) const
+    {
+        return withT(rotation, -(rotation * position));
+    }
+};
+
 std::vector<Mistake> buildCatalogue()
 {
     std::vector<Mistake> all;
@@ -258,26 +282,22 @@ std::vector<Mistake> buildCatalogue()
         "transposed-rotation", "the pose's rotation transposed (R used as Rᵀ: a row- vs column-major 3×3, or a "
                                "camera-to-world rotation used as world-to-camera)",
         [](const Camera& camera) {
-            const glm::dmat4 f = cvFromEye(camera), cv = f * camera.eyeFromWorld;
-            const glm::dmat3 r = rotationOf(cv);
-            const glm::dvec3 t(cv[3]), eye = -glm::transpose(r) * t;
-            const glm::dmat3 rt = glm::transpose(r);
+            const FilePose pose = FilePose::of(camera);
+            const glm::dmat3 rt = glm::transpose(pose.r);
             return std::vector<ViewVariant>{
                 {"translation kept", "consistent if the pose's rotation is transposed (R used as Rᵀ) and t kept: a "
-                                     "row- vs column-major rotation", f * viewOf(rt, t)},
+                                     "row- vs column-major rotation", pose.withT(rt, pose.t)},
                 {"eye kept", "consistent if the pose's rotation is transposed (R used as Rᵀ) with the eye where it "
-                             "is: a camera-to-world rotation used as world-to-camera", f * viewOf(rt, -rt * eye)}};
+                             "is: a camera-to-world rotation used as world-to-camera", pose.withEye(rt, pose.eye)}};
         }));
     all.push_back(otherViews(
         "quaternion-order", "a pose's quaternion read in the other component order (x y z w as w x y z, or the reverse)",
         [](const Camera& camera) {
-            const glm::dmat4 f = cvFromEye(camera), cv = f * camera.eyeFromWorld;
-            const glm::dmat3 r = rotationOf(cv);
-            const glm::dvec3 t(cv[3]), eye = -glm::transpose(r) * t;
+            const FilePose pose = FilePose::of(camera);
             std::vector<ViewVariant> out;
             for (const bool worldToCamera : {true, false})
                 for (const bool xyzwAsWxyz : {true, false}) {
-                    const glm::dmat3 stored = worldToCamera ? r : glm::transpose(r);
+                    const glm::dmat3 stored = worldToCamera ? pose.r : glm::transpose(pose.r);
                     const glm::dvec4 q = quaternionFromRotation(stored);  // w x y z in q[0..3]
                     // Stored x y z w and read as w x y z (w' = x, x' = y, y' = z, z' = w), or stored
                     // w x y z and read as x y z w (w' = z, x' = w, y' = x, z' = y): each undoes the
@@ -286,27 +306,25 @@ std::vector<Mistake> buildCatalogue()
                                                        : rotationFromQuaternion(q[3], q[0], q[1], q[2], "quaternion");
                     const glm::dmat3 rUsed = worldToCamera ? used : glm::transpose(used);
                     const std::string order = xyzwAsWxyz ? "x y z w read as w x y z" : "w x y z read as x y z w";
-                    const std::string pose = worldToCamera ? "world-to-camera" : "camera-to-world";
-                    out.push_back({pose + ", " + order,
-                                   "consistent if the " + pose + (worldToCamera ? " (COLMAP-style)" : " (TUM-style)") +
+                    const std::string stores = worldToCamera ? "world-to-camera" : "camera-to-world";
+                    out.push_back({stores + ", " + order,
+                                   "consistent if the " + stores + (worldToCamera ? " (COLMAP-style)" : " (TUM-style)") +
                                        " quaternion was read in the other order (" + order + ")",
-                                   f * (worldToCamera ? viewOf(rUsed, t) : viewOf(rUsed, -rUsed * eye))});
+                                   worldToCamera ? pose.withT(rUsed, pose.t) : pose.withEye(rUsed, pose.eye)});
                 }
             return out;
         }));
     all.push_back(otherViews(
         "pose-units", "the pose's translation in other units than the scene (millimetres or centimetres for metres)",
         [](const Camera& camera) {
-            const glm::dmat4 f = cvFromEye(camera), cv = f * camera.eyeFromWorld;
-            const glm::dmat3 r = rotationOf(cv);
-            const glm::dvec3 t(cv[3]), eye = -glm::transpose(r) * t;
+            const FilePose pose = FilePose::of(camera);
             std::vector<ViewVariant> out;
             for (const double k : {1000.0, 0.001, 100.0, 0.01}) {
                 out.push_back({"t " + factorText(k), "consistent if the world-to-camera translation t is " + factorText(k) +
-                                                         " (another unit than the scene's)", f * viewOf(r, k * t)});
+                                                         " (another unit than the scene's)", pose.withT(pose.r, k * pose.t)});
                 out.push_back({"eye " + factorText(k), "consistent if the eye position (a camera-to-world translation) is " +
                                                            factorText(k) + " (another unit than the scene's)",
-                               f * viewOf(r, -r * (k * eye))});
+                               pose.withEye(pose.r, k * pose.eye)});
             }
             return out;
         }));

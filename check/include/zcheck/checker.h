@@ -128,6 +128,13 @@ struct DepthMap {
 
     // A map of `quantity` as a file was read `reading`'s way, with what the reading declares.
     static DepthMap of(DepthMapFile file, DepthQuantity quantity, const DepthMapReading& reading);
+    // A map of values exact to their binary32 spacing, nothing declared (tests, arrays).
+    static DepthMap exact(int width, int height, DepthQuantity quantity, std::vector<double> values)
+    {
+        DepthMap map;
+        map.width = width, map.height = height, map.quantity = quantity, map.value = std::move(values);
+        return map;
+    }
     // A value as the file stored it (before scale and offset).
     double storedOf(double v) const { return (v - offset) * (scale > 0 ? scale : 1.0); }
     // Value i's: its step (its own, the file's, at least the declared quantum) and the declared accuracy.
