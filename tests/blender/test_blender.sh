@@ -4,7 +4,10 @@
 # camera object; an animated one) and an orthographic one (render_and_check.py);
 # zcheck.blender writes the manifest, and `zcheck dataset verify` must find every frame
 # consistent, and exactly the frames broken on purpose inconsistent: a camera's shift_x
-# written with the wrong sign, and a Z pass flipped upside down.
+# written with the wrong sign (and --diagnose must name it), and a Z pass flipped upside down.
+# Maps as pipelines deliver them, from the same renders: Cycles's 1e10 background undeclared
+# (rejected, diagnosed as the miss value) and Z passes rounded to millimetres (rejected,
+# diagnosed as a 0.001 grid, accepted with "quantum": 0.001).
 #
 #   PYTHONPATH=build/python bash tests/blender/test_blender.sh build/cli/zcheck ../shared/data/models
 #
@@ -202,6 +205,84 @@ if [[ $verify_status -eq 1 ]] && inconsistent "$tmp/results_z.jsonl" tall_0003; 
     pass "one Z pass flipped upside down: exactly that frame (tall_0003) inconsistent"
 else
     fail "one Z pass flipped upside down: exactly that frame (tall_0003) inconsistent (exit $verify_status)"
+fi
+
+# --- Cycles's own miss value, undeclared: every frame rejected, the diagnosis names it ----------
+python3 - "$out/manifest.jsonl" "$out/manifest_no_miss.jsonl" << 'EOF'
+import json, sys
+with open(sys.argv[1]) as src, open(sys.argv[2], "w") as dst:
+    for line in src:
+        record = json.loads(line)
+        record.pop("miss", None)
+        dst.write(json.dumps(record) + "\n")
+EOF
+set +e
+"$zcheck" dataset verify "$out/manifest_no_miss.jsonl" --scene "$out/scene.obj" --quantity eye-z --diagnose \
+    -o "$tmp/results_no_miss.jsonl" > /dev/null 2>&1
+status=$?
+set -e
+if [[ $status -eq 1 ]] && python3 - "$tmp/results_no_miss.jsonl" << 'EOF'; then
+import json, sys
+records = [json.loads(line) for line in open(sys.argv[1])]
+assert len(records) == 10 and not any(r["consistent"] for r in records)
+for r in records:
+    named = [h for h in r.get("diagnosis", []) if h["hypothesis"] == "miss-value" and h["consistent"]]
+    assert named and "--miss '>=1e9'" in named[0]["explanation"], (r["frame"], r.get("diagnosis"), r.get("closest"))
+print(f"      {records[0]['frame']}: {named[0]['explanation']}")
+EOF
+    pass "Cycles's 1e10 background without --miss: all 10 frames rejected, each diagnosed as its miss value"
+else
+    fail "Cycles's 1e10 background without --miss: all 10 frames rejected, each diagnosed as its miss value (exit $status)"
+fi
+
+# --- a Cycles Z pass rounded to millimetres (as a 16-bit pipeline stores it, read back as float
+# metres): rejected as exact, diagnosed as a 0.001 grid, accepted with quantum 0.001 --------------
+# (NumPy from Debian's python3, which the Python tests use too)
+numpy_python=/usr/bin/python3
+[[ -x $numpy_python ]] || numpy_python=python3
+"$numpy_python" - "$out" << 'EOF'
+import json, os, sys
+import numpy as np
+import zcheck
+out = sys.argv[1]
+records = [json.loads(line) for line in open(os.path.join(out, "manifest.jsonl"))]
+rounded = []
+for r in records:
+    if r["frame"] not in ("square_0001", "square_0004"):
+        continue
+    camera = zcheck.Camera.from_dict(r["camera"])
+    z = zcheck.read_depth_map(os.path.join(out, r["depth"]), camera, channel=r["channel"], miss=">=1e9")
+    mm = np.where(np.isfinite(z), np.round(z * 1000) / 1000, np.nan).astype(np.float32)
+    np.save(os.path.join(out, r["frame"] + "_mm.npy"), mm)
+    line = {k: v for k, v in r.items() if k not in ("channel", "miss")}
+    line["depth"] = r["frame"] + "_mm.npy"
+    rounded.append(line)
+with open(os.path.join(out, "manifest_mm.jsonl"), "w") as f:
+    f.writelines(json.dumps(line) + "\n" for line in rounded)
+with open(os.path.join(out, "manifest_mm_declared.jsonl"), "w") as f:
+    f.writelines(json.dumps({**line, "quantum": 0.001}) + "\n" for line in rounded)
+EOF
+set +e
+"$zcheck" dataset verify "$out/manifest_mm.jsonl" --scene "$out/scene.obj" --quantity eye-z --diagnose \
+    -o "$tmp/results_mm.jsonl" > /dev/null 2>&1
+rounded_status=$?
+"$zcheck" dataset verify "$out/manifest_mm_declared.jsonl" --scene "$out/scene.obj" --quantity eye-z \
+    -o "$tmp/results_mm_declared.jsonl" > /dev/null 2>&1
+declared_status=$?
+set -e
+if [[ $rounded_status -eq 1 && $declared_status -eq 0 ]] && python3 - "$tmp/results_mm.jsonl" << 'EOF'; then
+import json, sys
+records = [json.loads(line) for line in open(sys.argv[1])]
+assert len(records) == 2 and not any(r["consistent"] for r in records)
+for r in records:
+    named = [h for h in r.get("diagnosis", []) if h["hypothesis"] == "quantum" and h["consistent"]]
+    assert named and "--quantum 0.001" in named[0]["explanation"], (r["frame"], r.get("diagnosis"), r.get("closest"))
+    print(f"      {r['frame']}: {named[0]['explanation']}; worst {r['map_errors']['max_abs']:.6f} m")
+EOF
+    pass "Cycles's Z pass rounded to millimetres: rejected, diagnosed as a 0.001 grid, accepted with quantum 0.001"
+else
+    fail "Cycles's Z pass rounded to millimetres: rejected, diagnosed as a 0.001 grid, accepted with quantum 0.001" \
+        "(exits $rounded_status, $declared_status)"
 fi
 
 finish
