@@ -204,7 +204,7 @@ void addAccuracyOptions(CLI::App* command, MapAccuracy& accuracy)
         ->group(group);
     command->add_option("--rel-tolerance", accuracy.relative,
                         "values are good only to this fraction of themselves (a rasterizer's reconstructed Z pass:\n"
-                        "5e-4); added to every pixel's tolerance")
+                        "1e-3 for Blender's Eevee); added to every pixel's tolerance")
         ->check(kBelowOne)
         ->group(group);
     command->add_option("--abs-tolerance", accuracy.absolute,

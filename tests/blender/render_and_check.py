@@ -65,6 +65,7 @@ RESOLUTION = (320, 240)
 PERCENTAGE = 50
 PIXEL_ASPECTS = {"tall": (1.0, 1.4), "square": (1.0, 1.0)}
 FRAMES = [1, 2, 3, 4, 5]
+EEVEE_FRAMES = [1, 4]
 TARGET = (0.0, 0.0, 0.8)
 MAX_PROJECTION_DIFFERENCE_PX = 1e-3
 ALLOWED_SAMPLE_OFFSET_PX = 2.0 ** -8  # zcheck verify's S (README, "zcheck verify")
@@ -382,6 +383,24 @@ def main():
                                                     **options)
         finally:
             cameras["B"].data.shift_x = -cameras["B"].data.shift_x
+
+    # Eevee, the rasterizer, through the same square-pixel cameras (frames 1 and 4, perspective):
+    # its Z pass is reconstructed from a depth buffer, and nothing hit is stored as it stores it.
+    # The manifest declares nothing: the test asks what verify and its diagnosis make of it.
+    scene.render.engine = "BLENDER_EEVEE"
+    scene.eevee.taa_render_samples = 1
+    eevee_folder = os.path.join(outdir, "eevee")
+    os.makedirs(eevee_folder, exist_ok=True)
+    for frame in EEVEE_FRAMES:
+        scene.frame_set(frame)
+        scene.render.filepath = os.path.join(eevee_folder, f"depth_{frame:04d}.exr")
+        bpy.ops.render.render(write_still=True)
+        if not os.path.isfile(scene.render.filepath):
+            raise RuntimeError(f"Eevee frame {frame}: Blender wrote no {scene.render.filepath}")
+    zcheck.blender.write_cameras(os.path.join(outdir, "manifest_eevee.jsonl"), EEVEE_FRAMES, scene=scene,
+                                 depth="eevee/depth_{frame:04d}.exr", quantity="eye-z",
+                                 channel="ViewLayer.Depth.Z", name="eevee_{frame:04d}")
+    print("render_and_check: Eevee rendered frames " + ", ".join(map(str, EEVEE_FRAMES)), flush=True)
 
     for name, records in (("manifest.jsonl", manifest), ("manifest_shift_flipped.jsonl", flipped)):
         with open(os.path.join(outdir, name), "w") as out:

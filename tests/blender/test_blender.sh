@@ -7,7 +7,9 @@
 # written with the wrong sign (and --diagnose must name it), and a Z pass flipped upside down.
 # Maps as pipelines deliver them, from the same renders: Cycles's 1e10 background undeclared
 # (rejected, diagnosed as the miss value) and Z passes rounded to millimetres (rejected,
-# diagnosed as a 0.001 grid, accepted with "quantum": 0.001).
+# diagnosed as a 0.001 grid, accepted with "quantum": 0.001); and Eevee's reconstructed Z pass
+# (rejected as exact and diagnosed, accepted with --miss 65504 --rel-tolerance 1e-3, still
+# rejected when flipped).
 #
 #   PYTHONPATH=build/python bash tests/blender/test_blender.sh build/cli/zcheck ../shared/data/models
 #
@@ -283,6 +285,48 @@ EOF
 else
     fail "Cycles's Z pass rounded to millimetres: rejected, diagnosed as a 0.001 grid, accepted with quantum 0.001" \
         "(exits $rounded_status, $declared_status)"
+fi
+
+# --- Eevee, the rasterizer: its reconstructed Z pass as it comes ----------------------------------
+# Undeclared, rejected, and the diagnosis names what to declare (its 65504 where nothing is hit,
+# its accuracy); declared as a user would (--miss 65504 --rel-tolerance 1e-3), accepted; and the
+# same declaration does not hide a convention mistake: a flipped Z pass is rejected, named y-flip.
+eevee_verify() {  # MANIFEST RESULTS OPTIONS...: its exit status in $eevee_status
+    local manifest=$1 results=$2
+    shift 2
+    set +e
+    "$zcheck" dataset verify "$manifest" --scene "$out/scene.obj" --quantity eye-z "$@" -o "$results" > /dev/null 2>&1
+    eevee_status=$?
+    set -e
+}
+eevee_verify "$out/manifest_eevee.jsonl" "$tmp/results_eevee_exact.jsonl" --diagnose
+exact_status=$eevee_status
+eevee_verify "$out/manifest_eevee.jsonl" "$tmp/results_eevee_declared.jsonl" --miss 65504 --rel-tolerance 1e-3
+declared_status=$eevee_status
+oiiotool "$out/eevee/depth_0001.exr" --flip -o "$out/eevee/depth_0001_flipped.exr"
+sed 's#eevee/depth_0001.exr#eevee/depth_0001_flipped.exr#' "$out/manifest_eevee.jsonl" | grep eevee_0001 > "$out/manifest_eevee_flipped.jsonl"
+eevee_verify "$out/manifest_eevee_flipped.jsonl" "$tmp/results_eevee_flipped.jsonl" --miss 65504 --rel-tolerance 1e-3 --diagnose
+flipped_status=$eevee_status
+if [[ $exact_status -eq 1 && $declared_status -eq 0 && $flipped_status -eq 1 ]] &&
+    python3 - "$tmp/results_eevee_exact.jsonl" "$tmp/results_eevee_declared.jsonl" "$tmp/results_eevee_flipped.jsonl" << 'EOF'; then
+import json, sys
+exact, declared, flipped = ([json.loads(line) for line in open(path)] for path in sys.argv[1:4])
+assert len(exact) == len(declared) == 2 and len(flipped) == 1
+for r in exact:
+    named = [h for h in r.get("diagnosis", []) if h["consistent"]]
+    assert named and "miss-value" in named[0]["hypothesis"] and "--miss '65504'" in named[0]["explanation"], (r["frame"], named)
+    print(f"      {r['frame']} as exact: {named[0]['hypothesis']}")
+for r in declared:
+    e = r["map_errors"]
+    print(f"      {r['frame']} declared: relative error median {e['median_rel']:.2g}, p99 {e['p99_rel']:.2g}, max {e['max_rel']:.2g}")
+    assert r["consistent"] and e["p99_rel"] <= 1e-3 and e["median_rel"] > 1e-5, e  # good to 1e-3, not exact
+named = [h["hypothesis"] for h in flipped[0].get("diagnosis", []) if h["consistent"]]
+assert not flipped[0]["consistent"] and named and named[0] == "y-flip", named
+EOF
+    pass "Eevee's Z pass: rejected as exact (65504 and its accuracy named), accepted as declared, flipped named y-flip"
+else
+    fail "Eevee's Z pass: rejected as exact (65504 and its accuracy named), accepted as declared, flipped named y-flip" \
+        "(exits $exact_status, $declared_status, $flipped_status)"
 fi
 
 finish
