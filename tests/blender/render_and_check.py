@@ -387,20 +387,25 @@ def main():
     # Eevee, the rasterizer, through the same square-pixel cameras (frames 1 and 4, perspective):
     # its Z pass is reconstructed from a depth buffer, and nothing hit is stored as it stores it.
     # The manifest declares nothing: the test asks what verify and its diagnosis make of it.
-    scene.render.engine = "BLENDER_EEVEE"
-    scene.eevee.taa_render_samples = 1
-    eevee_folder = os.path.join(outdir, "eevee")
-    os.makedirs(eevee_folder, exist_ok=True)
-    for frame in EEVEE_FRAMES:
-        scene.frame_set(frame)
-        scene.render.filepath = os.path.join(eevee_folder, f"depth_{frame:04d}.exr")
-        bpy.ops.render.render(write_still=True)
-        if not os.path.isfile(scene.render.filepath):
-            raise RuntimeError(f"Eevee frame {frame}: Blender wrote no {scene.render.filepath}")
-    zcheck.blender.write_cameras(os.path.join(outdir, "manifest_eevee.jsonl"), EEVEE_FRAMES, scene=scene,
-                                 depth="eevee/depth_{frame:04d}.exr", quantity="eye-z",
-                                 channel="ViewLayer.Depth.Z", name="eevee_{frame:04d}")
-    print("render_and_check: Eevee rendered frames " + ", ".join(map(str, EEVEE_FRAMES)), flush=True)
+    # Eevee needs an OpenGL context (Mesa's, headless): where Blender has none, the test says so
+    # and skips these frames (no manifest_eevee.jsonl) rather than failing the Cycles checks.
+    try:
+        scene.render.engine = "BLENDER_EEVEE"
+        scene.eevee.taa_render_samples = 1
+        eevee_folder = os.path.join(outdir, "eevee")
+        os.makedirs(eevee_folder, exist_ok=True)
+        for frame in EEVEE_FRAMES:
+            scene.frame_set(frame)
+            scene.render.filepath = os.path.join(eevee_folder, f"depth_{frame:04d}.exr")
+            bpy.ops.render.render(write_still=True)
+            if not os.path.isfile(scene.render.filepath):
+                raise RuntimeError(f"frame {frame}: Blender wrote no {scene.render.filepath}")
+        zcheck.blender.write_cameras(os.path.join(outdir, "manifest_eevee.jsonl"), EEVEE_FRAMES, scene=scene,
+                                     depth="eevee/depth_{frame:04d}.exr", quantity="eye-z",
+                                     channel="ViewLayer.Depth.Z", name="eevee_{frame:04d}")
+        print("render_and_check: Eevee rendered frames " + ", ".join(map(str, EEVEE_FRAMES)), flush=True)
+    except Exception as e:  # noqa: BLE001 - any failure of the engine is reported, not fatal
+        print(f"render_and_check: Eevee could not render here: {e}", flush=True)
 
     for name, records in (("manifest.jsonl", manifest), ("manifest_shift_flipped.jsonl", flipped)):
         with open(os.path.join(outdir, name), "w") as out:
