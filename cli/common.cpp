@@ -20,28 +20,28 @@ CLI::Validator nonEmpty(const std::string& what, const std::string& description)
         [what](std::string& value) { return value.empty() ? "the " + what + " is empty" : std::string(); }, description);
 }
 
+// A number (all of the text) for which `holds` is true; else "'x' is not a number" or
+// "must be <rule>, got 'x'".
+CLI::Validator number(bool (*holds)(double), const std::string& rule, const std::string& description)
+{
+    return CLI::Validator(
+        [holds, rule](std::string& value) {
+            char* end = nullptr;
+            const double v = std::strtod(value.c_str(), &end);
+            if (value.empty() || *end != '\0') return "'" + value + "' is not a number";
+            if (!holds(v)) return "must be " + rule + ", got '" + value + "'";
+            return std::string();
+        },
+        description);
+}
+
 }  // namespace
 
 const CLI::Validator kNonEmptyPath = nonEmpty("path", "PATH");
 const CLI::Validator kNonEmptyList = nonEmpty("list", "LIST");
-const CLI::Validator kPositiveFinite(
-    [](std::string& value) {
-        char* end = nullptr;
-        const double v = std::strtod(value.c_str(), &end);
-        if (value.empty() || *end != '\0') return "'" + value + "' is not a number";
-        if (!std::isfinite(v) || !(v > 0)) return "must be a positive finite number, got '" + value + "'";
-        return std::string();
-    },
-    "NUMBER > 0");
-const CLI::Validator kBelowOne(
-    [](std::string& value) {
-        char* end = nullptr;
-        const double v = std::strtod(value.c_str(), &end);
-        if (value.empty() || *end != '\0') return "'" + value + "' is not a number";
-        if (!(v > 0 && v < 1)) return "must be a number in (0, 1), got '" + value + "'";
-        return std::string();
-    },
-    "0 < NUMBER < 1");
+const CLI::Validator kPositiveFinite = number([](double v) { return std::isfinite(v) && v > 0; },
+                                               "a positive finite number", "NUMBER > 0");
+const CLI::Validator kBelowOne = number([](double v) { return v > 0 && v < 1; }, "a number in (0, 1)", "0 < NUMBER < 1");
 const CLI::Range kThreadRange(1, 1024);
 const CLI::Range kImageSideRange(1, 16384);
 

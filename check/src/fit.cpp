@@ -53,11 +53,11 @@ struct Sample {
     double tolerance = 0;        // the comparison's tolerance there (withTolerances), as a relative eye-z change
 };
 
-// The model: where camera c's ray through the sample's pixel centre meets the sample's plane,
-// in c's eye space.
-glm::dvec3 eyePointOnPlane(const Camera& c, const Sample& s)
+// The model: where camera c's ray through the sample's pixel centre (moved by `offset`, window
+// pixels) meets the sample's plane, in c's eye space.
+glm::dvec3 eyePointOnPlane(const Camera& c, const Sample& s, const glm::dvec2& offset = glm::dvec2(0.0))
 {
-    const EyePlaneRay ray = worldEyePlaneRayThroughWindow(c, windowFromPixelCentre(c, s.col, s.row));
+    const EyePlaneRay ray = worldEyePlaneRayThroughWindow(c, windowFromPixelCentre(c, s.col, s.row) + offset);
     const double t = (s.offset - glm::dot(s.normal, ray.origin)) / glm::dot(s.normal, ray.direction);
     return glm::dvec3(c.eyeFromWorld * glm::dvec4(ray.origin + t * ray.direction, 1.0));
 }
@@ -680,13 +680,8 @@ FitResult fitDeparture(const Scene& scene, const Camera& camera, const DepthMap&
             const glm::dvec2 along = windowFromImageOffset(camera, d.sampleOffset.x != 0 ? glm::dvec2(1, 0) : glm::dvec2(0, 1));
             std::vector<Sample> telling;
             for (const Sample& sample : problem.samples) {
-                const glm::dvec2 centre = windowFromPixelCentre(departed, sample.col, sample.row);
-                auto eyeZAt = [&](const glm::dvec2& pWindow) {
-                    const EyePlaneRay ray = worldEyePlaneRayThroughWindow(departed, pWindow);
-                    const double t = (sample.offset - glm::dot(sample.normal, ray.origin)) / glm::dot(sample.normal, ray.direction);
-                    return departed.eyeZOf(glm::dvec3(departed.eyeFromWorld * glm::dvec4(ray.origin + t * ray.direction, 1.0)));
-                };
-                const double before = eyeZAt(centre - 0.5 * along), after = eyeZAt(centre + 0.5 * along);
+                const double before = departed.eyeZOf(eyePointOnPlane(departed, sample, -0.5 * along));
+                const double after = departed.eyeZOf(eyePointOnPlane(departed, sample, 0.5 * along));
                 if (std::abs(after - before) > 1e-3 * std::abs(after + before) / 2) telling.push_back(sample);
             }
             if (telling.size() >= 64) problem.samples = std::move(telling);

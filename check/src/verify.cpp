@@ -24,7 +24,9 @@ namespace {
 
 // Window depths of map values at one window point (NaN for a miss), with eyePointFromDepth's
 // arithmetic; the viewing ray is built once for the point, however many values are read there
-// (a value and its neighbour one storage step away).
+// (a value and its neighbour one storage step away). Misses are kindOfDepthValue's; a window or
+// NDC value out of range keeps its depth for the comparison to judge, a negative eye-z or
+// distance has none.
 class WindowDepthAt {
 public:
     WindowDepthAt(const Camera& camera, const glm::dvec2& pWindow, DepthQuantity quantity)
@@ -34,23 +36,19 @@ public:
 
     double operator()(double value)
     {
-        if (!std::isfinite(value)) return NAN;
+        const DepthValueKind kind = kindOfDepthValue(camera_, quantity_, value);
+        const bool linear = quantity_ == DepthQuantity::EyeZ || quantity_ == DepthQuantity::Distance;
+        if (kind == DepthValueKind::Miss || (kind == DepthValueKind::OutOfRange && linear)) return NAN;
         switch (quantity_) {
-        case DepthQuantity::Window:
-            return value == camera_.clearDepth() || value == camera_.windowDepthFar() ? NAN : value;
-        case DepthQuantity::Ndc: {
-            const double window = camera_.windowDepthFromNdcZ(value);
-            if (window == camera_.clearDepth() || window == camera_.windowDepthFar()) return NAN;
-            return windowFromEye(camera_, eyeFromWindow(camera_, {pWindow_, window})).z;
-        }
+        case DepthQuantity::Window: return value;
+        case DepthQuantity::Ndc:
+            return windowFromEye(camera_, eyeFromWindow(camera_, {pWindow_, camera_.windowDepthFromNdcZ(value)})).z;
         case DepthQuantity::EyeZ: {
-            if (!(value > 0)) return NAN;
             const Ray& r = ray();
             const double t = (value - camera_.eyeZOf(r.origin)) / camera_.eyeZOf(r.direction);
             return windowFromEye(camera_, r.origin + t * r.direction).z;
         }
         case DepthQuantity::Distance: {
-            if (!(value > 0)) return NAN;
             if (!planeRay_) planeRay_ = eyePlaneRayFrom(ray());
             return windowFromEye(camera_, planeRay_->origin + value * planeRay_->direction).z;
         }
@@ -373,11 +371,11 @@ void countOutOfRange(const Camera& camera, const DepthMap& map, ComparisonReport
 
 void requireDepthsInRange(const Camera& camera, const DepthMap& map, const std::string& name)
 {
-    ComparisonReport count;
-    countOutOfRange(camera, map, count);
-    if (count.outOfRange == 0) return;
     for (const double v : map.value)
         if (kindOfDepthValue(camera, map.quantity, v) == DepthValueKind::Depth) return;
+    ComparisonReport count;  // only misses and values out of range: which, and where the first is
+    countOutOfRange(camera, map, count);
+    if (count.outOfRange == 0) return;
     throw Error(name + ": it holds no " + toString(map.quantity) + " depth — " + std::to_string(count.outOfRange) +
                 " values lie outside " + depthValueRange(camera, map.quantity) +
                 " (e.g. " + formatNumber(count.outOfRangeValue) + " at pixel (" + std::to_string(count.outOfRangeCol) +

@@ -143,6 +143,31 @@ assert found == expected, f"inconsistent frames {sorted(found)}, expected {sorte
 EOF
 }
 
+# quietly MANIFEST RESULTS OPTIONS...: `zcheck dataset verify` of the Blender scene's eye-z, its
+# output dropped; its exit status in $quiet_status.
+quietly() {
+    local manifest=$1 results=$2
+    shift 2
+    set +e
+    "$zcheck" dataset verify "$manifest" --scene "$out/scene.obj" --quantity eye-z "$@" -o "$results" > /dev/null 2>&1
+    quiet_status=$?
+    set -e
+}
+# diagnosed RESULTS FRAMES HYPOTHESIS PHRASE: FRAMES records, none consistent, each with a consistent
+# HYPOTHESIS whose explanation holds PHRASE (printed with the frame's worst error).
+diagnosed() {
+    python3 - "$@" << 'EOF'
+import json, sys
+path, frames, hypothesis, phrase = sys.argv[1], int(sys.argv[2]), sys.argv[3], sys.argv[4]
+records = [json.loads(line) for line in open(path)]
+assert len(records) == frames and not any(r["consistent"] for r in records), [r["frame"] for r in records]
+for r in records:
+    named = [h for h in r.get("diagnosis", []) if h["hypothesis"] == hypothesis and h["consistent"]]
+    assert named and phrase in named[0]["explanation"], (r["frame"], r.get("diagnosis"), r.get("closest"))
+    print(f"      {r['frame']}: {named[0]['explanation']}; worst {r['map_errors']['max_abs']:.6g}")
+EOF
+}
+
 # --- every frame as rendered: consistent -------------------------------------------------------
 verify "$out/manifest.jsonl" "$tmp/results.jsonl"
 if [[ $verify_status -eq 0 ]] && inconsistent "$tmp/results.jsonl"; then
@@ -163,11 +188,8 @@ fi
 # --- and --diagnose names the mistake ----------------------------------------------------------
 # The shift moved cx by 2 · 0.05 · viewfac px (12 px with square pixels, 16.8 with tall ones) to
 # W - cx: the principal point mirrored in x.
-set +e
-"$zcheck" dataset verify "$out/manifest_shift_flipped.jsonl" --scene "$out/scene.obj" --quantity eye-z --miss '>=1e9' \
-    --diagnose -o "$tmp/results_shift_diagnosed.jsonl" > /dev/null 2>&1
-set -e
-if python3 - "$out/manifest.jsonl" "$out/manifest_shift_flipped.jsonl" "$tmp/results_shift_diagnosed.jsonl" << 'EOF'; then
+quietly "$out/manifest_shift_flipped.jsonl" "$tmp/results_shift_diagnosed.jsonl" --miss '>=1e9' --diagnose
+if [[ $quiet_status -eq 1 ]] && python3 - "$out/manifest.jsonl" "$out/manifest_shift_flipped.jsonl" "$tmp/results_shift_diagnosed.jsonl" << 'EOF'; then
 import json, sys
 true_cams = {r["frame"]: r["camera"] for r in map(json.loads, open(sys.argv[1]))}
 declared = {r["frame"]: r["camera"] for r in map(json.loads, open(sys.argv[2]))}
@@ -218,23 +240,11 @@ with open(sys.argv[1]) as src, open(sys.argv[2], "w") as dst:
         record.pop("miss", None)
         dst.write(json.dumps(record) + "\n")
 EOF
-set +e
-"$zcheck" dataset verify "$out/manifest_no_miss.jsonl" --scene "$out/scene.obj" --quantity eye-z --diagnose \
-    -o "$tmp/results_no_miss.jsonl" > /dev/null 2>&1
-status=$?
-set -e
-if [[ $status -eq 1 ]] && python3 - "$tmp/results_no_miss.jsonl" << 'EOF'; then
-import json, sys
-records = [json.loads(line) for line in open(sys.argv[1])]
-assert len(records) == 10 and not any(r["consistent"] for r in records)
-for r in records:
-    named = [h for h in r.get("diagnosis", []) if h["hypothesis"] == "miss-value" and h["consistent"]]
-    assert named and "--miss '>=1e9'" in named[0]["explanation"], (r["frame"], r.get("diagnosis"), r.get("closest"))
-print(f"      {records[0]['frame']}: {named[0]['explanation']}")
-EOF
+quietly "$out/manifest_no_miss.jsonl" "$tmp/results_no_miss.jsonl" --diagnose
+if [[ $quiet_status -eq 1 ]] && diagnosed "$tmp/results_no_miss.jsonl" 10 miss-value "--miss '>=1e9'"; then
     pass "Cycles's 1e10 background without --miss: all 10 frames rejected, each diagnosed as its miss value"
 else
-    fail "Cycles's 1e10 background without --miss: all 10 frames rejected, each diagnosed as its miss value (exit $status)"
+    fail "Cycles's 1e10 background without --miss: all 10 frames rejected, each diagnosed as its miss value (exit $quiet_status)"
 fi
 
 # --- a Cycles Z pass rounded to millimetres (as a 16-bit pipeline stores it, read back as float
@@ -264,23 +274,11 @@ with open(os.path.join(out, "manifest_mm.jsonl"), "w") as f:
 with open(os.path.join(out, "manifest_mm_declared.jsonl"), "w") as f:
     f.writelines(json.dumps({**line, "quantum": 0.001}) + "\n" for line in rounded)
 EOF
-set +e
-"$zcheck" dataset verify "$out/manifest_mm.jsonl" --scene "$out/scene.obj" --quantity eye-z --diagnose \
-    -o "$tmp/results_mm.jsonl" > /dev/null 2>&1
-rounded_status=$?
-"$zcheck" dataset verify "$out/manifest_mm_declared.jsonl" --scene "$out/scene.obj" --quantity eye-z \
-    -o "$tmp/results_mm_declared.jsonl" > /dev/null 2>&1
-declared_status=$?
-set -e
-if [[ $rounded_status -eq 1 && $declared_status -eq 0 ]] && python3 - "$tmp/results_mm.jsonl" << 'EOF'; then
-import json, sys
-records = [json.loads(line) for line in open(sys.argv[1])]
-assert len(records) == 2 and not any(r["consistent"] for r in records)
-for r in records:
-    named = [h for h in r.get("diagnosis", []) if h["hypothesis"] == "quantum" and h["consistent"]]
-    assert named and "--quantum 0.001" in named[0]["explanation"], (r["frame"], r.get("diagnosis"), r.get("closest"))
-    print(f"      {r['frame']}: {named[0]['explanation']}; worst {r['map_errors']['max_abs']:.6f} m")
-EOF
+quietly "$out/manifest_mm.jsonl" "$tmp/results_mm.jsonl" --diagnose
+rounded_status=$quiet_status
+quietly "$out/manifest_mm_declared.jsonl" "$tmp/results_mm_declared.jsonl"
+declared_status=$quiet_status
+if [[ $rounded_status -eq 1 && $declared_status -eq 0 ]] && diagnosed "$tmp/results_mm.jsonl" 2 quantum "--quantum 0.001"; then
     pass "Cycles's Z pass rounded to millimetres: rejected, diagnosed as a 0.001 grid, accepted with quantum 0.001"
 else
     fail "Cycles's Z pass rounded to millimetres: rejected, diagnosed as a 0.001 grid, accepted with quantum 0.001" \
@@ -291,26 +289,18 @@ fi
 # Undeclared, rejected, and the diagnosis names what to declare (its 65504 where nothing is hit,
 # its accuracy); declared as a user would (--miss 65504 --rel-tolerance 1e-3), accepted; and the
 # same declaration does not hide a convention mistake: a flipped Z pass is rejected, named y-flip.
-eevee_verify() {  # MANIFEST RESULTS OPTIONS...: its exit status in $eevee_status
-    local manifest=$1 results=$2
-    shift 2
-    set +e
-    "$zcheck" dataset verify "$manifest" --scene "$out/scene.obj" --quantity eye-z "$@" -o "$results" > /dev/null 2>&1
-    eevee_status=$?
-    set -e
-}
 if [[ ! -s $out/manifest_eevee.jsonl ]]; then
     echo "skip  Eevee's Z pass: Eevee could not render on this machine (render_and_check's log above says why)"
     finish
 fi
-eevee_verify "$out/manifest_eevee.jsonl" "$tmp/results_eevee_exact.jsonl" --diagnose
-exact_status=$eevee_status
-eevee_verify "$out/manifest_eevee.jsonl" "$tmp/results_eevee_declared.jsonl" --miss 65504 --rel-tolerance 1e-3
-declared_status=$eevee_status
+quietly "$out/manifest_eevee.jsonl" "$tmp/results_eevee_exact.jsonl" --diagnose
+exact_status=$quiet_status
+quietly "$out/manifest_eevee.jsonl" "$tmp/results_eevee_declared.jsonl" --miss 65504 --rel-tolerance 1e-3
+declared_status=$quiet_status
 oiiotool "$out/eevee/depth_0001.exr" --flip -o "$out/eevee/depth_0001_flipped.exr"
 sed 's#eevee/depth_0001.exr#eevee/depth_0001_flipped.exr#' "$out/manifest_eevee.jsonl" | grep eevee_0001 > "$out/manifest_eevee_flipped.jsonl"
-eevee_verify "$out/manifest_eevee_flipped.jsonl" "$tmp/results_eevee_flipped.jsonl" --miss 65504 --rel-tolerance 1e-3 --diagnose
-flipped_status=$eevee_status
+quietly "$out/manifest_eevee_flipped.jsonl" "$tmp/results_eevee_flipped.jsonl" --miss 65504 --rel-tolerance 1e-3 --diagnose
+flipped_status=$quiet_status
 if [[ $exact_status -eq 1 && $declared_status -eq 0 && $flipped_status -eq 1 ]] &&
     python3 - "$tmp/results_eevee_exact.jsonl" "$tmp/results_eevee_declared.jsonl" "$tmp/results_eevee_flipped.jsonl" << 'EOF'; then
 import json, sys
