@@ -7,7 +7,7 @@ set -euo pipefail
 packages=(cmake ninja-build g++ pkg-config python3
           libembree-dev libglm-dev libopenimageio-dev openimageio-tools catch2 libtbb-dev
           libcli11-dev nlohmann-json3-dev libpng-dev libhdf5-dev
-          pybind11-dev python3-dev python3-numpy python3-pytest
+          pybind11-dev python3-dev python3-numpy python3-pytest python3-venv
           libegl-dev libgl1-mesa-dri)  # the llvmpipe yardstick of `zcheck bench --reference`
 if [[ ${1:-} == --test ]]; then
     packages+=(colmap blender slurm-wlm munge python3-h5py)
