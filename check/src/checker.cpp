@@ -3,7 +3,6 @@
 
 #include "zcheck/error.h"
 #include "zcheck/export.h"
-#include "zcheck/verify.h"
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -152,12 +151,6 @@ QuantityImage Checker::render(const Camera& camera, ExportQuantity quantity, Rou
     // The ray route's eye-space points are exact: exports of eye-z, distance and positions read them.
     const RenderResult drawn = route == Route::Ray ? renderRay(camera, {}, EyePoints::Keep) : renderRaster(camera);
     return quantityImage(scene_, camera, drawn, quantity);
-}
-
-const VertexNeighbours& Checker::neighbours() const
-{
-    std::call_once(neighboursOnce_, [&] { neighbours_ = std::make_unique<VertexNeighbours>(scene_, &rays_, &raster_); });
-    return *neighbours_;
 }
 
 }  // namespace zcheck

@@ -230,7 +230,7 @@ private:
     RayRenderer rays_;
     RasterRenderer raster_;
     mutable std::once_flag neighboursOnce_;
-    mutable std::unique_ptr<VertexNeighbours> neighbours_;
+    mutable std::shared_ptr<const VertexNeighbours> neighbours_;  // built in zcheck::diagnose (verify.cpp)
 };
 
 }  // namespace zcheck

@@ -457,6 +457,12 @@ void measureMapErrors(const Camera& camera, const DepthMap& map, VerifyResult& r
     e.maxRel = relative.empty() ? 0 : *std::max_element(relative.begin(), relative.end());
 }
 
+const VertexNeighbours& Checker::neighbours() const
+{
+    std::call_once(neighboursOnce_, [&] { neighbours_ = std::make_shared<const VertexNeighbours>(scene_, &rays_, &raster_); });
+    return *neighbours_;
+}
+
 VerifyResult Checker::verify(const Camera& camera, const DepthMap& map) const
 {
     VerifyResult run = verifyAgainst(scene_, camera, map, renderRay(camera), neighbours());
