@@ -5,6 +5,7 @@
 
 #include "zcheck/mesh_loader.h"
 #include "zcheck/report.h"
+#include "zcheck/verify_map.h"
 
 #include <iostream>
 
@@ -44,14 +45,16 @@ int runVerifyCommand(const VerifyOptions& o)
     DepthMapFile& file = made.map;
     const DepthMap map = DepthMap::of(file, quantity, reading);
     const Checker checker(std::move(scene));
-    const VerifyOutcome verified =
-        verifyAndReport(checker, camera, map, {o.depthMap, quantityName, file.channel, reading}, o.diagnose);
+    const MapVerifier verifier(checker);
+    const DepthMapSource source{o.depthMap, quantityName, file.channel, reading};
+    const VerifiedMap verified = verifyMap(verifier, camera, map, o.diagnose, source.name());
+    const VerificationReport report = formatVerification(verified, source);
     const VerifyResult& run = verified.run;
     if (!o.outDir.empty()) {
-        folder.write(outputs, run.truth, run.map, run.comparison, verified.json, run.mapError);
+        folder.write(outputs, run.truth, run.map, run.comparison, report.json, run.mapError);
         outputs.commit();
     }
-    std::cout << (o.json ? verified.json : verified.summary) << (o.json ? "\n" : "");
+    std::cout << (o.json ? report.json : report.summary) << (o.json ? "\n" : "");
     return run.comparison.report.consistent() ? kExitConsistent : kExitInconsistent;
 }
 

@@ -3,6 +3,7 @@
 // and whether the diagnosis names that mistake.
 #include "zcheck/checker.h"
 #include "zcheck/export.h"
+#include "zcheck/map_verifier.h"
 #include "zcheck/mistakes.h"
 
 #include <algorithm>
@@ -50,9 +51,9 @@ inline bool anyHit(const RenderResult& render)
 }
 
 // Whether one of the diagnosis's consistent hypotheses is `name`.
-inline bool diagnosedAs(const Checker& checker, const Camera& camera, const DepthMap& map, const std::string& name)
+inline bool diagnosedAs(const MapVerifier& verifier, const Camera& camera, const DepthMap& map, const std::string& name)
 {
-    for (const Hypothesis& h : checker.diagnose(camera, map))
+    for (const Hypothesis& h : verifier.diagnose(camera, map))
         if (h.consistent && h.name == name) return true;
     return false;
 }

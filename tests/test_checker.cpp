@@ -4,6 +4,7 @@
 #include "zcheck/camera_file.h"
 #include "zcheck/error.h"
 #include "zcheck/kernel_choice.h"
+#include "zcheck/map_verifier.h"
 #include "zcheck/mistakes.h"
 #include "zcheck/percentile.h"
 #include "zcheck/report.h"
@@ -67,6 +68,7 @@ std::vector<CheckOptions> cleanFlippedAndBiased()
 TEST_CASE("one Checker used from several threads at once gives each the same answer", "[checker][threads]")
 {
     const Checker checker(builtinScene("builtin:default"));
+    const MapVerifier verifier(checker);
     const Camera camera(smallCamera(checker.scene()));
     const CheckResult alone = checker.check(camera);
     REQUIRE(alone.report.comparison.consistent());
@@ -78,7 +80,7 @@ TEST_CASE("one Checker used from several threads at once gives each the same ans
     for (std::size_t k = 0; k < results.size(); ++k)
         threads.emplace_back([&, k] {
             results[k] = checker.check(camera);
-            verified[k] = checker.verify(camera, map);  // builds the vertex index once, under call_once
+            verified[k] = verifier.verify(camera, map);  // builds the vertex index once, under call_once
         });
     for (auto& thread : threads) thread.join();
     for (std::size_t k = 0; k < results.size(); ++k) {
@@ -127,6 +129,7 @@ TEST_CASE("a map rendered under a mistake is diagnosed as that mistake, for ever
           "[checker][mistakes][diagnose]")
 {
     const Checker checker(builtinScene("builtin:default"));
+    const MapVerifier verifier(checker);
     CameraSpec spec = smallCamera(checker.scene());
     spec.convention = Convention::preset("vulkan");
     const Camera camera(spec);
@@ -140,8 +143,8 @@ TEST_CASE("a map rendered under a mistake is diagnosed as that mistake, for ever
         // turned away, a transposed projection): the diagnosis names none (test below).
         if (!testing::anyHit(wrong)) continue;
         const DepthMap map = testing::windowMapOf(camera, wrong);
-        if (checker.verify(camera, map).comparison.report.consistent()) continue;  // invisible here
-        const bool named = testing::diagnosedAs(checker, camera, map, mistake.name);
+        if (verifier.verify(camera, map).comparison.report.consistent()) continue;  // invisible here
+        const bool named = testing::diagnosedAs(verifier, camera, map, mistake.name);
         INFO(mistake.name);
         CHECK(named);
         diagnosed += named ? 1 : 0;
@@ -152,9 +155,10 @@ TEST_CASE("a map rendered under a mistake is diagnosed as that mistake, for ever
 TEST_CASE("verify refuses a map whose size is not the camera's", "[checker]")
 {
     const Checker checker(builtinScene("builtin:default"));
+    const MapVerifier verifier(checker);
     const Camera camera(smallCamera(checker.scene()));
     const DepthMap map = DepthMap::exact(10, 10, DepthQuantity::EyeZ, std::vector<double>(100, 1.0));
-    REQUIRE_THROWS_WITH(checker.verify(camera, map), Catch::Contains("10x10") && Catch::Contains("160x120"));
+    REQUIRE_THROWS_WITH(verifier.verify(camera, map), Catch::Contains("10x10") && Catch::Contains("160x120"));
 }
 
 // The comparison runs in fixed 64×64 tiles merged in tile order; its report must not
@@ -440,6 +444,7 @@ TEST_CASE("camera-pose mistakes: an inverted extrinsic and OpenCV axes used as O
     // builtin:near-crossing has geometry all around its eye, so a camera turned 180° about its
     // x axis, or placed by the inverse of its view, still sees surfaces.
     const Checker checker(builtinScene("builtin:near-crossing"));
+    const MapVerifier verifier(checker);
     for (const std::string convention : {"opengl", "opencv"}) {
         CameraSpec spec = smallCamera(checker.scene());
         spec.convention = Convention::preset(convention);
@@ -455,8 +460,8 @@ TEST_CASE("camera-pose mistakes: an inverted extrinsic and OpenCV axes used as O
                                             [](std::uint32_t id) { return id != kNoPrimitive; });
             REQUIRE(hits > camera.width() * camera.height() / 10);
             const DepthMap map = testing::windowMapOf(camera, wrong);
-            REQUIRE_FALSE(checker.verify(camera, map).comparison.report.consistent());
-            REQUIRE(testing::diagnosedAs(checker, camera, map, name));
+            REQUIRE_FALSE(verifier.verify(camera, map).comparison.report.consistent());
+            REQUIRE(testing::diagnosedAs(verifier, camera, map, name));
         }
     }
 }
@@ -464,10 +469,11 @@ TEST_CASE("camera-pose mistakes: an inverted extrinsic and OpenCV axes used as O
 TEST_CASE("a map with no surface is explained by no hypothesis (a view that sees nothing explains nothing)", "[checker][diagnose]")
 {
     const Checker checker(builtinScene("builtin:default"));
+    const MapVerifier verifier(checker);
     const Camera camera(smallCamera(checker.scene()));
     const DepthMap empty = DepthMap::exact(camera.width(), camera.height(), DepthQuantity::Window,
                                            std::vector<double>(std::size_t(camera.width()) * camera.height(), camera.clearDepth()));
-    const std::vector<Hypothesis> diagnosis = checker.diagnose(camera, empty);
+    const std::vector<Hypothesis> diagnosis = verifier.diagnose(camera, empty);
     for (const Hypothesis& h : diagnosis) {
         INFO(h.name << " " << h.variant);
         REQUIRE_FALSE(h.consistent);
@@ -1123,6 +1129,7 @@ TEST_CASE("regression: a best hypothesis that left almost every pixel unexplaine
     // A map of noise on the default scene: no hypothesis explains it, and none is named as if it
     // nearly did ("closest: field-of-view" pointed the user at a mistake the map does not show).
     const Checker checker(builtinScene("builtin:default"));
+    const MapVerifier verifier(checker);
     const Camera camera(smallCamera(checker.scene()));
     DepthMap noise = DepthMap::exact(camera.width(), camera.height(), DepthQuantity::EyeZ, {});
     std::uint32_t state = 12345;
@@ -1130,9 +1137,9 @@ TEST_CASE("regression: a best hypothesis that left almost every pixel unexplaine
         state = state * 1664525u + 1013904223u;
         noise.value.push_back(1.0 + 9.0 * (state >> 8) / double(1u << 24));
     }
-    const VerifyResult run = checker.verify(camera, noise);
+    const VerifyResult run = verifier.verify(camera, noise);
     const ComparisonReport& c = run.comparison.report;
-    const std::vector<Hypothesis> diagnosis = checker.diagnose(camera, noise);
+    const std::vector<Hypothesis> diagnosis = verifier.diagnose(camera, noise);
     REQUIRE_FALSE(diagnosis.front().consistent);
     const std::string text = formatDiagnosis(diagnosis, c.bothHit + c.rayOnly + c.rasterOnly);
     INFO(text);

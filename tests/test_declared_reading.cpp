@@ -2,6 +2,7 @@
 // half floats' own steps, a stated accuracy, holes) accepts them; without it they are rejected
 // and the diagnosis names the option; and declared accuracy does not hide a convention mistake.
 #include "zcheck/declared_reading.h"
+#include "zcheck/map_verifier.h"
 #include "zcheck/verify.h"
 
 #include "zcheck/inverse_projection.h"
@@ -40,15 +41,15 @@ DepthMap truthMap(const Checker& checker, const Camera& camera, ExportQuantity q
     return mapOf(checker.scene(), camera, checker.renderRay(camera), quantity);
 }
 
-bool consistent(const Checker& checker, const Camera& camera, const DepthMap& map)
+bool consistent(const MapVerifier& verifier, const Camera& camera, const DepthMap& map)
 {
-    return checker.verify(camera, map).comparison.report.consistent();
+    return verifier.verify(camera, map).comparison.report.consistent();
 }
 
 // The first consistent hypothesis's name, "" for none.
-std::string bestConsistent(const Checker& checker, const Camera& camera, const DepthMap& map)
+std::string bestConsistent(const MapVerifier& verifier, const Camera& camera, const DepthMap& map)
 {
-    for (const Hypothesis& h : checker.diagnose(camera, map))
+    for (const Hypothesis& h : verifier.diagnose(camera, map))
         if (h.consistent) return h.name;
     return "";
 }
@@ -98,16 +99,17 @@ TEST_CASE("millimetre-rounded floats are accepted with --quantum 0.001, rejected
         for (ExportQuantity q : {ExportQuantity::EyeZ, ExportQuantity::Distance}) {
             const Room room(convention);
             const Checker checker(room.scene);
+            const MapVerifier verifier(checker);
             const Camera camera(room.spec);
             DepthMap map = truthMap(checker, camera, q);
             for (double& v : map.value)
                 if (std::isfinite(v)) v = double(float(std::round(v * 1000) / 1000));
             INFO(convention << " " << toString(q));
-            REQUIRE_FALSE(consistent(checker, camera, map));
-            REQUIRE(bestConsistent(checker, camera, map) == "quantum");
+            REQUIRE_FALSE(consistent(verifier, camera, map));
+            REQUIRE(bestConsistent(verifier, camera, map) == "quantum");
             DepthMap declared = map;
             declared.accuracy.quantum = 0.001;
-            REQUIRE(consistent(checker, camera, declared));
+            REQUIRE(consistent(verifier, camera, declared));
         }
 }
 
@@ -115,6 +117,7 @@ TEST_CASE("half floats carry their own step: a float16 map verifies without opti
 {
     const Room room;
     const Checker checker(room.scene);
+    const MapVerifier verifier(checker);
     const Camera camera(room.spec);
     DepthMap map = truthMap(checker, camera, ExportQuantity::EyeZ);
     DepthMap asBinary32 = map;
@@ -128,14 +131,15 @@ TEST_CASE("half floats carry their own step: a float16 map verifies without opti
     REQUIRE(binary16Step(1.0) == std::ldexp(1.0, -10));
     REQUIRE(binary16Step(3.0) == std::ldexp(1.0, -9));
     REQUIRE(binary16Step(1e-6) == std::ldexp(1.0, -24));
-    REQUIRE(consistent(checker, camera, map));
-    REQUIRE_FALSE(consistent(checker, camera, asBinary32));  // the same values read as binary32
+    REQUIRE(consistent(verifier, camera, map));
+    REQUIRE_FALSE(consistent(verifier, camera, asBinary32));  // the same values read as binary32
 }
 
 TEST_CASE("a miss value where nothing is hit is named with the --miss rule that reads it", "[declared]")
 {
     const Room room;
     const Checker checker(room.scene);
+    const MapVerifier verifier(checker);
     const Camera camera(room.spec);
     const DepthMap exact = truthMap(checker, camera, ExportQuantity::EyeZ);
     for (const double sentinel : {1e10, 65504.0}) {
@@ -144,14 +148,14 @@ TEST_CASE("a miss value where nothing is hit is named with the --miss rule that 
         for (double& v : map.value)
             if (!std::isfinite(v)) v = sentinel, ++misses;
         REQUIRE(misses > 1000);
-        REQUIRE_FALSE(consistent(checker, camera, map));
+        REQUIRE_FALSE(consistent(verifier, camera, map));
         const RenderResult truth = checker.renderRay(camera);
         const ReadingFindings found = findReading(camera, map, truth);
         REQUIRE(found.missValue == sentinel);
         REQUIRE(found.missPixels == misses);
         REQUIRE(found.missRule == (sentinel >= 1e9 ? ">=1e9" : "65504"));
-        REQUIRE(bestConsistent(checker, camera, map) == "miss-value");
-        const std::vector<Hypothesis> diagnosis = checker.diagnose(camera, map);
+        REQUIRE(bestConsistent(verifier, camera, map) == "miss-value");
+        const std::vector<Hypothesis> diagnosis = verifier.diagnose(camera, map);
         REQUIRE(diagnosis.front().explanation.find("pass --miss") != std::string::npos);
     }
 }
@@ -160,6 +164,7 @@ TEST_CASE("holes are failures unless allowed; allowed, they are counted and a fl
 {
     const Room room;
     const Checker checker(room.scene);
+    const MapVerifier verifier(checker);
     const Camera camera(room.spec);
     const DepthMap exact = truthMap(checker, camera, ExportQuantity::EyeZ);
     DepthMap map = exact;
@@ -167,10 +172,10 @@ TEST_CASE("holes are failures unless allowed; allowed, they are counted and a fl
     std::int64_t holes = 0;
     for (double& v : map.value)
         if (std::isfinite(v) && random() % 20 == 0) v = NAN, ++holes;
-    REQUIRE_FALSE(consistent(checker, camera, map));
-    REQUIRE(bestConsistent(checker, camera, map) == "holes");
+    REQUIRE_FALSE(consistent(verifier, camera, map));
+    REQUIRE(bestConsistent(verifier, camera, map) == "holes");
     map.accuracy.allowHoles = true;
-    const VerifyResult run = checker.verify(camera, map);
+    const VerifyResult run = verifier.verify(camera, map);
     const ComparisonReport& r = run.comparison.report;
     REQUIRE(r.consistent());
     // Every hole is a pixel only the truth sees; those at an edge are explained there already.
@@ -179,30 +184,31 @@ TEST_CASE("holes are failures unless allowed; allowed, they are counted and a fl
     REQUIRE(r.holes >= holes * 98 / 100);
     // Holes allowed do not make a y-flipped map pass.
     const DepthMap flipped = flippedRows(map);
-    REQUIRE_FALSE(consistent(checker, camera, flipped));
-    REQUIRE(bestConsistent(checker, camera, flipped) == "y-flip");
+    REQUIRE_FALSE(consistent(verifier, camera, flipped));
+    REQUIRE(bestConsistent(verifier, camera, flipped) == "y-flip");
 }
 
 TEST_CASE("a map good only to a stated accuracy: accepted with it, and its option is named", "[declared]")
 {
     const Room room;
     const Checker checker(room.scene);
+    const MapVerifier verifier(checker);
     const Camera camera(room.spec);
     DepthMap map = truthMap(checker, camera, ExportQuantity::EyeZ);
     for (double& v : map.value) v *= 1 - 4e-4;  // Eevee's Z pass: 4·10⁻⁴ short everywhere
-    REQUIRE_FALSE(consistent(checker, camera, map));
+    REQUIRE_FALSE(consistent(verifier, camera, map));
     bool named = false;
-    for (const Hypothesis& h : checker.diagnose(camera, map))
+    for (const Hypothesis& h : verifier.diagnose(camera, map))
         named |= h.consistent && h.name == "tolerance" && h.explanation.find("--rel-tolerance 0.0005") != std::string::npos;
     REQUIRE(named);
     DepthMap declared = map;
     declared.accuracy.relative = 5e-4;
-    REQUIRE(consistent(checker, camera, declared));
+    REQUIRE(consistent(verifier, camera, declared));
     declared.accuracy.relative = 3e-4;  // less than the map's error
-    REQUIRE_FALSE(consistent(checker, camera, declared));
+    REQUIRE_FALSE(consistent(verifier, camera, declared));
     DepthMap absolute = map;
     absolute.accuracy.absolute = 0.002;  // 4e-4 × 3.7 m = 1.5 mm at the farthest
-    REQUIRE(consistent(checker, camera, absolute));
+    REQUIRE(consistent(verifier, camera, absolute));
 }
 
 TEST_CASE("a noisy, quantized, holed RGB-D map: accepted with its options; flipped, distance or moved: rejected and named",
@@ -211,6 +217,7 @@ TEST_CASE("a noisy, quantized, holed RGB-D map: accepted with its options; flipp
     for (const char* convention : {"opencv", "opengl"}) {
         const Room room(convention);
         const Checker checker(room.scene);
+        const MapVerifier verifier(checker);
         const Camera camera(room.spec);
         const DepthMap exact = truthMap(checker, camera, ExportQuantity::EyeZ);
         MapAccuracy sensor;  // what its user knows of it: millimetres, holes, and 6σ of its noise, relative
@@ -220,25 +227,25 @@ TEST_CASE("a noisy, quantized, holed RGB-D map: accepted with its options; flipp
         REQUIRE(sensor.relative < 0.05);
         DepthMap map = kinectLike(exact, 0.03, 11);
         INFO(convention);
-        REQUIRE_FALSE(consistent(checker, camera, map));
+        REQUIRE_FALSE(consistent(verifier, camera, map));
         map.accuracy = sensor;
-        REQUIRE(consistent(checker, camera, map));
+        REQUIRE(consistent(verifier, camera, map));
         // Flipped rows.
         const DepthMap flipped = flippedRows(map);
-        REQUIRE_FALSE(consistent(checker, camera, flipped));
-        REQUIRE(bestConsistent(checker, camera, flipped) == "y-flip");
+        REQUIRE_FALSE(consistent(verifier, camera, flipped));
+        REQUIRE(bestConsistent(verifier, camera, flipped) == "y-flip");
         // Distance stored where eye-z was declared.
         DepthMap distance = kinectLike(truthMap(checker, camera, ExportQuantity::Distance), 0.03, 12);
         distance.accuracy = sensor;
         distance.quantity = DepthQuantity::EyeZ;  // declared eye-z, holds distance
-        REQUIRE_FALSE(consistent(checker, camera, distance));
-        REQUIRE(bestConsistent(checker, camera, distance) == "distance-as-eye-z");
+        REQUIRE_FALSE(consistent(verifier, camera, distance));
+        REQUIRE(bestConsistent(verifier, camera, distance) == "distance-as-eye-z");
         // Seen from an eye 5 cm to the side.
         CameraSpec moved = room.spec;
         moved.view.eye.x += 0.05, moved.view.target.x += 0.05;
         const Camera movedCamera(moved);
         DepthMap fromElsewhere = kinectLike(truthMap(checker, movedCamera, ExportQuantity::EyeZ), 0.03, 13);
         fromElsewhere.accuracy = sensor;
-        REQUIRE_FALSE(consistent(checker, camera, fromElsewhere));
+        REQUIRE_FALSE(consistent(verifier, camera, fromElsewhere));
     }
 }

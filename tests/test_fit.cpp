@@ -8,6 +8,7 @@
 // thresholds of the anti-aliasing test); the "held-out" half (terrain, Vulkan's y-down
 // window, window and distance maps) was not looked at while choosing them.
 #include "zcheck/fit.h"
+#include "zcheck/map_verifier.h"
 
 #include "zcheck/camera_file.h"
 
@@ -43,10 +44,11 @@ const Setup kSetups[] = {
 struct Bench {
     Scene scene;
     Checker checker;
+    MapVerifier verifier;
     Camera camera;
     ExportQuantity quantity;
     explicit Bench(const Setup& s)
-        : scene(builtinScene(s.scene)), checker(scene), camera(specOf(scene, s)), quantity(s.quantity)
+        : scene(builtinScene(s.scene)), checker(scene), verifier(checker), camera(specOf(scene, s)), quantity(s.quantity)
     {
     }
     static CameraSpec specOf(const Scene& scene, const Setup& s)
@@ -68,8 +70,8 @@ struct Bench {
     // explains the map whole: a departure that is one (`catalogued`) is named by it.
     Hypothesis diagnosed(const DepthMap& map, const std::string& name, const std::string& catalogued = "") const
     {
-        REQUIRE_FALSE(checker.verify(camera, map).comparison.report.consistent());
-        const std::vector<Hypothesis> diagnosis = checker.diagnose(camera, map);
+        REQUIRE_FALSE(verifier.verify(camera, map).comparison.report.consistent());
+        const std::vector<Hypothesis> diagnosis = verifier.diagnose(camera, map);
         for (const Hypothesis& h : diagnosis)
             if (h.name == name) return h;
         if (!catalogued.empty() && !diagnosis.empty() && diagnosis.front().name == catalogued && diagnosis.front().consistent)
@@ -255,7 +257,7 @@ TEST_CASE("regression: correct maps sampled less than 2^-8 px off the pixel cent
             Departure d;
             d.sampleOffset = offset;
             const ComparisonReport r =
-                b.checker.verify(b.camera, b.mapDrawnWith(b.camera.spec(), departedSampling(b.camera, d))).comparison.report;
+                b.verifier.verify(b.camera, b.mapDrawnWith(b.camera.spec(), departedSampling(b.camera, d))).comparison.report;
             INFO("unexplained " << r.unexplained());
             REQUIRE(r.bothHit > 1000);
             REQUIRE(r.consistent());
@@ -280,7 +282,7 @@ TEST_CASE("a resolved multisample depth map is named anti-aliased, consistent ex
             for (std::size_t i = 0; i < map.value.size(); ++i) map.value[i] += drawn.windowDepth.value[i] / 4;
         }
         for (double& v : map.value) v = double(float(v));
-        const std::vector<Hypothesis> diagnosis = b.checker.diagnose(camera, map);
+        const std::vector<Hypothesis> diagnosis = b.verifier.diagnose(camera, map);
         REQUIRE_FALSE(diagnosis.empty());
         const Hypothesis& best = diagnosis.front();
         INFO(best.name << ": " << best.explanation << ", unexplained " << best.unexplained << " of " << best.compared
@@ -314,7 +316,7 @@ TEST_CASE("regression: a rescaled NDC map's far-plane misses read as surfaces on
     const DepthMap map = scaled(b.mapDrawnWith(b.camera.spec()), 1.002);
     Departure d;
     d.valueScale = 1.002;
-    const ComparisonReport r = b.checker.verify(b.camera, departedReading(b.camera, map, d)).comparison.report;
+    const ComparisonReport r = b.verifier.verify(b.camera, departedReading(b.camera, map, d)).comparison.report;
     INFO("unexplained " << r.unexplained());
     REQUIRE(r.bothMiss > 1000);
     REQUIRE(r.consistent());

@@ -8,6 +8,7 @@
 // The mesh and the clip-from-world matrix are the camera's own; what is independent is
 // everything after them: Mesa's clipping, rasterization and depth buffer.
 #include "zcheck/gl_reference.h"
+#include "zcheck/map_verifier.h"
 #include "zcheck/mesh_loader.h"
 
 #include "diagnosis_helpers.h"
@@ -81,9 +82,9 @@ DepthMap glDepthMap(const Scene& scene, const Camera& camera, GlDepth setup, int
 }
 
 // The map verified through the camera: consistent, with enough surface compared to mean it.
-void requireConsistent(const Checker& checker, const Camera& camera, const DepthMap& map)
+void requireConsistent(const MapVerifier& verifier, const Camera& camera, const DepthMap& map)
 {
-    const ComparisonReport r = checker.verify(camera, map).comparison.report;
+    const ComparisonReport r = verifier.verify(camera, map).comparison.report;
     INFO("unexplained " << r.unexplained() << " of " << r.bothHit << " both hit, max error/tolerance " << r.maxErrorOverTolerance);
     REQUIRE(r.bothHit > 5000);
     REQUIRE(r.consistent());
@@ -104,10 +105,11 @@ TEST_CASE("OpenGL depth buffers drawn by Mesa's llvmpipe verify as consistent", 
     for (const std::string& path : scenes()) {
         const Scene scene = loadScene(path);
         const Checker checker(scene);
+        const MapVerifier verifier(checker);
         for (GlDepth setup : {GlDepth::MinusOneToOne, GlDepth::ZeroToOne, GlDepth::Reversed}) {
             INFO(path << ", " << nameOf(setup));
             const Camera camera(glCameraSpec(scene, setup, 320, 240));
-            requireConsistent(checker, camera, glDepthMap(scene, camera, setup));
+            requireConsistent(verifier, camera, glDepthMap(scene, camera, setup));
         }
     }
 }
@@ -119,6 +121,7 @@ TEST_CASE("OpenGL depth buffers verify as consistent in every projection model",
     REQUIRE(reference::glReferenceAvailable());
     const Scene scene = loadScene("builtin:default");
     const Checker checker(scene);
+    const MapVerifier verifier(checker);
     const CameraSpec base = glCameraSpec(scene, GlDepth::MinusOneToOne, 320, 240);
     const double n = base.projection.near, t = std::tan(glm::radians(base.projection.fovyDeg) / 2);
     const double sceneHalfHeight = glm::length(base.view.eye - base.view.target) * t;
@@ -148,7 +151,7 @@ TEST_CASE("OpenGL depth buffers verify as consistent in every projection model",
             CameraSpec spec = glCameraSpec(scene, setup, 320, 240);
             spec.projection = projection;
             const Camera camera(spec);
-            requireConsistent(checker, camera, glDepthMap(scene, camera, setup));
+            requireConsistent(verifier, camera, glDepthMap(scene, camera, setup));
         }
 }
 
@@ -157,28 +160,29 @@ TEST_CASE("OpenGL depth buffers read under the wrong depth set-up are diagnosed 
     REQUIRE(reference::glReferenceAvailable());
     const Scene scene = loadScene("builtin:default");
     const Checker checker(scene);
+    const MapVerifier verifier(checker);
     // A [0, 1] (Direct3D-style) projection matrix drawn without glClipControl: OpenGL takes its
     // clip z for the classic [-1, 1] range, and the buffer holds depths in [0.5, 1].
     const Camera zeroToOne(glCameraSpec(scene, GlDepth::ZeroToOne, 320, 240));
     const Camera classic(glCameraSpec(scene, GlDepth::MinusOneToOne, 320, 240));
     const DepthMap zeroToOneMap = glDepthMap(scene, zeroToOne, GlDepth::MinusOneToOne);
-    REQUIRE_FALSE(checker.verify(classic, zeroToOneMap).comparison.report.consistent());
-    REQUIRE(testing::diagnosedAs(checker, classic, zeroToOneMap, "ndc-range"));
+    REQUIRE_FALSE(verifier.verify(classic, zeroToOneMap).comparison.report.consistent());
+    REQUIRE(testing::diagnosedAs(verifier, classic, zeroToOneMap, "ndc-range"));
     // A reversed-Z buffer declared as standard [0, 1] depth.
     CameraSpec standardSpec = glCameraSpec(scene, GlDepth::Reversed, 320, 240);
     standardSpec.depth.reversed = false;
     const Camera reversed(glCameraSpec(scene, GlDepth::Reversed, 320, 240)), standard(standardSpec);
     const DepthMap reversedMap = glDepthMap(scene, reversed, GlDepth::Reversed);
-    REQUIRE_FALSE(checker.verify(standard, reversedMap).comparison.report.consistent());
-    REQUIRE(testing::diagnosedAs(checker, standard, reversedMap, "reversed-as-standard"));
+    REQUIRE_FALSE(verifier.verify(standard, reversedMap).comparison.report.consistent());
+    REQUIRE(testing::diagnosedAs(verifier, standard, reversedMap, "reversed-as-standard"));
     // glReadPixels' rows taken as they come, bottom row first, for an image's top-down rows.
     const DepthMap classicMap = glDepthMap(scene, classic, GlDepth::MinusOneToOne);
     DepthMap bottomUp = classicMap;
     for (int row = 0; row < bottomUp.height; ++row)
         std::copy_n(classicMap.value.begin() + std::ptrdiff_t(row) * bottomUp.width, bottomUp.width,
                     bottomUp.value.begin() + std::ptrdiff_t(bottomUp.height - 1 - row) * bottomUp.width);
-    REQUIRE_FALSE(checker.verify(classic, bottomUp).comparison.report.consistent());
-    REQUIRE(testing::diagnosedAs(checker, classic, bottomUp, "y-flip"));
+    REQUIRE_FALSE(verifier.verify(classic, bottomUp).comparison.report.consistent());
+    REQUIRE(testing::diagnosedAs(verifier, classic, bottomUp, "y-flip"));
 }
 
 TEST_CASE("a depth buffer resolved from Mesa's multisampling is diagnosed with the sample GL reports", "[verify][diagnose][real-renderer]")
@@ -190,13 +194,14 @@ TEST_CASE("a depth buffer resolved from Mesa's multisampling is diagnosed with t
     REQUIRE(reference::glReferenceAvailable());
     const Scene scene = loadScene("builtin:default");
     const Checker checker(scene);
+    const MapVerifier verifier(checker);
     const Camera camera(glCameraSpec(scene, GlDepth::MinusOneToOne, 320, 240));
     for (int samples : {4}) {
         INFO(samples << "× MSAA");
         std::vector<std::array<float, 2>> positions;
         const DepthMap map = glDepthMap(scene, camera, GlDepth::MinusOneToOne, samples, &positions);
         REQUIRE(positions.size() == std::size_t(samples));
-        const std::vector<Hypothesis> diagnosis = checker.diagnose(camera, map);
+        const std::vector<Hypothesis> diagnosis = verifier.diagnose(camera, map);
         REQUIRE_FALSE(diagnosis.empty());
         const Hypothesis& best = diagnosis.front();
         INFO(best.name << ": " << best.explanation << ", unexplained " << best.unexplained);
@@ -221,7 +226,7 @@ TEST_CASE("a depth buffer resolved from Mesa's multisampling is diagnosed with t
         for (int row = 0; row < map.height; ++row)
             std::copy_n(map.value.begin() + std::ptrdiff_t(row) * map.width, map.width,
                         bottomUp.value.begin() + std::ptrdiff_t(map.height - 1 - row) * map.width);
-        const std::vector<Hypothesis> both = checker.diagnose(camera, bottomUp);
+        const std::vector<Hypothesis> both = verifier.diagnose(camera, bottomUp);
         REQUIRE_FALSE(both.empty());
         INFO("flipped: " << both.front().name << ": " << both.front().explanation << ", unexplained " << both.front().unexplained);
         REQUIRE(both.front().consistent);

@@ -1,4 +1,5 @@
 // zcheck verify: a correct map verifies; each classic mutation is rejected and diagnosed.
+#include "zcheck/map_verifier.h"
 #include "zcheck/mistakes.h"
 #include "zcheck/verify.h"
 
@@ -20,9 +21,9 @@ using testing::mapOf;
 namespace {
 
 // The first hypothesis that makes the map consistent, or "".
-std::string diagnosis(const Checker& checker, const Camera& camera, const DepthMap& map)
+std::string diagnosis(const MapVerifier& verifier, const Camera& camera, const DepthMap& map)
 {
-    for (const Hypothesis& h : checker.diagnose(camera, map))
+    for (const Hypothesis& h : verifier.diagnose(camera, map))
         if (h.consistent) return h.name + (h.variant.empty() ? "" : " " + h.variant);
     return "";
 }
@@ -43,6 +44,7 @@ TEST_CASE("a depth map from the raster route verifies, in every quantity and con
 {
     Setup s;
     const Checker checker(s.scene);
+    const MapVerifier verifier(checker);
     for (const auto& convention : Convention::presetNames())
         for (bool reversed : {false, true}) {
             CameraSpec spec = s.spec;
@@ -51,7 +53,7 @@ TEST_CASE("a depth map from the raster route verifies, in every quantity and con
             const Camera camera(spec);
             const RenderResult drawn = checker.renderRaster(camera);
             for (ExportQuantity q : {ExportQuantity::Window, ExportQuantity::EyeZ, ExportQuantity::Distance}) {
-                const VerifyResult run = checker.verify(camera, mapOf(s.scene, camera, drawn, q));
+                const VerifyResult run = verifier.verify(camera, mapOf(s.scene, camera, drawn, q));
                 INFO(convention << (reversed ? " reversed " : " ") << toString(q) << ": unexplained "
                                 << run.comparison.report.unexplained());
                 REQUIRE(run.comparison.report.bothHit > 10000);
@@ -64,6 +66,7 @@ TEST_CASE("mutated depth maps are rejected and the diagnosis names the mutation"
 {
     Setup s;
     const Checker checker(s.scene);
+    const MapVerifier verifier(checker);
     for (const auto& convention : {std::string("opengl"), std::string("direct3d"), std::string("vulkan")}) {
         CameraSpec spec = s.spec;
         spec.convention = Convention::preset(convention);
@@ -71,8 +74,8 @@ TEST_CASE("mutated depth maps are rejected and the diagnosis names the mutation"
         const RenderResult drawn = checker.renderRaster(camera);
         auto requireDiagnosed = [&](const std::string& mutation, const DepthMap& map, const std::string& expected) {
             INFO(convention << ": " << mutation);
-            REQUIRE_FALSE(checker.verify(camera, map).comparison.report.consistent());
-            REQUIRE(diagnosis(checker, camera, map) == expected);
+            REQUIRE_FALSE(verifier.verify(camera, map).comparison.report.consistent());
+            REQUIRE(diagnosis(verifier, camera, map) == expected);
         };
         // Flipped vertically.
         DepthMap flipped = mapOf(s.scene, camera, drawn, ExportQuantity::Window);
@@ -112,12 +115,13 @@ TEST_CASE("a map that no hypothesis explains is diagnosed as such", "[verify][di
 {
     Setup s;
     const Checker checker(s.scene);
+    const MapVerifier verifier(checker);
     const Camera camera(s.spec);
     DepthMap noise = mapOf(s.scene, camera, checker.renderRaster(camera), ExportQuantity::EyeZ);
     for (std::size_t i = 0; i < noise.value.size(); ++i)
         if (std::isfinite(noise.value[i])) noise.value[i] *= 1.0 + 0.05 * std::sin(double(i));
-    REQUIRE_FALSE(checker.verify(camera, noise).comparison.report.consistent());
-    REQUIRE(diagnosis(checker, camera, noise).empty());
+    REQUIRE_FALSE(verifier.verify(camera, noise).comparison.report.consistent());
+    REQUIRE(diagnosis(verifier, camera, noise).empty());
 }
 
 
@@ -175,6 +179,7 @@ TEST_CASE("regression: verify rejected a correct map whose sample landed across 
     const double tilt = -2 * 6 * float32QuantumAtHalf / (across * pixel);  // B rises towards the camera
     const SharedEdge s(0.01 + across * pixel, tilt);
     const Checker checker(s.scene);
+    const MapVerifier verifier(checker);
     const RenderResult truth = checker.renderRay(s.camera);
     const std::size_t centre = 50 * 100 + 50;
     REQUIRE(truth.primitiveId[centre] == 0);  // the truth sees A at this pixel
@@ -189,7 +194,7 @@ TEST_CASE("regression: verify rejected a correct map whose sample landed across 
     REQUIRE(gapQuanta > 5);  // beyond A's own tolerance (4 q, A faces the camera: m = 0) ...
     REQUIRE(gapQuanta < 7);  // ... and within the old 8 q gate
     map.value[centre] = onB;
-    const VerifyResult run = checker.verify(s.camera, map);
+    const VerifyResult run = verifier.verify(s.camera, map);
     INFO("unexplained " << run.comparison.report.unexplained());
     REQUIRE(run.comparison.report.consistent());
     REQUIRE(run.comparison.pixelClass[centre] == PixelClass::Agree);
@@ -199,7 +204,7 @@ TEST_CASE("regression: verify rejected a correct map whose sample landed across 
     bool failedNearer = false;
     for (double k = 0; k <= 40; k += 0.5) {
         map.value[centre] = truth.windowDepth.value[centre] + k * float32QuantumAtHalf;
-        const bool passes = checker.verify(s.camera, map).comparison.report.consistent();
+        const bool passes = verifier.verify(s.camera, map).comparison.report.consistent();
         INFO("offset " << k << " q");
         REQUIRE_FALSE((passes && failedNearer));
         failedNearer = failedNearer || !passes;
@@ -239,6 +244,7 @@ TEST_CASE("every swap of the four quantities is diagnosed by its own name", "[ve
     Setup s;
     s.spec.width = 96, s.spec.height = 72;
     const Checker checker(s.scene);
+    const MapVerifier verifier(checker);
     const std::pair<ExportQuantity, DepthQuantity> quantities[] = {{ExportQuantity::Window, DepthQuantity::Window},
                                                                    {ExportQuantity::Ndc, DepthQuantity::Ndc},
                                                                    {ExportQuantity::EyeZ, DepthQuantity::EyeZ},
@@ -256,13 +262,13 @@ TEST_CASE("every swap of the four quantities is diagnosed by its own name", "[ve
                 for (double& v : map.value) v = double(float(v));  // as stored in a float32 file
                 const std::string name = toString(deliveredQuantity) + "-as-" + toString(declared);
                 INFO(convention << ": " << name);
-                if (checker.verify(camera, map).comparison.report.consistent()) {
+                if (verifier.verify(camera, map).comparison.report.consistent()) {
                     // No mistake here: Direct3D's window depth is its NDC z.
                     REQUIRE((convention == "direct3d" && name.find("window") != std::string::npos &&
                              name.find("ndc") != std::string::npos));
                     continue;
                 }
-                REQUIRE(testing::diagnosedAs(checker, camera, map, name));
+                REQUIRE(testing::diagnosedAs(verifier, camera, map, name));
             }
     }
 }
@@ -274,6 +280,7 @@ TEST_CASE("a field of view off by 2 % is measured in each model's own terms, for
     // (fovy, focal length, fx and fy; a frustum's scale), within 1e-4 of the truth.
     Setup s;
     const Checker checker(s.scene);
+    const MapVerifier verifier(checker);
     const std::string examples = std::string(ZCHECK_TESTS_DIR) + "/../examples/";
     for (const char* file : {"perspective.json", "lens.json", "pinhole.json", "frustum.json"}) {
         INFO(file);
@@ -288,9 +295,9 @@ TEST_CASE("a field of view off by 2 % is measured in each model's own terms, for
         p.left *= 1.02, p.right *= 1.02, p.bottom *= 1.02, p.top *= 1.02;
         const Camera camera(declared);
         const DepthMap map = testing::windowMapOf(Camera(drawn), checker.renderRaster(Camera(drawn)));
-        REQUIRE_FALSE(checker.verify(camera, map).comparison.report.consistent());
+        REQUIRE_FALSE(verifier.verify(camera, map).comparison.report.consistent());
         const Hypothesis* found = nullptr;
-        const std::vector<Hypothesis> diagnosis = checker.diagnose(camera, map);
+        const std::vector<Hypothesis> diagnosis = verifier.diagnose(camera, map);
         for (const Hypothesis& h : diagnosis)
             if (h.name == "field-of-view") found = &h;
         REQUIRE(found);
@@ -319,6 +326,7 @@ TEST_CASE("regression: the other NDC range was never tried for a raw-matrix came
     // silently skipped. The z row is now remapped directly: injected and re-read, every model.
     Setup s;
     const Checker checker(s.scene);
+    const MapVerifier verifier(checker);
     const Mistake& ndcRange = testing::mistakeNamed("ndc-range");
     // (A raw matrix keeps its own convention: its depth row is written for it.)
     for (const char* file : {"matrix-direct3d.json", "orthographic.json", "oblique-cabinet.json"})
@@ -332,8 +340,8 @@ TEST_CASE("regression: the other NDC range was never tried for a raw-matrix came
             RouteFaults faults;
             REQUIRE(ndcRange.inject(camera, faults));
             const DepthMap map = testing::windowMapOf(camera, checker.render(camera, ndcRange.route, faults));
-            REQUIRE_FALSE(checker.verify(camera, map).comparison.report.consistent());
-            REQUIRE(testing::diagnosedAs(checker, camera, map, "ndc-range"));
+            REQUIRE_FALSE(verifier.verify(camera, map).comparison.report.consistent());
+            REQUIRE(testing::diagnosedAs(verifier, camera, map, "ndc-range"));
         }
 }
 
@@ -343,18 +351,19 @@ TEST_CASE("the diagnosis's sampled screen never rules out a consistent reading, 
     Setup s;
     s.spec.width = 320, s.spec.height = 240;
     const Checker checker(s.scene);
+    const MapVerifier verifier(checker);
     const Camera camera(s.spec);
     const RenderResult truth = checker.renderRay(camera);
     const DepthMap correct = mapOf(s.scene, camera, checker.renderRaster(camera), ExportQuantity::EyeZ);
-    REQUIRE_FALSE(screenUnexplained(s.scene, camera, correct, truth, checker.neighbours()));
+    REQUIRE_FALSE(screenUnexplained(s.scene, camera, correct, truth, verifier.neighbours()));
     // Wrong by 1 % over one half of the image, and by far more elsewhere: the screen
     // rules it out, and its estimate is near the full comparison's count.
     for (double factor : {1.01, 1.5}) {
         DepthMap wrong = correct;
         for (std::size_t i = 0; i < wrong.value.size(); ++i)
             if (std::isfinite(wrong.value[i]) && i % 320 < 160) wrong.value[i] *= factor;
-        const std::int64_t full = checker.verify(camera, wrong).comparison.report.unexplained();
-        const auto estimate = screenUnexplained(s.scene, camera, wrong, truth, checker.neighbours());
+        const std::int64_t full = verifier.verify(camera, wrong).comparison.report.unexplained();
+        const auto estimate = screenUnexplained(s.scene, camera, wrong, truth, verifier.neighbours());
         INFO("factor " << factor << ": full " << full);
         REQUIRE(full > 10000);
         REQUIRE(estimate);
@@ -364,14 +373,15 @@ TEST_CASE("the diagnosis's sampled screen never rules out a consistent reading, 
     DepthMap few = correct;
     for (std::size_t i = 0, changed = 0; i < few.value.size() && changed < 50; ++i)
         if (std::isfinite(few.value[i])) few.value[i] *= 1.2, ++changed;
-    REQUIRE_FALSE(screenUnexplained(s.scene, camera, few, truth, checker.neighbours()));
-    REQUIRE(checker.verify(camera, few).comparison.report.unexplained() == 50);
+    REQUIRE_FALSE(screenUnexplained(s.scene, camera, few, truth, verifier.neighbours()));
+    REQUIRE(verifier.verify(camera, few).comparison.report.unexplained() == 50);
 }
 
 TEST_CASE("two mistakes at once are diagnosed by both names: flipped and reversed, flipped and a quantity swap", "[verify][diagnose]")
 {
     Setup s;
     const Checker checker(s.scene);
+    const MapVerifier verifier(checker);
     CameraSpec reversedSpec = s.spec;
     reversedSpec.depth.reversed = true;
     const Camera camera(s.spec), reversedCamera(reversedSpec);
@@ -383,17 +393,18 @@ TEST_CASE("two mistakes at once are diagnosed by both names: flipped and reverse
     };
     // A reversed-Z renderer's buffer, flipped vertically, declared as standard depth.
     const DepthMap flippedReversed = flipped(mapOf(s.scene, reversedCamera, checker.renderRaster(reversedCamera), ExportQuantity::Window));
-    REQUIRE(testing::diagnosedAs(checker, camera, flippedReversed, "y-flip + reversed-as-standard"));
+    REQUIRE(testing::diagnosedAs(verifier, camera, flippedReversed, "y-flip + reversed-as-standard"));
     // Ray distance, flipped vertically, declared as eye-z.
     DepthMap flippedDistance = flipped(mapOf(s.scene, camera, checker.renderRaster(camera), ExportQuantity::Distance));
     flippedDistance.quantity = DepthQuantity::EyeZ;
-    REQUIRE(testing::diagnosedAs(checker, camera, flippedDistance, "y-flip + distance-as-eye-z"));
+    REQUIRE(testing::diagnosedAs(verifier, camera, flippedDistance, "y-flip + distance-as-eye-z"));
 }
 
 TEST_CASE("a mirrored principal point, depth without near added, and a map quantized finer than declared are named", "[verify][diagnose]")
 {
     Setup s;
     const Checker checker(s.scene);
+    const MapVerifier verifier(checker);
     // The off-axis frustum example drawn with its principal point mirrored about the centre.
     CameraSpec offAxis = readCameraFile(std::string(ZCHECK_TESTS_DIR) + "/../examples/frustum.json");
     offAxis.view = s.spec.view;
@@ -402,20 +413,20 @@ TEST_CASE("a mirrored principal point, depth without near added, and a map quant
     mirroredSpec.projection.left = -offAxis.projection.right, mirroredSpec.projection.right = -offAxis.projection.left;
     mirroredSpec.projection.bottom = -offAxis.projection.top, mirroredSpec.projection.top = -offAxis.projection.bottom;
     const Camera declared(offAxis), mirrored(mirroredSpec);
-    REQUIRE(testing::diagnosedAs(checker, declared, testing::windowMapOf(mirrored, checker.renderRaster(mirrored)),
+    REQUIRE(testing::diagnosedAs(verifier, declared, testing::windowMapOf(mirrored, checker.renderRaster(mirrored)),
                                  "principal-point-mirrored"));
     // Eye-z minus near (linear depth scaled by far - near, near not added).
     const Camera camera(s.spec);
     DepthMap withoutNear = mapOf(s.scene, camera, checker.renderRaster(camera), ExportQuantity::EyeZ);
     for (double& v : withoutNear.value)
         if (std::isfinite(v)) v = double(float(v - camera.nearDistance()));
-    REQUIRE(testing::diagnosedAs(checker, camera, withoutNear, "affine-depth-offset"));
+    REQUIRE(testing::diagnosedAs(verifier, camera, withoutNear, "affine-depth-offset"));
     // A unorm16 depth buffer declared as float32.
     CameraSpec unorm16Spec = s.spec;
     unorm16Spec.depth.format = DepthFormat::Unorm16;
     const Camera unorm16(unorm16Spec);
     REQUIRE(s.spec.depth.format == DepthFormat::Float32);
-    REQUIRE(testing::diagnosedAs(checker, camera, testing::windowMapOf(unorm16, checker.renderRaster(unorm16)), "quantized-depth"));
+    REQUIRE(testing::diagnosedAs(verifier, camera, testing::windowMapOf(unorm16, checker.renderRaster(unorm16)), "quantized-depth"));
 }
 
 TEST_CASE("two camera mistakes at once are diagnosed by both names: reversed and aspect inverted", "[verify][diagnose]")
@@ -424,13 +435,14 @@ TEST_CASE("two camera mistakes at once are diagnosed by both names: reversed and
     // camera (neither is a re-reading of the map), so the pair needs a truth of its own.
     Setup s;
     const Checker checker(s.scene);
+    const MapVerifier verifier(checker);
     const Camera camera(s.spec);
     CameraSpec drawn = s.spec;
     drawn.depth.reversed = true;
     drawn.projection.aspect = double(s.spec.height) / s.spec.width;
     const Camera drawnCamera(drawn);
     const DepthMap map = mapOf(s.scene, drawnCamera, checker.renderRaster(drawnCamera), ExportQuantity::Window);
-    const std::vector<Hypothesis> diagnosis = checker.diagnose(camera, map);
+    const std::vector<Hypothesis> diagnosis = verifier.diagnose(camera, map);
     REQUIRE_FALSE(diagnosis.empty());
     const Hypothesis& best = diagnosis.front();
     INFO("best: " << best.name << ", unexplained " << best.unexplained);

@@ -4,6 +4,7 @@
 // rendered through it, and the diagnosis, given the camera the mistake made, must name the
 // mistake — at several magnitudes, on two scenes and in several conventions.
 #include "zcheck/fit.h"
+#include "zcheck/map_verifier.h"
 #include "zcheck/mesh_loader.h"
 #include "zcheck/verify.h"
 
@@ -81,9 +82,9 @@ struct Named {
 
 // Whether the diagnosis of `map` under the declared camera holds a consistent hypothesis of that
 // name (and variant, when given); the diagnosis's first lines when not, for the log.
-bool names(const Checker& checker, const Camera& declared, const DepthMap& map, const Named& wanted, std::string& seen)
+bool names(const MapVerifier& verifier, const Camera& declared, const DepthMap& map, const Named& wanted, std::string& seen)
 {
-    for (const Hypothesis& h : checker.diagnose(declared, map)) {
+    for (const Hypothesis& h : verifier.diagnose(declared, map)) {
         if (h.consistent && h.name == wanted.mistake && (wanted.variant.empty() || h.variant == wanted.variant)) return true;
         if (seen.size() < 600)
             seen += h.name + " [" + h.variant + "] " + (h.consistent ? "consistent" : std::to_string(h.unexplained)) + "; ";
@@ -93,16 +94,17 @@ bool names(const Checker& checker, const Camera& declared, const DepthMap& map, 
 
 // The map the renderer's camera draws (the ray route stands in for the renderer), judged under
 // the declared camera: rejected as it stands, and named.
-void requireNamed(const Checker& checker, const CameraSpec& renderer, const CameraSpec& declared, ExportQuantity quantity,
+void requireNamed(const MapVerifier& verifier, const CameraSpec& renderer, const CameraSpec& declared, ExportQuantity quantity,
                   const Named& wanted)
 {
+    const Checker& checker = verifier.checker();
     const Camera rendering(renderer), judging(declared);
     const DepthMap map = mapOf(checker.scene(), rendering, checker.renderRay(rendering), quantity);
     INFO(wanted.mistake << " [" << wanted.variant << "], " << declared.convention.name << ", " << toString(quantity));
     REQUIRE(testing::anyHit(checker.renderRay(rendering)));
-    REQUIRE_FALSE(checker.verify(judging, map).comparison.report.consistent());
+    REQUIRE_FALSE(verifier.verify(judging, map).comparison.report.consistent());
     std::string seen;
-    const bool named = names(checker, judging, map, wanted, seen);
+    const bool named = names(verifier, judging, map, wanted, seen);
     INFO("diagnosis: " << seen);
     CHECK(named);
 }
@@ -126,6 +128,7 @@ TEST_CASE("a principal point off along one axis, by any amount, is found and mea
                           Case{&bunny(), "vulkan", 240, 180, {17.25, 0}, ExportQuantity::Window},
                           Case{&bunny(), "opengl", 240, 180, {-6.5, 0}, ExportQuantity::EyeZ}}) {
         const Checker checker(*c.scene);
+        const MapVerifier verifier(checker);
         const CameraSpec declared = smallSpec(checker.scene(), c.convention, c.width, c.height);
         Departure moved;
         moved.principalShift = c.shift;
@@ -133,9 +136,9 @@ TEST_CASE("a principal point off along one axis, by any amount, is found and mea
         const Camera rendering(renderer), judging(declared);
         const DepthMap map = mapOf(checker.scene(), rendering, checker.renderRay(rendering), c.quantity);
         INFO(c.convention << " shift (" << c.shift.x << ", " << c.shift.y << ")");
-        REQUIRE_FALSE(checker.verify(judging, map).comparison.report.consistent());
+        REQUIRE_FALSE(verifier.verify(judging, map).comparison.report.consistent());
         bool found = false;
-        for (const Hypothesis& h : checker.diagnose(judging, map))
+        for (const Hypothesis& h : verifier.diagnose(judging, map))
             if (h.consistent && h.name == "sample-offset") {
                 found = true;
                 // The image moved with the principal point: sampled at minus the shift.
@@ -150,6 +153,7 @@ TEST_CASE("a principal point off along one axis, by any amount, is found and mea
 TEST_CASE("cx and cy exchanged are named", "[diagnose][vision]")
 {
     const Checker checker(builtinScene("builtin:default"));
+    const MapVerifier verifier(checker);
     for (const char* convention : {"opencv", "opengl"}) {
         CameraSpec declared = smallSpec(checker.scene(), convention, 200, 150);
         declared.projection.type = ProjectionType::Pinhole;
@@ -157,13 +161,14 @@ TEST_CASE("cx and cy exchanged are named", "[diagnose][vision]")
         declared.projection.cx = 100, declared.projection.cy = 75;  // centred (pinhole: the top-left pixel's centre is 0)
         CameraSpec renderer = declared;
         renderer.projection.cx = 75, renderer.projection.cy = 100;
-        requireNamed(checker, renderer, declared, ExportQuantity::EyeZ, {"cx-cy-swapped", ""});
+        requireNamed(verifier, renderer, declared, ExportQuantity::EyeZ, {"cx-cy-swapped", ""});
     }
 }
 
 TEST_CASE("a transposed rotation is named, with t kept or the eye kept", "[diagnose][vision]")
 {
     const Checker checker(builtinScene("builtin:default"));
+    const MapVerifier verifier(checker);
     for (const char* convention : {"opencv", "opengl"}) {
         const CameraSpec base = smallSpec(checker.scene(), convention);
         // The renderer's pose: a rotation from a quaternion, aimed at the scene.
@@ -172,9 +177,9 @@ TEST_CASE("a transposed rotation is named, with t kept or the eye kept", "[diagn
         const glm::dmat4 cv = cvFromEyeAxes(renderer.convention) * renderer.view.eyeFromWorld;
         const glm::dvec3 t(cv[3]), eye = -(glm::transpose(r) * t);
         // The file's pose read with Rᵀ: t kept, or the eye kept.
-        requireNamed(checker, renderer, withPose(base, glm::transpose(r), t), ExportQuantity::EyeZ,
+        requireNamed(verifier, renderer, withPose(base, glm::transpose(r), t), ExportQuantity::EyeZ,
                      {"transposed-rotation", "translation kept"});
-        requireNamed(checker, renderer, withPose(base, glm::transpose(r), -(glm::transpose(r) * eye)), ExportQuantity::Window,
+        requireNamed(verifier, renderer, withPose(base, glm::transpose(r), -(glm::transpose(r) * eye)), ExportQuantity::Window,
                      {"transposed-rotation", "eye kept"});
     }
 }
@@ -182,6 +187,7 @@ TEST_CASE("a transposed rotation is named, with t kept or the eye kept", "[diagn
 TEST_CASE("a quaternion read in the other order is named, world-to-camera and camera-to-world", "[diagnose][vision]")
 {
     const Checker checker(builtinScene("builtin:default"));
+    const MapVerifier verifier(checker);
     const CameraSpec base = smallSpec(checker.scene(), "opencv");
     const double w = 0.71, x = -0.18, y = 0.62, z = 0.27;
     // COLMAP-style: the world-to-camera quaternion (w, x, y, z), t kept.
@@ -189,10 +195,10 @@ TEST_CASE("a quaternion read in the other order is named, world-to-camera and ca
     const glm::dvec3 t(renderer.view.eyeFromWorld[3]);
     // The same four numbers taken as x y z w: w' = the stored w's place read as... the file
     // holds "w x y z" and a reader expecting "x y z w" builds (w' = z, x' = w, y' = x, z' = y).
-    requireNamed(checker, renderer, withPose(base, rotationOf(z, w, x, y), t), ExportQuantity::EyeZ,
+    requireNamed(verifier, renderer, withPose(base, rotationOf(z, w, x, y), t), ExportQuantity::EyeZ,
                  {"quaternion-order", "world-to-camera, x y z w read as w x y z"});
     // The file holds "x y z w" read as "w x y z": w' = x, x' = y, y' = z, z' = w.
-    requireNamed(checker, renderer, withPose(base, rotationOf(x, y, z, w), t), ExportQuantity::Distance,
+    requireNamed(verifier, renderer, withPose(base, rotationOf(x, y, z, w), t), ExportQuantity::Distance,
                  {"quaternion-order", "world-to-camera, w x y z read as x y z w"});
     // TUM-style: the camera-to-world quaternion of the same pose, the eye kept.
     const glm::dmat3 r = rotationOf(w, x, y, z), c2w = glm::transpose(r);
@@ -200,7 +206,7 @@ TEST_CASE("a quaternion read in the other order is named, world-to-camera and ca
     const double cw = w, cx = -x, cy = -y, cz = -z;  // the conjugate: the inverse rotation
     REQUIRE(rotationOf(cw, cx, cy, cz)[0][1] == Approx(c2w[0][1]).margin(1e-12));
     const glm::dmat3 misread = glm::transpose(rotationOf(cz, cw, cx, cy));
-    requireNamed(checker, renderer, withPose(base, misread, -(misread * eye)), ExportQuantity::EyeZ,
+    requireNamed(verifier, renderer, withPose(base, misread, -(misread * eye)), ExportQuantity::EyeZ,
                  {"quaternion-order", "camera-to-world, x y z w read as w x y z"});
 }
 
@@ -208,6 +214,7 @@ TEST_CASE("a mesh turned between Y-up and Z-up, and a mesh in other units, are n
 {
     for (const Scene* scene : {&bunny()}) {
         const Checker checker(*scene);
+        const MapVerifier verifier(checker);
         for (const char* convention : {"opengl", "vulkan"}) {
             const CameraSpec declared = smallSpec(checker.scene(), convention);
             // The renderer's mesh turned −90° about x (Blender's OBJ import of a Y-up file): the
@@ -222,7 +229,7 @@ TEST_CASE("a mesh turned between Y-up and Z-up, and a mesh in other units, are n
                 if (!testing::anyHit(renderer.renderRay(camera))) continue;  // turned out of view: no evidence
                 INFO(convention << " turned " << degrees);
                 std::string seen;
-                const bool named = names(checker, camera, map, {"mesh-up-axis", ""}, seen);
+                const bool named = names(verifier, camera, map, {"mesh-up-axis", ""}, seen);
                 INFO(seen);
                 CHECK(named);
             }
@@ -235,6 +242,7 @@ TEST_CASE("a mesh turned between Y-up and Z-up, and a mesh in other units, are n
         Scene scaled = defaultScene;
         for (glm::vec3& p : scaled.positions) p *= float(k);
         const Checker renderer(std::move(scaled)), checker(defaultScene);
+        const MapVerifier verifier(checker);
         // A camera the scaled mesh is in view of: the default one's pose with its eye scaled too,
         // declared with the eye where the file says (scaled back).
         CameraSpec seeing = smallSpec(defaultScene, "opengl");
@@ -245,7 +253,7 @@ TEST_CASE("a mesh turned between Y-up and Z-up, and a mesh in other units, are n
         const DepthMap map = mapOf(renderer.scene(), camera, renderer.renderRay(camera), ExportQuantity::Distance);
         INFO("mesh × " << k);
         std::string seen;
-        const bool named = names(checker, camera, map, {"mesh-units", ""}, seen);
+        const bool named = names(verifier, camera, map, {"mesh-units", ""}, seen);
         INFO(seen);
         CHECK(named);
     }
@@ -254,22 +262,24 @@ TEST_CASE("a mesh turned between Y-up and Z-up, and a mesh in other units, are n
 TEST_CASE("a pose translation in millimetres is named, for t and for the eye", "[diagnose][vision]")
 {
     const Checker checker(builtinScene("builtin:default"));
+    const MapVerifier verifier(checker);
     const CameraSpec renderer = smallSpec(checker.scene(), "opencv");
     const Camera rendering(renderer);
     const glm::dmat3 r = glm::dmat3(rendering.eyeFromWorld);  // opencv: eye axes are OpenCV's
     const glm::dvec3 t(rendering.eyeFromWorld[3]), eye = -(glm::transpose(r) * t);
     // The camera file written in millimetres: t × 1000, or the eye × 1000.
-    requireNamed(checker, renderer, withPose(renderer, r, 1000.0 * t), ExportQuantity::EyeZ, {"pose-units", "t / 1000"});
-    requireNamed(checker, renderer, withPose(renderer, r, -(r * (1000.0 * eye))), ExportQuantity::EyeZ,
+    requireNamed(verifier, renderer, withPose(renderer, r, 1000.0 * t), ExportQuantity::EyeZ, {"pose-units", "t / 1000"});
+    requireNamed(verifier, renderer, withPose(renderer, r, -(r * (1000.0 * eye))), ExportQuantity::EyeZ,
                  {"pose-units", "eye / 1000"});
     // And in centimetres read as metres by the renderer (the map's eye 100× nearer the origin).
-    requireNamed(checker, withPose(renderer, r, -(r * (0.01 * eye))), renderer, ExportQuantity::Distance,
+    requireNamed(verifier, withPose(renderer, r, -(r * (0.01 * eye))), renderer, ExportQuantity::Distance,
                  {"pose-units", "eye / 100"});
 }
 
 TEST_CASE("an eye a little nearer or farther along the viewing direction is measured", "[diagnose][vision]")
 {
     const Checker checker(builtinScene("builtin:default"));
+    const MapVerifier verifier(checker);
     for (const double fraction : {0.01, -0.03}) {
         const CameraSpec declared = smallSpec(checker.scene(), "opengl");
         CameraSpec renderer = declared;
@@ -277,10 +287,10 @@ TEST_CASE("an eye a little nearer or farther along the viewing direction is meas
         const Camera rendering(renderer), judging(declared);
         const DepthMap map = mapOf(checker.scene(), rendering, checker.renderRay(rendering), ExportQuantity::EyeZ);
         INFO("eye moved " << fraction << " of the way to the target");
-        REQUIRE_FALSE(checker.verify(judging, map).comparison.report.consistent());
+        REQUIRE_FALSE(verifier.verify(judging, map).comparison.report.consistent());
         bool found = false;
         std::string seen;
-        for (const Hypothesis& h : checker.diagnose(judging, map)) {
+        for (const Hypothesis& h : verifier.diagnose(judging, map)) {
             seen += h.name + (h.consistent ? " consistent; " : "; ");
             if (h.consistent && h.name == "pose") {
                 found = true;
@@ -301,42 +311,47 @@ TEST_CASE("held out: the vision mistakes on other scenes, conventions, quantitie
     const Scene teapot = loadScene(std::string(ZCHECK_MODELS_DIR) + "/teapot.obj");
     {  // a principal point 23.4 px off in x, Direct3D, a distance map
         const Checker checker(spot);
+        const MapVerifier verifier(checker);
         const CameraSpec declared = smallSpec(spot, "direct3d", 256, 192);
         Departure moved;
         moved.principalShift = {23.4, 0};
-        requireNamed(checker, departedCameraSpec(Camera(declared), moved), declared, ExportQuantity::Distance,
+        requireNamed(verifier, departedCameraSpec(Camera(declared), moved), declared, ExportQuantity::Distance,
                      {"sample-offset", ""});
     }
     {  // a transposed rotation, eye kept, Vulkan, on the bunny
         const Checker checker(bunny());
+        const MapVerifier verifier(checker);
         const CameraSpec base = smallSpec(bunny(), "vulkan");
         const glm::dmat3 r = rotationOf(0.55, -0.32, 0.61, 0.47);
         const CameraSpec renderer = aimed(base, r);
         const glm::dmat4 cv = cvFromEyeAxes(renderer.convention) * renderer.view.eyeFromWorld;
         const glm::dvec3 eye = -(glm::transpose(r) * glm::dvec3(cv[3]));
-        requireNamed(checker, renderer, withPose(base, glm::transpose(r), -(glm::transpose(r) * eye)), ExportQuantity::Distance,
+        requireNamed(verifier, renderer, withPose(base, glm::transpose(r), -(glm::transpose(r) * eye)), ExportQuantity::Distance,
                      {"transposed-rotation", "eye kept"});
     }
     {  // a camera-to-world quaternion stored w x y z and read as x y z w, OpenGL, the teapot
         const Checker checker(teapot);
+        const MapVerifier verifier(checker);
         const CameraSpec base = smallSpec(teapot, "opengl");
         const double w = 0.35, x = 0.52, y = -0.44, z = 0.64;
         const CameraSpec renderer = aimed(base, glm::transpose(rotationOf(w, x, y, z)));  // c2w = R(q)
         const glm::dmat4 cv = cvFromEyeAxes(renderer.convention) * renderer.view.eyeFromWorld;
         const glm::dvec3 eye = -(rotationOf(w, x, y, z) * glm::dvec3(cv[3]));
         const glm::dmat3 misreadC2w = rotationOf(z, w, x, y), r = glm::transpose(misreadC2w);
-        requireNamed(checker, renderer, withPose(base, r, -(r * eye)), ExportQuantity::EyeZ,
+        requireNamed(verifier, renderer, withPose(base, r, -(r * eye)), ExportQuantity::EyeZ,
                      {"quaternion-order", "camera-to-world, x y z w read as w x y z"});
     }
     {  // the pose's t written in centimetres, Direct3D, a window map
         const Checker checker(teapot);
+        const MapVerifier verifier(checker);
         const CameraSpec renderer = smallSpec(teapot, "direct3d");
         const glm::dmat4 cv = cvFromEyeAxes(renderer.convention) * Camera(renderer).eyeFromWorld;
-        requireNamed(checker, renderer, withPose(renderer, glm::dmat3(cv), 100.0 * glm::dvec3(cv[3])), ExportQuantity::Window,
+        requireNamed(verifier, renderer, withPose(renderer, glm::dmat3(cv), 100.0 * glm::dvec3(cv[3])), ExportQuantity::Window,
                      {"pose-units", "t / 100"});
     }
     {  // the mesh turned +90° about x, OpenCV, eye-z
         const Checker checker(spot);
+        const MapVerifier verifier(checker);
         const CameraSpec declared = smallSpec(spot, "opencv");
         Scene turned = spot;
         for (glm::vec3& p : turned.positions) p = glm::vec3(p.x, -p.z, p.y);
@@ -345,38 +360,41 @@ TEST_CASE("held out: the vision mistakes on other scenes, conventions, quantitie
         const DepthMap map = mapOf(renderer.scene(), camera, renderer.renderRay(camera), ExportQuantity::EyeZ);
         REQUIRE(testing::anyHit(renderer.renderRay(camera)));
         std::string seen;
-        const bool named = names(checker, camera, map, {"mesh-up-axis", ""}, seen);
+        const bool named = names(verifier, camera, map, {"mesh-up-axis", ""}, seen);
         INFO(seen);
         CHECK(named);
     }
     {  // cx and cy exchanged off centre, 320×240, a window map, Metal
         const Checker checker(spot);
+        const MapVerifier verifier(checker);
         CameraSpec declared = smallSpec(spot, "metal", 320, 240);
         declared.projection.type = ProjectionType::Pinhole;
         declared.projection.fx = declared.projection.fy = 300;
         declared.projection.cx = 150, declared.projection.cy = 110;
         CameraSpec renderer = declared;
         std::swap(renderer.projection.cx, renderer.projection.cy);
-        requireNamed(checker, renderer, declared, ExportQuantity::Window, {"cx-cy-swapped", ""});
+        requireNamed(verifier, renderer, declared, ExportQuantity::Window, {"cx-cy-swapped", ""});
     }
     {  // the eye 2 % farther from the target, Metal, the bunny, distance
         const Checker checker(bunny());
+        const MapVerifier verifier(checker);
         const CameraSpec declared = smallSpec(bunny(), "metal");
         CameraSpec renderer = declared;
         renderer.view.eye -= 0.02 * (declared.view.target - declared.view.eye);
-        requireNamed(checker, renderer, declared, ExportQuantity::Distance, {"pose", ""});
+        requireNamed(verifier, renderer, declared, ExportQuantity::Distance, {"pose", ""});
     }
     {  // the mesh in centimetres drawn as metres (100× too large), eye-z, the teapot
         Scene scaled = teapot;
         for (glm::vec3& p : scaled.positions) p *= 100.0f;
         const Checker renderer(std::move(scaled)), checker(teapot);
+        const MapVerifier verifier(checker);
         CameraSpec seeing = smallSpec(teapot, "vulkan");
         seeing.view.eye *= 100.0, seeing.view.target *= 100.0;
         seeing.projection.near *= 100.0, seeing.projection.far *= 100.0;
         const Camera camera(seeing);
         const DepthMap map = mapOf(renderer.scene(), camera, renderer.renderRay(camera), ExportQuantity::EyeZ);
         std::string seen;
-        const bool named = names(checker, camera, map, {"mesh-units", ""}, seen);
+        const bool named = names(verifier, camera, map, {"mesh-units", ""}, seen);
         INFO(seen);
         CHECK(named);
     }

@@ -32,8 +32,6 @@ void requireSomethingCompared(const ComparisonReport& report, const std::string&
 
 Checker::Checker(Scene scene) : scene_(std::move(scene)), rays_(scene_), raster_(scene_) {}
 
-Checker::~Checker() = default;
-
 namespace {
 
 using Clock = std::chrono::steady_clock;

@@ -29,12 +29,18 @@ void DatasetRunOptions::parseShard(const std::string& text)
     shard = i, shards = n;
 }
 
-const Checker& SceneCheckers::operator()(const std::string& scene)
+struct SceneCheckers::Built {
+    explicit Built(Scene scene) : checker(std::move(scene)), verifier(checker) {}
+    const Checker checker;
+    const MapVerifier verifier;
+};
+
+const MapVerifier& SceneCheckers::operator()(const std::string& scene)
 {
     const std::lock_guard<std::mutex> lock(mutex_);
-    auto& checker = checkers_[scene];
-    if (!checker) checker = std::make_shared<const Checker>(loadScene(scene));
-    return *checker;
+    auto& built = built_[scene];
+    if (!built) built = std::make_shared<const Built>(loadScene(scene));
+    return built->verifier;
 }
 
 DatasetRunner::DatasetRunner(Dataset dataset, DatasetRunOptions options, DepthMapReader readDepthMap,
@@ -107,12 +113,12 @@ FrameResult DatasetRunner::verify(std::size_t index, VerifiedMap* keep) const
         const FramePlan plan = planFrame(frame, options_);
         result.map.quantity = plan.quantityName;
         result.map.reading = plan.reading;
-        const Checker& checker = (*checkers_)(plan.scene);
-        CameraForMap made = frameCameraAndMap(frame, plan, checker.scene(), options_, readDepthMap_);
+        const MapVerifier& verifier = (*checkers_)(plan.scene);
+        CameraForMap made = frameCameraAndMap(frame, plan, verifier.checker().scene(), options_, readDepthMap_);
         const Camera camera(made.spec);
         result.map.channel = made.map.channel;
         const DepthMap map = DepthMap::of(std::move(made.map), plan.quantity, plan.reading);
-        VerifiedMap verified = verifyMap(checker, camera, map, options_.diagnose, "depth map '" + frame.depth + "'");
+        VerifiedMap verified = verifyMap(verifier, camera, map, options_.diagnose, result.map.name());
         result.verified = true;
         result.report = verified.run.report;
         result.diagnosed = verified.diagnosed;

@@ -512,7 +512,7 @@ std::vector<Mistake> buildCatalogue()
     swapped.reread = nullptr;
     all.push_back(swapped);
     // A field of view off by a small factor is measured, not guessed: fit.h's field-of-view
-    // family, in Checker::diagnose.
+    // family, in MapVerifier::diagnose.
 
     // What the numbers are.
     Mistake linear{"linear-depth", "linear eye depth (z − n)/(f − n) stored as the window depth", Route::Raster, {}, {}};

@@ -31,12 +31,13 @@ void fillComparison(PyReport& r, const Comparison& c, const RenderResult& ray, c
     r.comparedWindowDepth = compared.windowDepth.value;
 }
 
-void fillVerification(PyReport& r, VerifyOutcome verified)
+void fillVerification(PyReport& r, VerifiedMap verified, const DepthMapSource& source)
 {
+    VerificationReport formatted = formatVerification(verified, source);
     r.verify = true;
     r.report = verified.run.report;
-    r.json = std::move(verified.json);
-    r.summary = std::move(verified.summary);
+    r.json = std::move(formatted.json);
+    r.summary = std::move(formatted.summary);
     if (verified.diagnosed) r.diagnosis = std::move(verified.diagnosis);
     fillComparison(r, verified.run.comparison, verified.run.truth, verified.run.map);
 }

@@ -5,8 +5,10 @@
 #include "zcheck/checker.h"
 #include "zcheck/depth_map_reading.h"
 #include "zcheck/error.h"
+#include "zcheck/map_verifier.h"
 #include "zcheck/quantity.h"
 #include "zcheck/report.h"
+#include "zcheck/verify_map.h"
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -49,6 +51,14 @@ DepthMapReading readingOf(const ReadingArguments& arguments);
 // The quantity argument: a required depth quantity's name (a zcheck.Error when None or not one).
 DepthQuantity quantityArgument(const py::object& quantity, std::string& name);
 
+// zcheck.Checker: a Checker and, beside it, the MapVerifier that its verify, verify_file and
+// diagnose share (map_verifier.h: the neighbour index is built once per Checker, not per map).
+struct PyChecker {
+    explicit PyChecker(Scene scene) : checker(std::move(scene)), verifier(checker) {}
+    const Checker checker;
+    const MapVerifier verifier;
+};
+
 // zcheck.Report: the result of Checker.check, Checker.verify or Checker.verify_file.
 struct PyReport {
     CheckReport report;
@@ -62,8 +72,9 @@ struct PyReport {
     std::optional<std::vector<Hypothesis>> diagnosis;
 };
 void fillComparison(PyReport& r, const Comparison& c, const RenderResult& ray, const RenderResult& compared);
-// A verification (verifyAndReport, report.h) as a Report: verify and verify_file share it.
-void fillVerification(PyReport& r, VerifyOutcome verified);
+// A verification (verifyMap, verify_map.h) as a Report, its JSON and summary formatted as
+// `zcheck verify` formats them (formatVerification, report.h): verify and verify_file share it.
+void fillVerification(PyReport& r, VerifiedMap verified, const DepthMapSource& source);
 
 // Pickling (pickling.cpp): each class's state as plain Python values, and back.
 py::tuple cameraState(const Camera& camera);

@@ -117,7 +117,7 @@ void bindDatasets(py::module_& m)
                 {
                     py::gil_scoped_release release;
                     const FramePlan plan = planFrame(frame, d.options());
-                    made = frameCameraAndMap(frame, plan, (*d.checkers)(plan.scene).scene(), d.options(), readMap);
+                    made = frameCameraAndMap(frame, plan, (*d.checkers)(plan.scene).checker().scene(), d.options(), readMap);
                 }
                 return py::make_tuple(Camera(made.spec), image(made.map.value, made.map.width, made.map.height));
             },

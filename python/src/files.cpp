@@ -20,7 +20,7 @@ PYBIND11_MODULE(_zcheck_files, m)
     bindDatasets(m);
     m.def(
         "verify_file",
-        [](const Checker& checker, const Camera& camera, const std::string& path, const py::object& quantityArg,
+        [](const PyChecker& self, const Camera& camera, const std::string& path, const py::object& quantityArg,
            std::optional<std::string> channel, const py::object& miss, const py::object& scale, const py::object& offset,
            std::optional<std::string> sidecar, const py::object& quantum, const py::object& relTolerance,
            const py::object& absTolerance, const py::object& allowHoles, bool diagnose, std::optional<int> threads) {
@@ -40,7 +40,8 @@ PYBIND11_MODULE(_zcheck_files, m)
                 const auto limit = threadLimit(threads);
                 const DepthMapFile file = readDepthMap(path, reading, camera.width(), camera.height());
                 const DepthMap map = DepthMap::of(file, quantity, reading);
-                fillVerification(*r, verifyAndReport(checker, camera, map, {path, quantityName, file.channel, reading}, diagnose));
+                const DepthMapSource source{path, quantityName, file.channel, reading};
+                fillVerification(*r, verifyMap(self.verifier, camera, map, diagnose, source.name()), source);
             }
             return r;
         },

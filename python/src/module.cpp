@@ -878,28 +878,30 @@ verdict, and per-pixel images. to_dict() is the document `zcheck check --json` (
         });
 
     // ----------------------------------------------------------------------------- Checker
-    py::class_<Checker>(m, "Checker", R"doc(One scene with both routes built once (Embree's BVH and the rasterizer), and every
+    py::class_<PyChecker>(m, "Checker", R"doc(One scene with both routes built once (Embree's BVH and the rasterizer), and every
 question zcheck answers about it. Immutable and thread-safe: its methods release the GIL and may be
 called from several Python threads at once.)doc")
         .def(py::init([](const Scene& scene) {
                  Scene copy = scene;
                  py::gil_scoped_release release;
-                 return std::make_unique<Checker>(std::move(copy));
+                 return std::make_unique<PyChecker>(std::move(copy));
              }),
              py::arg("scene"), "Validates the scene and builds both routes (the scene is copied).")
-        .def_property_readonly("scene", &Checker::scene, py::return_value_policy::reference_internal)
+        .def_property_readonly(
+            "scene", [](const PyChecker& self) -> const Scene& { return self.checker.scene(); },
+            py::return_value_policy::reference_internal)
         .def(
             "check",
-            [](const Checker& checker, std::optional<Camera> camera, std::optional<int> threads, bool keepPixels) {
+            [](const PyChecker& self, std::optional<Camera> camera, std::optional<int> threads, bool keepPixels) {
                 auto r = std::make_unique<PyReport>();
                 {
                     py::gil_scoped_release release;
                     const auto limit = threadLimit(threads);
-                    const Camera cam = camera ? *camera : Camera(checker.scene().defaultCamera);
+                    const Camera cam = camera ? *camera : Camera(self.checker.scene().defaultCamera);
                     CheckOptions options;
                     options.keepPixels = keepPixels;
-                    const CheckResult run = checker.check(cam, options);
-                    requireSomethingCompared(run.report.comparison, checker.scene().name);
+                    const CheckResult run = self.checker.check(cam, options);
+                    requireSomethingCompared(run.report.comparison, self.checker.scene().name);
                     r->report = run.report;
                     r->json = checkReportJson(run.report);
                     r->summary = formatSummary(run.report);
@@ -918,7 +920,7 @@ Report's pixel_classes, error_over_tolerance, ray_window_depth and compared_wind
 raise zcheck.Error.)doc")
         .def(
             "render",
-            [](const Checker& checker, const Camera& camera, const std::string& quantityName, const std::string& routeName,
+            [](const PyChecker& self, const Camera& camera, const std::string& quantityName, const std::string& routeName,
                py::object dtype, std::optional<int> threads) -> py::array {
                 const ExportQuantity quantity = exportQuantityFromName(quantityName);
                 const Route route = routeFromName(routeName);
@@ -929,7 +931,7 @@ raise zcheck.Error.)doc")
                 {
                     py::gil_scoped_release release;
                     const auto limit = threadLimit(threads);
-                    img = checker.render(camera, quantity, route);
+                    img = self.checker.render(camera, quantity, route);
                 }
                 const py::ssize_t H = img.height, W = img.width;
                 if (quantity == ExportQuantity::PrimitiveId) return image(img.id, img.width, img.height);
@@ -960,7 +962,7 @@ Misses hold the quantity's miss value: the clear value (window), NDC z of the fa
 +inf (eye-z, distance), NaN (positions, normals), 0xFFFFFFFF (primitive-id).)doc")
         .def(
             "verify",
-            [](const Checker& checker, const Camera& camera, py::object depth, const py::object& quantityArg,
+            [](const PyChecker& self, const Camera& camera, py::object depth, const py::object& quantityArg,
                const py::object& miss, const py::object& scale, const py::object& offset, const py::object& quantum,
                const py::object& relTolerance, const py::object& absTolerance, const py::object& allowHoles, bool diagnose,
                std::optional<int> threads) {
@@ -973,7 +975,8 @@ Misses hold the quantity's miss value: the clear value (window), NDC z of the fa
                 {
                     py::gil_scoped_release release;
                     const auto limit = threadLimit(threads);
-                    fillVerification(*r, verifyAndReport(checker, camera, map, {"<array>", quantityName, "", reading}, diagnose));
+                    const DepthMapSource source{"<array>", quantityName, "", reading};
+                    fillVerification(*r, verifyMap(self.verifier, camera, map, diagnose, source.name()), source);
                 }
                 return r;
             },
@@ -1004,7 +1007,7 @@ diagnose: when inconsistent, also run diagnose() and put it in the report (`--di
 Returns a Report whose to_dict() is `zcheck verify --json`'s document (depth_map.file "<array>").)doc")
         .def(
             "diagnose",
-            [](const Checker& checker, const Camera& camera, py::object depth, const py::object& quantityArg,
+            [](const PyChecker& self, const Camera& camera, py::object depth, const py::object& quantityArg,
                const py::object& miss, const py::object& scale, const py::object& offset, const py::object& quantum,
                const py::object& relTolerance, const py::object& absTolerance, const py::object& allowHoles,
                std::optional<int> threads) {
@@ -1017,7 +1020,7 @@ Returns a Report whose to_dict() is `zcheck verify --json`'s document (depth_map
                 {
                     py::gil_scoped_release release;
                     const auto limit = threadLimit(threads);
-                    hypotheses = checker.diagnose(camera, map);
+                    hypotheses = self.verifier.diagnose(camera, map);
                 }
                 return diagnosisList(hypotheses);
             },
@@ -1033,9 +1036,9 @@ parameters as {name, value, declared} (e.g. fovy_deg, sample_dx_px, near, value_
 its median relative depth residual ("residual": fitted vs declared camera). The consistent
 ones name what explains the map (e.g. "y-flip", "distance-as-eye-z", "sample-offset").
 Arguments as for verify().)doc")
-        .def("__repr__", [](const Checker& c) {
-            return "<zcheck.Checker scene '" + c.scene().name + "', " + std::to_string(c.scene().triangleCount()) +
-                   " triangles>";
+        .def("__repr__", [](const PyChecker& self) {
+            const Scene& scene = self.checker.scene();
+            return "<zcheck.Checker scene '" + scene.name + "', " + std::to_string(scene.triangleCount()) + " triangles>";
         });
 
     // ----------------------------------------------------------------------------- functions

@@ -323,27 +323,23 @@ std::string verifyReportJson(const CheckReport& report, const DepthMapSource& so
     return prettyJson(document);
 }
 
-VerifyOutcome verifyAndReport(const Checker& checker, const Camera& camera, const DepthMap& map,
-                              const DepthMapSource& source, bool diagnose)
+VerificationReport formatVerification(const VerifiedMap& verified, const DepthMapSource& source)
 {
-    VerifyOutcome out;
-    VerifiedMap verified = verifyMap(checker, camera, map, diagnose, "depth map '" + source.file + "'");
-    out.run = std::move(verified.run);
-    out.diagnosed = verified.diagnosed;
-    out.diagnosis = std::move(verified.diagnosis);
-    out.json = verifyReportJson(out.run.report, source, out.diagnosed ? &out.diagnosis : nullptr);
-    out.summary = formatSummary(out.run.report, "ground truth (Embree) vs depth map '" + source.file + "' channel '" +
-                                                    source.channel + "' (" + source.quantity + ")");
-    if (out.diagnosed) {
-        const ComparisonReport& c = out.run.comparison.report;
-        out.summary += "\n" + formatDiagnosis(out.diagnosis, c.bothHit + c.rayOnly + c.rasterOnly);
+    VerificationReport out;
+    const CheckReport& report = verified.run.report;
+    out.json = verifyReportJson(report, source, verified.diagnosed ? &verified.diagnosis : nullptr);
+    out.summary = formatSummary(report, "ground truth (Embree) vs depth map '" + source.file + "' channel '" +
+                                            source.channel + "' (" + source.quantity + ")");
+    if (verified.diagnosed) {
+        const ComparisonReport& c = verified.run.comparison.report;
+        out.summary += "\n" + formatDiagnosis(verified.diagnosis, c.bothHit + c.rayOnly + c.rasterOnly);
     }
     return out;
 }
 
 std::string formatDiagnosis(const std::vector<Hypothesis>& hypotheses, std::int64_t compared)
 {
-    // Ranked (Checker::diagnose): the consistent ones first, then those failing only at edges.
+    // Ranked (MapVerifier::diagnose): the consistent ones first, then those failing only at edges.
     if (hypotheses.empty()) return "diagnosis  no hypothesis applies to this camera and map\n";
     auto named = [](const Hypothesis& h) {
         std::string text = h.explanation;

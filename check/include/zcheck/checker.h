@@ -1,5 +1,5 @@
 #pragma once
-// Checker: one scene, both routes built once, and every question zcheck answers about it.
+// Checker: one scene, both routes built once, checked through any camera (library zcheck::check).
 //
 //   const zcheck::Checker checker(zcheck::loadScene("bunny.obj"));   // BVH and raster set-up, once
 //   const zcheck::Camera camera(zcheck::readCameraFile("camera.json"));
@@ -14,8 +14,10 @@
 // camera's definition (camera_rays.h), the raster route its matrices — and compares them per
 // pixel with the tolerance model (compare.h); asked to keep no per-pixel result
 // (CheckOptions::keepPixels), it does so 64×64 tile by tile, each tile traced, drawn and
-// compared while in the cache, for the same report. verify() and diagnose() judge a depth map
-// rendered elsewhere against the ray route (verify.h).
+// compared while in the cache, for the same report. A depth map rendered elsewhere is judged
+// against the ray route above this library: MapVerifier (zcheck::diagnose, map_verifier.h)
+// holds a Checker and verifies and diagnoses maps through its routes (rayRenderer(),
+// rasterRenderer()).
 //
 // Thread-safety: a Checker is immutable after construction; every member function is const
 // and may be called from several threads at once. Each call allocates its own results.
@@ -26,8 +28,6 @@
 #include "zcheck/ray_renderer.h"
 #include "zcheck/scene.h"
 
-#include <memory>
-#include <mutex>
 #include <string>
 #include <vector>
 
@@ -78,7 +78,7 @@ struct CheckReport {
     ComparisonReport comparison;
     Timings timings;
     std::vector<std::string> warnings;  // about the inputs (PolygonPlanarity::warning), in the report
-    MapAccuracy declared;               // verify: what the map declared (DepthMap::accuracy); check: nothing
+    MapAccuracy declared;               // verify: what the map's reading declared; check: nothing
     std::string secondRoute = "raster"; // what the truth is compared with: "raster" (check) or "map" (verify),
                                         // as the report and its JSON keys name it
     MapErrors mapErrors;                // verify: the map's errors in its units; check: nothing compared
@@ -86,7 +86,7 @@ struct CheckReport {
                                         // in [0, 1], the camera's depth range"), for values out of range
 
     // Fills what the report says of its inputs: the scene (name, triangles, warnings), the
-    // camera and the tolerance. Checker::check and verify share it.
+    // camera and the tolerance. Checker::check and verifying a map (verify.h) share it.
     void describeInputs(const Scene& checked, const Camera& used, const ToleranceModel& model);
 };
 
@@ -107,83 +107,6 @@ struct CheckOptions {
     bool keepPixels = true;
 };
 
-// How one value of a map is judged (value units): the step it was stored or rounded with (0:
-// binary32's own spacing at the value), and the accuracy its producer declares, ± (absolute +
-// relative·|value|).
-struct ValueAccuracy {
-    double step = 0;
-    double relative = 0, absolute = 0;
-};
-
-// A depth map rendered elsewhere, as read: values per pixel in one depth quantity.
-struct DepthMap {
-    int width = 0, height = 0;
-    DepthQuantity quantity = DepthQuantity::Window;
-    std::vector<double> value;   // row 0 at the top; misses and values out of range as
-                                 // kindOfDepthValue (inverse_projection.h) defines them
-    double valueQuantum = 0;     // the storage step of `value` (1/scale for integer files); 0: binary32
-    std::vector<float> valueStep;  // each value's own step (binary16 files), overriding valueQuantum; or empty
-    MapAccuracy accuracy;        // what its producer declares (depth_map_reading.h)
-    double scale = 0, offset = 0;  // how stored values became `value`: stored / scale + offset (scale 0: 1)
-
-    // A map of `quantity` as a file was read `reading`'s way, with what the reading declares.
-    static DepthMap of(DepthMapFile file, DepthQuantity quantity, const DepthMapReading& reading);
-    // A map of values exact to their binary32 spacing, nothing declared (tests, arrays).
-    static DepthMap exact(int width, int height, DepthQuantity quantity, std::vector<double> values)
-    {
-        DepthMap map;
-        map.width = width, map.height = height, map.quantity = quantity, map.value = std::move(values);
-        return map;
-    }
-    // A value as the file stored it (before scale and offset).
-    double storedOf(double v) const { return (v - offset) * (scale > 0 ? scale : 1.0); }
-    // Value i's: its step (its own, the file's, at least the declared quantum) and the declared accuracy.
-    ValueAccuracy accuracyAt(std::size_t i) const
-    {
-        const double own = valueStep.empty() ? valueQuantum : double(valueStep[i]);
-        return {std::max(own, accuracy.quantum), accuracy.relative, accuracy.absolute};
-    }
-};
-
-struct VerifyResult {
-    RenderResult truth;       // the ray route
-    RenderResult map;         // the map as a render result (see verify.h for the surface it saw)
-    Comparison comparison;
-    CheckReport report;
-    std::vector<float> mapError;  // Checker::verify: per pixel map − truth in report.mapErrors' units,
-                                  // NaN where not compared on depth; empty otherwise
-};
-
-// A parameter a diagnosis measured: "fovy_deg", "sample_dx_px", "near", "value_scale", ...
-struct FittedValue {
-    std::string name;
-    double value = 0;      // fitted
-    double declared = 0;   // what the camera file or the reading says
-};
-
-// One hypothesis of the diagnosis: a mistake of the catalogue (mistakes.h), perhaps one of
-// several variants of it, under which the map was re-read or the truth re-rendered.
-struct Hypothesis {
-    std::string name;         // the mistake's name, e.g. "distance-as-eye-z", "half-pixel"
-    std::string variant;      // which variant, e.g. "x and y"; empty when there is one
-    std::string explanation;  // "consistent if read as ray distance instead of eye-z"
-    bool consistent = false;
-    std::int64_t unexplained = 0;
-    bool estimated = false;   // `unexplained` estimated from a sample that already ruled the
-                              // hypothesis out (verify.h, screenUnexplained)
-    std::vector<FittedValue> fitted;  // a fitted hypothesis's values (fit.h); empty for the catalogue's
-    // Of the unexplained pixels, those at edges of the truth (a 3×3 neighbourhood that is not
-    // one plane), and of those the ones whose depth lies between the truth's around them.
-    std::int64_t unexplainedAtEdges = 0, blendsAtEdges = 0;
-    std::int64_t compared = 0;  // pixels where either side sees a surface (full comparisons only)
-    // Not consistent, but only at edges: every unexplained pixel at an edge, and at most 10 % of
-    // the compared ones (a silhouette-rich 200×150 view has 4 % at its edges): "consistent
-    // except N edge pixels".
-    bool consistentExceptEdges() const;
-};
-
-class VertexNeighbours;
-
 // Refuses a comparison with nothing in it (throws Error naming `scene`): a camera that sees
 // no geometry proves nothing, and must not be reported CONSISTENT. check/verify front-ends
 // call it on the report before they print a verdict.
@@ -194,7 +117,6 @@ public:
     // Validates the scene (throws Error: no triangles, an index out of range) and builds both
     // routes: Embree's BVH (timed, Timings::bvhBuildMs) and the rasterizer.
     explicit Checker(Scene scene);
-    ~Checker();
     Checker(const Checker&) = delete;
     Checker& operator=(const Checker&) = delete;
 
@@ -212,16 +134,10 @@ public:
     // quantities, positions, normals or primitive ids.
     QuantityImage render(const Camera& camera, ExportQuantity quantity, Route route) const;
 
-    // A depth map rendered elsewhere against the ray route's ground truth, with the same
-    // tolerance model; `map` must be camera.width() × camera.height() (throws Error otherwise).
-    VerifyResult verify(const Camera& camera, const DepthMap& map) const;
-    // Every hypothesis of the mistake catalogue that has a meaning for this camera and map,
-    // then every fitted family (fit.h), each confirmed by a full comparison; ranked: the
-    // consistent ones first, then by unexplained pixels, ties in that order.
-    std::vector<Hypothesis> diagnose(const Camera& camera, const DepthMap& map) const;
-
-    // Triangles around each vertex position, built on first use (verify's surface search).
-    const VertexNeighbours& neighbours() const;
+    // The routes themselves, for those who judge maps through them (MapVerifier): the ray
+    // route's single rays (RayRenderer::primitiveAt) and the rasterizer's drawing.
+    const RayRenderer& rayRenderer() const { return rays_; }
+    const RasterRenderer& rasterRenderer() const { return raster_; }
 
 private:
     CheckResult checkTileByTile(const Camera& camera, const CheckOptions& options) const;
@@ -229,8 +145,6 @@ private:
     Scene scene_;
     RayRenderer rays_;
     RasterRenderer raster_;
-    mutable std::once_flag neighboursOnce_;
-    mutable std::shared_ptr<const VertexNeighbours> neighbours_;  // built in zcheck::diagnose (verify.cpp)
 };
 
 }  // namespace zcheck

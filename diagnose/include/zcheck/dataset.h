@@ -16,6 +16,7 @@
 #include "zcheck/checker.h"
 #include "zcheck/dataset_source.h"
 #include "zcheck/image_io.h"
+#include "zcheck/map_verifier.h"
 #include "zcheck/verify_map.h"
 
 #include <cstddef>
@@ -77,21 +78,24 @@ struct FrameResult {
     bool verified = false;             // report and diagnosis hold a verification
     CheckReport report;                // the comparison, as `zcheck verify --json` reports it
     bool diagnosed = false;
-    std::vector<Hypothesis> diagnosis;  // ranked (Checker::diagnose)
+    std::vector<Hypothesis> diagnosis;  // ranked (MapVerifier::diagnose)
     double seconds = 0;                // wall time of the frame: reading, verifying, diagnosing
 
     bool consistent() const { return verified && report.comparison.consistent(); }
 };
 
 
-// Scenes loaded and their checkers built once, by name, for any number of runners (thread-safe).
+// Scenes loaded and their checkers built once, by name, for any number of runners (thread-safe);
+// each with its map verifier beside it, so that every frame of a scene shares one neighbour index.
 class SceneCheckers {
 public:
-    const Checker& operator()(const std::string& scene);
+    // The scene's verifier (its checker: MapVerifier::checker()), built on first use.
+    const MapVerifier& operator()(const std::string& scene);
 
 private:
+    struct Built;  // a checker and its verifier
     std::mutex mutex_;
-    std::map<std::string, std::shared_ptr<const Checker>> checkers_;
+    std::map<std::string, std::shared_ptr<const Built>> built_;
 };
 
 class DatasetRunner {

@@ -2,9 +2,9 @@
 // What a rejected map's values say its reading should have declared — the options of `verify`
 // that would have accepted it (a miss value, a rounding grid, holes, a stated accuracy) —
 // measured against the ground truth, so that a correct map read without them is named as such
-// instead of being blamed on a convention. Checker::diagnose judges each finding (and all of
-// them together) with a full comparison, like every hypothesis: nothing here accepts a map by
-// itself.
+// instead of being blamed on a convention (library zcheck::diagnose). MapVerifier::diagnose
+// judges each finding (and all of them together) with a full comparison, like every
+// hypothesis: nothing here accepts a map by itself.
 //
 //   miss value  one finite value holds ≥ 90 % of the pixels where the truth sees nothing, at
 //               least 16 of them, and at most 1 % of its pixels are where the truth hits: the
@@ -15,12 +15,14 @@
 //               (k = −6..0) or 2^−k (k = 1..24) at least 16 binary32 spacings of the largest
 //               value: values rounded to a grid coarser than their storage.
 //   holes       pixels without a value where the truth hits that the comparison leaves
-//               unexplained once the miss value above is read as one (Checker::diagnose counts them).
-//   tolerance   only where no convention explains the map (Checker::diagnose asks last): an
+//               unexplained once the miss value above is read as one (MapVerifier::diagnose
+//               counts them).
+//   tolerance   only where no convention explains the map (MapVerifier::diagnose asks last): an
 //               eye-z or distance map whose values where both see a surface lie within a small
 //               relative (≤ 1 %) or absolute error of the truth; the more uniform of the two
 //               (largest over median) is suggested, rounded up to one significant digit.
 #include "zcheck/checker.h"
+#include "zcheck/depth_map.h"
 
 #include <cstdint>
 #include <optional>

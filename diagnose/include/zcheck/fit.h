@@ -30,8 +30,11 @@
 //             offset samples weigh less than a face-on one's), Cauchy's fit again, then the
 //             inliers' largest residual minimised (Lawson's iteration).
 //
-// Checker::diagnose then confirms each fitted camera with the full comparison.
+// MapVerifier::diagnose (map_verifier.h) then confirms each fitted camera with the full
+// comparison. Library zcheck::diagnose.
 #include "zcheck/checker.h"
+#include "zcheck/depth_map.h"
+#include "zcheck/hypothesis.h"
 
 #include <functional>
 #include <string>
@@ -106,7 +109,7 @@ FitResult fitDeparture(const Scene& scene, const Camera& camera, const DepthMap&
                        FitFamily family, const TruthRender& render);
 
 // What a fit found, in the camera's own terms, for people ("a vertical field of view of
-// 61.5° instead of 60°") and as named values (FittedValue, checker.h) for --json; the last
+// 61.5° instead of 60°") and as named values (FittedValue, hypothesis.h) for --json; the last
 // value is the residual, fitted against declared.
 std::string describeFit(const Camera& camera, const DepthMap& map, const FitResult& fit);
 std::vector<FittedValue> fittedValues(const Camera& camera, const DepthMap& map, const FitResult& fit);

@@ -1,12 +1,13 @@
 #pragma once
-// The mistake catalogue: the classic transform-chain mistakes, one list, one name each.
+// The mistake catalogue: the classic transform-chain mistakes, one list, one name each
+// (library zcheck::diagnose).
 //
 // Every mistake can be used two ways:
 //   inject — make one route of an otherwise correct chain commit it (the suite: a checker is
 //            as good as the mistakes it catches);
 //   reread — given a depth map that is inconsistent, ask "would a renderer that made this
 //            mistake have produced it?" by re-reading the map, or re-rendering the truth,
-//            under the mistake (the diagnosis in Checker::diagnose).
+//            under the mistake (the diagnosis, MapVerifier::diagnose in map_verifier.h).
 // Some mistakes only have one use: a renderer's clipping or interpolation mistakes cannot be
 // undone by re-reading a finished map (inject only), and a map's values taken for another
 // quantity have no route to inject into (reread only); the other function is then empty.
@@ -15,6 +16,7 @@
 //       if (zcheck::RouteFaults faults; mistake.inject && mistake.inject(camera, faults))
 //           zcheck::RenderResult wrong = checker.render(camera, mistake.route, faults);
 #include "zcheck/checker.h"
+#include "zcheck/depth_map.h"
 
 #include <functional>
 #include <optional>

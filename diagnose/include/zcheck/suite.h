@@ -12,7 +12,7 @@
 //                pixels (and at least 10). A y-flip of a mirror-symmetric picture, or no near
 //                clipping where nothing crosses the near plane, is not applicable, and said so.
 // The suite passes when every clean configuration is consistent (no false positive) and every
-// applicable fault is detected.
+// applicable fault is detected. Library zcheck::diagnose.
 #include "zcheck/checker.h"
 #include "zcheck/mistakes.h"
 

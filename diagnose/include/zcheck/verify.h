@@ -1,7 +1,7 @@
 #pragma once
 // Verifying a depth map rendered elsewhere (a GPU, an engine, Blender, a simulator) against
-// the ray route's ground truth — Checker::verify and Checker::diagnose (checker.h) — and the
-// pieces they are made of.
+// the ray route's ground truth (library zcheck::diagnose): the pieces MapVerifier::verify and
+// MapVerifier::diagnose (map_verifier.h) are made of, and what a verification returns.
 //
 // The map does not say which surface it saw: each hit takes the ground truth's surface when
 // the comparison's rule (PixelJudge) accepts the map's depth on it; otherwise, among the
@@ -12,6 +12,7 @@
 // otherwise the truth's surface (a depth error) or kUnknownPrimitive. The accepted depths at a pixel are therefore one interval around the
 // true depth: a map nearer the truth never fails where a farther one passes.
 #include "zcheck/checker.h"
+#include "zcheck/depth_map.h"
 
 #include <cmath>
 #include <mutex>
@@ -21,6 +22,17 @@
 #include <vector>
 
 namespace zcheck {
+
+// A map compared with the ray route's ground truth: both as render results, the comparison, and
+// its report (secondRoute "map").
+struct VerifyResult {
+    RenderResult truth;       // the ray route
+    RenderResult map;         // the map as a render result (the surface each hit saw: above)
+    Comparison comparison;
+    CheckReport report;
+    std::vector<float> mapError;  // MapVerifier::verify: per pixel map − truth in report.mapErrors' units,
+                                  // NaN where not compared on depth; empty otherwise
+};
 
 // Triangles around each vertex position (positions, not indices: loaders duplicate vertices),
 // for guessing which surface a map saw, and, given the ray route, the triangles seen at points
@@ -177,7 +189,7 @@ struct EdgeTally {
 EdgeTally tallyEdges(const Camera& camera, const RenderResult& truth, const RenderResult& map, const Comparison& comparison);
 
 // The map's errors in its own units (report.mapErrors, mapError per pixel), from a comparison
-// of it: Checker::verify's last step (a diagnosis's readings skip it).
+// of it: MapVerifier::verify's last step (a diagnosis's readings skip it).
 void measureMapErrors(const Camera& camera, const DepthMap& map, VerifyResult& run);
 
 // The comparison of `map` against an already rendered ground truth `truth` (one BVH, one

@@ -1,5 +1,7 @@
 #pragma once
-// Reports, for people and for programs: every document zcheck prints or writes, as text.
+// Reports, for people and for programs: every document zcheck prints or writes, as text
+// (library zcheck::report). They format results already computed — a check, a verification
+// and its diagnosis (verifyMap, verify_map.h), the suite — and run nothing themselves.
 // JSON documents are indented for people, with arrays of numbers (matrix rows, vectors) on
 // one line; invalid UTF-8 in strings (file names) is replaced, never thrown over. The keys
 // are those the README documents for `--json`.
@@ -24,17 +26,14 @@ std::string formatSummary(const CheckReport& report,
 // `zcheck verify --json`: the check report plus the map's source and, when given, the diagnosis.
 std::string verifyReportJson(const CheckReport& report, const DepthMapSource& source,
                              const std::vector<Hypothesis>* diagnosis = nullptr);
-// One verification as `zcheck verify` reports it: verifyMap (verify_map.h), the JSON document
-// and the summary. The command line and the Python module both go through it.
-struct VerifyOutcome {
-    VerifyResult run;
-    bool diagnosed = false;
-    std::vector<Hypothesis> diagnosis;
+// One verification (verifyMap's result, verify_map.h) as `zcheck verify` reports it: the JSON
+// document, with the diagnosis when it was diagnosed, and the summary, the diagnosis lines
+// included. The command line and the Python module both format it here.
+struct VerificationReport {
     std::string json;      // `zcheck verify --json`
-    std::string summary;   // `zcheck verify`, the diagnosis line included
+    std::string summary;   // `zcheck verify`
 };
-VerifyOutcome verifyAndReport(const Checker& checker, const Camera& camera, const DepthMap& map,
-                              const DepthMapSource& source, bool diagnose);
+VerificationReport formatVerification(const VerifiedMap& verified, const DepthMapSource& source);
 
 // The diagnosis lines for people: the best hypothesis (and up to three more that also explain
 // the map, or all of it but a handful of edge pixels), or the closest one — unless it leaves at
