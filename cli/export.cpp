@@ -4,9 +4,9 @@
 
 #include "camera_json.h"
 #include "zcheck/atomic_file.h"
+#include "zcheck/departure.h"
 #include "zcheck/error.h"
 #include "zcheck/export.h"
-#include "zcheck/fit.h"
 #include "zcheck/mesh_loader.h"
 #include "zcheck/png_file.h"
 #include "zcheck/version.h"

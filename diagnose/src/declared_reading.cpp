@@ -1,5 +1,6 @@
 #include "zcheck/declared_reading.h"
 
+#include "numerics.h"
 #include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
 
@@ -141,10 +142,9 @@ std::optional<MapAccuracy> toleranceFinding(const Camera& camera, const DepthMap
             absolute.push_back(error), relative.push_back(error / expected);
         }
     if (absolute.size() < 16) return std::nullopt;
-    auto largestOverMedian = [](std::vector<double> v, double& largest) {
+    auto largestOverMedian = [](const std::vector<double>& v, double& largest) {
         largest = *std::max_element(v.begin(), v.end());
-        std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
-        return largest / std::max(v[v.size() / 2], 1e-300);
+        return largest / std::max(medianOf(v), 1e-300);
     };
     double largestAbsolute = 0, largestRelative = 0;
     const double spreadAbsolute = largestOverMedian(absolute, largestAbsolute);

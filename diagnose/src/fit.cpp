@@ -1,15 +1,14 @@
 #include "zcheck/fit.h"
 
+#include "numerics.h"
 #include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
 #include "zcheck/verify.h"
 
-#include <glm/gtc/matrix_transform.hpp>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <memory>
 #include <optional>
 
@@ -176,162 +175,22 @@ struct Problem {
     }
 };
 
-double medianOf(std::vector<double> v)
+// Levenberg–Marquardt (numerics.h) from the problem's base, at most `iterations` steps; returns
+// the departure reached. The cost is Cauchy's, refreshed every step, or with `weights` the
+// weighted sum of squares. Converged: in tolerances, when no residual moved by a hundredth of
+// one (a step size says nothing there: a face-on pixel's tolerance is 1e-7 of its depth);
+// otherwise at a millionth of a pixel, of a scale, of the depth. Cauchy's scale is floored at
+// binary32's resolution or at a hundredth of a tolerance.
+Departure solved(const Problem& problem, const std::vector<double>* weights = nullptr, int iterations = 30)
 {
-    if (v.empty()) return 0;
-    const auto middle = v.begin() + std::ptrdiff_t(v.size() / 2);
-    std::nth_element(v.begin(), middle, v.end());
-    return *middle;
-}
-
-double medianAbsolute(const std::vector<double>& r)
-{
-    std::vector<double> a(r.size());
-    std::transform(r.begin(), r.end(), a.begin(), [](double x) { return std::abs(x); });
-    return medianOf(std::move(a));
-}
-
-// Cauchy's robust cost at scale c.
-double robustCost(const std::vector<double>& r, double c)
-{
-    if (r.empty()) return INFINITY;
-    double sum = 0;
-    for (double x : r) sum += std::log1p((x / c) * (x / c));
-    return sum;
-}
-
-// Solves A·x = b (n ≤ 6) by Gaussian elimination with partial pivoting; false if singular.
-bool solve(std::vector<double> A, std::vector<double> b, int n, std::vector<double>& x)
-{
-    for (int col = 0; col < n; ++col) {
-        int pivot = col;
-        for (int row = col + 1; row < n; ++row)
-            if (std::abs(A[row * n + col]) > std::abs(A[pivot * n + col])) pivot = row;
-        if (!(std::abs(A[pivot * n + col]) > 0)) return false;
-        for (int k = 0; k < n; ++k) std::swap(A[col * n + k], A[pivot * n + k]);
-        std::swap(b[col], b[pivot]);
-        for (int row = col + 1; row < n; ++row) {
-            const double f = A[row * n + col] / A[col * n + col];
-            for (int k = col; k < n; ++k) A[row * n + k] -= f * A[col * n + k];
-            b[row] -= f * b[col];
-        }
-    }
-    x.assign(n, 0);
-    for (int row = n - 1; row >= 0; --row) {
-        double sum = b[row];
-        for (int k = row + 1; k < n; ++k) sum -= A[row * n + k] * x[k];
-        x[row] = sum / A[row * n + row];
-    }
-    return std::all_of(x.begin(), x.end(), [](double v) { return std::isfinite(v); });
-}
-
-// The robust scale of the residuals: 2.4 × their MAD-estimated spread, floored at binary32's
-// resolution or at a hundredth of a tolerance (a map that matches exactly would otherwise
-// weigh its rounding).
-double cauchyScale(const std::vector<double>& r, bool inTolerances)
-{
-    return std::max(2.4 * 1.4826 * medianAbsolute(r), inTolerances ? 1e-2 : 1e-7);
-}
-
-// Levenberg–Marquardt from the problem's base, at most `iterations` steps; returns the
-// departure reached. The cost is Cauchy's, refreshed every step, or with `weights` the weighted
-// sum of squares.
-Departure levenbergMarquardt(const Problem& problem, const std::vector<double>* weights = nullptr, int iterations = 30)
-{
-    const int n = problem.parameterCount();
-    std::vector<double> p(static_cast<std::size_t>(n), 0.0);
-    std::vector<double> r = problem.residuals(problem.at(p));
-    if (r.empty()) return problem.base;
-    double lambda = 1e-3;
-    constexpr double h = 1e-6;
-    auto costOf = [&](const std::vector<double>& res, double c) {
-        if (!weights) return robustCost(res, c);
-        if (res.empty()) return double(INFINITY);
-        double sum = 0;
-        for (std::size_t k = 0; k < res.size(); ++k) sum += (*weights)[k] * res[k] * res[k];
-        return sum;
-    };
-    for (int iteration = 0; iteration < iterations; ++iteration) {
-        const double c = cauchyScale(r, problem.inTolerances);
-        const double cost = costOf(r, c);
-        // Weighted normal equations with a forward-difference Jacobian.
-        std::vector<std::vector<double>> J(static_cast<std::size_t>(n));
-        for (int j = 0; j < n; ++j) {
-            std::vector<double> q = p;
-            q[std::size_t(j)] += h;
-            J[std::size_t(j)] = problem.residuals(problem.at(q));
-            if (J[std::size_t(j)].empty()) return problem.at(p);
-            for (std::size_t k = 0; k < r.size(); ++k) J[std::size_t(j)][k] = (J[std::size_t(j)][k] - r[k]) / h;
-        }
-        std::vector<double> A(std::size_t(n * n), 0.0), g(std::size_t(n), 0.0);
-        for (std::size_t k = 0; k < r.size(); ++k) {
-            const double w = weights ? (*weights)[k] : 1 / (1 + (r[k] / c) * (r[k] / c));
-            if (w == 0) continue;
-            for (int a = 0; a < n; ++a) {
-                g[std::size_t(a)] -= w * J[std::size_t(a)][k] * r[k];
-                for (int b = 0; b < n; ++b) A[std::size_t(a * n + b)] += w * J[std::size_t(a)][k] * J[std::size_t(b)][k];
-            }
-        }
-        bool improved = false;
-        std::vector<double> step;
-        double change = 0;  // the step's largest change of a residual
-        while (lambda < 1e10) {
-            std::vector<double> damped = A;
-            for (int a = 0; a < n; ++a) damped[std::size_t(a * n + a)] *= 1 + lambda;
-            if (solve(damped, g, n, step)) {
-                std::vector<double> q = p;
-                for (int a = 0; a < n; ++a) q[std::size_t(a)] += step[std::size_t(a)];
-                std::vector<double> rq = problem.residuals(problem.at(q));
-                if (costOf(rq, c) < cost) {
-                    for (std::size_t k = 0; k < r.size(); ++k) change = std::max(change, std::abs(rq[k] - r[k]));
-                    p = std::move(q), r = std::move(rq), lambda = std::max(lambda / 4, 1e-9), improved = true;
-                    break;
-                }
-            }
-            lambda *= 8;
-        }
-        double size = 0;
-        for (double s : step) size = std::max(size, std::abs(s));
-        if (!improved) break;
-        // Converged: in tolerances, when no residual moved by a hundredth of one (a step size
-        // says nothing there: a face-on pixel's tolerance is 1e-7 of its depth); otherwise at a
-        // millionth of a pixel, of a scale, of the depth.
-        if (problem.inTolerances ? change < 1e-2 : size < 1e-6) break;
-    }
-    return problem.at(p);
-}
-
-// A line y = a + b·x through points weighed by their scales (y's change for a relative eye-z
-// change), by least median of squares: of `line` and the lines through 256 pairs of points,
-// the one whose residuals' median is smallest. Global, and indifferent to up to half the points
-// lying off it.
-struct LinePoint {
-    double x, y, sigma;
-};
-struct Line {
-    double a, b;
-};
-Line leastMedianLine(const std::vector<LinePoint>& points, Line line)
-{
-    const std::size_t n = points.size();
-    auto medianOfLine = [&](const Line& l) {
-        std::vector<double> r(n);
-        for (std::size_t k = 0; k < n; ++k) r[k] = (l.a + l.b * points[k].x - points[k].y) / points[k].sigma;
-        return medianAbsolute(r);
-    };
-    double bestMedian = medianOfLine(line);
-    constexpr std::size_t kPairs = 256;
-    for (std::size_t k = 0; n >= 16 && k < kPairs; ++k) {
-        const LinePoint& p = points[k * n / kPairs];
-        const LinePoint& q = points[(k * n / kPairs + n / 2 + 37 * k) % n];
-        if (!(std::abs(p.x - q.x) > 1e-9 * std::max(std::abs(p.x), std::abs(q.x)))) continue;
-        Line trial;
-        trial.b = (p.y - q.y) / (p.x - q.x);
-        trial.a = p.y - trial.b * p.x;
-        const double median = medianOfLine(trial);
-        if (median < bestMedian) line = trial, bestMedian = median;
-    }
-    return line;
+    LevenbergMarquardtOptions options;
+    options.iterations = iterations;
+    options.scaleFloor = problem.inTolerances ? 1e-2 : 1e-7;
+    options.residualChange = problem.inTolerances ? 1e-2 : 0;
+    options.weights = weights;
+    const std::optional<std::vector<double>> p = levenbergMarquardt(
+        problem.parameterCount(), [&](const std::vector<double>& q) { return problem.residuals(problem.at(q)); }, options);
+    return p ? problem.at(*p) : problem.base;
 }
 
 // The start of the two families whose values are linear in their parameters, found globally
@@ -397,15 +256,6 @@ std::vector<Sample> withTolerances(const Scene& scene, const Camera& declared, c
     return samples;
 }
 
-// The largest of the residuals `inliers` marks.
-double largestOf(const std::vector<double>& r, const std::vector<double>& inliers)
-{
-    double most = 0;
-    for (std::size_t k = 0; k < r.size(); ++k)
-        if (inliers[k] > 0) most = std::max(most, std::abs(r[k]));
-    return most;
-}
-
 // The rounds' fit refined in the comparison's own terms: every residual in its pixel's
 // tolerance (Problem::residuals), which the confirmation asks each pixel to stay within, and
 // Cauchy's fit again in those units. Then, where most samples are within their tolerance but
@@ -421,7 +271,7 @@ Departure polished(const Scene& scene, Problem problem, const Departure& start)
     if (problem.samples.size() < 16) return start;
     problem.inTolerances = true;
     problem.base = start;
-    Departure best = levenbergMarquardt(problem);
+    Departure best = solved(problem);
     const std::vector<double> r1 = problem.residuals(best);
     if (r1.empty()) return start;
     std::vector<double> weights(r1.size());
@@ -430,7 +280,7 @@ Departure polished(const Scene& scene, Problem problem, const Departure& start)
     if (medianAbsolute(r1) > 1) return best;
     problem.base = best;
     for (int iteration = 0; iteration < 12 && bestLargest > 0.9; ++iteration) {
-        const Departure d = levenbergMarquardt(problem, &weights, 3);  // the weights change anyway
+        const Departure d = solved(problem, &weights, 3);  // the weights change anyway
         const std::vector<double> r = problem.residuals(d);
         if (r.empty()) break;
         const double most = largestOf(r, weights);
@@ -483,78 +333,6 @@ std::vector<Sample> samplesOf(const Scene& scene, const Camera& declared, const 
 bool isRawMatrix(const Camera& camera) { return camera.spec().projection.type == ProjectionType::Matrix; }
 
 }  // namespace
-
-glm::dvec2 windowFromImageOffset(const Camera& camera, const glm::dvec2& offset)
-{
-    // Image y grows downward; window y too where the window's origin is at the top.
-    return {offset.x, (camera.windowYFromImageY(1) - camera.windowYFromImageY(0)) * offset.y};
-}
-
-CameraSpec departedCameraSpec(const Camera& declared, const Departure& d)
-{
-    CameraSpec spec = declared.spec();
-    const bool nearFarMove = d.nearDistance > 0 || d.farDistance > 0;
-    if (nearFarMove) {
-        if (isRawMatrix(declared)) throw Error("a raw projection matrix has no near and far to move");
-        if (d.nearDistance > 0) spec.projection.near = d.nearDistance;
-        if (d.farDistance > 0) spec.projection.far = d.farDistance;
-    }
-    // Sampling at pixel centre + offset sees what a camera whose image moved by −offset sees at
-    // the centre: eye-z, distance and window depth are the same, and the comparison then judges
-    // every pixel (its depth conversion, its edges) at the point that was sampled.
-    const glm::dvec2 imageShift = d.principalShift - d.sampleOffset;
-    if (d.focalScale != glm::dvec2(1.0) || imageShift != glm::dvec2(0.0)) {
-        // The focal lengths scale eye x and y (the principal point stays: an off-axis frustum's
-        // bounds scale about the axis), and the principal point moves the image by tx·w in clip
-        // space (ndcFromWindow's scale turns pixels into NDC).
-        const Camera withNearFar(spec);
-        glm::dmat4 m = withNearFar.clipFromEye;
-        m[0] *= d.focalScale.x, m[1] *= d.focalScale.y;
-        const glm::dvec2 shift = windowFromImageOffset(declared, imageShift);
-        const double tx = shift.x * declared.ndcFromWindow[0][0], ty = shift.y * declared.ndcFromWindow[1][1];
-        for (int c = 0; c < 4; ++c) m[c][0] += tx * m[c][3], m[c][1] += ty * m[c][3];
-        spec.projection.type = ProjectionType::Matrix;
-        spec.projection.clipFromEye = m;
-    }
-    if (d.eyeShift != glm::dvec3(0.0) || d.eyeTurn != glm::dvec3(0.0)) {
-        const double angle = glm::length(d.eyeTurn);
-        glm::dmat4 turn(1.0);
-        if (angle > 0) turn = glm::rotate(glm::dmat4(1.0), angle, d.eyeTurn / angle);
-        glm::dmat4 move(1.0);
-        move[3] = glm::dvec4(d.eyeShift, 1.0);
-        spec.view.hasMatrix = true;
-        spec.view.eyeFromWorld = move * turn * declared.eyeFromWorld;
-    }
-    return spec;
-}
-
-RayFaults departedSampling(const Camera& declared, const Departure& departure)
-{
-    RayFaults faults;
-    faults.shiftPixels = windowFromImageOffset(declared, departure.sampleOffset);
-    return faults;
-}
-
-DepthMap departedReading(const Camera& declared, const DepthMap& map, const Departure& d)
-{
-    DepthMap out = map;
-    if (d.valueScale == 1 && d.valueOffset == 0) return out;
-    for (int row = 0; row < map.height; ++row)
-        for (int col = 0; col < map.width; ++col) {
-            // A miss as read, or once undone as binary32 stores it: a far plane's 1 scaled by
-            // 1.002 and back is 1 − 2^−25, which only rounding returns to the far plane.
-            double& v = out.value[std::size_t(row) * map.width + col];
-            const glm::dvec2 pWindow = windowFromPixelCentre(declared, col, row);
-            const double undone = (v - d.valueOffset) / d.valueScale;
-            v = isMissValue(declared, pWindow, v, map.quantity) || isMissValue(declared, pWindow, double(float(undone)), map.quantity)
-                    ? NAN
-                    : undone;
-        }
-    const double scale = std::abs(d.valueScale);
-    out.valueQuantum /= scale, out.accuracy.quantum /= scale, out.accuracy.absolute /= scale;
-    for (float& step : out.valueStep) step = float(step / scale);
-    return out;
-}
 
 std::string toString(FitFamily family)
 {
@@ -710,7 +488,7 @@ FitResult fitDeparture(const Scene& scene, const Camera& camera, const DepthMap&
             problem.base = start;
         }
         if (round == 0) problem.base = linearStart(problem);
-        const Departure next = levenbergMarquardt(problem);
+        const Departure next = solved(problem);
         out.samples = problem.samples.size();
         out.residual = medianAbsolute(problem.residuals(next, false));
         const bool moved = (shiftedStart && round == 0) || glm::length(next.sampleOffset - d.sampleOffset) > 1e-4 ||
@@ -742,163 +520,6 @@ FitResult fitDeparture(const Scene& scene, const Camera& camera, const DepthMap&
     }
     out.departure = d;
     return out;
-}
-
-namespace {
-
-std::string signedNumber(double v, int digits = 4)
-{
-    char text[32];
-    std::snprintf(text, sizeof text, "%+.*g", digits, std::abs(v) < 5e-13 ? 0.0 : v);
-    return text;
-}
-
-std::string number(double v, int digits = 4)
-{
-    char text[32];
-    std::snprintf(text, sizeof text, "%.*g", digits, v);
-    return text;
-}
-
-// The standard sample positions of 4× and 8× multisampling (in 1/16 pixel, x right and y away
-// from the framebuffer's first row: down in Direct3D, Vulkan and Metal, up in OpenGL, where
-// GL_SAMPLE_POSITION reports the same numbers from the lower-left corner — Mesa's llvmpipe does)
-// the offset in the image matches within 1/64 px, as "sample k of N× MSAA".
-std::string msaaSampleOf(const Camera& camera, const glm::dvec2& imageOffset)
-{
-    const glm::dvec2 offset = windowFromImageOffset(camera, imageOffset);
-    static const int four[4][2] = {{-2, -6}, {6, -2}, {-6, 2}, {2, 6}};
-    static const int eight[8][2] = {{1, -3}, {-1, 3}, {5, 1}, {-3, -5}, {-5, 5}, {-7, -1}, {3, 7}, {7, -7}};
-    auto near = [&](const int p[2]) { return std::abs(offset.x - p[0] / 16.0) < 1.0 / 64 && std::abs(offset.y - p[1] / 16.0) < 1.0 / 64; };
-    if (std::abs(offset.x) < 1.0 / 64 && std::abs(offset.y) < 1.0 / 64) return "";
-    for (int k = 0; k < 4; ++k)
-        if (near(four[k])) return "sample " + std::to_string(k) + " of 4× MSAA's standard pattern";
-    for (int k = 0; k < 8; ++k)
-        if (near(eight[k])) return "sample " + std::to_string(k) + " of 8× MSAA's standard pattern";
-    return "";
-}
-
-glm::dvec3 eyePositionOf(const glm::dmat4& eyeFromWorld) { return glm::dvec3(glm::inverse(eyeFromWorld)[3]); }
-
-}  // namespace
-
-std::vector<FittedValue> fittedValues(const Camera& camera, const DepthMap&, const FitResult& fit)
-{
-    const Departure& d = fit.departure;
-    const Projection& p = camera.spec().projection;
-    std::vector<FittedValue> out;
-    switch (fit.family) {
-    case FitFamily::SampleOffset:
-        out = {{"sample_dx_px", d.sampleOffset.x, 0}, {"sample_dy_px", d.sampleOffset.y, 0}};
-        break;
-    case FitFamily::FieldOfView: {
-        const double k = d.focalScale.x;
-        out.push_back({"focal_scale", k, 1});
-        if (p.type == ProjectionType::Perspective)
-            out.push_back({"fovy_deg", glm::degrees(2 * std::atan(std::tan(glm::radians(p.fovyDeg) / 2) / k)), p.fovyDeg});
-        if (p.type == ProjectionType::Lens) out.push_back({"focal_mm", p.focalMm * k, p.focalMm});
-        if (p.type == ProjectionType::Pinhole) out.push_back({"fx", p.fx * k, p.fx}), out.push_back({"fy", p.fy * k, p.fy});
-        break;
-    }
-    case FitFamily::Intrinsics:
-        out = {{"focal_scale_x", d.focalScale.x, 1},
-               {"focal_scale_y", d.focalScale.y, 1},
-               {"principal_dx_px", d.principalShift.x, 0},
-               {"principal_dy_px", d.principalShift.y, 0}};
-        if (p.type == ProjectionType::Pinhole) {
-            out.push_back({"fx", p.fx * d.focalScale.x, p.fx});
-            out.push_back({"fy", p.fy * d.focalScale.y, p.fy});
-            out.push_back({"cx", p.cx + d.principalShift.x, p.cx});
-            out.push_back({"cy", p.cy + d.principalShift.y, p.cy});
-        }
-        break;
-    case FitFamily::NearFar:
-        out = {{"near", d.nearDistance > 0 ? d.nearDistance : camera.nearDistance(), camera.nearDistance()},
-               {"far", d.farDistance > 0 ? d.farDistance : camera.farDistance(), camera.farDistance()}};
-        break;
-    case FitFamily::DepthScale: out = {{"value_scale", d.valueScale, 1}, {"value_offset", d.valueOffset, 0}}; break;
-    case FitFamily::Pose: {
-        const glm::dvec3 eye = eyePositionOf(camera.eyeFromWorld);
-        const glm::dvec3 moved = eyePositionOf(Camera(departedCameraSpec(camera, d)).eyeFromWorld);
-        out = {{"eye_x", moved.x, eye.x},
-               {"eye_y", moved.y, eye.y},
-               {"eye_z", moved.z, eye.z},
-               {"turn_deg", glm::degrees(glm::length(d.eyeTurn)), 0}};
-        break;
-    }
-    }
-    out.push_back({"residual", fit.residual, fit.initialResidual});
-    return out;
-}
-
-std::string describeFit(const Camera& camera, const DepthMap& map, const FitResult& fit)
-{
-    const Departure& d = fit.departure;
-    const Projection& p = camera.spec().projection;
-    switch (fit.family) {
-    case FitFamily::SampleOffset: {
-        const glm::dvec2 whole = glm::round(d.sampleOffset);
-        const glm::dvec2 within = d.sampleOffset - whole;
-        std::string text = "depth sampled at (" + signedNumber(within.x, 3) + ", " + signedNumber(within.y, 3) +
-                           ") px from the pixel centre (x right, y down)";
-        if (const std::string msaa = msaaSampleOf(camera, within); !msaa.empty()) text += " — " + msaa;
-        if (whole != glm::dvec2(0.0))
-            text += (within == glm::dvec2(0.0) ? "" : ",") + std::string(" the image shifted by (") +
-                    signedNumber(whole.x) + ", " + signedNumber(whole.y) + ") px";
-        if (std::max(std::abs(d.sampleOffset.x), std::abs(d.sampleOffset.y)) >= 2)
-            text += ": the principal point off by (" + signedNumber(-d.sampleOffset.x, 4) + ", " +
-                    signedNumber(-d.sampleOffset.y, 4) + ") px (x right, y down) — cx or cy, or Blender's shift_x or "
-                    "shift_y (in units of the larger sensor side) with the wrong sign";
-        return text;
-    }
-    case FitFamily::FieldOfView: {
-        const double k = d.focalScale.x;
-        switch (p.type) {
-        case ProjectionType::Perspective:
-            return "a vertical field of view of " + number(glm::degrees(2 * std::atan(std::tan(glm::radians(p.fovyDeg) / 2) / k))) +
-                   "° (the camera says " + number(p.fovyDeg) + "°)";
-        case ProjectionType::Lens:
-            return "a focal length of " + number(p.focalMm * k) + " mm (the camera says " + number(p.focalMm) + " mm)";
-        case ProjectionType::Pinhole:
-            return "focal lengths fx " + number(p.fx * k, 6) + ", fy " + number(p.fy * k, 6) + " px (the camera says " +
-                   number(p.fx, 6) + ", " + number(p.fy, 6) + ")";
-        default:
-            return "a view " + number(1 / k) + " times as wide and high as the camera says";
-        }
-    }
-    case FitFamily::Intrinsics: {
-        std::string text = "focal lengths × (" + number(d.focalScale.x, 5) + ", " + number(d.focalScale.y, 5) +
-                           ") and the principal point moved by (" + signedNumber(d.principalShift.x, 3) + ", " +
-                           signedNumber(d.principalShift.y, 3) + ") px (x right, y down)";
-        if (p.type == ProjectionType::Pinhole)
-            text += ": fx " + number(p.fx * d.focalScale.x, 6) + ", fy " + number(p.fy * d.focalScale.y, 6) + ", cx " +
-                    number(p.cx + d.principalShift.x, 6) + ", cy " + number(p.cy + d.principalShift.y, 6);
-        return text;
-    }
-    case FitFamily::NearFar:
-        return "near " + number(d.nearDistance > 0 ? d.nearDistance : camera.nearDistance(), 5) + ", far " +
-               number(d.farDistance > 0 ? d.farDistance : camera.farDistance(), 5) + " (the camera says " +
-               number(camera.nearDistance(), 5) + ", " + number(camera.farDistance(), 5) + ")";
-    case FitFamily::DepthScale:
-        return "the map's values " + number(d.valueScale, 5) + " × the " + toString(map.quantity) +
-               (std::abs(d.valueOffset) > 0 ? " " + signedNumber(d.valueOffset, 5) : std::string()) +
-               " (a unit or scale mistake: divide by " + number(d.valueScale, 5) + ")";
-    case FitFamily::Pose: {
-        const glm::dvec3 eye = eyePositionOf(camera.eyeFromWorld);
-        const glm::dvec3 moved = eyePositionOf(Camera(departedCameraSpec(camera, d)).eyeFromWorld);
-        std::string text = "the eye at (" + number(moved.x, 5) + ", " + number(moved.y, 5) + ", " + number(moved.z, 5) +
-                           ") instead of (" + number(eye.x, 5) + ", " + number(eye.y, 5) + ", " + number(eye.z, 5) + ")";
-        const View& v = camera.spec().view;
-        if (!v.hasMatrix) {
-            const double before = glm::length(v.target - eye), after = glm::length(v.target - moved);
-            if (before > 0) text += ", " + number(100 * std::abs(after - before) / before, 3) + " % " +
-                                    (after > before ? "farther from" : "nearer to") + " the target";
-        }
-        text += ", turned " + number(glm::degrees(glm::length(d.eyeTurn)), 3) + "°";
-        return text;
-    }
-    }
-    return "";
 }
 
 }  // namespace zcheck

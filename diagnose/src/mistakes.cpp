@@ -1,6 +1,6 @@
 #include "zcheck/mistakes.h"
 
-#include "zcheck/fit.h"
+#include "zcheck/departure.h"
 #include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
 #include "zcheck/pose.h"

@@ -1,5 +1,6 @@
 #include "zcheck/verify.h"
 
+#include "numerics.h"
 #include "zcheck/drawn_polygon.h"
 #include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
@@ -394,19 +395,6 @@ VerifyResult verifyAgainst(const Scene& scene, const Camera& camera, const Depth
     run.report.comparison = run.comparison.report;
     return run;
 }
-
-namespace {
-
-// The value at rank ⌈q·n⌉ − 1 of `values` (reordered), 0 for none.
-double quantileOf(std::vector<double>& values, double q)
-{
-    if (values.empty()) return 0;
-    const std::size_t rank = std::size_t(std::max(0.0, std::ceil(q * double(values.size())) - 1));
-    std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(rank), values.end());
-    return values[rank];
-}
-
-}  // namespace
 
 void measureMapErrors(const Camera& camera, const DepthMap& map, VerifyResult& run)
 {
