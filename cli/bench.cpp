@@ -2,7 +2,9 @@
 // compares with what the checked pipelines themselves cost: Mesa's llvmpipe drawing the same
 // depth buffer, and Embree tracing the same rays at its best. Not a test: it measures.
 #include "common.h"
+#include "plugin.h"
 
+#include "zcheck/detail/clock.h"
 #include "zcheck/embree_reference.h"
 #include "zcheck/error.h"
 #include "zcheck/gl_reference.h"
@@ -26,14 +28,8 @@ namespace zcheck::cli {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double millisecondsSince(Clock::time_point start)
-{
-    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-// The workload of the speed issue: a million-triangle terrain seen from above at 1080p,
-// every pixel covered.
+// The named workload terrain-1M-1080p: a million-triangle terrain seen from above at 1080p,
+// every pixel covered (docs/speed.md).
 const char* const kWorkloadScene = "builtin:terrain?n=709&size=2";
 CameraSpec workloadCamera()
 {
@@ -232,9 +228,14 @@ int runBenchCommand(const BenchOptions& o)
         embree.trace(camera, primitiveId);  // warm-up
         for (int r = 0; r < o.repeat; ++r) embreeTrace.ms.push_back(embree.trace(camera, primitiveId));
         if (progress) std::fprintf(stderr, "\rbench: llvmpipe reference%20s", ""), std::fflush(stderr);
-        if (!reference::glReferenceAvailable()) {
-            glSkipped = "not built (libegl-dev was missing at build time)";
-        } else {
+        const reference::GlYardstickFunctions* gl = nullptr;
+        try {
+            using Entry = const reference::GlYardstickFunctions* (*)();
+            gl = reinterpret_cast<Entry>(pluginEntry("libzcheck_gl_yardstick.so", "zcheck_gl_yardstick"))();
+        } catch (const std::runtime_error& e) {
+            glSkipped = std::string("its plugin is missing (built only where libegl-dev is installed): ") + e.what();
+        }
+        if (gl) {
             reference::GlDepthInput input;
             input.positions = &scene.positions[0].x;
             input.vertexCount = scene.positions.size();
@@ -247,10 +248,10 @@ int runBenchCommand(const BenchOptions& o)
             input.zeroToOne = camera.convention().ndcZMin() == 0.0;
             input.threads = threads;
             try {
-                const reference::GlDepthTiming gl = reference::timeGlDepthDraw(input, o.repeat);
+                const reference::GlDepthTiming drawn = gl->timeDraw(input, o.repeat);
                 const RenderResult lastRaster = RasterRenderer(scene).render(camera);
-                glDraw.ms = gl.drawMs;
-                glRenderer = gl.renderer;
+                glDraw.ms = drawn.drawMs;
+                glRenderer = drawn.renderer;
                 // The same picture? Coverage and depth per pixel. OpenGL's window has y up; the
                 // camera's viewport may not (Vulkan, Direct3D, Metal): each pixel is found
                 // through NDC, where both agree.
@@ -262,14 +263,14 @@ int runBenchCommand(const BenchOptions& o)
                     return std::size_t(row) * W + col;
                 };
                 std::size_t same = 0;
-                for (int row = 0; row < H && !gl.depth.empty(); ++row)
+                for (int row = 0; row < H && !drawn.depth.empty(); ++row)
                     for (int col = 0; col < W; ++col) {
-                        const float depth = gl.depth[std::size_t(row) * W + col];
+                        const float depth = drawn.depth[std::size_t(row) * W + col];
                         const std::size_t i = pixelOf(col, row);
                         const bool glHit = depth != float(camera.clearDepth());
                         same += glHit == lastRaster.hit(i) && (!glHit || std::abs(depth - lastRaster.windowDepth.value[i]) <= 1e-5);
                     }
-                glAgreement = gl.depth.empty() ? NAN : double(same) / double(gl.depth.size());
+                glAgreement = drawn.depth.empty() ? NAN : double(same) / double(drawn.depth.size());
             } catch (const std::exception& e) {
                 glSkipped = e.what();
             }
@@ -381,7 +382,7 @@ Command addBenchCommand(CLI::App& app)
                       "a depth-only OpenGL draw on Mesa llvmpipe through EGL, and print the ratios to the targets");
     command->add_flag("--json", o->json, "print the measurements as JSON");
     command->footer(
-        "Without --scene and --camera the workload is the speed issue's: builtin:terrain?n=709&size=2\n"
+        "Without --scene and --camera the workload is terrain-1M-1080p: builtin:terrain?n=709&size=2\n"
         "(1,002,528 triangles) at 1920x1080, unorm24, OpenGL perspective fovy 60, near 0.01, far 10,\n"
         "eye (0, 0.6, -0.15) looking at the origin: every pixel covered.\n"
         "Each repeat is a whole check in a child process of its own, as `zcheck check` runs it: the\n"
@@ -389,11 +390,12 @@ Command addBenchCommand(CLI::App& app)
         "The child then checks again with the same BVH keeping both routes' full-frame renders, whose\n"
         "trace, raster and compare are the phases timed (their buffers new), and once more ('warm':\n"
         "memory the check before freed is reused, as when a program checks many cameras). Peak RSS\n"
-        "is the largest child's, after the first check. Embree's reference builds run in children too; its trace and llvmpipe's\n"
-        "draws repeat in this process. Lines are\n"
+        "is the largest child's, after the first check. Embree's reference builds run in children too;\n"
+        "its trace and llvmpipe's draws repeat in this process (llvmpipe's from the plugin\n"
+        "libzcheck_gl_yardstick.so, loaded only here). Lines are\n"
         "'<phase> median <ms> ms best <ms> ms <rate>' and 'ratio <name> <value> target <bound>'.\n"
         "Examples:\n"
-        "  zcheck bench --reference                         the workload, with both references\n"
+        "  zcheck bench --reference                         terrain-1M-1080p, with both references\n"
         "  zcheck bench --scene terrain.obj --camera cam.json --threads 1 --json\n"
         "  zcheck bench --scene 'builtin:terrain?n=1416&size=2' --width 3840 --height 2160");
     return {command, [o] { return runBenchCommand(*o); }};

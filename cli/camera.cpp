@@ -146,8 +146,10 @@ Command addCameraCommand(CLI::App& app)
     command->add_option("--convention", o->camera.convention, "show the camera in this convention");
     addImageSizeOptions(command, o->size);
     command->add_option("-o,--output", o->output, "write the camera file (zcheck, nerfstudio, opencv) instead of printing")
+        ->type_name("FILE")
         ->check(kNonEmptyPath);
     command->add_option("--out", o->outDir, "write the COLMAP model (cameras.txt, images.txt) into this folder")
+        ->type_name("DIR")
         ->check(kNonEmptyPath);
     return {command, [o] { return runCameraCommand(*o); }};
 }

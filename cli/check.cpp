@@ -64,7 +64,7 @@ Command addCheckCommand(CLI::App& app)
     command->add_flag("--reversed-z", o->reversedZ, "use reversed-Z (near -> far end of the range, test GREATER)");
     command->add_option("--out", o->outDir,
                         "write ray_depth.exr, raster_depth.exr, error_heatmap.png, coverage_classes.png "
-                        "and report.json into this directory (all or none of them: see README)")
+                        "and report.json into this folder (all or none of them)")->type_name("DIR")
         ->check(kNonEmptyPath);
     command->add_flag("--json", o->json, "print the report as JSON instead of the summary");
     command->footer(

@@ -362,22 +362,26 @@ FramePictures picturesOf(const FrameRecord& r, const std::shared_ptr<SceneChecke
     }
 }
 
-int runDatasetReport(const std::vector<std::string>& files, const std::string& html, const std::string& json)
+int runDatasetReport(const std::vector<std::string>& files, const std::string& outDir, bool json)
 {
     OutputFiles outputs;
     for (const std::string& f : files) outputs.addInput(f);
-    if (!html.empty()) outputs.add(html, "--html");
-    if (!json.empty()) outputs.add(json, "--json");
+    const std::string summaryFile = (fs::path(outDir) / "summary.json").string(), htmlFile = (fs::path(outDir) / "report.html").string();
+    if (!outDir.empty()) {
+        outputs.addFolder(outDir, "--out");
+        outputs.add(summaryFile, "--out");
+        outputs.add(htmlFile, "--out");
+    }
     std::vector<ResultsFile> results;
     for (const std::string& f : files) results.push_back(readResults(f));
     const DatasetSummary summary = summarizeResults(results);
-    if (!json.empty()) outputs.writeText(json, datasetSummaryJson(summary) + "\n");
-    if (!html.empty()) {
+    if (!outDir.empty()) {
+        outputs.writeText(summaryFile, datasetSummaryJson(summary) + "\n");
         const auto checkers = std::make_shared<SceneCheckers>();
-        outputs.writeText(html, datasetReportHtml(summary, [&](const FrameRecord& r) { return picturesOf(r, checkers); }));
+        outputs.writeText(htmlFile, datasetReportHtml(summary, [&](const FrameRecord& r) { return picturesOf(r, checkers); }));
     }
     outputs.commit();
-    std::cout << datasetSummaryText(summary);
+    std::cout << (json ? datasetSummaryJson(summary) + "\n" : datasetSummaryText(summary));
     const bool all = summary.missing.empty() && summary.consistent == summary.frames;
     return all ? kExitConsistent : kExitInconsistent;
 }
@@ -446,8 +450,7 @@ int runDatasetSubmit(const SubmitOptions& o)
                                "/logs/report.out\n" + header + "set -uo pipefail\nresults=()\nfor i in $(seq 0 " +
                                std::to_string(o.tasks - 1) + "); do\n  f=" + shellQuoted(dir) +
                                "/results-$i.jsonl\n  [[ -s $f ]] && results+=(\"$f\")\ndone\n" + shellQuoted(exe) +
-                               " dataset report \"${results[@]}\" --json " + shellQuoted(dir + "/summary.json") + " --html " +
-                               shellQuoted(dir + "/report.html") + "\nstatus=$?\necho $status > " +
+                               " dataset report \"${results[@]}\" --out " + shellQuoted(dir) + "\nstatus=$?\necho $status > " +
                                shellQuoted(dir + "/report.status") + "\nexit $status\n";
     outputs.writeText(dir + "/verify.sbatch", verify);
     outputs.writeText(dir + "/report.sbatch", report);
@@ -499,21 +502,26 @@ Command addDatasetCommand(CLI::App& app)
                   "  zcheck dataset verify transforms.json --scene mesh.ply --quantity eye-z -o results.jsonl");
     addDatasetVerifyOptions(verifyCommand, *verify);
     verifyCommand->add_option("--shard", verify->shard, "I/N: frames I, I+N, I+2N, ... (N tasks cover the dataset once)");
-    verifyCommand->add_option("-o,--output", verify->output, "the results file (JSON Lines); '-' or none: standard output");
+    verifyCommand->add_option("-o,--output", verify->output, "the results file (JSON Lines); '-' or none: standard output")
+        ->type_name("FILE");
     verifyCommand->add_flag("--resume", verify->resume,
                             "complete the -o file: frames already in it are skipped, a torn last line is dropped");
 
     struct ReportOptions {
         std::vector<std::string> files;
-        std::string html, json;
+        std::string outDir;
+        bool json = false;
     };
     auto report = std::make_shared<ReportOptions>();
     CLI::App* reportCommand = dataset->add_subcommand(
         "report", "Merge result files (of shards, resumed runs) and say what they hold: frames consistent,\n"
                   "inconsistent, in error, missing or recorded twice, the mistakes found, the worst frames.");
     reportCommand->add_option("results", report->files, "results files (JSON Lines)")->required()->check(kNonEmptyPath);
-    reportCommand->add_option("--html", report->html, "write a self-contained HTML report")->check(kNonEmptyPath);
-    reportCommand->add_option("--json", report->json, "write the summary as JSON")->check(kNonEmptyPath);
+    reportCommand->add_option("--out", report->outDir,
+                              "the folder to write summary.json (the summary as JSON) and report.html (a self-contained "
+                              "page with the worst frames' pictures) into, both or neither")->type_name("DIR")
+        ->check(kNonEmptyPath);
+    reportCommand->add_flag("--json", report->json, "print the summary as JSON instead of text");
 
     auto import = std::make_shared<DatasetVerifyOptions>();
     auto manifest = std::make_shared<std::string>();
@@ -522,7 +530,8 @@ Command addDatasetCommand(CLI::App& app)
     importCommand->add_option("source", import->source, "a transforms.json or a COLMAP model folder")->required()->check(kNonEmptyPath);
     importCommand->add_option("--depth", import->depthPattern, "COLMAP: the depth map pattern ({name}, {stem})");
     importCommand->add_option("--camera-format", import->cameraFormat, "the source's format when its content should not decide");
-    importCommand->add_option("-o,--output", *manifest, "the manifest to write")->required()->check(kNonEmptyPath);
+    importCommand->add_option("-o,--output", *manifest, "the manifest to write")
+        ->type_name("FILE")->required()->check(kNonEmptyPath);
 
     auto submit = std::make_shared<SubmitOptions>();
     CLI::App* submitCommand = dataset->add_subcommand(
@@ -535,6 +544,7 @@ Command addDatasetCommand(CLI::App& app)
         ->required()
         ->check(CLI::Range(1, 100000));
     submitCommand->add_option("--out", submit->out, "the folder for the scripts, results, logs and report")
+        ->type_name("DIR")
         ->required()
         ->check(kNonEmptyPath);
     submitCommand->add_option("--sbatch-arg", submit->sbatchArguments,
@@ -544,7 +554,7 @@ Command addDatasetCommand(CLI::App& app)
 
     return {dataset, [=] {
                 if (verifyCommand->parsed()) return runDatasetVerify(*verify);
-                if (reportCommand->parsed()) return runDatasetReport(report->files, report->html, report->json);
+                if (reportCommand->parsed()) return runDatasetReport(report->files, report->outDir, report->json);
                 if (importCommand->parsed()) return runDatasetImport(*import, *manifest);
                 return runDatasetSubmit(*submit);
             }};

@@ -132,7 +132,8 @@ Command addExportCommand(CLI::App& app)
                               "primitive-id (several only into .exr)")
         ->capture_default_str();
     addSceneAndCameraOptions(command, o->input);
-    command->add_option("-o,--output", o->output, "FILE.exr | .pfm | .tif | .png (written atomically)")
+    command->add_option("-o,--output", o->output, "the depth file: .exr, .pfm, .tif, .npy, .h5, .bin (COLMAP) or .png (written atomically)")
+        ->type_name("FILE")
         ->check(kNonEmptyPath);
     command->add_option("--scale", o->scale, "16-bit PNG: stored = value x scale (e.g. 1000 = millimetres)")
         ->check(kPositiveFinite);

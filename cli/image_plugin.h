@@ -3,9 +3,8 @@
 // plugin libzcheck_images.so. OpenImageIO pulls in ~260 shared libraries and ~0.35 s of
 // start-up; loading it only when a command reads or writes an EXR, TIFF, PFM or PNG depth
 // file keeps `zcheck --help`, `--version`, `matrices`, `precision` and `unproject --pixel`
-// fast. The plugin is looked for next to the executable (the build tree), then at the
-// install's relative location (bin/../lib/zcheck). A plugin that cannot be loaded is an
-// internal failure (exit 3) naming the paths tried.
+// fast. It is found as every plugin is (plugin.h); one that cannot be loaded is an internal
+// failure (exit 3) naming the paths tried.
 #include "zcheck/image_io.h"
 
 namespace zcheck::cli {

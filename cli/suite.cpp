@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <iostream>
 
 namespace zcheck::cli {
@@ -20,7 +21,8 @@ namespace {
 
 struct SuiteOptions {
     bool quick = false;
-    std::string filter, jsonFile, htmlFile, modelsDir;
+    std::string filter, outDir, modelsDir;
+    bool json = false;
     int threads = 0;
 };
 
@@ -28,8 +30,12 @@ int runSuiteCommand(const SuiteOptions& o)
 {
     const auto threadLimit = limitThreads(o.threads);
     OutputFiles outputs;  // validated now, not after a long run
-    if (!o.jsonFile.empty()) outputs.add(o.jsonFile, "--json");
-    if (!o.htmlFile.empty()) outputs.add(o.htmlFile, "--html");
+    const std::filesystem::path out(o.outDir);
+    if (!o.outDir.empty()) {
+        outputs.addFolder(o.outDir, "--out");
+        outputs.add((out / "suite.json").string(), "--out");
+        outputs.add((out / "suite.html").string(), "--out");
+    }
     std::vector<SuiteConfig> configs;
     std::string modelsDir = o.modelsDir;
     if (const char* fromEnvironment = std::getenv("ZCHECK_MODELS_DIR"); modelsDir.empty() && fromEnvironment)
@@ -51,13 +57,18 @@ int runSuiteCommand(const SuiteOptions& o)
                          seconds, failuresSoFar, outcome.config.label().c_str(), terminal && done < total ? "" : "\n");
     });
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::cout << "zcheck suite" << (o.quick ? " --quick" : "") << ": " << configs.size() << " configurations x "
-              << injectableMistakes().size() << " faults in " << std::lround(seconds) << " s\n\n"
-              << suiteTable(result) << "\nverdict    " << (result.passed() ? "PASSED" : "FAILED") << "\n";
-
-    if (!o.jsonFile.empty()) outputs.writeText(o.jsonFile, suiteReportJson(result, o.quick, seconds));
-    if (!o.htmlFile.empty()) outputs.writeText(o.htmlFile, suiteReportHtml(result, seconds));
+    const std::string json = suiteReportJson(result, o.quick, seconds);
+    if (!o.outDir.empty()) {
+        outputs.writeText((out / "suite.json").string(), json);
+        outputs.writeText((out / "suite.html").string(), suiteReportHtml(result, seconds));
+    }
     outputs.commit();
+    if (o.json)
+        std::cout << json << "\n";
+    else
+        std::cout << "zcheck suite" << (o.quick ? " --quick" : "") << ": " << configs.size() << " configurations x "
+                  << injectableMistakes().size() << " faults in " << std::lround(seconds) << " s\n\n"
+                  << suiteTable(result) << "\nverdict    " << (result.passed() ? "PASSED" : "FAILED") << "\n";
     return result.passed() ? kExitConsistent : kExitInconsistent;
 }
 
@@ -72,9 +83,11 @@ Command addSuiteCommand(CLI::App& app)
                  "Exit status 0 only when both hold.");
     command->add_flag("--quick", o->quick, "a representative subset (what CTest runs)");
     command->add_option("--filter", o->filter, "only configurations whose label contains TEXT");
-    command->add_option("--json", o->jsonFile, "write the results as JSON")->check(kNonEmptyPath);
-    command->add_option("--html", o->htmlFile, "write a self-contained HTML report with images of every failure")
+    command->add_option("--out", o->outDir,
+                        "the folder to write suite.json (every configuration and fault with its result) and suite.html (a "
+                        "self-contained report with images of every failure) into, both or neither")->type_name("DIR")
         ->check(kNonEmptyPath);
+    command->add_flag("--json", o->json, "print the results as JSON instead of the table");
     command->add_option("--models", o->modelsDir,
                         "folder of the shared meshes (stanford-bunny.obj, spot.obj, teapot.obj, suzanne.obj); "
                         "default: $ZCHECK_MODELS_DIR, else the built-in scenes only")

@@ -154,7 +154,8 @@ Command addUnprojectCommand(CLI::App& app)
                         "sidecar given with --sidecar says, else window)");
     command->add_option("--depth-map", o->depthMap, "a depth map to turn into a point cloud")->check(kNonEmptyPath);
     addDepthMapOptions(command, o->reading);
-    command->add_option("-o,--output", o->output, "the PLY file to write (atomically)")->check(kNonEmptyPath);
+    command->add_option("-o,--output", o->output, "the PLY file to write (atomically)")
+        ->type_name("FILE")->check(kNonEmptyPath);
     command->add_option("--space", o->space, "eye | world coordinates for points")->capture_default_str();
     command->add_option("--stride", o->stride, "use every K-th pixel in x and y, 1..16384")
         ->capture_default_str()

@@ -76,7 +76,8 @@ Command addVerifyCommand(CLI::App& app)
                         "given with --sidecar says, else window)");
     addDepthMapOptions(command, o->reading);
     command->add_flag("--diagnose", o->diagnose, "when inconsistent, test the classic hypotheses and name the one that fits");
-    command->add_option("--out", o->outDir, "write truth and map depth EXRs, heatmap, classes and report.json")
+    command->add_option("--out", o->outDir, "write ray_depth.exr, map_depth.exr, map_error.exr, error_heatmap.png, coverage_classes.png and "
+                        "report.json into this folder (all or none of them)")->type_name("DIR")
         ->check(kNonEmptyPath);
     addThreadsOption(command, o->threads);
     command->add_flag("--json", o->json, "print the report as JSON");

@@ -1,14 +1,23 @@
 #!/usr/bin/env bash
 # zcheck suite --quick: every clean configuration consistent, every applicable fault
-# detected, JSON and a self-contained HTML report written.
+# detected, JSON and a self-contained HTML report written into --out, --json printing the same
+# document.
 set -euo pipefail
 source "$(dirname "$0")/lib.sh"
 zcheck=$1
 models=$2
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-"$zcheck" suite --quick --models "$models" --json "$tmp/suite.json" --html "$tmp/suite.html" > "$tmp/table.txt"
+"$zcheck" suite --quick --models "$models" --out "$tmp/run" > "$tmp/table.txt"
 grep -q "verdict    PASSED" "$tmp/table.txt"
+"$zcheck" suite --quick --models "$models" --json > "$tmp/printed.json"
+python3 - "$tmp" <<'PY'
+import json, sys
+tmp = sys.argv[1]
+printed, written = json.load(open(f"{tmp}/printed.json")), json.load(open(f"{tmp}/run/suite.json"))
+assert printed["detection"] == written["detection"] and printed["passed"] is True, (printed["detection"], written["detection"])
+PY
+mv "$tmp/run/suite.json" "$tmp/run/suite.html" "$tmp/"
 python3 - "$tmp" <<'PY'
 import json, sys
 tmp = sys.argv[1]
@@ -28,6 +37,12 @@ PY
 grep -q "configurations x 20 faults" "$tmp/pinhole.txt"
 set +e
 "$zcheck" suite --quick --models "$models" --filter "no such configuration" > /dev/null 2>&1
+status=$?
+set -e
+[[ $status -eq 2 ]]
+# The old file options are gone: --json takes no value.
+set +e
+"$zcheck" suite --quick --models "$models" --json "$tmp/x.json" > /dev/null 2> "$tmp/err.txt"
 status=$?
 set -e
 [[ $status -eq 2 ]]

@@ -24,6 +24,8 @@ cmake --build "$tmp/example" > "$tmp/build.log" 2>&1 || { cat "$tmp/build.log" >
 "$tmp/prefix/bin/zcheck" --version | grep -q "$(cat "$source_dir/CMakeLists.txt" | sed -n 's/^project(zcheck VERSION \([0-9.]*\).*/\1/p')"
 # It starts without OpenImageIO, and loads it (the installed plugin) when it writes an image.
 ! ldd "$tmp/prefix/bin/zcheck" | grep -q OpenImageIO
+# Nor any GL library: `bench --reference` loads its llvmpipe yardstick as a plugin.
+! ldd "$tmp/prefix/bin/zcheck" | grep -qi "libEGL\|libGL"
 "$tmp/prefix/bin/zcheck" export --quantity eye-z -o "$tmp/depth.exr" > /dev/null
 "$tmp/prefix/bin/zcheck" verify --depth-map "$tmp/depth.exr" --quantity eye-z > /dev/null
 echo "package_consumer: 1 passed, 0 failed"

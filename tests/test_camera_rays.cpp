@@ -5,7 +5,7 @@
 #include "zcheck/camera_file.h"
 #include "zcheck/camera_rays.h"
 #include "zcheck/inverse_projection.h"
-#include "zcheck/kernel_choice.h"
+#include "zcheck/detail/kernel_choice.h"
 #include "zcheck/ray_renderer.h"
 
 #include "kernel_testing.h"

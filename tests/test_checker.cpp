@@ -3,14 +3,16 @@
 #include "zcheck/checker.h"
 #include "zcheck/camera_file.h"
 #include "zcheck/error.h"
-#include "zcheck/kernel_choice.h"
+#include "zcheck/inverse_projection.h"
+#include "zcheck/detail/kernel_choice.h"
 #include "zcheck/map_verifier.h"
 #include "zcheck/mistakes.h"
-#include "zcheck/percentile.h"
 #include "zcheck/report.h"
 #include "zcheck/verify.h"
 
 #include "diagnosis_helpers.h"
+#include "percentile.h"   // check/src: the comparison's private parts, tested white-box
+#include "slope_table.h"
 #include "kernel_testing.h"
 
 #include <catch2/catch.hpp>
@@ -22,6 +24,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <map>
 #include <optional>
 #include <random>
 
@@ -379,7 +382,7 @@ TEST_CASE("a judge's slopes are each triangle's own, for its camera, one at a ti
             auto requireRow = [&](const char* when) {
                 for (const auto& [rowJudge, camera] : {std::pair{&a, &wideCamera}, std::pair{&b, &narrowCamera}}) {
                     std::vector<double> slope(row.size(), -1.0);
-                    rowJudge->slopes(row.data(), row.size(), slope.data());
+                    slopesOf(*rowJudge, row.data(), row.size(), slope.data());
                     for (std::size_t j = 0; j < row.size(); ++j) {
                         INFO(form << ", " << sourceName << ", " << when << ": lane " << j << ", primitive " << row[j]);
                         REQUIRE(slope[j] == (row[j] < scene.triangleCount() ? expected(*camera, row[j]) : 0.0));
@@ -429,7 +432,7 @@ TEST_CASE("a judge's table of slopes filled from several threads at once holds e
                 if (k % 3 == 0) {
                     for (std::size_t j = 0; j < r.size(); ++j) slope[j] = judge->slope(r[j]);
                 } else {
-                    judge->slopes(r.data(), r.size(), slope);
+                    slopesOf(*judge, r.data(), r.size(), slope);
                 }
                 for (std::size_t j = 0; j < r.size(); ++j)
                     if (slope[j] != (r[j] < n ? expected[r[j]] : 0.0)) ++wrong;
@@ -762,6 +765,122 @@ TEST_CASE("the comparison's AVX-512 form on rows of NaN, a zero bound and the bi
     const std::optional<ComparisonReport> biasReport = requireFormsAgree(scene, camera, atBiasRule);
     REQUIRE(biasReport);
     REQUIRE(biasReport->biasSamples == 11);
+}
+
+namespace {
+// Each pixel's class in both kernel forms (TileComparison over `ray` and `raster`, with the raster's
+// quanta and allowances) must be what PixelJudge says of that pixel alone (EachCall: no table),
+// its ratio |Δ| / bound in the common case, and the bias samples those where the bias rule holds.
+// Counts the classes met into `seen`.
+void requireJudgesRule(const Scene& scene, const Camera& camera, const RenderResult& rayRender, const RenderResult& rasterRender,
+                       const std::vector<double>& quantum, const std::vector<double>& allowance,
+                       std::map<PixelClass, std::int64_t>& seen)
+{
+    const PixelJudge judge(scene, camera, {}, SlopeSource::EachCall);
+    const PixelJudge::ToleranceTerms terms = judge.toleranceTerms();
+    RoutePixels ray = RoutePixels::of(rayRender), raster = RoutePixels::of(rasterRender);
+    raster.quantum = quantum.data(), raster.allowance = allowance.data();
+    for (const char* form : {"baseline", "auto"}) {
+        INFO(form);
+        Comparison perPixel;
+        const std::optional<ComparisonReport> report = testing::withEnvironment("ZCHECK_COMPARE_KERNEL", form, [&] {
+            const PixelJudge tableJudge(scene, camera);
+            TileComparison tiles(tableJudge, &perPixel);
+            for (int tile = 0; tile < tiles.tiles().count(); ++tile) tiles.compareTile(tile, ray, raster);
+            return tiles.finish();
+        });
+        REQUIRE(report);
+        std::int64_t biasSamples = 0;
+        for (int row = 0; row < camera.height(); ++row)
+            for (int col = 0; col < camera.width(); ++col) {
+                const std::size_t i = std::size_t(row) * std::size_t(camera.width()) + std::size_t(col);
+                const std::uint32_t a = rayRender.primitiveId[i], b = rasterRender.primitiveId[i];
+                const double d = rayRender.windowDepth.value[i], e = rasterRender.windowDepth.value[i], q = quantum[i];
+                const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
+                PixelClass expected = PixelClass::BothMiss;
+                double bound = 0;
+                if (a != kNoPrimitive && b != kNoPrimitive)
+                    expected = judge.bothHit(d, a, e, b, q, pWindow, bound, allowance[i]);
+                else if (a != kNoPrimitive || b != kNoPrimitive)
+                    expected = judge.oneHit(a != kNoPrimitive, a != kNoPrimitive ? d : e, a != kNoPrimitive ? a : b, q, pWindow);
+                INFO("pixel (" << col << ", " << row << ")");
+                REQUIRE(perPixel.pixelClass[i] == expected);
+                ++seen[expected];
+                if (a != kNoPrimitive && a == b) {
+                    REQUIRE(perPixel.errorOverTolerance[i] == float(std::abs(e - d) / bound));
+                    bool dominates;
+                    terms.quantizationDominates(judge.slope(a), q, allowance[i], dominates);
+                    biasSamples += dominates;
+                }
+            }
+        REQUIRE(report->biasSamples == biasSamples);
+    }
+}
+}  // namespace
+
+TEST_CASE("the tolerance rule is one: PixelJudge's, the baseline row pass's and the AVX-512 row pass's classes agree on every pixel",
+          "[compare][kernel][tolerance]")
+{
+    // The tolerance C·q + S·m + E + a and the bias test's rule are written once (compare.h,
+    // ToleranceTerms) and instantiated for one pixel and for eight lanes. Made-up routes (every
+    // coverage case, |Δ| at, above and below the bound, declared allowances, quanta of every
+    // kind), then real renders of builtin:default and of a soup of slivers, clean, with rows
+    // flipped and with the ray's samples moved by under the snapping (surfaces meeting at edges,
+    // coverage explained and not).
+    std::map<PixelClass, std::int64_t> seen;
+    {
+        const Scene scene = builtinScene("builtin:terrain?n=8");
+        const std::uint32_t triangles = std::uint32_t(scene.triangleCount());
+        CameraSpec spec = scene.defaultCamera;
+        spec.width = 131, spec.height = 67;
+        const Camera camera(spec);
+        const PixelJudge judge(scene, camera, {}, SlopeSource::EachCall);
+        MadeUpRoutes routes(camera);
+        std::vector<double> allowance(routes.quantum.size());
+        std::mt19937 random{7};
+        auto uniform = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(random); };
+        for (std::size_t i = 0; i < routes.quantum.size(); ++i) {
+            const std::uint32_t t = random() % triangles, u = (t + 1 + random() % (triangles - 1)) % triangles;
+            // Quanta of a format's kind, and large ones, where E falls below a unit in the last
+            // place of C·q + S·m (the sum in another order then rounds differently).
+            const double q = random() % 3 == 0 ? std::ldexp(1.0 + random() % 7, 2 + int(random() % 8))
+                                               : std::ldexp(1.0 + random() % 7, -24 + int(random() % 12));
+            allowance[i] = random() % 3 == 0 ? q * double(random() % 40) : 0.0;
+            double bound;
+            judge.toleranceTerms().bound(judge.slope(t), q, allowance[i], bound);
+            double rayDepth = uniform(0.01, 0.99), rasterDepth = rayDepth + uniform(-2.0, 2.0) * bound;
+            if (random() % 3 == 0) rayDepth = 0.0, rasterDepth = random() % 2 ? bound : std::nextafter(bound, INFINITY);  // |Δ| at the bound
+            routes.setCommon(i, t, rayDepth, rasterDepth, q);
+            switch (random() % 6) {
+            case 0: routes.raster.primitiveId[i] = kNoPrimitive; break;
+            case 1: routes.ray.primitiveId[i] = kNoPrimitive; break;
+            case 2: routes.ray.primitiveId[i] = routes.raster.primitiveId[i] = kNoPrimitive; break;
+            case 3: routes.raster.primitiveId[i] = u; break;
+            default: break;
+            }
+        }
+        requireJudgesRule(scene, camera, routes.ray, routes.raster, routes.quantum, allowance, seen);
+    }
+    for (const bool soup : {false, true}) {
+        const Checker checker(soup ? testing::triangleSoup(false, 41) : builtinScene("builtin:default"));
+        const Camera camera(soup ? testing::kernelCamera("opengl", DepthFormat::Unorm24, false, false)
+                                 : checker.scene().defaultCamera);
+        for (const int fault : {0, 1, 2}) {
+            RayFaults faults;  // none; rows flipped; samples a fraction of the snapping off the centre
+            faults.flipRows = fault == 1;
+            if (fault == 2) faults.shiftPixels = {0.003, -0.002};
+            const RenderResult ray = checker.renderRay(camera, faults), raster = checker.renderRaster(camera);
+            std::vector<double> quantum(ray.primitiveId.size()), allowance(ray.primitiveId.size(), 0.0);
+            for (std::size_t i = 0; i < quantum.size(); ++i)
+                quantum[i] = storageQuantum(camera.depth().format, ray.windowDepth.value[i]);
+            requireJudgesRule(checker.scene(), camera, ray, raster, quantum, allowance, seen);
+        }
+    }
+    for (const PixelClass c : {PixelClass::BothMiss, PixelClass::Agree, PixelClass::DepthError, PixelClass::EdgeSurface,
+                               PixelClass::RayOnly, PixelClass::RasterOnly, PixelClass::RayOnlyEdge, PixelClass::RasterOnlyEdge}) {
+        INFO(toString(c));
+        REQUIRE(seen[c] > 0);
+    }
 }
 
 // compareRoutes gives its keepers floors from a sample of rows (the 97th percentile of the

@@ -6,7 +6,7 @@
 #include "zcheck/clip.h"
 #include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
-#include "zcheck/lane_mask.h"
+#include "zcheck/detail/lane_mask.h"
 #include "zcheck/large_buffer.h"
 #include "zcheck/tile_grid.h"
 

@@ -101,7 +101,6 @@ std::vector<std::string> scenes()
 
 TEST_CASE("OpenGL depth buffers drawn by Mesa's llvmpipe verify as consistent", "[verify][real-renderer]")
 {
-    REQUIRE(reference::glReferenceAvailable());
     for (const std::string& path : scenes()) {
         const Scene scene = loadScene(path);
         const Checker checker(scene);
@@ -118,7 +117,6 @@ TEST_CASE("OpenGL depth buffers verify as consistent in every projection model",
 {
     // Off-axis frustum, orthographic box, cabinet oblique, an off-centre pinhole, a lens and an
     // infinite far plane: the matrices differ, Mesa's rasterization is the same.
-    REQUIRE(reference::glReferenceAvailable());
     const Scene scene = loadScene("builtin:default");
     const Checker checker(scene);
     const MapVerifier verifier(checker);
@@ -157,7 +155,6 @@ TEST_CASE("OpenGL depth buffers verify as consistent in every projection model",
 
 TEST_CASE("OpenGL depth buffers read under the wrong depth set-up are diagnosed by name", "[verify][diagnose][real-renderer]")
 {
-    REQUIRE(reference::glReferenceAvailable());
     const Scene scene = loadScene("builtin:default");
     const Checker checker(scene);
     const MapVerifier verifier(checker);
@@ -191,7 +188,6 @@ TEST_CASE("a depth buffer resolved from Mesa's multisampling is diagnosed with t
     // application reading it back would: the resolve keeps one sample's depth, so the map is a
     // map sampled off the pixel centre, and the fit must find one of the positions GL reports
     // (glGetMultisamplefv: x right, y up from the pixel's lower-left corner).
-    REQUIRE(reference::glReferenceAvailable());
     const Scene scene = loadScene("builtin:default");
     const Checker checker(scene);
     const MapVerifier verifier(checker);

@@ -1,4 +1,7 @@
 #include "zcheck/checker.h"
+
+#include "zcheck/detail/clock.h"
+
 #include "zcheck/pose.h"
 
 #include "zcheck/error.h"
@@ -33,12 +36,6 @@ void requireSomethingCompared(const ComparisonReport& report, const std::string&
 Checker::Checker(Scene scene) : scene_(std::move(scene)), rays_(scene_), raster_(scene_) {}
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double millisecondsSince(Clock::time_point start)
-{
-    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 }  // namespace
 

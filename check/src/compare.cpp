@@ -4,10 +4,11 @@
 #include "zcheck/drawn_polygon.h"
 #include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
-#include "zcheck/kernel_choice.h"
-#include "zcheck/lane_mask.h"
+#include "zcheck/detail/kernel_choice.h"
+#include "zcheck/detail/lane_mask.h"
 #include "zcheck/large_buffer.h"
-#include "zcheck/percentile.h"
+#include "percentile.h"
+#include "slope_table.h"
 
 #ifdef ZCHECK_X86_AVX512
 #include <immintrin.h>
@@ -105,6 +106,22 @@ namespace {
 // (kernel_choice.h), both bit-identical to DepthSlopeFrame::slope of each (the same IEEE
 // operations in the same order).
 constexpr std::size_t kSlopeLanes = 64;
+
+// The corners of `n` ≤ Lanes triangles dealt into lane arrays in double, for kernels that then
+// work on several triangles per instruction: corner[v][axis][k] is corner v of triangle
+// `triangle[k]`. The indices must be in range (validateScene). Always inlined, so that each
+// form of a kernel compiles its own copy.
+template <std::size_t Lanes>
+ZCHECK_ALWAYS_INLINE inline void cornersInLanes(const Scene& scene, const std::uint32_t* triangle, std::size_t n,
+                                                double (&corner)[3][3][Lanes])
+{
+    for (std::size_t k = 0; k < n; ++k) {
+        const glm::uvec3& t = scene.triangles[triangle[k]];
+        for (int v = 0; v < 3; ++v)
+            for (int axis = 0; axis < 3; ++axis) corner[v][axis][k] = double(scene.positions[t[v]][axis]);
+    }
+}
+
 ZCHECK_ALWAYS_INLINE inline void slopesTogether(const DepthSlopeFrame& frame, const Scene& scene, std::uint32_t first,
                                                 std::size_t n, double* slope)
 {
@@ -148,32 +165,46 @@ PixelJudge::PixelJudge(const Scene& scene, const Camera& camera, const Tolerance
       terms_{ToleranceModel::constantQuanta(camera.depth()), tolerance.snapPixels(),
              16 * std::ldexp(1.0, -52) * std::max(std::abs(camera.depth().rangeMin), std::abs(camera.depth().rangeMax))},
       avx512_(useAvx512Form("ZCHECK_COMPARE_KERNEL", "baseline")),
-      slopeFrame_(camera, tolerance.slopeCredit),
-      source_(slopes)
+      slopeFrame_(camera, tolerance.slopeCredit)
 {
-    if (source_ != SlopeSource::TableOfSeen) return;
+    if (slopes == SlopeSource::TableOfSeen) table_ = std::make_unique<SlopeTable>(scene_, slopeFrame_, avx512_);
+}
+
+PixelJudge::~PixelJudge() = default;
+
+double PixelJudge::slope(std::uint32_t primitive) const
+{
+    if (!known(primitive)) return 0.0;
+    if (table_ && table_->ready(primitive)) return table_->at(primitive);
+    return computeSlope(primitive);
+}
+
+SlopeTable::SlopeTable(const Scene& scene, const DepthSlopeFrame& frame, bool avx512)
+    : scene_(scene), frame_(frame), avx512_(avx512)
+{
     const std::size_t n = scene.triangles.size();
+    none_ = std::uint32_t(n);
     slopeOfTriangle_.resize(n + 1);  // uninitialised: an entry is read only once its block is ready
     slopeOfTriangle_[n] = 0.0;
-    blockCount_ = std::uint32_t((n + kSlopeBlock - 1) / kSlopeBlock);
+    blockCount_ = std::uint32_t((n + kBlock - 1) / kBlock);
     blockState_ = std::make_unique<std::atomic<std::uint8_t>[]>(blockCount_);
 }
 
-bool PixelJudge::makeBlockReady(std::uint32_t block) const
+bool SlopeTable::makeBlockReady(std::uint32_t block) const
 {
     std::atomic<std::uint8_t>& state = blockState(block);
     std::uint8_t notComputed = 0;
     if (!state.compare_exchange_strong(notComputed, 1, std::memory_order_acquire))
-        return notComputed == kBlockReady;  // false: another thread is computing it
-    static_assert(kSlopeBlock == kSlopeLanes, "a block's slopes are computed together");
+        return notComputed == kReady;  // false: another thread is computing it
+    static_assert(kBlock == kSlopeLanes, "a block's slopes are computed together");
     auto* together = &slopesTogetherBaseline;
 #ifdef ZCHECK_X86_AVX512
     if (avx512_) together = &slopesTogetherAvx512;
 #endif
-    const std::size_t first = std::size_t(block) * kSlopeBlock;
-    together(slopeFrame_, scene_, std::uint32_t(first), std::min<std::size_t>(kSlopeBlock, scene_.triangles.size() - first),
+    const std::size_t first = std::size_t(block) * kBlock;
+    together(frame_, scene_, std::uint32_t(first), std::min<std::size_t>(kBlock, scene_.triangles.size() - first),
              slopeOfTriangle_.data() + first);
-    state.store(kBlockReady, std::memory_order_release);
+    state.store(kReady, std::memory_order_release);
     return true;
 }
 
@@ -403,7 +434,7 @@ struct RowInputs {
     // rowLanesAvx512 only: where these are given, it computes the three arrays above itself
     // (which are then not read): the slopes from PixelJudge::slopeTableFor, the quantum one for
     // all, the relative error in closed form.
-    const double* slopeTable = nullptr;  // PixelJudge::slopeTableFor (where gatherable())
+    const double* slopeTable = nullptr;  // SlopeTable::tableFor (where gatherable())
     std::uint32_t slopeTableNone = 0;
     std::optional<double> constantQuantum;
     std::optional<CameraRays::RelativeForm> relativeForm;
@@ -462,7 +493,9 @@ ZCHECK_ALWAYS_INLINE inline void rowLanesBaseline(const RowInputs& in, const Pix
         out.signedErrorQuanta[j] = PixelMeasures::signedErrorQuanta(in.rayDepth[j], in.rasterDepth[j], q);
         out.ratio[j] = ratioOf(error, out.bound[j]);
         agree[j] = error <= out.bound[j];
-        bias[j] = common[j] & (terms.S * m + a <= 0.1 * q);
+        bool dominates;
+        terms.quantizationDominates(m, q, a, dominates);
+        bias[j] = common[j] & dominates;
     }
     if (in.pixelClass) {
         // Without a branch, so that the loop stays SIMD: the class as arithmetic, the ratio's
@@ -505,7 +538,7 @@ ZCHECK_ALWAYS_INLINE inline void rowLanesBaseline(const RowInputs& in, const Pix
     out.hit = laneBits(hit, std::size_t(n)), out.bias = laneBits(bias, std::size_t(n));
 }
 
-// Whether rowLanesAvx512 can look up slopes in a table whose largest index (slopeTableNone())
+// Whether rowLanesAvx512 can look up slopes in a table whose largest index (SlopeTable::none())
 // is this itself: its gathers take signed 32-bit indices (so not for 2^31 triangles or more,
 // beyond any scene a machine of today holds; the lane loops then look them up).
 inline bool gatherable(std::uint32_t largestIndex) { return largestIndex < (1u << 31); }
@@ -514,7 +547,7 @@ inline bool gatherable(std::uint32_t largestIndex) { return largestIndex < (1u <
 ZCHECK_INTRINSICS_BEGIN
 // A row's surface (the triangle both routes hit, else kNoPrimitive) into `surface`, sixteen
 // lanes at a time, and, as bits, the lanes that begin a run in one slope block of the scene's
-// (PixelJudge::slopeTableForRuns): found from the lanes in registers, each one's left
+// (SlopeTable::tableForRuns): found from the lanes in registers, each one's left
 // neighbour's block shifted in, where reading the stored surface back one lane off waited on
 // the stores (~10 % of the row pass's samples).
 static_assert(kLanes <= 64, "a row's run starts fit one word");
@@ -522,7 +555,7 @@ ZCHECK_TARGET_AVX512 std::uint64_t surfaceAndBlockRunsAvx512(const std::uint32_t
                                                              const std::uint32_t* rasterPrimitive, int n,
                                                              std::uint32_t blocks, std::uint32_t* surface)
 {
-    static_assert(PixelJudge::kSlopeBlock == 64, "a block is a shift by 6");
+    static_assert(SlopeTable::kBlock == 64, "a block is a shift by 6");
     const __m512i none = _mm512_set1_epi32(int(kNoPrimitive)), blockCount = _mm512_set1_epi32(int(blocks));
     __m512i previousBlocks = _mm512_set1_epi32(-1);  // lane 15: the block left of lane 0, none of the scene's
     std::uint64_t runStarts = 0;
@@ -552,8 +585,7 @@ ZCHECK_TARGET_AVX512 void rowLanesAvx512(const RowInputs& in, const PixelJudge::
 {
     alignas(64) float errorQuantaOfLane[kLanes], relativeOfLane[kLanes];
     const __m256i none = _mm256_set1_epi32(int(kNoPrimitive));
-    const __m512d C = _mm512_set1_pd(terms.C), S = _mm512_set1_pd(terms.S), E = _mm512_set1_pd(terms.E);
-    const __m512d tenth = _mm512_set1_pd(0.1), zero = _mm512_setzero_pd(), infinity = _mm512_set1_pd(INFINITY);
+    const __m512d zero = _mm512_setzero_pd(), infinity = _mm512_set1_pd(INFINITY);
     const __m512i magnitude = _mm512_set1_epi64(0x7fffffffffffffff);  // std::abs: the sign bit cleared
     // A keeper's candidates: the common lanes at or above its leastKeepable() (none at 2^32).
     const std::uint64_t leastQ = counts.errorQuanta.leastKeepable(), leastE = counts.relativeEyeZ.leastKeepable();
@@ -590,9 +622,9 @@ ZCHECK_TARGET_AVX512 void rowLanesAvx512(const RowInputs& in, const PixelJudge::
             relative = _mm512_div_pd(_mm512_sub_pd(rayDepth, rasterDepth), _mm512_sub_pd(rasterDepth, relativeA));
         if (in.relativeForm) relative = _mm512_castsi512_pd(_mm512_and_si512(_mm512_castpd_si512(relative), magnitude));
         const __m512d allowance = in.allowance == kNoAllowance ? zero : _mm512_maskz_loadu_pd(lanes, in.allowance + j);
-        // terms.of(m, q, a) = C·q + S·m + E + a, in that order.
-        const __m512d slopeTerm = _mm512_mul_pd(S, m);
-        const __m512d bound = _mm512_add_pd(_mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(C, q), slopeTerm), E), allowance);
+        // The tolerance model's rules, as the baseline form and PixelJudge apply them (compare.h).
+        __m512d bound;
+        terms.bound(m, q, allowance, bound);
         const __m512d difference = _mm512_sub_pd(rasterDepth, rayDepth);
         const __m512d error = _mm512_castsi512_pd(_mm512_and_si512(_mm512_castpd_si512(difference), magnitude));
         const __m512d signedErrorQuanta = _mm512_div_pd(difference, q);
@@ -603,7 +635,9 @@ ZCHECK_TARGET_AVX512 void rowLanesAvx512(const RowInputs& in, const PixelJudge::
         const __m512d ratio =
             _mm512_mask_blend_pd(_mm512_cmp_pd_mask(bound, zero, _CMP_GT_OQ), unbounded, _mm512_div_pd(error, bound));
         const __mmask8 a = _mm512_mask_cmp_pd_mask(lanes, error, bound, _CMP_LE_OQ);
-        const __mmask8 b = _mm512_mask_cmp_pd_mask(c, _mm512_add_pd(slopeTerm, allowance), _mm512_mul_pd(tenth, q), _CMP_LE_OQ);
+        decltype(m <= m) dominates;
+        terms.quantizationDominates(m, q, allowance, dominates);
+        const __mmask8 b = c & _mm512_movepi64_mask(__m512i(dominates));
         _mm512_store_pd(out.bound + j, bound);
         _mm512_store_pd(out.signedErrorQuanta + j, signedErrorQuanta);
         _mm512_store_pd(out.errorQuanta + j, errorQuanta);
@@ -653,7 +687,7 @@ RoutePixels RoutePixels::of(const RenderResult& render)
 
 struct TileComparison::Impl {
     // `ownJudge` empty: `judge` is the caller's.
-    Impl(std::optional<PixelJudge> ownJudge, const PixelJudge* callersJudge, Comparison* perPixel,
+    Impl(std::unique_ptr<const PixelJudge> ownJudge, const PixelJudge* callersJudge, Comparison* perPixel,
          float errorQuantaFloor, float relativeEyeZFloor)
         : ownJudge(std::move(ownJudge)),
           judge(callersJudge ? *callersJudge : *this->ownJudge),
@@ -684,7 +718,7 @@ struct TileComparison::Impl {
                                             const RoutePixels& raster);
 #endif
 
-    const std::optional<PixelJudge> ownJudge;
+    const std::unique_ptr<const PixelJudge> ownJudge;
     const PixelJudge& judge;
     const Camera& camera;
     Comparison* perPixel;
@@ -788,10 +822,11 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tileBegin
             in.allowance = raster.allowance ? raster.allowance + b0 : kNoAllowance;
 #ifdef ZCHECK_X86_AVX512
             if constexpr (kAvx512) {
+                const SlopeTable* table = judge.slopeTable();
                 const std::uint64_t blockRuns =
-                    surfaceAndBlockRunsAvx512(rayPrimitives, rasterPrimitives, n, judge.slopeBlockCount(), surface);
-                if (gatherable(judge.slopeTableNone()))
-                    in.slopeTable = judge.slopeTableForRuns(surface, blockRuns), in.slopeTableNone = judge.slopeTableNone();
+                    surfaceAndBlockRunsAvx512(rayPrimitives, rasterPrimitives, n, table ? table->blockCount() : 0, surface);
+                if (table && gatherable(table->none()))
+                    in.slopeTable = table->tableForRuns(surface, blockRuns), in.slopeTableNone = table->none();
                 in.constantQuantum = constantQuantum, in.relativeForm = relativeForm;
             }
 #endif
@@ -800,7 +835,7 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tileBegin
                     const bool common = rayPrimitives[j] != kNoPrimitive && rayPrimitives[j] == rasterPrimitives[j];
                     surface[j] = common ? rayPrimitives[j] : kNoPrimitive;
                 }
-            if (!in.slopeTable) judge.slopes(surface, std::size_t(n), slope);
+            if (!in.slopeTable) slopesOf(judge, surface, std::size_t(n), slope);
             if (!in.constantQuantum) measures.quanta(ray, raster, a0, b0, std::size_t(n), quantum);
             if (!in.relativeForm) measures.relativeEyeZErrors(ray, raster, a0, b0, col0, row, std::size_t(n), relative);
             const std::size_t i0 = std::size_t(row) * W + col0;
@@ -945,7 +980,7 @@ void TileComparison::Impl::compare(int tileBegin, int tileEnd, int rowBegin, int
 
 TileComparison::TileComparison(const Scene& scene, const Camera& camera, const ToleranceModel& tolerance,
                                Comparison* perPixel, float errorQuantaFloor, float relativeEyeZFloor)
-    : impl_(std::make_unique<Impl>(std::optional<PixelJudge>(std::in_place, scene, camera, tolerance), nullptr, perPixel,
+    : impl_(std::make_unique<Impl>(std::make_unique<const PixelJudge>(scene, camera, tolerance), nullptr, perPixel,
                                    errorQuantaFloor, relativeEyeZFloor))
 {
     sizePerPixel();
@@ -953,7 +988,7 @@ TileComparison::TileComparison(const Scene& scene, const Camera& camera, const T
 
 TileComparison::TileComparison(const PixelJudge& judge, Comparison* perPixel, float errorQuantaFloor,
                                float relativeEyeZFloor)
-    : impl_(std::make_unique<Impl>(std::nullopt, &judge, perPixel, errorQuantaFloor, relativeEyeZFloor))
+    : impl_(std::make_unique<Impl>(nullptr, &judge, perPixel, errorQuantaFloor, relativeEyeZFloor))
 {
     sizePerPixel();
 }

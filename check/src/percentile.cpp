@@ -1,4 +1,4 @@
-#include "zcheck/percentile.h"
+#include "percentile.h"
 
 #include <algorithm>
 #include <array>

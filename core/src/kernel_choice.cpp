@@ -1,4 +1,4 @@
-#include "zcheck/kernel_choice.h"
+#include "zcheck/detail/kernel_choice.h"
 
 #include "zcheck/error.h"
 

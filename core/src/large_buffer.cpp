@@ -1,5 +1,6 @@
 #include "zcheck/large_buffer.h"
 
+#include "zcheck/detail/streaming_stores.h"
 #include <malloc.h>
 #include <sys/mman.h>
 #include <unistd.h>

@@ -1,5 +1,6 @@
 #include "zcheck/input_file.h"
 
+#include "zcheck/detail/streaming_stores.h"
 #include "zcheck/error.h"
 #include "zcheck/large_buffer.h"
 

@@ -3,13 +3,15 @@
 // binned into tiles as in Abrash's Larrabee rasterizer.
 #include "zcheck/raster_renderer.h"
 
+#include "zcheck/detail/streaming_stores.h"
+
 #include "raster_testing.h"
 
 #include "zcheck/clip.h"
 #include "zcheck/error.h"
 #include "zcheck/large_buffer.h"
 #include "zcheck/inverse_projection.h"
-#include "zcheck/kernel_choice.h"
+#include "zcheck/detail/kernel_choice.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>

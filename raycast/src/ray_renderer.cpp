@@ -1,9 +1,11 @@
 #include "zcheck/ray_renderer.h"
 
-#include "zcheck/error.h"
 #include "zcheck/camera_rays.h"
+#include "zcheck/detail/clock.h"
+#include "zcheck/detail/kernel_choice.h"
+#include "zcheck/detail/streaming_stores.h"
+#include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
-#include "zcheck/kernel_choice.h"
 #include "zcheck/large_buffer.h"
 
 #include <embree3/rtcore.h>
@@ -23,12 +25,6 @@
 namespace zcheck {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double millisecondsSince(Clock::time_point start)
-{
-    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 struct DeviceDeleter {
     void operator()(RTCDevice device) const { rtcReleaseDevice(device); }

@@ -1,6 +1,7 @@
 #include "zcheck/embree_reference.h"
 
 #include "zcheck/camera_rays.h"
+#include "zcheck/detail/clock.h"
 #include "zcheck/error.h"
 
 #include <embree3/rtcore.h>
@@ -13,12 +14,6 @@
 namespace zcheck::reference {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double millisecondsSince(Clock::time_point start)
-{
-    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 constexpr int kTile = 8;    // pixels per tile side
 constexpr int kPacket = 4;  // a packet covers 4×4 pixels

@@ -347,11 +347,6 @@ void validate(const GlDepthInput& input, int repeats)
 
 } // namespace
 
-bool glReferenceAvailable()
-{
-    return true;
-}
-
 GlDepthTiming timeGlDepthDraw(const GlDepthInput& input, int repeats)
 {
     validate(input, repeats);

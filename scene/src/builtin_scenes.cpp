@@ -1,6 +1,7 @@
 // Built-in scenes: procedural geometry with known shape, each with the camera it is meant
 // to be seen with. Every scene is deliberately asymmetric (left/right and top/bottom), so a
 // flipped or shifted image can never match the true one.
+#include "zcheck/detail/streaming_stores.h"
 #include "zcheck/error.h"
 #include "zcheck/large_buffer.h"
 #include "zcheck/scene.h"

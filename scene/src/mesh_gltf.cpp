@@ -34,6 +34,7 @@
 // Cost: time linear in the input plus the output; memory is the output plus the JSON DOM
 // (nlohmann: a few bytes per JSON byte for real files, up to ~40 for JSON made of empty
 // objects) plus decoded data: URIs and external buffers. Nothing recurses on input structure.
+#include "zcheck/detail/streaming_stores.h"
 #include "zcheck/error.h"
 #include "zcheck/large_buffer.h"
 #include "zcheck/mesh_formats.h"

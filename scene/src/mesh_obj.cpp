@@ -2,6 +2,7 @@
 // coordinates, normals, groups, materials and smoothing are read past; free-form curves and
 // surfaces are not geometry zcheck can draw and are ignored. A statement zcheck does not
 // know is refused, so that a file of some other kind is not read as an empty mesh.
+#include "zcheck/detail/streaming_stores.h"
 #include "zcheck/error.h"
 #include "zcheck/large_buffer.h"
 #include "zcheck/mesh_formats.h"

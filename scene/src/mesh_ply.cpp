@@ -1,6 +1,7 @@
 // PLY (Greg Turk's format, as documented by Paul Bourke): a text header of `element` and
 // `property` lines up to `end_header`, then the items of each element in order, ascii (one
 // item a line) or binary (packed, in the declared byte order).
+#include "zcheck/detail/streaming_stores.h"
 #include "zcheck/error.h"
 #include "zcheck/large_buffer.h"
 #include "zcheck/mesh_formats.h"

@@ -1,6 +1,7 @@
 // STL: binary (an 80-byte header, a uint32 triangle count, 50 bytes a triangle: normal,
 // three vertices as binary32, a 16-bit attribute) or ascii (solid … facet … outer loop,
 // three `vertex x y z`, endloop, endfacet … endsolid). Vertices are not shared.
+#include "zcheck/detail/streaming_stores.h"
 #include "zcheck/error.h"
 #include "zcheck/large_buffer.h"
 #include "zcheck/mesh_formats.h"

@@ -847,15 +847,14 @@ for cmd in ("check", "verify"):
     case("output", f"{cmd}-out-is-input", base + ["--out", "cam.json"], r"'cam\.json'.*(not a folder|input)",
          files=files)
 SUITE = ["suite", "--quick", "--models", "{models}"]
-case("output", "suite-json-missing-folder", SUITE + ["--json", "missing/dir/x.json"],
-     r"'missing/dir/x\.json'.*(does not exist|No such)", limit=2.0)
-case("output", "suite-html-missing-folder", SUITE + ["--html", "missing/dir/x.html"],
-     r"'missing/dir/x\.html'.*(does not exist|No such)", limit=2.0)
-case("output", "suite-json-is-directory", SUITE + ["--json", "r.json"], r"'r\.json'.*(folder|directory)",
-     files={"r.json": DIR}, limit=2.0)
-case("output", "suite-json-trailing-slash", SUITE + ["--json", "out/"], r"'out/'.*(folder|file path)", limit=2.0)
-case("output", "suite-html-same-as-json", SUITE + ["--json", "r.out", "--html", "r.out"], r"'r\.out'.*same file",
-     guard=("r.out",), limit=2.0)
+case("output", "suite-out-missing-parent", SUITE + ["--out", "missing/dir/res"],
+     r"'missing/dir/res'.*(does not exist|No such)", limit=2.0)
+case("output", "suite-out-is-regular-file", SUITE + ["--out", "res.txt"], r"'res\.txt'.*not a folder",
+     files={"res.txt": "kept\n"}, guard=("res.txt",), limit=2.0)
+case("output", "suite-out-json-is-directory", SUITE + ["--out", "res"], r"suite\.json'?.*(folder|directory)",
+     files={"res/suite.json": DIR, "res/suite.html": "kept\n"}, guard=("res/suite.html",), limit=2.0)
+case("output", "suite-out-empty", SUITE + ["--out", ""], r"--out.*empty", limit=2.0)
+case("output", "suite-json-takes-no-file", SUITE + ["--json", "r.json"], r"r\.json", limit=2.0)
 
 # Full disk: RLIMIT_FSIZE 20 KiB, every output larger than that.
 FSIZE = 20 * 1024
@@ -1340,6 +1339,8 @@ case("dataset", "report-malformed-line-not-last", ["dataset", "report", "r.jsonl
 case("dataset", "report-two-datasets", ["dataset", "report", "a.jsonl", "b.jsonl"],
      r"'b\.jsonl' line 1.*dataset 'b\.json'.*'a\.json'.*(do not merge|different)",
      files={"a.jsonl": record(source="a.json", of=2), "b.jsonl": record(1, 2, source="b.json")})
+case("dataset", "report-out-is-a-results-file", ["dataset", "report", "r.jsonl", "--out", "r.jsonl"],
+     r"'r\.jsonl'.*(not a folder|input)", files={"r.jsonl": record()}, guard=("r.jsonl",))
 case("dataset", "import-manifest", ["dataset", "import", "m.jsonl", "-o", "out.jsonl"], r"'m\.jsonl'.*manifest already",
      files={"m.jsonl": '{"frame": "f0", "camera": "cam.json", "depth": "d.pfm", "quantity": "eye-z"}\n', **MAP_CAM})
 case("dataset", "submit-tasks-0", ["dataset", "submit", "t.json", "--quantity", "eye-z", "--tasks", "0", "--out", "run",
@@ -1380,7 +1381,7 @@ depth-map/unproject-png16-wrong-size depth-map/unproject-scale-negative depth-ma
 depth-map/unproject-scale-0 depth-map/verify-scale-inf
 output/unproject-output-is-input-absolute output/unproject-output-is-camera output/export-output-trailing-slash
 output/export-unknown-format output/export-png-normal output/export-pfm-primitive-id output/verify-out-empty
-output/verify-out-is-input output/check-out-is-input output/suite-json-trailing-slash
+output/verify-out-is-input output/check-out-is-input
 output/verify-out-heatmap-is-directory output/check-out-heatmap-is-directory output/export-preview-same-as-output
 full-disk/unproject-ascii-ply
 options/export-quantity-list-bogus options/export-quantity-empty options/unproject-map-quantity-bogus
@@ -1392,7 +1393,7 @@ options/suite-models-missing
 nothing-to-compare/check-camera-looks-away-json nothing-to-compare/verify-camera-looks-away-out
 mesh/obj-coordinate-1e19 options/suite-filter-matches-nothing output/unproject-output-is-directory
 output/export-output-is-directory output/export-png-without-scale output/unproject-output-missing-folder
-output/suite-json-is-directory output/suite-html-same-as-json full-disk/export-exr-with-preview
+output/suite-out-json-is-directory output/suite-json-takes-no-file full-disk/export-exr-with-preview
 depth-map/verify-depth-map-empty-path camera/verify-width-100000 camera/unproject-up-parallel
 camera-import/camera-opencv-xml-deep-nesting camera-import/check-gltf-camera-scaled-to-zero
 """.split())

@@ -118,9 +118,9 @@ def test_shards_and_a_resumed_run_give_the_single_run_s_summary(made):
     source = p["broken_transforms"]
     single = m.root / "single.jsonl"
     verify(made, source, "--diagnose", results=single)
-    code, out, err = run_cli("dataset", "report", single, "--json", m.root / "single_summary.json")
+    code, out, err = run_cli("dataset", "report", single, "--json")
     assert code == 1, err
-    summary = json.loads((m.root / "single_summary.json").read_text())
+    summary = json.loads(out)
     assert summary["frames"] == FRAMES and summary["inconsistent"] == 5 and summary["errors"] == 1
     assert summary["by_mistake"] == {"y-flip": 1, "inverted-extrinsic": 1, "opencv-opengl-axes": 1, "distance-as-eye-z": 1,
                                      "depth-scale": 1}
@@ -140,8 +140,8 @@ def test_shards_and_a_resumed_run_give_the_single_run_s_summary(made):
     resumed = shards[1].read_text().splitlines()
     assert len(resumed) == len(lines) and all(json.loads(line) for line in resumed)
     assert sorted(json.loads(line)["index"] for line in resumed) == list(range(1, FRAMES, 3))
-    code, out, err = run_cli("dataset", "report", *shards, "--json", m.root / "sharded_summary.json")
-    assert json.loads((m.root / "sharded_summary.json").read_text()) == summary
+    code, out, err = run_cli("dataset", "report", *shards, "--json")
+    assert json.loads(out) == summary
 
 
 def test_report_finds_missing_and_duplicated_frames(made):
@@ -149,9 +149,9 @@ def test_report_finds_missing_and_duplicated_frames(made):
     a, b = m.root / "a.jsonl", m.root / "b.jsonl"
     verify(made, p["transforms"], "--shard", "0/2", results=a)
     verify(made, p["transforms"], "--shard", "0/4", results=b)
-    code, out, err = run_cli("dataset", "report", a, b, "--json", m.root / "partial.json")
+    code, out, err = run_cli("dataset", "report", a, b, "--out", m.root / "partial")
     assert code == 1
-    partial = json.loads((m.root / "partial.json").read_text())
+    partial = json.loads((m.root / "partial" / "summary.json").read_text())
     assert partial["missing"] == list(range(1, FRAMES, 2))
     assert len(partial["duplicates"]) == len(range(0, FRAMES, 4))
     assert "missing    indices 1 3 5" in out
@@ -188,8 +188,8 @@ def test_html_report_has_the_worst_frames_pictures(made):
     m, p = made
     results = m.root / "for_html.jsonl"
     verify(made, p["broken_transforms"], "--diagnose", results=results)
-    html = m.root / "report.html"
-    code, out, err = run_cli("dataset", "report", results, "--html", html)
+    html = m.root / "html_report" / "report.html"
+    code, out, err = run_cli("dataset", "report", results, "--out", m.root / "html_report")
     page = html.read_text()
     assert page.count("data:image/png;base64,") == 3 * 5  # depth, heatmap, classes of the 5 inconsistent frames
     assert "frame_021.png" in page and "not verified" in page
@@ -303,7 +303,7 @@ def test_a_slurm_job_array_gives_the_single_process_summary(made, tmp_path):
     source = p["broken_transforms"]
     single = m.root / "for_slurm.jsonl"
     verify(made, source, "--diagnose", results=single)
-    run_cli("dataset", "report", single, "--json", tmp_path / "single.json")
+    run_cli("dataset", "report", single, "--out", tmp_path / "single")
     state = tmp_path / "slurm"
     started = subprocess.run(["bash", LOCAL_SLURM, "start", state], capture_output=True, text=True, timeout=120)
     try:
@@ -314,7 +314,7 @@ def test_a_slurm_job_array_gives_the_single_process_summary(made, tmp_path):
                               timeout=600, env=env, cwd=m.root)
         assert done.returncode == 1, done.stdout + done.stderr  # inconsistent frames: the report's status
         assert "verify job" in done.stdout and "(3 tasks), report job" in done.stdout
-        assert json.loads((tmp_path / "run" / "summary.json").read_text()) == json.loads((tmp_path / "single.json").read_text())
+        assert json.loads((tmp_path / "run" / "summary.json").read_text()) == json.loads((tmp_path / "single" / "summary.json").read_text())
         assert all((tmp_path / "run" / f"results-{i}.jsonl").exists() for i in range(3))
         assert "data:image/png;base64," in (tmp_path / "run" / "report.html").read_text()
     finally:

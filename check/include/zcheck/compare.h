@@ -35,15 +35,11 @@
 //
 // Verdict: consistent ⇔ no unexplained coverage mismatch, no depth error and no bias.
 #include "zcheck/camera.h"
-#include "zcheck/kernel_choice.h"
-#include "zcheck/lane_mask.h"
 #include "zcheck/large_buffer.h"
 #include "zcheck/render.h"
 #include "zcheck/scene.h"
 #include "zcheck/tile_grid.h"
 
-#include <algorithm>
-#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -174,27 +170,25 @@ struct DepthSlopeFrame {
 // Thread-safe: const calls may run from several threads at once.
 //
 // Where a judge finds a triangle's slope m (SlopeSource), the same value either way:
-// - TableOfSeen, for judging whole images: the first time any triangle of a block of 64
-//   consecutive ones is asked for, the whole block's m is computed (several per instruction,
-//   its corners read as a stream) into a table of 8 bytes per triangle, where every later
-//   question finds it with one load. Only the blocks of triangles the judge is asked about are
-//   computed: the million-triangle speed workload shows 246,522 of its triangles at 1080p, in
-//   4,237 of its 15,665 blocks, and a table of all of them computed up front cost 3-4.5 ms on
-//   two threads (9.5 on one) against a comparison of 11-18 ms; at four million triangles the
-//   comparison took ~7 ms less. (Slopes remembered per thread instead, triangle by triangle,
-//   cost the comparison more: ~922,000 runs of pixels to look up per frame, with their
-//   corners gathered at random.)
+// - TableOfSeen, for judging whole images: the slopes of the triangles asked about are computed
+//   once, a block of consecutive triangles at a time, into a table the comparison's kernels read
+//   with one load (check/src/slope_table.h).
 // - EachCall, for a judge asked about a few thousand pixels or fewer (verify's probes of a
 //   camera, a fit's samples): m computed from the triangle at every call; making it costs
 //   nothing per triangle.
 enum class SlopeSource { TableOfSeen, EachCall };
 
+class SlopeTable;
+
 class PixelJudge {
 public:
-    // Reads ZCHECK_COMPARE_KERNEL (kernel_choice.h) and throws Error for a value but
+    // Reads ZCHECK_COMPARE_KERNEL (auto or baseline: the AVX-512 forms or not) and throws Error for a value but
     // `baseline`, `auto` or empty; so do compareRoutes and TileComparison, which make one.
     PixelJudge(const Scene& scene, const Camera& camera, const ToleranceModel& tolerance = {},
                SlopeSource slopes = SlopeSource::TableOfSeen);
+    ~PixelJudge();
+    PixelJudge(const PixelJudge&) = delete;
+    PixelJudge& operator=(const PixelJudge&) = delete;
 
     // One surface's tolerance at depth-storage quantum q, in window-depth units:
     // C·q + S·m + E + a (m = 0 for kUnknownPrimitive, which earns no slope credit; a, the
@@ -203,11 +197,33 @@ public:
     double surfaceTolerance(std::uint32_t primitive, double q, double allowance = 0) const;
     // The same for a surface whose slope m = slope(primitive) is known already.
     double toleranceForSlope(double m, double q, double allowance = 0) const { return terms_.of(m, q, allowance); }
-    // Its terms, for a kernel that computes it several lanes at a time (the same operations
-    // in the same order as of()).
+    // The tolerance model's terms and its two rules, written once for every form of the
+    // comparison: `Real` is double for one pixel, or a vector of doubles with + * and <= (GCC's
+    // vector extensions: the AVX-512 row pass's eight lanes), computed with the same operations
+    // in the same order, so the forms agree bit for bit. (Always inlined: into the AVX-512 form
+    // as eight lanes, never called as a function of the baseline target.)
     struct ToleranceTerms {
         double C, S, E;
-        double of(double m, double q, double a = 0) const { return C * q + S * m + E + a; }
+        // The tolerance C·q + S·m + E + a, into `bound`.
+        template <class Real>
+        __attribute__((always_inline)) void bound(const Real& m, const Real& q, const Real& a, Real& bound) const
+        {
+            bound = C * q + S * m + E + a;
+        }
+        double of(double m, double q, double a = 0) const
+        {
+            double b;
+            bound(m, q, a, b);
+            return b;
+        }
+        // Whether quantization dominates the tolerance, S·m + a ≤ q/10, into `dominates` (bool,
+        // or a vector of lane masks): the pixels the bias test counts (above).
+        template <class Real, class Mask>
+        __attribute__((always_inline)) void quantizationDominates(const Real& m, const Real& q, const Real& a,
+                                                                  Mask& dominates) const
+        {
+            dominates = S * m + a <= 0.1 * q;
+        }
     };
     const ToleranceTerms& toleranceTerms() const { return terms_; }
     // Both routes hit: d_ray on `rayPrimitive`, d_raster on `rasterPrimitive`, at window point
@@ -226,65 +242,10 @@ public:
     // Whether the primitive's plane meets the pixel's ray on the near or far plane.
     bool atClipPlane(std::uint32_t primitive, const glm::dvec2& pWindow) const;
     // m of the primitive's plane (DepthSlopeFrame::slope), 0 for one not of the scene.
-    double slope(std::uint32_t primitive) const
-    {
-        if (!known(primitive)) return 0.0;
-        if (source_ == SlopeSource::TableOfSeen &&
-            (blockState(primitive / kSlopeBlock).load(std::memory_order_acquire) == kBlockReady ||
-             makeBlockReady(primitive / kSlopeBlock)))
-            return slopeOfTriangle_[primitive];
-        return computeSlope(primitive);
-    }
-    // slope() of n primitives into `slope`. Inlined, so that a lane loop of each form of a
-    // kernel (kernel_choice.h) loads several per instruction from the table once it finds every
-    // block asked about ready (most rows of a frame after its first few).
-    ZCHECK_ALWAYS_INLINE void slopes(const std::uint32_t* primitive, std::size_t n, double* slope) const
-    {
-        if (const double* table = slopeTableFor(primitive, n)) {
-            const std::uint32_t none = slopeTableNone();
-            for (std::size_t j = 0; j < n; ++j) slope[j] = table[std::min(primitive[j], none)];
-            return;
-        }
-        for (std::size_t j = 0; j < n; ++j) slope[j] = this->slope(primitive[j]);
-    }
-    // The table of slopes when it holds those of every primitive[0, n) (TableOfSeen: every
-    // block asked about ready, or made ready now by this thread), else null (another thread is
-    // computing one of them): slope(p) is then table[min(p, slopeTableNone())], for a kernel
-    // that looks them up itself.
-    ZCHECK_ALWAYS_INLINE const double* slopeTableFor(const std::uint32_t* primitive, std::size_t n) const
-    {
-        if (source_ != SlopeSource::TableOfSeen) return nullptr;
-        // Each block asked about once per run of lanes in it (a row of a frame crosses few),
-        // found 64 lanes at a time without a branch per lane; none for a primitive not of the scene.
-        const std::uint32_t blocks = blockCount_;
-        for (std::size_t j0 = 0; j0 < n; j0 += kSlopeBlock) {
-            const std::uint32_t* p = primitive + j0;
-            const std::size_t lanes = std::min<std::size_t>(kSlopeBlock, n - j0);
-            alignas(64) std::uint8_t runStart[kSlopeBlock];
-            runStart[0] = p[0] / kSlopeBlock < blocks && (j0 == 0 || p[0] / kSlopeBlock != p[-1] / kSlopeBlock);
-            for (std::size_t j = 1; j < lanes; ++j)
-                runStart[j] = (p[j] / kSlopeBlock < blocks) & (p[j] / kSlopeBlock != p[j - 1] / kSlopeBlock);
-            if (!blocksMadeReady(p, laneBits(runStart, lanes))) return nullptr;
-        }
-        std::atomic_thread_fence(std::memory_order_acquire);  // blocksMadeReady's relaxed loads saw each block's release
-        return slopeOfTriangle_.data();
-    }
-    // slopeTableFor of up to 64 lanes whose run starts the caller found itself: the lanes j of
-    // `runStarts` (bits) whose primitive[j] lies in a block of the scene (< slopeBlockCount()
-    // after division by kSlopeBlock) and in another block than primitive[j − 1], and lane 0
-    // when it does. (The comparison's AVX-512 form finds them while it makes the row's surface.)
-    ZCHECK_ALWAYS_INLINE const double* slopeTableForRuns(const std::uint32_t* primitive, std::uint64_t runStarts) const
-    {
-        if (source_ != SlopeSource::TableOfSeen || !blocksMadeReady(primitive, runStarts)) return nullptr;
-        std::atomic_thread_fence(std::memory_order_acquire);  // as in slopeTableFor
-        return slopeOfTriangle_.data();
-    }
-    // TableOfSeen: triangles [b·kSlopeBlock, (b+1)·kSlopeBlock) are block b; there are
-    // slopeBlockCount() (none for another source).
-    static constexpr std::uint32_t kSlopeBlock = 64;
-    std::uint32_t slopeBlockCount() const { return blockCount_; }
-    // The table's entry for any primitive not of the scene: 0, and always there.
-    std::uint32_t slopeTableNone() const { return std::uint32_t(scene_.triangles.size()); }
+    double slope(std::uint32_t primitive) const;
+    // TableOfSeen: the table the comparison's kernels read slopes from (check/src/slope_table.h,
+    // private to zcheck_check); null for EachCall.
+    const SlopeTable* slopeTable() const { return table_.get(); }
     // Whether the comparison's AVX-512 forms run (ZCHECK_COMPARE_KERNEL, read when the judge
     // was made).
     bool avx512Form() const { return avx512_; }
@@ -299,40 +260,13 @@ private:
     glm::dvec3 vertex(std::uint32_t primitive, int corner) const;
     double computeSlope(std::uint32_t primitive) const;  // DepthSlopeFrame::slope of its corners
 
-    // TableOfSeen: block b's byte in blockState_ goes 0 (not computed) → 1 (being computed, by
-    // the thread that made it so) → kBlockReady (its slopes in the table, stored with release:
-    // read them after an acquire).
-    static constexpr std::uint8_t kBlockReady = 2;
-    std::atomic<std::uint8_t>& blockState(std::uint32_t block) const { return blockState_[block]; }
-    // Computes block b into the table unless another thread is computing it; whether it is ready.
-    bool makeBlockReady(std::uint32_t block) const;
-    // Whether the blocks of primitive[j] for the set bits j of `runStarts` are all ready, those
-    // not ready yet computed now (makeBlockReady) unless another thread is at it (relaxed loads:
-    // the caller fences before it reads the table). (Left to the lane-by-lane path, a row that
-    // met a new block looked up each of its lanes' slopes alone: 12 % of 1080p's tile rows.)
-    ZCHECK_ALWAYS_INLINE bool blocksMadeReady(const std::uint32_t* primitive, std::uint64_t runStarts) const
-    {
-        bool ready = true;
-        forEachSetBit(runStarts, [&](std::size_t j) ZCHECK_ALWAYS_INLINE {
-            const std::uint32_t block = primitive[j] / kSlopeBlock;
-            if (blockState(block).load(std::memory_order_relaxed) != kBlockReady) ready &= makeBlockReady(block);
-        });
-        return ready;
-    }
-
     const Scene& scene_;
     const Camera& camera_;
     ToleranceModel tolerance_;
     ToleranceTerms terms_;
     bool avx512_;  // ZCHECK_COMPARE_KERNEL: the AVX-512 forms (avx512Form())
     DepthSlopeFrame slopeFrame_;
-    SlopeSource source_;
-    // TableOfSeen: m of triangle t once its block is ready; written by const calls only under
-    // the block's state above, each entry once. One entry more, 0, for any primitive not of the
-    // scene.
-    mutable LargeVector<double> slopeOfTriangle_;
-    std::unique_ptr<std::atomic<std::uint8_t>[]> blockState_;  // zeroed: no block computed
-    std::uint32_t blockCount_ = 0;
+    std::unique_ptr<SlopeTable> table_;  // TableOfSeen's; null for EachCall
 };
 
 // One route's results over a rectangle of the image, as the comparison reads them: pixel

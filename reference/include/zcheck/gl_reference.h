@@ -72,8 +72,6 @@ struct GlDepthTiming {
 };
 
 // True when this module was compiled in; the build compiles it only when EGL is found.
-bool glReferenceAvailable();
-
 // Draws the mesh once untimed, then `repeats` (≥ 0) timed times, and reads back the last
 // draw's depth. Throws std::invalid_argument for bad input, and std::runtime_error with a
 // one-line message naming the failing EGL/GL step (e.g. "no EGL display (surfaceless)",
@@ -81,4 +79,13 @@ bool glReferenceAvailable();
 // GL_ARB_clip_control)"). Every EGL/GL resource is released on both paths.
 GlDepthTiming timeGlDepthDraw(const GlDepthInput& input, int repeats);
 
+// What the plugin libzcheck_gl_yardstick.so offers `zcheck bench --reference`, which loads it
+// only then: the zcheck executable links no GL library.
+struct GlYardstickFunctions {
+    GlDepthTiming (*timeDraw)(const GlDepthInput& input, int repeats);  // timeGlDepthDraw
+};
+
 }  // namespace zcheck::reference
+
+// The plugin's one entry point.
+extern "C" const zcheck::reference::GlYardstickFunctions* zcheck_gl_yardstick();

@@ -6,7 +6,6 @@
 // or a mesh file path (loaded by mesh_loader.h).
 #include "zcheck/camera.h"
 #include "zcheck/camera_import.h"
-#include "zcheck/kernel_choice.h"
 
 #include <glm/glm.hpp>
 
@@ -60,21 +59,6 @@ struct Scene {
     // Appends another soup (indices are offset).
     void append(const std::vector<glm::vec3>& morePositions, const std::vector<glm::uvec3>& moreTriangles);
 };
-
-// The corners of `n` ≤ Lanes triangles dealt into lane arrays in double, for kernels that then
-// work on several triangles per instruction: corner[v][axis][k] is corner v of triangle
-// `triangle[k]`. The indices must be in range (validateScene). Always inlined, so that each
-// form of a kernel (kernel_choice.h) compiles its own copy.
-template <std::size_t Lanes>
-ZCHECK_ALWAYS_INLINE inline void cornersInLanes(const Scene& scene, const std::uint32_t* triangle, std::size_t n,
-                                                double (&corner)[3][3][Lanes])
-{
-    for (std::size_t k = 0; k < n; ++k) {
-        const glm::uvec3& t = scene.triangles[triangle[k]];
-        for (int v = 0; v < 3; ++v)
-            for (int axis = 0; axis < 3; ++axis) corner[v][axis][k] = double(scene.positions[t[v]][axis]);
-    }
-}
 
 // Throws Error for a scene with no triangles or an index out of range.
 void validateScene(const Scene& scene);

@@ -1,4 +1,5 @@
 #pragma once
+// Internal to zcheck (core/detail, never installed).
 // The choice, at run time, between a routine's AVX-512 form and its baseline form.
 //
 // The raster's vector kernels and the comparison's row pass (hand-written, eight lanes at a

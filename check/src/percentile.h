@@ -1,4 +1,5 @@
 #pragma once
+// Private to zcheck_check (check/src/): the comparison's percentiles.
 // The 99th percentile of many non-negative binary32 values in one pass, without storing them
 // all: the comparison's p99 of |Δ|/q and of the relative eye-z error over two million pixels.
 //
@@ -15,8 +16,8 @@
 //   LargestValues mine(width * height / 100 + 2);                // one per thread
 //   mine.add(float(errorQuanta));                                // each value
 //   std::optional<double> p99 = LargestValues::percentile99({&mine, &other});
-#include "zcheck/kernel_choice.h"
-#include "zcheck/lane_mask.h"
+#include "zcheck/detail/kernel_choice.h"
+#include "zcheck/detail/lane_mask.h"
 
 #include <algorithm>
 #include <cstddef>

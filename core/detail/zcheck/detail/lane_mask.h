@@ -1,4 +1,5 @@
 #pragma once
+// Internal to zcheck (core/detail, never installed).
 // The lanes set in a mask of one byte per lane (0 or 1), in increasing order: for the masks
 // of the lane loops (kernel_choice.h) where a few lanes of many are set, so that a loop over
 // them takes no branch per lane, and none per eight lanes either. Each 64 lanes' bytes are
@@ -10,7 +11,7 @@
 //
 // Bytes [0, n) are the mask; bytes from n up to n rounded up to 8 are read and ignored (the
 // array must hold them). Always inlined, so that each form of a kernel compiles its own copy.
-#include "zcheck/kernel_choice.h"
+#include "zcheck/detail/kernel_choice.h"
 
 #include <algorithm>
 #include <cstddef>
