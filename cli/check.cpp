@@ -74,7 +74,7 @@ Command addCheckCommand(CLI::App& app)
         "  zcheck check --camera examples/frustum.json --out results/   camera file; images + report.json\n"
         "  zcheck check --scene 'builtin:terrain?n=708' --width 1920 --height 1080 --json\n"
         "Depths are compared as window depth (the depth-buffer value) per pixel; the tolerance is\n"
-        "C*q + S*m (q: storage quantum, m: depth slope per pixel, S = 2^-8 px). See README.md.");
+        "C*q + S*m (q: storage quantum, m: depth slope per pixel, S = 2^-8 px). See docs/tolerance.md.");
     addThreadsOption(command, o->threads);
     return {command, [o] { return runCheckCommand(*o); }};
 }

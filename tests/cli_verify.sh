@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# zcheck verify end to end, the README's worked example: a map exported from the raster
+# zcheck verify end to end, docs/verify.md's example: a map exported from the raster
 # route verifies (float EXR and millimetre PNG); a wrong one is rejected and diagnosed.
 set -euo pipefail
 source "$(dirname "$0")/lib.sh"

@@ -13,6 +13,11 @@ if grep -rIl "$build\|$source_dir" "$tmp/prefix/include" "$tmp/prefix/lib/cmake"
     exit 1
 fi
 test -f "$tmp/prefix/include/zcheck/version.h"
+# Nothing that only makes zcheck fast is installed, and no installed header reaches for it.
+for internal in kernel_choice.h lane_mask.h streaming_stores.h clock.h percentile.h slope_table.h detail; do
+    test ! -e "$tmp/prefix/include/zcheck/$internal"
+done
+! grep -rlE '"zcheck/detail/|ZCHECK_ALWAYS_INLINE|<immintrin.h>' "$tmp/prefix/include"
 test ! -e "$tmp/prefix/include/zcheck/version.h.in"
 cmake -S "$source_dir/examples/cpp" -B "$tmp/example" -DCMAKE_PREFIX_PATH="$tmp/prefix" > "$tmp/configure.log" 2>&1 ||
     { cat "$tmp/configure.log" >&2; exit 1; }
@@ -20,6 +25,14 @@ cmake --build "$tmp/example" > "$tmp/build.log" 2>&1 || { cat "$tmp/build.log" >
 "$tmp/example/consistency_gate" > "$tmp/out.txt"
 [[ $(grep -c "CONSISTENT" "$tmp/out.txt") -eq 5 ]]
 ! grep -q "INCONSISTENT" "$tmp/out.txt"
+# A map with its rows flipped: inconsistent (exit 1), and the diagnosis names the y-flip.
+set +e
+"$tmp/example/verify_map" > "$tmp/verify.txt"
+status=$?
+set -e
+[[ $status -eq 1 ]]
+grep -q "^map INCONSISTENT$" "$tmp/verify.txt"
+grep -q "^consistent if y-flip:" "$tmp/verify.txt"
 # The installed command-line tool runs from the prefix (no build-tree paths compiled in).
 "$tmp/prefix/bin/zcheck" --version | grep -q "$(cat "$source_dir/CMakeLists.txt" | sed -n 's/^project(zcheck VERSION \([0-9.]*\).*/\1/p')"
 # It starts without OpenImageIO, and loads it (the installed plugin) when it writes an image.

@@ -11,8 +11,6 @@ namespace zcheck {
 
 namespace {
 
-bool isRawMatrix(const Camera& camera) { return camera.spec().projection.type == ProjectionType::Matrix; }
-
 bool isMiss(const Camera& camera, double value, DepthQuantity quantity)
 {
     return kindOfDepthValue(camera, quantity, value) == DepthValueKind::Miss;

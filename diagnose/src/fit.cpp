@@ -16,7 +16,6 @@ namespace zcheck {
 
 namespace {
 
-
 // The map's value of the eye-space point under `camera`, as `quantity`.
 double valueOfEyePoint(const Camera& camera, const glm::dvec3& pEye, DepthQuantity quantity)
 {
@@ -329,8 +328,6 @@ std::vector<Sample> samplesOf(const Scene& scene, const Camera& declared, const 
     for (std::size_t k = 0; k < kMost; ++k) kept.push_back(all[k * all.size() / kMost]);
     return kept;
 }
-
-bool isRawMatrix(const Camera& camera) { return camera.spec().projection.type == ProjectionType::Matrix; }
 
 }  // namespace
 

@@ -133,7 +133,6 @@ glm::dmat4 scaledRows(const Camera& camera, double kx, double ky)
 }
 
 bool hasFovy(const Camera& camera) { return camera.spec().projection.type == ProjectionType::Perspective; }
-bool isRawMatrix(const Camera& camera) { return camera.spec().projection.type == ProjectionType::Matrix; }
 
 // The z row rebuilt with near and far exchanged (the mapping's formula, see camera.cpp).
 glm::dmat4 nearFarSwapped(const Camera& camera)

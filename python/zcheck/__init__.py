@@ -102,7 +102,7 @@ def _jsonable(value, path):
 
 
 def _camera_from_dict(cls, d, source="camera dict"):
-    """A camera from a dict with the camera file's keys (see the README's "The camera file"):
+    """A camera from a dict with the camera file's keys (see docs/camera.md, "The camera file"):
 
         zcheck.Camera.from_dict({
             "convention": "opengl",

@@ -68,7 +68,7 @@ FRAMES = [1, 2, 3, 4, 5]
 EEVEE_FRAMES = [1, 4]
 TARGET = (0.0, 0.0, 0.8)
 MAX_PROJECTION_DIFFERENCE_PX = 1e-3
-ALLOWED_SAMPLE_OFFSET_PX = 2.0 ** -8  # zcheck verify's S (README, "zcheck verify")
+ALLOWED_SAMPLE_OFFSET_PX = 2.0 ** -8  # zcheck verify's S (docs/verify.md)
 
 
 def arguments():

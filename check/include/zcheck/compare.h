@@ -293,7 +293,7 @@ struct RoutePixels {
 // order and thread count, and the same as compareRoutes'. `perPixel`, when given, receives
 // the classes and ratios (sized here, not cleared: each compareTile writes every pixel of its
 // tile, so they are whole once every tile is compared); without it nothing per pixel is kept. Keepers' floors:
-// see percentile.h; finish() returns nullopt when one was too high (compare again without).
+// see check/src/percentile.h; finish() returns nullopt when one was too high (compare again without).
 class TileComparison {
 public:
     static constexpr int kTileSize = 64;

@@ -194,6 +194,10 @@ private:
     double near_ = 0, far_ = 0;
 };
 
+// Whether the camera's projection is a raw matrix (ProjectionType::Matrix): it has no parameters
+// of its own (no field of view, near or far to change), only its matrix.
+inline bool isRawMatrix(const Camera& camera) { return camera.spec().projection.type == ProjectionType::Matrix; }
+
 // A camera that sees a bounding sphere (centre, radius) whole, looking at it from the front
 // right and above, 640×480, near/far hugging the sphere. Used for meshes without a camera.
 CameraSpec framingCameraSpec(const glm::dvec3& centre, double radius);

@@ -62,7 +62,7 @@ public:
 
     const TileGrid& tiles() const;  // kTileSize squares over the camera's image
     // How drawTile writes: for a reader soon after (Cached: a tile compared as it is drawn), or
-    // into a whole image read much later (Streaming: copyRowStreaming, large_buffer.h).
+    // into a whole image read much later (Streaming: streaming stores, which do not first read in the lines they overwrite).
     enum class Stores { Cached, Streaming };
     // The tile's stored depth values and primitive ids (kNoPrimitive where nothing was drawn)
     // into windowDepth/primitive, which point at the tile's first pixel: pixel (col, row) of

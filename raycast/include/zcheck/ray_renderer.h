@@ -49,7 +49,7 @@ public:
     // Builds the BVH and the triangles' planes (timed together); throws Error. `scene` must
     // outlive it: Embree reads its index buffer in place. Where the processor has AVX-512 (F,
     // DQ, VL) the trace runs a form of itself compiled for it, bit-identical to the baseline
-    // form (kernel_choice.h); the environment variable ZCHECK_RAY_KERNEL=baseline, read here,
+    // form (chosen at run time); the environment variable ZCHECK_RAY_KERNEL=baseline, read here,
     // forces the baseline form, and any value but that, `auto` or empty throws Error.
     explicit RayRenderer(const Scene& scene);
     ~RayRenderer();

@@ -4,7 +4,7 @@
 // and its diagnosis (verifyMap, verify_map.h), the suite — and run nothing themselves.
 // JSON documents are indented for people, with arrays of numbers (matrix rows, vectors) on
 // one line; invalid UTF-8 in strings (file names) is replaced, never thrown over. The keys
-// are those the README documents for `--json`.
+// are those docs/ documents for `--json` (docs/tolerance.md, verify.md, diagnosis.md, datasets.md).
 #include "zcheck/checker.h"
 #include "zcheck/depth_map_reading.h"
 #include "zcheck/precision.h"

@@ -4,7 +4,7 @@
 //   error heatmap    — |Δ| / tolerance on both-hit pixels: black 0, through blue and green to
 //                      yellow at 1 (the tolerance), red above; unexplained coverage magenta;
 //                      misses black, explained edges dark grey.
-//   coverage classes — one colour per PixelClass (legend in the README).
+//   coverage classes — one colour per PixelClass (legend in docs/tolerance.md).
 #include "zcheck/compare.h"
 
 #include <cstdint>
