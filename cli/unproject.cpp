@@ -3,7 +3,7 @@
 #include "common.h"
 #include "image_plugin.h"
 
-#include "camera_json.h"
+#include "zcheck/detail/camera_json.h"
 #include "zcheck/atomic_file.h"
 #include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"

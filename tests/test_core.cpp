@@ -1,9 +1,9 @@
 // Core: conventions, cameras and the inverse-projection module, against textbook matrices,
 // GLM's independent implementations and round trips.
 #include "zcheck/camera.h"
-#include "camera_json.h"
 #include "zcheck/camera_file.h"
 #include "zcheck/clip.h"
+#include "zcheck/detail/camera_json.h"
 #include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
 #include "zcheck/lane_mask.h"

@@ -1,6 +1,6 @@
 #include "zcheck/camera_file.h"
 
-#include "camera_json.h"
+#include "zcheck/detail/camera_json.h"
 
 #include "zcheck/error.h"
 #include "zcheck/input_file.h"

@@ -1,6 +1,6 @@
 #include "zcheck/depth_map_reading.h"
 
-#include "camera_json.h"
+#include "zcheck/detail/camera_json.h"
 #include "zcheck/input_file.h"
 
 #include "zcheck/error.h"

@@ -25,7 +25,7 @@
 //   binning_x/y above 1 and a non-empty roi are refused (the image is not the calibrated one).
 #include "camera_importers.h"
 
-#include "camera_json.h"
+#include "zcheck/detail/camera_json.h"
 #include "xml_lite.h"
 #include "yaml_lite.h"
 #include "zcheck/error.h"

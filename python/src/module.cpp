@@ -7,7 +7,6 @@
 // The GIL is released around every render, check, verify, diagnosis, scene load and BVH build.
 #include "bindings.h"
 
-#include "camera_json.h"
 #include "zcheck/camera.h"
 #include "zcheck/camera_file.h"
 #include "zcheck/camera_sources.h"
