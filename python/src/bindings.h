@@ -27,8 +27,6 @@ namespace py = pybind11;
 
 // Raises zcheck.Error with `message`.
 [[noreturn]] void fail(const std::string& message);
-// The export quantity that stores a depth quantity (its channel name: window, ndc, Z, distance).
-ExportQuantity exportOf(DepthQuantity q);
 // At most N worker threads for one call (TBB's limit is process-wide while it lives); none: all.
 std::unique_ptr<tbb::global_control> threadLimit(std::optional<int> threads);
 

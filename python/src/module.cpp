@@ -100,7 +100,7 @@ glm::dmat4 matrixFromArray(py::handle object, const std::string& what, bool allo
                      formatNumber(v(r, c)) + ")");
             m[c][int(r)] = v(r, c);
         }
-    if (d.shape(0) == 4 && (m[0][3] != 0 || m[1][3] != 0 || m[2][3] != 0 || m[3][3] != 1) && allow3x4)
+    if (d.shape(0) == 4 && allow3x4 && !hasRigidLastRow(m))
         fail(what + " must have the last row 0 0 0 1 (a rigid transform for column vectors)");
     return m;
 }
@@ -136,27 +136,6 @@ auto prefixedErrors(const std::string& where, Make&& make)
 
 // ---------------------------------------------------------------------------------------------
 // names
-
-std::string joined(const std::vector<std::string>& names)
-{
-    std::string out;
-    for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
-    return out;
-}
-
-ExportQuantity exportQuantityFromName(const std::string& name)
-{
-    const auto& names = exportQuantityNames();
-    for (std::size_t i = 0; i < names.size(); ++i)
-        if (names[i] == name) return ExportQuantity(i);
-    fail("unknown quantity '" + name + "' (expected one of " + joined(names) + ")");
-}
-
-const std::vector<std::string>& depthQuantityNames()
-{
-    static const std::vector<std::string> names = {"window", "ndc", "eye-z", "distance"};
-    return names;
-}
 
 constexpr int kPixelClassCount = int(PixelClass::Hole) + 1;  // the last class (compare.h)
 
@@ -308,15 +287,18 @@ Camera cameraFromOpencv(py::object K, py::object R, py::object t, py::object wid
         const DoubleArray rd = asDoubles(r), td = asDoubles(tt);
         const auto rv = rd.unchecked<2>();
         const double* tv = td.data();
+        glm::dmat3 rotation;
+        glm::dvec3 translation;
         for (int i = 0; i < 3; ++i) {
             for (int c = 0; c < 3; ++c) {
                 if (!std::isfinite(rv(i, c)))
                     fail(at + "R[" + std::to_string(i) + ", " + std::to_string(c) + "] is not finite");
-                eyeFromWorld[c][i] = rv(i, c);
+                rotation[c][i] = rv(i, c);
             }
             if (!std::isfinite(tv[i])) fail(at + "t[" + std::to_string(i) + "] is not finite");
-            eyeFromWorld[3][i] = tv[i];
+            translation[i] = tv[i];
         }
+        eyeFromWorld = poseFromRotationTranslation(rotation, translation);
         named = "R";
     } else if (!camFromWorld.is_none()) {
         eyeFromWorld = matrixFromArray(camFromWorld, at + "cam_from_world", true);
@@ -340,11 +322,10 @@ Camera cameraFromMatrices(py::object clipFromEye, py::object eyeFromWorld, py::o
     const std::string where = "Camera.from_matrices";
     const std::string at = where + ": ";
     const auto [imageWidth, imageHeight] = requireImageSize(width, height, where);
-    if (vectors != "column" && vectors != "row")
-        fail(at + "vectors must be \"column\" (p' = M·p) or \"row\" (p' = p·M, Direct3D style), got '" + vectors + "'");
+    const std::optional<MatrixVectors> side = matrixVectorsFromName(vectors);
+    if (!side) fail(at + "vectors must be " + kMatrixVectorsNames + ", got '" + vectors + "'");
     auto read = [&](py::handle object, const std::string& name) {
-        const glm::dmat4 m = matrixFromArray(object, at + name, false);
-        return vectors == "row" ? glm::transpose(m) : m;
+        return matrixForVectors(matrixFromArray(object, at + name, false), *side);
     };
     CameraSpec spec;
     spec.convention = conventionNamed(convention, where);
@@ -396,10 +377,7 @@ py::dict matricesDict(const Camera& camera)
 
 glm::ivec2 requirePixel(const Camera& camera, int col, int row)
 {
-    if (col < 0 || col >= camera.width() || row < 0 || row >= camera.height())
-        fail("pixel (" + std::to_string(col) + ", " + std::to_string(row) + ") is outside the " +
-             std::to_string(camera.width()) + "x" + std::to_string(camera.height()) + " image");
-    return {col, row};
+    return pixelInImage(camera, col, row, "pixel (" + std::to_string(col) + ", " + std::to_string(row) + ")");
 }
 
 py::dict rayDict(const EyePlaneRay& r)
@@ -429,15 +407,12 @@ py::dict pointAt(const Camera& camera, int col, int row, double value, const std
 {
     const DepthQuantity quantity = depthQuantityFromName(quantityName);
     const glm::ivec2 pixel = requirePixel(camera, col, row);
-    requireDepthValue(camera, quantity, value, "depth");
-    const glm::dvec2 pWindow = windowFromPixelCentre(camera, pixel.x, pixel.y);
-    const auto pEye = eyePointFromDepth(camera, pWindow, value, quantity);
-    if (!pEye) fail("depth " + formatNumber(value) + " is a miss for quantity " + quantityName);
+    const PointAtDepth point = pointAtDepth(camera, windowFromPixelCentre(camera, pixel.x, pixel.y), value, quantity, "depth");
     py::dict out;
-    out["eye"] = arrayFromVec3(*pEye);
-    out["world"] = arrayFromVec3(glm::dvec3(camera.worldFromEye * glm::dvec4(*pEye, 1.0)));
-    out["eye_z"] = camera.eyeZOf(*pEye);
-    out["distance"] = distanceOfEyePoint(camera, *pEye);
+    out["eye"] = arrayFromVec3(point.pEye);
+    out["world"] = arrayFromVec3(point.pWorld);
+    out["eye_z"] = point.eyeZ;
+    out["distance"] = point.distance;
     return out;
 }
 
@@ -467,18 +442,13 @@ DepthMap mapFromArray(py::handle depth, const Camera& camera, const DepthMapRead
         fail("depth is an integer array (" + dtypeText(a) +
              "): give scale= (stored value = depth × scale, e.g. 1000 for millimetres; 0 = miss)");
     const DoubleArray d = asDoubles(a);
-    DepthMap out;
-    out.width = camera.width(), out.height = camera.height(), out.quantity = quantity;
-    out.value.assign(d.data(), d.data() + d.size());
-    if (!integer && a.dtype().itemsize() == 2) {
-        out.valueStep.resize(out.value.size());
-        for (std::size_t i = 0; i < out.value.size(); ++i) out.valueStep[i] = float(reading.depthStepOf(binary16Step(out.value[i])));
-    }
-    for (double& v : out.value) v = reading.depthOf(v, integer);
-    out.valueQuantum = integer ? 1.0 / reading.scale : 0.0;
-    out.accuracy = reading.accuracy;
-    out.scale = reading.scale, out.offset = reading.offset;
-    return out;
+    DepthMapFile stored;
+    stored.width = camera.width(), stored.height = camera.height();
+    stored.value.assign(d.data(), d.data() + d.size());
+    depthsFromStored(stored,
+                     integer ? StoredValues::Integer : (a.dtype().itemsize() == 2 ? StoredValues::Half : StoredValues::Float),
+                     reading);
+    return DepthMap::of(std::move(stored), quantity, reading);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1045,8 +1015,9 @@ Arguments as for verify().)doc")
         "unproject",
         [](const Camera& camera, py::object depth, const std::string& quantityName, const std::string& space,
            int stride, const py::object& miss, const py::object& scale, const py::object& offset) {
-            if (space != "eye" && space != "world") fail("space must be eye or world, got '" + space + "'");
-            if (stride < 1 || stride > 16384) fail("stride must be in 1..16384, got " + std::to_string(stride));
+            const PointSpace pointSpace = pointSpaceFromName(space, "space");
+            if (stride < 1 || stride > Camera::kMaxImageSide)
+                fail("stride must be in 1.." + std::to_string(Camera::kMaxImageSide) + ", got " + std::to_string(stride));
             const DepthQuantity quantity = depthQuantityFromName(quantityName);
             ReadingArguments arguments;
             arguments.miss = miss, arguments.scale = scale, arguments.offset = offset;
@@ -1054,8 +1025,7 @@ Arguments as for verify().)doc")
             UnprojectedMap cloud;
             {
                 py::gil_scoped_release release;
-                cloud = unprojectMap(camera, input.value, quantity, space == "eye" ? PointSpace::Eye : PointSpace::World,
-                                     stride);
+                cloud = unprojectMap(camera, input.value, quantity, pointSpace, stride);
             }
             const py::ssize_t n = py::ssize_t(cloud.points.size());
             py::array_t<double> points({n, py::ssize_t(3)});
