@@ -1,8 +1,13 @@
+// What both extension modules use: errors, arguments, thread limits, and filling a Report.
 #include "bindings.h"
+
+#include <cmath>
 
 namespace zcheck::python {
 
 void fail(const std::string& message) { throw Error(message); }
+
+py::object jsonLoads(const std::string& text) { return py::module_::import("json").attr("loads")(text); }
 
 std::unique_ptr<tbb::global_control> threadLimit(std::optional<int> threads)
 {
