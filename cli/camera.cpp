@@ -2,10 +2,10 @@
 // convention, or written in another format (camera_export.h).
 #include "common.h"
 
-#include "camera_json.h"
 #include "zcheck/atomic_file.h"
 #include "zcheck/camera_export.h"
 #include "zcheck/camera_sources.h"
+#include "zcheck/detail/camera_json.h"
 #include "zcheck/error.h"
 #include "zcheck/mesh_loader.h"
 #include "zcheck/pose.h"

@@ -43,7 +43,7 @@ const CLI::Validator kPositiveFinite = number([](double v) { return std::isfinit
                                                "a positive finite number", "NUMBER > 0");
 const CLI::Validator kBelowOne = number([](double v) { return v > 0 && v < 1; }, "a number in (0, 1)", "0 < NUMBER < 1");
 const CLI::Range kThreadRange(1, 1024);
-const CLI::Range kImageSideRange(1, 16384);
+const CLI::Range kImageSideRange(1, Camera::kMaxImageSide);
 
 std::unique_ptr<tbb::global_control> limitThreads(int threads)
 {
@@ -249,7 +249,7 @@ DepthMapReading DepthMapOptions::reading(const std::string& quantityName) const
 {
     DepthMapReading r;
     r.channel = channel;
-    r.quantityChannel = channelNameOf(exportQuantitiesFromList(quantityName).front());
+    r.quantityChannel = channelNameOf(exportQuantityOf(depthQuantityFromName(quantityName)));
     r.scale = scale, r.offset = offset;
     if (!miss.empty()) r.miss = MissRule::parse(miss);
     r.accuracy = accuracy;

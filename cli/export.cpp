@@ -2,9 +2,9 @@
 #include "common.h"
 #include "image_plugin.h"
 
-#include "camera_json.h"
 #include "zcheck/atomic_file.h"
 #include "zcheck/departure.h"
+#include "zcheck/detail/camera_json.h"
 #include "zcheck/error.h"
 #include "zcheck/export.h"
 #include "zcheck/mesh_loader.h"

@@ -3,8 +3,8 @@
 #include "common.h"
 #include "image_plugin.h"
 
-#include "camera_json.h"
 #include "zcheck/atomic_file.h"
+#include "zcheck/detail/camera_json.h"
 #include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
 #include "zcheck/point_cloud.h"
@@ -32,17 +32,14 @@ glm::ivec2 parsePixel(const std::string& text, const Camera& camera)
     const std::vector<double> v = parseNumberList(text, "--pixel");
     if (v.size() != 2 || v[0] != std::floor(v[0]) || v[1] != std::floor(v[1]))
         throw Error("--pixel: expected COL,ROW as two whole numbers, got '" + text + "'");
-    if (v[0] < 0 || v[0] >= camera.width() || v[1] < 0 || v[1] >= camera.height())
-        throw Error("--pixel " + text + " is outside the " + std::to_string(camera.width()) + "x" +
-                    std::to_string(camera.height()) + " image");
-    return {int(v[0]), int(v[1])};
+    return pixelInImage(camera, v[0], v[1], "--pixel " + text);
 }
 
 nlohmann::json vec3Json(const glm::dvec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); }
 
 int runUnprojectCommand(const UnprojectOptions& o)
 {
-    if (o.space != "eye" && o.space != "world") throw Error("--space must be eye or world, got '" + o.space + "'");
+    const PointSpace space = pointSpaceFromName(o.space, "--space");
     CameraOptions cameraOptions = o.camera;
     std::string quantityName = o.quantity;
     const std::string compareWith = takeFromSidecar(o.reading, cameraOptions, quantityName);
@@ -66,7 +63,6 @@ int runUnprojectCommand(const UnprojectOptions& o)
         spec = cameraSpecFrom(cameraOptions);
     }
     const Camera camera(spec);
-    auto toWorld = [&](const glm::dvec3& pEye) { return glm::dvec3(camera.worldFromEye * glm::dvec4(pEye, 1.0)); };
 
     if (!o.pixel.empty() && (!o.depthMap.empty() || !o.output.empty()))
         throw Error("--pixel and --depth-map/-o are alternatives: one pixel's ray or point, or a whole map as a point cloud");
@@ -91,11 +87,9 @@ int runUnprojectCommand(const UnprojectOptions& o)
             out["ray"]["world"] = rayJson(rayWorld);
             out["ray"]["eye"] = rayJson(rayEye);
         } else {
-            requireDepthValue(camera, quantity, *o.depth, "--depth");
-            const auto pEye = eyePointFromDepth(camera, pWindow, *o.depth, quantity);
-            if (!pEye) throw Error("--depth " + formatNumber(*o.depth) + " is a miss for quantity " + quantityName);
-            out["point"] = {{"eye", vec3Json(*pEye)}, {"world", vec3Json(toWorld(*pEye))},
-                            {"eye_z", camera.eyeZOf(*pEye)}, {"distance", distanceOfEyePoint(camera, *pEye)}};
+            const PointAtDepth point = pointAtDepth(camera, pWindow, *o.depth, quantity, "--depth");
+            out["point"] = {{"eye", vec3Json(point.pEye)}, {"world", vec3Json(point.pWorld)},
+                            {"eye_z", point.eyeZ}, {"distance", point.distance}};
         }
         std::cout << prettyJson(out) << "\n";
         return kExitConsistent;
@@ -111,7 +105,7 @@ int runUnprojectCommand(const UnprojectOptions& o)
     const DepthMapFile map =
         sized ? std::move(*sized) : readDepthMapFile(o.depthMap, o.reading.reading(quantityName), camera.width(), camera.height());
     const UnprojectedMap cloud =
-        unprojectMap(camera, map.value, quantity, o.space == "eye" ? PointSpace::Eye : PointSpace::World, o.stride);
+        unprojectMap(camera, map.value, quantity, space, o.stride);
     std::string outOfRange;  // values the quantity cannot hold: never dropped silently
     if (cloud.outOfRange > 0) {
         const glm::ivec2 at = cloud.firstOutOfRange;

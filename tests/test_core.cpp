@@ -1,9 +1,9 @@
 // Core: conventions, cameras and the inverse-projection module, against textbook matrices,
 // GLM's independent implementations and round trips.
 #include "zcheck/camera.h"
-#include "camera_json.h"
 #include "zcheck/camera_file.h"
 #include "zcheck/clip.h"
+#include "zcheck/detail/camera_json.h"
 #include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
 #include "zcheck/detail/lane_mask.h"
@@ -464,6 +464,56 @@ TEST_CASE("cameras beyond what binary32 ray tracing can represent are refused, n
     REQUIRE_THROWS_WITH(Camera(spec), Catch::Contains("near-plane window") && Catch::Contains("1e15"));
     spec.projection.left = -1e14;  // within the bound
     REQUIRE_NOTHROW(Camera(spec));
+}
+
+TEST_CASE("a matrix written for row vectors is the transpose, in the camera file as in matrixForVectors", "[core][camera-file]")
+{
+    REQUIRE(matrixVectorsFromName("column") == MatrixVectors::Column);
+    REQUIRE(matrixVectorsFromName("row") == MatrixVectors::Row);
+    REQUIRE_FALSE(matrixVectorsFromName("columns"));
+    const double rows[4][4] = {{1.2, 0, 0.3, 0}, {0, 1.5, -0.2, 0}, {0, 0, -1.002, -0.2002}, {0, 0, -1, 0}};
+    const glm::dmat4 m = matrixFromRows(rows);
+    REQUIRE(matrixForVectors(m, MatrixVectors::Column) == m);
+    REQUIRE(matrixForVectors(m, MatrixVectors::Row) == glm::transpose(m));
+    REQUIRE(matrixForVectors(matrixForVectors(m, MatrixVectors::Row), MatrixVectors::Row) == m);
+    // p' = p·M for row vectors is p' = Mᵀ·p: the same point either way.
+    const glm::dvec4 p(0.3, -0.2, -2, 1);
+    const glm::dmat4 written = matrixForVectors(m, MatrixVectors::Row);
+    glm::dvec4 rowTimesMatrix(0.0);
+    for (int c = 0; c < 4; ++c)
+        for (int k = 0; k < 4; ++k) rowTimesMatrix[c] += p[k] * written[c][k];  // (p·W)_c = Σ_k p_k W[k][c]
+    REQUIRE(rowTimesMatrix == m * p);
+    // The camera file reads 16 numbers written for row vectors as their transpose.
+    auto numbers = [](const glm::dmat4& matrix) {
+        std::string out;
+        for (int r = 0; r < 4; ++r)
+            for (int c = 0; c < 4; ++c) out += (out.empty() ? "" : ", ") + formatNumber(matrix[c][r]);
+        return out;
+    };
+    auto read = [&](const glm::dmat4& matrix, const std::string& vectors) {
+        return cameraSpecFromJsonText(R"({"projection": {"type": "matrix", "clip_from_eye": [)" + numbers(matrix) +
+                                          R"(], "layout": "row-major", "vectors": ")" + vectors +
+                                          R"("}, "view": {"eye": [0, 0, 3], "target": [0, 0, 0]}})",
+                                      "test")
+            .projection.clipFromEye;
+    };
+    REQUIRE(read(written, "row") == read(m, "column"));
+    REQUIRE_THROWS_WITH(read(m, "columns"), std::string("test: 'projection.vectors' must be ") + kMatrixVectorsNames);
+}
+
+TEST_CASE("each depth quantity is stored as the export quantity of its name", "[core][quantity]")
+{
+    REQUIRE(depthQuantityNames() == std::vector<std::string>{"window", "ndc", "eye-z", "distance"});
+    for (const std::string& name : depthQuantityNames()) {
+        const ExportQuantity stored = exportQuantityOf(depthQuantityFromName(name));
+        REQUIRE(toString(stored) == name);
+        REQUIRE(exportQuantityFromName(name) == stored);
+    }
+    REQUIRE(channelNameOf(exportQuantityOf(DepthQuantity::EyeZ)) == "Z");
+    REQUIRE(exportQuantityFromName("primitive-id") == ExportQuantity::PrimitiveId);
+    REQUIRE_THROWS_WITH(exportQuantityFromName("depth"),
+                        "unknown quantity 'depth' (expected one of window, ndc, eye-z, distance, position-eye, "
+                        "position-world, normal, primitive-id)");
 }
 
 TEST_CASE("regression: prettyJson rewrote number lists inside strings", "[json]")

@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <unistd.h>
+#include <vector>
 
 using namespace zcheck;
 namespace fs = std::filesystem;
@@ -165,6 +166,42 @@ TEST_CASE("miss values: a number, nan, inf or a comparison, matched on the store
     for (const std::string bad : {"", "abc", ">=", ">=inf", "<nan", "1e10x", "==3"})
         REQUIRE_THROWS_WITH(MissRule::parse(bad), Catch::Contains("miss value '" + bad + "' is neither a number"));
     REQUIRE(MissRule::parse(">=1e9").text() == ">=1e9");
+}
+
+TEST_CASE("depthsFromStored: the one rule readers and Python's arrays apply to stored values", "[depthmap]")
+{
+    DepthMapReading millimetres;
+    millimetres.scale = 1000, millimetres.offset = 0.5;
+    DepthMapFile integers;
+    integers.width = 3, integers.height = 1, integers.value = {0, 1500, 65535};
+    depthsFromStored(integers, StoredValues::Integer, millimetres);
+    REQUIRE(std::isnan(integers.value[0]));  // 0 is a miss in integer maps
+    REQUIRE(integers.value[1] == Approx(2.0));
+    REQUIRE(integers.value[2] == Approx(66.035));
+    REQUIRE(integers.valueQuantum == Approx(0.001));
+    REQUIRE(integers.valueStep.empty());
+
+    DepthMapFile halves;
+    halves.width = 2, halves.height = 1, halves.value = {1.0, 1000.0};
+    depthsFromStored(halves, StoredValues::Half, DepthMapReading{});
+    REQUIRE(halves.value == std::vector<double>{1.0, 1000.0});
+    REQUIRE(halves.valueStep == std::vector<float>{float(std::ldexp(1.0, -10)), 0.5f});  // binary16's spacing
+    REQUIRE(halves.valueQuantum == 0);
+
+    DepthMapFile floats;
+    floats.width = 3, floats.height = 1, floats.value = {0.0, NAN, 2.0};
+    depthsFromStored(floats, StoredValues::Float, DepthMapReading{});
+    REQUIRE(floats.value[0] == 0.0);  // a float 0 is a value (the quantity decides whether it is a miss)
+    REQUIRE(std::isnan(floats.value[1]));
+    REQUIRE(floats.value[2] == 2.0);
+    REQUIRE((floats.valueStep.empty() && floats.valueQuantum == 0));
+
+    REQUIRE_THROWS_WITH(DepthMapReading::requireScale(-2, "scale"), "scale must be a positive finite number, got -2");
+    REQUIRE_THROWS_WITH(DepthMapReading::requireOffset(INFINITY, "--offset"), "--offset must be a finite number, got inf");
+    REQUIRE(MapAccuracy::requireDeclared(0.5, "rel_tolerance", true) == 0.5);
+    REQUIRE_THROWS_WITH(MapAccuracy::requireDeclared(1, "rel_tolerance", true),
+                        "rel_tolerance must be a finite number >= 0 and below 1, got 1");
+    REQUIRE_THROWS_WITH(MapAccuracy::requireDeclared(-0.1, "quantum", false), "quantum must be a finite number >= 0, got -0.1");
 }
 
 TEST_CASE("integer maps: depth = stored / scale + offset, 0 a miss unless --miss says otherwise; 8 bits refused", "[depthmap]")

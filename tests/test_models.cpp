@@ -1,7 +1,7 @@
 // Projection models and views beyond the foundation: each against its defining formula.
 #include "zcheck/camera.h"
-#include "camera_json.h"
 #include "zcheck/camera_file.h"
+#include "zcheck/detail/camera_json.h"
 #include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
 #include "zcheck/precision.h"

@@ -80,6 +80,25 @@ TEST_CASE("rotationFromQuaternion normalises a rounded quaternion and refuses a 
     REQUIRE_THROWS_WITH(rotationFromQuaternion(NAN, 0, 0, 1, "q"), Catch::Contains("not finite"));
 }
 
+TEST_CASE("poseFromRotationTranslation is [R | t]: x_cam = R x_world + t, as OpenCV and COLMAP store a pose", "[pose]")
+{
+    std::mt19937 random(9);
+    const glm::dmat3 r = randomRotation(random);
+    const glm::dvec3 t(1, -2, 3), pWorld(0.5, 4, -7);
+    const glm::dmat4 pose = poseFromRotationTranslation(r, t);
+    REQUIRE(hasRigidLastRow(pose));
+    const glm::dvec4 pCam = pose * glm::dvec4(pWorld, 1.0);
+    const glm::dvec3 byHand = r * pWorld + t;
+    for (int k = 0; k < 3; ++k) REQUIRE(pCam[k] == Approx(byHand[k]).margin(1e-12));
+    REQUIRE(pCam.w == 1.0);
+    // Not a rigid transform's last row: refused by the pose rule, whose first shape rule it is.
+    glm::dmat4 projective = pose;
+    projective[2][3] = 1e-9;
+    REQUIRE_FALSE(hasRigidLastRow(projective));
+    REQUIRE_THROWS_WITH(requireRigid(projective, +1, "P"),
+                        "'P' must have the last row 0 0 0 1 (a rigid transform for column vectors)");
+}
+
 TEST_CASE("rigidInverse equals the general inverse of a rigid transform", "[pose]")
 {
     std::mt19937 random(3);

@@ -7,6 +7,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <utility>
 
 using namespace zcheck;
 
@@ -90,6 +91,35 @@ TEST_CASE("depth from either route, unprojected, lands on the surface it came fr
                 REQUIRE(rasterPoints == rasterHits);
                 REQUIRE(rayHits > 1000);
             }
+}
+
+TEST_CASE("pointAtDepth: one pixel's point in both spaces, a miss or an impossible value refused by name", "[unproject]")
+{
+    const Camera camera{CameraSpec{}};  // opengl, 640x480, perspective, looking at the origin
+    const glm::dvec2 pWindow = windowFromPixelCentre(camera, 100, 200);
+    const PointAtDepth p = pointAtDepth(camera, pWindow, 2.5, DepthQuantity::EyeZ, "depth");
+    REQUIRE(p.eyeZ == Approx(2.5));
+    REQUIRE(p.distance == Approx(glm::length(p.pEye)));  // from the centre of projection
+    const glm::dvec3 pBack = windowFromWorld(camera, p.pWorld);
+    REQUIRE(pBack.x == Approx(pWindow.x));
+    REQUIRE(pBack.y == Approx(pWindow.y));
+    // The same point given by its distance, and by its window depth.
+    for (const auto& [value, quantity] : {std::pair{p.distance, DepthQuantity::Distance},
+                                          std::pair{pBack.z, DepthQuantity::Window}}) {
+        const PointAtDepth q = pointAtDepth(camera, pWindow, value, quantity, "depth");
+        for (int k = 0; k < 3; ++k) REQUIRE(q.pWorld[k] == Approx(p.pWorld[k]).epsilon(1e-9));
+    }
+    REQUIRE_THROWS_WITH(pointAtDepth(camera, pWindow, camera.clearDepth(), DepthQuantity::Window, "--depth"),
+                        "--depth 1 is a miss for quantity window");
+    REQUIRE_THROWS_WITH(pointAtDepth(camera, pWindow, -1, DepthQuantity::EyeZ, "depth"),
+                        Catch::StartsWith("depth -1 (eye-z) must be > 0"));
+
+    REQUIRE(pixelInImage(camera, 639, 479, "pixel (639, 479)") == glm::ivec2(639, 479));
+    REQUIRE_THROWS_WITH(pixelInImage(camera, 640, 0, "pixel (640, 0)"), "pixel (640, 0) is outside the 640x480 image");
+    REQUIRE_THROWS_WITH(pixelInImage(camera, 0, -1, "--pixel 0,-1"), "--pixel 0,-1 is outside the 640x480 image");
+    REQUIRE(pointSpaceFromName("eye", "space") == PointSpace::Eye);
+    REQUIRE(pointSpaceFromName("world", "space") == PointSpace::World);
+    REQUIRE_THROWS_WITH(pointSpaceFromName("camera", "--space"), "--space must be eye or world, got 'camera'");
 }
 
 TEST_CASE("misses in every quantity are skipped", "[unproject]")

@@ -66,9 +66,21 @@ glm::dmat4 matrixFromRows(const double rows[4][4])
     return m;
 }
 
+std::optional<MatrixVectors> matrixVectorsFromName(const std::string& name)
+{
+    if (name == "column") return MatrixVectors::Column;
+    if (name == "row") return MatrixVectors::Row;
+    return std::nullopt;
+}
+
+glm::dmat4 matrixForVectors(const glm::dmat4& m, MatrixVectors vectors)
+{
+    return vectors == MatrixVectors::Row ? glm::transpose(m) : m;
+}
+
 namespace {
 
-constexpr int kMaxImageSide = 16384;
+constexpr int kMaxImageSide = Camera::kMaxImageSide;
 // About 85 bytes per pixel across both routes, the comparison and --out: 2^25 pixels
 // (8192×4096) stay within ~3 GiB; more would risk the machine's memory instead of failing
 // cleanly.

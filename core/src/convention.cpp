@@ -22,20 +22,13 @@ const std::vector<Convention>& presets()
     return all;
 }
 
-std::string joined(const std::vector<std::string>& names)
-{
-    std::string text;
-    for (const auto& name : names) text += (text.empty() ? "" : ", ") + name;
-    return text;
-}
-
 }  // namespace
 
 Convention Convention::preset(const std::string& name)
 {
     for (const auto& convention : presets())
         if (convention.name == name) return convention;
-    throw Error("unknown convention '" + name + "' (expected one of " + joined(presetNames()) + ")");
+    throw Error("unknown convention '" + name + "' (expected one of " + joinedNames(presetNames()) + ")");
 }
 
 const std::vector<std::string>& Convention::presetNames()
@@ -68,7 +61,7 @@ DepthFormat depthFormatFromName(const std::string& name)
 {
     for (DepthFormat format : {DepthFormat::Float32, DepthFormat::Unorm24, DepthFormat::Unorm16})
         if (toString(format) == name) return format;
-    throw Error("unknown depth format '" + name + "' (expected one of " + joined(depthFormatNames()) + ")");
+    throw Error("unknown depth format '" + name + "' (expected one of " + joinedNames(depthFormatNames()) + ")");
 }
 
 }  // namespace zcheck

@@ -16,6 +16,13 @@ std::string printableExcerpt(std::string_view text, std::size_t maxChars)
     return out;
 }
 
+std::string joinedNames(const std::vector<std::string>& names)
+{
+    std::string text;
+    for (const auto& name : names) text += (text.empty() ? "" : ", ") + name;
+    return text;
+}
+
 std::string formatNumber(double value)
 {
     if (std::isnan(value)) return "nan";

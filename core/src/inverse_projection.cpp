@@ -193,6 +193,31 @@ void requireDepthValue(const Camera& camera, DepthQuantity quantity, double valu
     if (!(value >= lo && value <= hi)) throw Error(given + " must lie in " + depthValueRange(camera, quantity));
 }
 
+PointAtDepth pointAtDepth(const Camera& camera, const glm::dvec2& pWindow, double value, DepthQuantity quantity,
+                          const std::string& name)
+{
+    requireDepthValue(camera, quantity, value, name);
+    const std::optional<glm::dvec3> pEye = eyePointFromDepth(camera, pWindow, value, quantity);
+    if (!pEye) throw Error(name + " " + formatNumber(value) + " is a miss for quantity " + toString(quantity));
+    return {*pEye, glm::dvec3(camera.worldFromEye * glm::dvec4(*pEye, 1.0)), camera.eyeZOf(*pEye),
+            distanceOfEyePoint(camera, *pEye)};
+}
+
+glm::ivec2 pixelInImage(const Camera& camera, double col, double row, const std::string& what)
+{
+    if (!(col >= 0 && col < camera.width() && row >= 0 && row < camera.height()))
+        throw Error(what + " is outside the " + std::to_string(camera.width()) + "x" + std::to_string(camera.height()) +
+                    " image");
+    return {int(col), int(row)};
+}
+
+PointSpace pointSpaceFromName(const std::string& name, const std::string& what)
+{
+    if (name == "eye") return PointSpace::Eye;
+    if (name == "world") return PointSpace::World;
+    throw Error(what + " must be eye or world, got '" + name + "'");
+}
+
 UnprojectedMap unprojectMap(const Camera& camera, const std::vector<double>& values, DepthQuantity quantity,
                             PointSpace space, int stride)
 {

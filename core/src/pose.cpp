@@ -53,7 +53,7 @@ RigidTransform requireRigid(const glm::dmat4& m, int determinant, const std::str
             if (!std::isfinite(m[c][r]))
                 throw Error("'" + what + "' is not finite (element row " + std::to_string(r) + ", column " +
                             std::to_string(c) + " is " + formatNumber(m[c][r]) + ")");
-    if (m[0][3] != 0 || m[1][3] != 0 || m[2][3] != 0 || m[3][3] != 1)
+    if (!hasRigidLastRow(m))
         throw Error("'" + what + "' must have the last row 0 0 0 1 (a rigid transform for column vectors)");
     const glm::dmat3 rotation(m);
     const double departure = departureOf(rotation);
@@ -74,6 +74,15 @@ RigidTransform requireRigid(const glm::dmat4& m, int determinant, const std::str
         out.departure = departure;
     }
     return out;
+}
+
+bool hasRigidLastRow(const glm::dmat4& m) { return m[0][3] == 0 && m[1][3] == 0 && m[2][3] == 0 && m[3][3] == 1; }
+
+glm::dmat4 poseFromRotationTranslation(const glm::dmat3& rotation, const glm::dvec3& translation)
+{
+    glm::dmat4 pose(rotation);
+    pose[3] = glm::dvec4(translation, 1.0);
+    return pose;
 }
 
 glm::dmat4 rigidInverse(const glm::dmat4& m)

@@ -17,17 +17,33 @@ std::string toString(DepthQuantity quantity)
     return "?";
 }
 
+namespace {
+const DepthQuantity kDepthQuantities[] = {DepthQuantity::Window, DepthQuantity::Ndc, DepthQuantity::EyeZ,
+                                          DepthQuantity::Distance};
+const ExportQuantity kAll[] = {ExportQuantity::Window,      ExportQuantity::Ndc,           ExportQuantity::EyeZ,
+                               ExportQuantity::Distance,    ExportQuantity::PositionEye,   ExportQuantity::PositionWorld,
+                               ExportQuantity::Normal,      ExportQuantity::PrimitiveId};
+
+template <class Quantity, std::size_t N>
+std::vector<std::string> namesOf(const Quantity (&all)[N])
+{
+    std::vector<std::string> names;
+    for (Quantity q : all) names.push_back(toString(q));
+    return names;
+}
+}  // namespace
+
 DepthQuantity depthQuantityFromName(const std::string& name)
 {
-    for (DepthQuantity q : {DepthQuantity::Window, DepthQuantity::Ndc, DepthQuantity::EyeZ, DepthQuantity::Distance})
+    for (DepthQuantity q : kDepthQuantities)
         if (toString(q) == name) return q;
     throw Error("unknown depth quantity '" + name + "' (expected window, ndc, eye-z or distance)");
 }
 
-namespace {
-const ExportQuantity kAll[] = {ExportQuantity::Window,      ExportQuantity::Ndc,           ExportQuantity::EyeZ,
-                               ExportQuantity::Distance,    ExportQuantity::PositionEye,   ExportQuantity::PositionWorld,
-                               ExportQuantity::Normal,      ExportQuantity::PrimitiveId};
+const std::vector<std::string>& depthQuantityNames()
+{
+    static const std::vector<std::string> names = namesOf(kDepthQuantities);
+    return names;
 }
 
 std::string toString(ExportQuantity quantity)
@@ -47,11 +63,7 @@ std::string toString(ExportQuantity quantity)
 
 const std::vector<std::string>& exportQuantityNames()
 {
-    static const std::vector<std::string> names = [] {
-        std::vector<std::string> all;
-        for (ExportQuantity q : kAll) all.push_back(toString(q));
-        return all;
-    }();
+    static const std::vector<std::string> names = namesOf(kAll);
     return names;
 }
 
@@ -69,14 +81,30 @@ std::vector<ExportQuantity> exportQuantitiesFromList(const std::string& text)
                     if (seen == q) throw Error("--quantity lists '" + name + "' twice");
                 out.push_back(q), found = true;
             }
-        if (!found) {
-            std::string known;
-            for (const auto& n : exportQuantityNames()) known += (known.empty() ? "" : ", ") + n;
-            throw Error("unknown quantity '" + name + "' (expected one or more of " + known + ", comma-separated)");
-        }
+        if (!found)
+            throw Error("unknown quantity '" + name + "' (expected one or more of " + joinedNames(exportQuantityNames()) +
+                        ", comma-separated)");
         start = end + 1;
     }
     return out;
+}
+
+ExportQuantity exportQuantityFromName(const std::string& name)
+{
+    for (ExportQuantity q : kAll)
+        if (toString(q) == name) return q;
+    throw Error("unknown quantity '" + name + "' (expected one of " + joinedNames(exportQuantityNames()) + ")");
+}
+
+ExportQuantity exportQuantityOf(DepthQuantity quantity)
+{
+    switch (quantity) {
+    case DepthQuantity::Window: return ExportQuantity::Window;
+    case DepthQuantity::Ndc: return ExportQuantity::Ndc;
+    case DepthQuantity::EyeZ: return ExportQuantity::EyeZ;
+    case DepthQuantity::Distance: return ExportQuantity::Distance;
+    }
+    return ExportQuantity::Window;
 }
 
 std::string channelNameOf(ExportQuantity quantity)

@@ -75,7 +75,7 @@ FramePlan planFrame(const DatasetFrame& frame, const DatasetRunOptions& options)
     plan.quantity = depthQuantityFromName(plan.quantityName);
     DepthMapReading& reading = plan.reading;
     reading.channel = frame.channel.value_or(options.channel);
-    reading.quantityChannel = channelNameOf(exportQuantitiesFromList(plan.quantityName).front());
+    reading.quantityChannel = channelNameOf(exportQuantityOf(plan.quantity));
     reading.scale = frame.scale ? *frame.scale : options.scale ? *options.scale : frame.impliedScale.value_or(0.0);
     reading.offset = frame.offset.value_or(options.offset.value_or(0.0));
     const std::string miss = frame.miss.value_or(options.miss);

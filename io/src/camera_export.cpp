@@ -2,8 +2,8 @@
 // a camera read from one format and written in another reads back as the same camera.
 #include "zcheck/camera_export.h"
 
-#include "camera_json.h"
 #include "zcheck/camera_file.h"
+#include "zcheck/detail/camera_json.h"
 #include "zcheck/error.h"
 #include "zcheck/pose.h"
 

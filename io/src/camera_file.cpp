@@ -1,6 +1,6 @@
 #include "zcheck/camera_file.h"
 
-#include "camera_json.h"
+#include "zcheck/detail/camera_json.h"
 
 #include "zcheck/error.h"
 #include "zcheck/input_file.h"
@@ -130,13 +130,12 @@ glm::dmat4 readMatrix(ObjectReader& object, const std::string& key)
     const std::string vectors = object.string("vectors", "");
     if (layout != "row-major" && layout != "column-major")
         object.failKey("layout", "must be \"row-major\" or \"column-major\" (how the 16 numbers of '" + key + "' are ordered)");
-    if (vectors != "column" && vectors != "row")
-        object.failKey("vectors", "must be \"column\" (p' = M·p) or \"row\" (p' = p·M, Direct3D style)");
+    const std::optional<MatrixVectors> side = matrixVectorsFromName(vectors);
+    if (!side) object.failKey("vectors", std::string("must be ") + kMatrixVectorsNames);
     double rows[4][4];
     for (int r = 0; r < 4; ++r)
         for (int c = 0; c < 4; ++c) rows[r][c] = layout == "row-major" ? v[std::size_t(4 * r + c)] : v[std::size_t(4 * c + r)];
-    const glm::dmat4 m = matrixFromRows(rows);
-    return vectors == "column" ? m : glm::transpose(m);
+    return matrixForVectors(matrixFromRows(rows), *side);
 }
 
 // "far": a number, or "inf" for an infinite far plane.
@@ -431,7 +430,9 @@ json matricesJson(const Camera& camera)
         {"far", camera.farIsInfinite() ? json("inf") : json(camera.farDistance())},
     };
     const bool rows = camera.convention().rowVectors;
-    auto native = [&](const glm::dmat4& m) { return matrixJson(rows ? glm::transpose(m) : m); };
+    auto native = [&](const glm::dmat4& m) {
+        return matrixJson(matrixForVectors(m, rows ? MatrixVectors::Row : MatrixVectors::Column));
+    };
     out["native"] = {
         {"convention", camera.convention().name},
         {"vectors", rows ? "row (p' = p·M): the transposes of the above" : "column (p' = M·p)"},

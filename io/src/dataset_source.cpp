@@ -1,8 +1,8 @@
 #include "zcheck/dataset_source.h"
 
 #include "camera_importers.h"
-#include "camera_json.h"
 #include "zcheck/camera_file.h"
+#include "zcheck/detail/camera_json.h"
 #include "zcheck/error.h"
 #include "zcheck/input_file.h"
 #include "zcheck/inverse_projection.h"

@@ -205,8 +205,6 @@ DepthMapFile readNpy(const std::string& path, const DepthMapReading& reading, in
     const std::size_t channel = std::size_t(std::stoll(map.channel));
     const unsigned char* data = b + headerStart + headerLength;
     map.value.resize(std::size_t(width) * std::size_t(height));
-    const bool half = kind == 'f' && size == 2;  // each value its own step (binary16Step)
-    if (half) map.valueStep.resize(map.value.size());
     for (long long row = 0; row < height; ++row)
         for (long long col = 0; col < width; ++col) {
             // C order: (row, col, c) at (row·W + col)·C + c; Fortran order: row + H·(col + W·c).
@@ -229,11 +227,10 @@ DepthMapFile readNpy(const std::string& path, const DepthMapReading& reading, in
             } else {
                 v = size == 2 ? double(std::int16_t(std::uint16_t(raw))) : double(std::int32_t(std::uint32_t(raw)));
             }
-            const std::size_t i = std::size_t(row) * std::size_t(width) + std::size_t(col);
-            map.value[i] = reading.depthOf(v, integer);
-            if (half) map.valueStep[i] = float(reading.depthStepOf(binary16Step(v)));
+            map.value[std::size_t(row) * std::size_t(width) + std::size_t(col)] = v;
         }
-    if (integer) map.valueQuantum = 1.0 / reading.scale;
+    const bool half = kind == 'f' && size == 2;
+    depthsFromStored(map, integer ? StoredValues::Integer : (half ? StoredValues::Half : StoredValues::Float), reading);
     return map;
 }
 

@@ -195,8 +195,7 @@ DepthMapFile readHdf5(const std::string& path, const DepthMapReading& reading, i
     map.width = reply.width, map.height = reply.height, map.channel = text;
     map.value.resize(pixels);
     std::memcpy(map.value.data(), received.data() + sizeof reply + reply.textBytes, pixels * sizeof(double));
-    for (double& v : map.value) v = reading.depthOf(v, reply.integer);
-    if (reply.integer) map.valueQuantum = 1.0 / reading.scale;
+    depthsFromStored(map, reply.integer ? StoredValues::Integer : StoredValues::Float, reading);
     return map;
 }
 

@@ -98,9 +98,8 @@ std::optional<DepthMapFile> readDepthMapNatively(const std::string& path, const 
                                                  int expectedHeight)
 {
     const double scale = reading.scale;
-    if (scale != 0 && !(scale > 0 && std::isfinite(scale)))
-        throw Error("--scale must be a positive finite number, got " + formatNumber(scale));
-    if (!std::isfinite(reading.offset)) throw Error("--offset must be a finite number, got " + formatNumber(reading.offset));
+    if (scale != 0) DepthMapReading::requireScale(scale, "--scale");
+    DepthMapReading::requireOffset(reading.offset, "--offset");
     checkInputFile(path, kDepthMapInput);
     // The format is decided by the file's first bytes, and only that format's reader sees it.
     char head[32] = {};
@@ -117,7 +116,7 @@ std::optional<DepthMapFile> readDepthMapNatively(const std::string& path, const 
     const auto* magic = reinterpret_cast<const unsigned char*>(head);
     if (magic[0] == 'P' && (magic[1] == 'f' || magic[1] == 'F') && std::isspace(magic[2])) {
         DepthMapFile map = readPfm(path, readInputFile(path, kDepthMapInput), reading, expectedWidth, expectedHeight);
-        for (double& v : map.value) v = reading.depthOf(v, false);
+        depthsFromStored(map, StoredValues::Float, reading);
         return map;
     }
     if (magic[0] == 0x89 && magic[1] == 'P' && magic[2] == 'N' && magic[3] == 'G') {
@@ -137,10 +136,10 @@ std::optional<DepthMapFile> readDepthMapNatively(const std::string& path, const 
             refuseDepthMap(path, what);
         }
         DepthMapFile map;
-        map.width = png.width, map.height = png.height, map.valueQuantum = 1.0 / scale;
+        map.width = png.width, map.height = png.height;
         map.channel = chooseDepthChannel(path, {"Y"}, reading.channel, reading.quantityChannel);
-        map.value.resize(png.codes.size());
-        for (std::size_t i = 0; i < png.codes.size(); ++i) map.value[i] = reading.depthOf(png.codes[i], true);
+        map.value.assign(png.codes.begin(), png.codes.end());
+        depthsFromStored(map, StoredValues::Integer, reading);
         return map;
     }
     const bool exr = magic[0] == 0x76 && magic[1] == 0x2f && magic[2] == 0x31 && magic[3] == 0x01;

@@ -1,6 +1,6 @@
 #include "zcheck/depth_map_reading.h"
 
-#include "camera_json.h"
+#include "zcheck/detail/camera_json.h"
 #include "zcheck/input_file.h"
 
 #include "zcheck/error.h"
@@ -100,14 +100,40 @@ std::string chooseDepthChannel(const std::string& path, const std::vector<std::s
     refuseDepthMap(path, "several of its channels are named as depth (" + listed(depth) + "); name the one to read with --channel");
 }
 
+double MapAccuracy::requireDeclared(double value, const std::string& name, bool relative)
+{
+    if (!(value >= 0) || !std::isfinite(value) || (relative && value >= 1))
+        throw Error(name + " must be a finite number >= 0" + (relative ? " and below 1" : "") + ", got " +
+                    formatNumber(value));
+    return value;
+}
+
 void MapAccuracy::require(const std::string& where) const
 {
-    auto check = [&](const char* name, double v) {
-        if (!(v >= 0) || !std::isfinite(v))
-            throw Error(where + ": " + name + " must be a finite number >= 0 (got " + formatNumber(v) + ")");
-    };
-    check("quantum", quantum), check("relative tolerance", relative), check("absolute tolerance", absolute);
-    if (relative >= 1) throw Error(where + ": relative tolerance must be below 1 (got " + formatNumber(relative) + ")");
+    requireDeclared(quantum, where + ": quantum", false);
+    requireDeclared(relative, where + ": relative tolerance", true);
+    requireDeclared(absolute, where + ": absolute tolerance", false);
+}
+
+void DepthMapReading::requireScale(double scale, const std::string& name)
+{
+    if (!(scale > 0 && std::isfinite(scale))) throw Error(name + " must be a positive finite number, got " + formatNumber(scale));
+}
+
+void DepthMapReading::requireOffset(double offset, const std::string& name)
+{
+    if (!std::isfinite(offset)) throw Error(name + " must be a finite number, got " + formatNumber(offset));
+}
+
+void depthsFromStored(DepthMapFile& map, StoredValues stored, const DepthMapReading& reading)
+{
+    if (stored == StoredValues::Half) {
+        map.valueStep.resize(map.value.size());
+        for (std::size_t i = 0; i < map.value.size(); ++i) map.valueStep[i] = float(reading.depthStepOf(binary16Step(map.value[i])));
+    }
+    const bool integer = stored == StoredValues::Integer;
+    for (double& v : map.value) v = reading.depthOf(v, integer);
+    map.valueQuantum = integer ? 1.0 / reading.scale : 0.0;
 }
 
 std::string MapAccuracy::options() const

@@ -187,14 +187,15 @@ DepthMapFile readDepthMap(const std::string& path, const DepthMapReading& readin
         refuseDepthMap(path, reason.empty() ? "the pixel data is truncated or corrupt" : reason);
     }
     // read_image scales integers to [0,1]; undo it to get the stored code.
-    const double maxCode = integer ? std::pow(2.0, double(format.size() * 8)) - 1 : 1.0;
-    if (format == OIIO::TypeDesc::HALF) {  // each value its own step (binary16Step)
-        map.valueStep.resize(pixels.size());
-        for (std::size_t i = 0; i < pixels.size(); ++i) map.valueStep[i] = float(reading.depthStepOf(binary16Step(pixels[i])));
+    if (integer) {
+        const double maxCode = std::pow(2.0, double(format.size() * 8)) - 1;
+        for (double& v : pixels) v = std::round(v * maxCode);
     }
-    for (double& v : pixels) v = reading.depthOf(integer ? std::round(v * maxCode) : v, integer);
-    if (integer) map.valueQuantum = 1.0 / scale;
     map.value = std::move(pixels);
+    depthsFromStored(map, integer                              ? StoredValues::Integer
+                          : format == OIIO::TypeDesc::HALF ? StoredValues::Half
+                                                            : StoredValues::Float,
+                     reading);
     return map;
 }
 

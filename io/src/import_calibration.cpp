@@ -25,9 +25,9 @@
 //   binning_x/y above 1 and a non-empty roi are refused (the image is not the calibrated one).
 #include "camera_importers.h"
 
-#include "camera_json.h"
 #include "xml_lite.h"
 #include "yaml_lite.h"
+#include "zcheck/detail/camera_json.h"
 #include "zcheck/error.h"
 #include "zcheck/input_file.h"
 #include "zcheck/pose.h"
@@ -313,9 +313,9 @@ private:
         const Node* t = anyOf({"T", "t", "tvec", "translation"}, &tKey);
         if (bool(r) != bool(t)) fail("a pose needs both a rotation (R or rvec) and a translation (T or tvec)");
         if (r) {
-            camFromWorld = glm::dmat4(rotationOf(matrix(*r, rKey), rKey));
+            const glm::dmat3 rotation = rotationOf(matrix(*r, rKey), rKey);
             const Matrix tv = shaped(*t, tKey, 3, 1);
-            camFromWorld[3] = glm::dvec4(tv.values[0], tv.values[1], tv.values[2], 1.0);
+            camFromWorld = poseFromRotationTranslation(rotation, {tv.values[0], tv.values[1], tv.values[2]});
         }
         CameraSet set;
         set.path = path_, set.format = CameraFormat::OpenCv;

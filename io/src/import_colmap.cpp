@@ -419,8 +419,9 @@ CameraSet readColmapModel(const std::string& path)
         try {
             spec.projection = intrinsics.intrinsics.projection(kPlaceholderNear, kPlaceholderFar, "intrinsics");
             double departure = 0;
-            glm::dmat4 camFromWorld(rotationFromQuaternion(image.q[0], image.q[1], image.q[2], image.q[3], "qvec", &departure));
-            camFromWorld[3] = glm::dvec4(image.t[0], image.t[1], image.t[2], 1.0);
+            const glm::dmat4 camFromWorld = poseFromRotationTranslation(
+                rotationFromQuaternion(image.q[0], image.q[1], image.q[2], image.q[3], "qvec", &departure),
+                {image.t[0], image.t[1], image.t[2]});
             spec.view = viewFromPose(camFromWorld, PoseDirection::CameraFromWorld, opencv, opencv, "qvec, tvec");
             spec.view.rotationDeparture = std::max(spec.view.rotationDeparture, departure);
             Camera validated(spec);

@@ -22,7 +22,7 @@
 // in the poses' coordinates.
 #include "camera_importers.h"
 
-#include "camera_json.h"
+#include "zcheck/detail/camera_json.h"
 #include "zcheck/error.h"
 #include "zcheck/input_file.h"
 #include "zcheck/pose.h"

@@ -1,19 +1,13 @@
+// What both extension modules use: errors, arguments, thread limits, and filling a Report.
 #include "bindings.h"
+
+#include <cmath>
 
 namespace zcheck::python {
 
 void fail(const std::string& message) { throw Error(message); }
 
-ExportQuantity exportOf(DepthQuantity q)
-{
-    switch (q) {
-    case DepthQuantity::Window: return ExportQuantity::Window;
-    case DepthQuantity::Ndc: return ExportQuantity::Ndc;
-    case DepthQuantity::EyeZ: return ExportQuantity::EyeZ;
-    case DepthQuantity::Distance: return ExportQuantity::Distance;
-    }
-    return ExportQuantity::Window;
-}
+py::object jsonLoads(const std::string& text) { return py::module_::import("json").attr("loads")(text); }
 
 std::unique_ptr<tbb::global_control> threadLimit(std::optional<int> threads)
 {
@@ -80,9 +74,8 @@ DepthMapReading readingOf(const ReadingArguments& a)
 {
     DepthMapReading reading;
     const std::optional<double> scale = numberArgument(a.scale, "scale"), offset = numberArgument(a.offset, "offset");
-    if (scale && !(std::isfinite(*scale) && *scale > 0))
-        fail("scale must be a positive finite number, got " + formatNumber(*scale));
-    if (offset && !std::isfinite(*offset)) fail("offset must be a finite number, got " + formatNumber(*offset));
+    if (scale) DepthMapReading::requireScale(*scale, "scale");
+    if (offset) DepthMapReading::requireOffset(*offset, "offset");
     reading.scale = scale ? *scale : 0.0;
     reading.offset = offset ? *offset : 0.0;
     if (py::isinstance<py::str>(a.miss)) {
@@ -93,13 +86,9 @@ DepthMapReading readingOf(const ReadingArguments& a)
                  " (one miss value or rule per map)");
         reading.miss = MissRule::parse(formatNumber(*numberArgument(a.miss, "miss")));
     }
-    // What the map declares: finite, >= 0 (MapAccuracy::require's rule, each named as its argument).
-    auto declared = [](const py::object& value, const char* name, bool belowOne) {
-        const double v = numberArgument(value, name).value_or(0.0);
-        if (!(v >= 0) || !std::isfinite(v) || (belowOne && v >= 1))
-            fail(std::string(name) + " must be a finite number >= 0" + (belowOne ? " and below 1" : "") + ", got " +
-                 formatNumber(v));
-        return v;
+    // What the map declares, by the library's rule (MapAccuracy::requireDeclared), named as its argument.
+    auto declared = [](const py::object& value, const char* name, bool relative) {
+        return MapAccuracy::requireDeclared(numberArgument(value, name).value_or(0.0), name, relative);
     };
     MapAccuracy& d = reading.accuracy;
     d.quantum = declared(a.quantum, "quantum", false);

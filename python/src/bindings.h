@@ -1,8 +1,15 @@
 #pragma once
-// What the two extension modules share: zcheck._zcheck (everything but image files) and
-// zcheck._zcheck_files (depth-map files through OpenImageIO, imported on first use so that
-// `import zcheck` does not pay OpenImageIO's start-up).
+// The binding helpers the files of python/src share. Each file binds one class as an adapter
+// (scene.cpp, camera.cpp with camera_factories.cpp, report.cpp, checker.cpp; dataset.cpp and
+// files.cpp in zcheck._zcheck_files) and module.cpp declares zcheck._zcheck and calls them.
+// The rules — what a valid pose, camera, scene or reading is — are the C++ libraries'; these
+// helpers only turn Python values into theirs and back, naming the caller's arguments.
+//
+// Two extension modules: zcheck._zcheck (everything but image files) and zcheck._zcheck_files
+// (depth-map files through OpenImageIO, imported on first use so that `import zcheck` does not
+// pay OpenImageIO's start-up). bindings.cpp is compiled into both; arrays.cpp into _zcheck.
 #include "zcheck/checker.h"
+#include "zcheck/depth_map.h"
 #include "zcheck/depth_map_reading.h"
 #include "zcheck/error.h"
 #include "zcheck/map_verifier.h"
@@ -25,12 +32,33 @@ namespace zcheck::python {
 
 namespace py = pybind11;
 
+// ---- each file's binding (module.cpp calls them in this order: a class before its users)
+void bindScene(py::module_& m);     // scene.cpp: zcheck.Scene
+void bindCamera(py::module_& m);    // camera.cpp: zcheck.Camera
+void bindCameraFactories(py::class_<Camera>& camera);  // camera_factories.cpp: its from_* and replace
+void bindReport(py::module_& m);    // report.cpp: zcheck.Report
+void bindChecker(py::module_& m);   // checker.cpp: zcheck.Checker
+void bindDatasets(py::module_& m);  // dataset.cpp, in _zcheck_files: zcheck/dataset.py's _Dataset
+
+// ---- errors and arguments (bindings.cpp)
+
 // Raises zcheck.Error with `message`.
 [[noreturn]] void fail(const std::string& message);
-// The export quantity that stores a depth quantity (its channel name: window, ndc, Z, distance).
-ExportQuantity exportOf(DepthQuantity q);
+// Runs `make` and prefixes a refusal with `where` ("Camera.from_opencv"): the rules are the
+// library's (pose.h, camera.h), the names of the arguments the caller's.
+template <class Make>
+auto prefixedErrors(const std::string& where, Make&& make)
+{
+    try {
+        return make();
+    } catch (const Error& e) {
+        throw Error(where + ": " + e.what());
+    }
+}
 // At most N worker threads for one call (TBB's limit is process-wide while it lives); none: all.
 std::unique_ptr<tbb::global_control> threadLimit(std::optional<int> threads);
+// json.loads(text): the dict of a JSON document the library wrote as text.
+py::object jsonLoads(const std::string& text);
 
 // A keyword argument that must be None or a real number (a Python int or float, a NumPy scalar):
 // anything else — a bool, a string, a list — is a zcheck.Error naming `name`.
@@ -50,6 +78,34 @@ struct ReadingArguments {
 DepthMapReading readingOf(const ReadingArguments& arguments);
 // The quantity argument: a required depth quantity's name (a zcheck.Error when None or not one).
 DepthQuantity quantityArgument(const py::object& quantity, std::string& name);
+
+// ---- numpy arrays (arrays.cpp, _zcheck only)
+
+using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+std::string shapeText(const py::array& a);  // "(120, 160)", "(3,)"
+std::string dtypeText(const py::array& a);  // "float64"
+// Any array-like of numbers (float, signed or unsigned integer); `what` names the argument.
+py::array numericArray(py::handle object, const std::string& what);
+DoubleArray asDoubles(const py::array& a);
+// A 4×4 (or, with `allow3x4`, 3×4 [R|t]) matrix written for column vectors, M[r, c]; a 4×4 pose
+// must have the last row 0 0 0 1 (pose.h's hasRigidLastRow).
+glm::dmat4 matrixFromArray(py::handle object, const std::string& what, bool allow3x4);
+py::array_t<double> arrayFromMatrix(const glm::dmat4& m);  // 4×4, M[r, c]
+py::array_t<double> arrayFromVec3(const glm::dvec3& p);
+// `depth` (height × width, any float or integer dtype) as the map verify and unproject take,
+// its values read as a file's are (depthsFromStored): integer arrays need a scale.
+DepthMap mapFromArray(py::handle depth, const Camera& camera, const DepthMapReading& reading, DepthQuantity quantity);
+
+// An (height, width) array of `values` (row 0 at the top).
+template <class T, class Allocator>
+py::array_t<T> image(const std::vector<T, Allocator>& values, int width, int height)
+{
+    py::array_t<T> out({py::ssize_t(height), py::ssize_t(width)});
+    std::copy(values.begin(), values.end(), out.mutable_data());
+    return out;
+}
+
+// ---- the classes' state shared between files
 
 // zcheck.Checker: a Checker and, beside it, the MapVerifier that its verify, verify_file and
 // diagnose share (map_verifier.h: the neighbour index is built once per Checker, not per map).
@@ -75,6 +131,11 @@ void fillComparison(PyReport& r, const Comparison& c, const RenderResult& ray, c
 // A verification (verifyMap, verify_map.h) as a Report, its JSON and summary formatted as
 // `zcheck verify` formats them (formatVerification, report.h): verify and verify_file share it.
 void fillVerification(PyReport& r, VerifiedMap verified, const DepthMapSource& source);
+// Checker.diagnose's list of dicts, and Report.diagnosis's (report.cpp).
+py::list diagnosisList(const std::vector<Hypothesis>& hypotheses);
+
+// A camera built and validated; a refusal is prefixed with `where` (the factory's name).
+Camera makeCamera(const CameraSpec& spec, const std::string& where);
 
 // Pickling (pickling.cpp): each class's state as plain Python values, and back.
 py::tuple cameraState(const Camera& camera);
@@ -83,17 +144,5 @@ py::tuple sceneState(const Scene& scene);
 Scene sceneFromState(const py::tuple& state);
 py::tuple reportState(const PyReport& report);
 PyReport reportFromState(const py::tuple& state);
-
-// zcheck._zcheck_files's datasets (dataset.cpp), adapted for zcheck/dataset.py.
-void bindDatasets(py::module_& m);
-
-// An (height, width) array of `values` (row 0 at the top).
-template <class T, class Allocator>
-py::array_t<T> image(const std::vector<T, Allocator>& values, int width, int height)
-{
-    py::array_t<T> out({py::ssize_t(height), py::ssize_t(width)});
-    std::copy(values.begin(), values.end(), out.mutable_data());
-    return out;
-}
 
 }  // namespace zcheck::python

@@ -38,7 +38,7 @@ DatasetRunOptions runOptions(const std::string& scene, std::optional<std::string
     o.accuracy = readingOf(arguments).accuracy;
     o.scene = scene;
     o.quantity = quantity.value_or("");
-    if (scale && !(*scale > 0 && std::isfinite(*scale))) fail("scale must be a positive finite number, got " + formatNumber(*scale));
+    if (scale) DepthMapReading::requireScale(*scale, "scale");
     o.scale = scale, o.offset = offset;
     if (!miss.is_none()) o.miss = py::isinstance<py::str>(miss) ? miss.cast<std::string>() : formatNumber(miss.cast<double>());
     o.channel = channel.value_or("");

@@ -31,7 +31,7 @@ PYBIND11_MODULE(_zcheck_files, m)
             const DepthQuantity quantity = quantityArgument(quantityArg, quantityName);
             DepthMapReading reading = readingOf({miss, scale, offset, quantum, relTolerance, absTolerance, allowHoles});
             reading.channel = channel ? *channel : "";
-            reading.quantityChannel = channelNameOf(exportOf(quantity));
+            reading.quantityChannel = channelNameOf(exportQuantityOf(quantity));
             if (sidecar) reading = withSidecar(reading, *sidecar);
             auto r = std::make_unique<PyReport>();
             r->verify = true;
@@ -62,7 +62,7 @@ PYBIND11_MODULE(_zcheck_files, m)
             arguments.miss = miss, arguments.scale = scale, arguments.offset = offset;
             DepthMapReading reading = readingOf(arguments);
             reading.channel = channel ? *channel : "";
-            if (quantity) reading.quantityChannel = channelNameOf(exportOf(depthQuantityFromName(*quantity)));
+            if (quantity) reading.quantityChannel = channelNameOf(exportQuantityOf(depthQuantityFromName(*quantity)));
             if (sidecar) reading = withSidecar(reading, *sidecar);
             DepthMapFile file;
             {

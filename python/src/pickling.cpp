@@ -7,7 +7,6 @@
 //   Report  every number of the report, the JSON and summary texts, the per-pixel arrays
 #include "bindings.h"
 
-#include "camera_json.h"
 #include "zcheck/camera_file.h"
 #include "zcheck/mesh_loader.h"
 

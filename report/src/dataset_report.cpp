@@ -1,7 +1,7 @@
 #include "zcheck/dataset_report.h"
 
-#include "camera_json.h"
 #include "report_json.h"
+#include "zcheck/detail/camera_json.h"
 #include "zcheck/error.h"
 #include "zcheck/input_file.h"
 #include "zcheck/png_file.h"

@@ -2,8 +2,8 @@
 
 #include "zcheck/error.h"
 
-#include "camera_json.h"
 #include "report_json.h"
+#include "zcheck/detail/camera_json.h"
 #include "zcheck/png_file.h"
 #include "zcheck/report_images.h"
 #include "zcheck/version.h"

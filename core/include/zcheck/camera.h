@@ -31,6 +31,7 @@
 #include <glm/glm.hpp>
 
 #include <cmath>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -185,6 +186,8 @@ public:
     // The largest world coordinate of the eye and of the near-plane window's corners (rays
     // are traced in binary32); the constructor refuses cameras beyond it.
     static constexpr double kMaxWorldCoordinate = 1e15;
+    // The largest image side in pixels (the smallest is 1); the constructor refuses larger images.
+    static constexpr int kMaxImageSide = 16384;
 
 private:
     void requireRepresentable() const;
@@ -214,5 +217,17 @@ void setMatrixHook(MatrixHook hook);
 
 // Row-major construction for readable matrix literals: rows[r][c] is row r, column c.
 glm::dmat4 matrixFromRows(const double rows[4][4]);
+
+// Which side of a matrix the vectors go, as an engine writes its matrices: column vectors
+// (p' = M·p: OpenGL, GLM, Vulkan, Metal, zcheck) or row vectors (p' = p·M: Direct3D,
+// DirectXMath), for which the same transform is written transposed.
+enum class MatrixVectors { Column, Row };
+// The names the camera file's "vectors" key and Python's vectors= take.
+inline constexpr const char* kMatrixVectorsNames = "\"column\" (p' = M·p) or \"row\" (p' = p·M, Direct3D style)";
+// "column" or "row"; nothing for any other name (the caller says kMatrixVectorsNames).
+std::optional<MatrixVectors> matrixVectorsFromName(const std::string& name);
+// A matrix written for `vectors` as zcheck holds it, for column vectors, and back: the
+// transpose for row vectors (an involution), `m` itself for column vectors.
+glm::dmat4 matrixForVectors(const glm::dmat4& m, MatrixVectors vectors);
 
 }  // namespace zcheck

@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace zcheck {
 
@@ -20,5 +21,8 @@ std::string formatNumber(double value);
 // At most `maxChars` characters of `text` for a message, each byte outside printable ASCII
 // as '?': file contents quoted in an error stay one readable line.
 std::string printableExcerpt(std::string_view text, std::size_t maxChars);
+
+// "opengl, direct3d, vulkan": the names a message says are accepted.
+std::string joinedNames(const std::vector<std::string>& names);
 
 }  // namespace zcheck

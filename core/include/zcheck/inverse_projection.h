@@ -18,9 +18,9 @@
 #include "zcheck/camera.h"
 #include "zcheck/quantity.h"
 
-#include <vector>
-
 #include <optional>
+#include <string>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -40,6 +40,11 @@ inline glm::dvec2 windowFromPixelCentre(const Camera& camera, int col, int row)
 {
     return {col + 0.5, camera.windowYFromImageY(row + 0.5)};
 }
+
+// Pixel (col, row) of the camera's image, whole numbers as the caller read them; throws Error
+// "<what> is outside the WxH image" for one outside [0, width) × [0, height). `what` names the
+// pixel as the caller was given it ("--pixel 3,4", "pixel (3, 4)").
+glm::ivec2 pixelInImage(const Camera& camera, double col, double row, const std::string& what);
 
 // The viewing ray through a window point, between the near and far planes.
 Ray eyeRayThroughWindow(const Camera& camera, const glm::dvec2& pWindow);
@@ -97,6 +102,18 @@ std::optional<glm::dvec3> eyePointFromDepth(const Camera& camera, const glm::dve
 // [0, 1], the camera's depth range").
 void requireDepthValue(const Camera& camera, DepthQuantity quantity, double value, const std::string& name);
 
+// The point seen at window point (x, y) at depth `value` of `quantity`, in both spaces and
+// both depths: what `zcheck unproject --pixel --depth` and Python's Camera.point_at give.
+struct PointAtDepth {
+    glm::dvec3 pEye, pWorld;
+    double eyeZ = 0;      // planar depth
+    double distance = 0;  // distanceOfEyePoint
+};
+// Refuses, naming `name` ("--depth", "depth"), a value requireDepthValue refuses and a value
+// that is a miss for the quantity (eyePointFromDepth: the clear value of window and ndc).
+PointAtDepth pointAtDepth(const Camera& camera, const glm::dvec2& pWindow, double value, DepthQuantity quantity,
+                          const std::string& name);
+
 // Batch unprojection of a whole map: `values` holds width·height depth values of `quantity`
 // (row 0 at the top, the camera's image size); every `stride`-th pixel in x and y from (0, 0)
 // becomes a point, misses (as eyePointFromDepth defines them) are skipped and counted.
@@ -111,6 +128,8 @@ struct UnprojectedMap {
     glm::ivec2 firstOutOfRange{-1, -1};  // the first of them in scan order, (col, row)
 };
 enum class PointSpace { Eye, World };
+// "eye" or "world"; throws Error "<what> must be eye or world, got '<name>'".
+PointSpace pointSpaceFromName(const std::string& name, const std::string& what);
 // Throws Error if values.size() is not width·height or stride < 1.
 UnprojectedMap unprojectMap(const Camera& camera, const std::vector<double>& values, DepthQuantity quantity,
                             PointSpace space = PointSpace::World, int stride = 1);

@@ -56,9 +56,20 @@ struct RigidTransform {
 };
 
 // `m` (column vectors) as a rigid transform whose rotation has determinant `determinant`
-// (+1 or −1). Refuses a non-finite entry, a last row other than 0 0 0 1, a departure beyond
-// kRotationRoundingBound (scale or shear) and the wrong determinant (a reflection).
+// (+1 or −1). Refuses a non-finite entry, a last row other than 0 0 0 1 (hasRigidLastRow), a
+// departure beyond kRotationRoundingBound (scale or shear) and the wrong determinant (a
+// reflection).
 RigidTransform requireRigid(const glm::dmat4& m, int determinant, const std::string& what);
+
+// The last row of `m` (column vectors) is exactly 0 0 0 1, as a rigid transform's is: the
+// first rule of requireRigid after finiteness, for callers that check a pose's shape before
+// the rest of the rule (Python's cam_from_world=, a 4x4 or 3x4 array).
+bool hasRigidLastRow(const glm::dmat4& m);
+
+// [R | t] with the last row 0 0 0 1, column vectors: x' = R·x + t. It is how OpenCV's R and t
+// (or rvec and tvec), COLMAP's qvec and tvec and Camera.from_opencv's R, t store a
+// world-to-camera pose. Not checked: viewFromPose (or requireRigid) checks it.
+glm::dmat4 poseFromRotationTranslation(const glm::dmat3& rotation, const glm::dvec3& translation);
 
 // [Rᵀ | −Rᵀt]: the inverse of a rigid transform, by transposition (no general inverse).
 glm::dmat4 rigidInverse(const glm::dmat4& m);

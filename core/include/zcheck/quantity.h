@@ -35,6 +35,7 @@ enum class DepthQuantity {
 };
 std::string toString(DepthQuantity quantity);
 DepthQuantity depthQuantityFromName(const std::string& name);  // throws Error naming the value
+const std::vector<std::string>& depthQuantityNames();           // window, ndc, eye-z, distance
 
 struct DepthImage {
     int width = 0;
@@ -50,7 +51,11 @@ enum class ExportQuantity { Window, Ndc, EyeZ, Distance, PositionEye, PositionWo
 std::string toString(ExportQuantity quantity);
 // "eye-z,normal" → {EyeZ, Normal}; throws Error naming an unknown or repeated name.
 std::vector<ExportQuantity> exportQuantitiesFromList(const std::string& commaSeparated);
+// One name; throws Error naming it and listing the names.
+ExportQuantity exportQuantityFromName(const std::string& name);
 const std::vector<std::string>& exportQuantityNames();
+// The export quantity that stores a depth quantity (the same name: window, ndc, eye-z, distance).
+ExportQuantity exportQuantityOf(DepthQuantity quantity);
 // The channel name a single-channel quantity is stored under (window, ndc, Z, distance).
 std::string channelNameOf(ExportQuantity quantity);
 

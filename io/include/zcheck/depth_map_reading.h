@@ -41,8 +41,11 @@ struct MapAccuracy {
     bool allowHoles = false;  // ... and a missing value where the surface is hit is a hole, not a failure
 
     bool any() const { return quantum > 0 || relative > 0 || absolute > 0 || allowHoles; }
-    // Throws Error naming `where` and the field unless every number is finite and ≥ 0 (and
-    // relative < 1).
+    // The rule each declared number keeps, whoever declares it: finite and ≥ 0, and below 1 for
+    // the relative tolerance. Returns `value`, or throws Error "<name> must be a finite number
+    // >= 0[ and below 1], got <value>", `name` as the caller calls it ("rel_tolerance").
+    static double requireDeclared(double value, const std::string& name, bool relative);
+    // Throws Error naming `where` and the field unless every number keeps requireDeclared's rule.
     void require(const std::string& where) const;
     // The options that declare this ("--quantum 0.001 --allow-holes"), "" for none.
     std::string options() const;
@@ -73,6 +76,13 @@ struct DepthMapReading {
     }
     // A step between stored values as a step between depths.
     double depthStepOf(double storedStep) const { return scale > 0 ? storedStep / scale : storedStep; }
+
+    // The rules of a given scale and offset, whoever gives them (options, keyword arguments): a
+    // scale is positive and finite (0 in `scale` means none was given), an offset finite. Each
+    // throws Error "<name> must be a positive finite number, got -2" (resp. "a finite number"),
+    // `name` as the caller calls the value ("--scale", "scale").
+    static void requireScale(double scale, const std::string& name);
+    static void requireOffset(double offset, const std::string& name);
 };
 
 // The channel of a file with channels `names` that holds depth: `wanted` when given (Error
@@ -93,6 +103,20 @@ struct DepthMapFile {
     std::vector<float> valueStep; // binary16 files (EXR HALF, .npy float16): each value's own step
                                   // (its binary16 spacing, after scale); empty otherwise
 };
+
+// How a map's values were stored, which decides the step between neighbouring values.
+enum class StoredValues {
+    Float,    // binary32 or binary64: the step depends on the value (DepthMap: binary32's spacing)
+    Half,     // binary16 (EXR HALF, .npy float16, a NumPy float16 array): each value's own step
+    Integer,  // integer codes (16-bit PNG, integer TIFF, .npy, HDF5): a step of 1, 1/scale in depth
+};
+// Turns `map.value`, holding the values as they were stored (row 0 at the top), into depths the
+// reading's way (DepthMapReading::depthOf: NaN for a miss, else stored / scale + offset), and
+// records the step they were stored with: valueQuantum 1/scale for integers (the caller has
+// refused integers without a scale), valueStep each half float's spacing after scale
+// (binary16Step), nothing for Float. The one rule every reader of stored values and the
+// Python module's arrays use.
+void depthsFromStored(DepthMapFile& map, StoredValues stored, const DepthMapReading& reading);
 
 // Reads a map in a format zcheck reads by itself — PFM, 16-bit PNG (libpng), NumPy .npy,
 // COLMAP dense maps, HDF5 (depth_formats.h) — told by its first bytes, as `reading` says; or
