@@ -580,9 +580,10 @@ ZCHECK_TARGET_AVX512 std::uint64_t surfaceAndBlockRunsAvx512(const std::uint32_t
 // operations lane for lane (bit-identical), its masks in mask registers and the keepers'
 // candidates found among them, a row in one pass. (The lane loops above compiled for AVX-512,
 // each through arrays of bytes, made the whole comparison ~1.3× as long; bench/speed-log.md.)
-ZCHECK_TARGET_AVX512 void rowLanesAvx512(const RowInputs& in, const PixelJudge::ToleranceTerms& terms,
+ZCHECK_TARGET_AVX512 void rowLanesAvx512(const RowInputs& in, const PixelJudge::ToleranceTerms& termsOfJudge,
                                          StatisticCounts& counts, RowLanes& out)
 {
+    const PixelJudge::ToleranceTerms terms = termsOfJudge;  // its C, S and E in registers for the row
     alignas(64) float errorQuantaOfLane[kLanes], relativeOfLane[kLanes];
     const __m256i none = _mm256_set1_epi32(int(kNoPrimitive));
     const __m512d zero = _mm512_setzero_pd(), infinity = _mm512_set1_pd(INFINITY);
