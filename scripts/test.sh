@@ -16,10 +16,16 @@ if [[ ${1:-} == --full ]]; then
     full=true
     shift
 fi
+stage() { echo "test.sh: $1 done after $SECONDS s" >&2; }
 ./scripts/deps.sh --test
+stage "set-up"
 ./scripts/build.sh
+stage "build and install"
 (cd build && ctest --output-on-failure --parallel "$(nproc)" --timeout 600 "$@")
+stage "tests"
 if $full; then
     fuzz/run.sh "${ZCHECK_FUZZ_SECONDS:-60}"
+    stage "fuzzing"
     ./scripts/sanitize.sh
+    stage "tests under the sanitizers"
 fi
