@@ -7,6 +7,7 @@
 // prints "loop frames N seconds S frames_per_second F" (the best of K loops).
 #include "zcheck/camera_sources.h"
 #include "zcheck/dataset.h"
+#include "zcheck/detail/clock.h"
 #include "zcheck/image_io.h"
 #include "zcheck/mesh_loader.h"
 #include "zcheck/verify_map.h"
@@ -15,7 +16,6 @@
 #include <tbb/global_control.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <memory>
 
@@ -61,10 +61,10 @@ int main(int argc, char** argv)
         int consistent = 0;
         for (int k = 0; k < repeat; ++k) {
             consistent = 0;
-            const auto start = std::chrono::steady_clock::now();
+            const auto start = Clock::now();
             for (const Frame& frame : frames)
                 consistent += verifyMap(verifier, Camera(frame.spec), frame.map, false).run.comparison.report.consistent();
-            best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+            best = std::min(best, secondsSince(start));
         }
         std::printf("loop frames %zu consistent %d seconds %.4f frames_per_second %.2f\n", frames.size(), consistent, best,
                     double(frames.size()) / best);

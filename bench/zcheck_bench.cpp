@@ -6,6 +6,7 @@
 #include "zcheck/camera_file.h"
 #include "zcheck/checker.h"
 
+#include "zcheck/detail/clock.h"
 #include "zcheck/embree_reference.h"
 #include "zcheck/error.h"
 #include "zcheck/large_buffer.h"
@@ -17,7 +18,6 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -68,10 +68,10 @@ void runPhase(const std::string& phase, const Scene& scene, const Camera& camera
         options.keepPixels = false;
         std::vector<double> compareMs;  // the comparison's share of each pass (Timings)
         const Stats ms = timeRepeated(repeats, [&] {
-            const auto start = std::chrono::steady_clock::now();
+            const auto start = Clock::now();
             const CheckResult run = checker.check(camera, options);
             compareMs.push_back(run.report.timings.compareMs);
-            return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+            return millisecondsSince(start);
         });
         std::sort(compareMs.begin(), compareMs.end());
         std::printf("check tile by tile %7.1f ms (best %7.1f), compare's share %5.1f ms | peak RSS %6.0f MiB\n", ms.median,
@@ -119,7 +119,7 @@ void runPhase(const std::string& phase, const Scene& scene, const Camera& camera
             auto pass = [&](int parts, auto rectOf) {
                 double first = 0;
                 const Stats ms = timeRepeated(repeats, [&] {
-                    const auto start = std::chrono::steady_clock::now();
+                    const auto start = Clock::now();
                     LargeVector<std::uint8_t> classes;
                     LargeVector<float> ratios;
                     classes.resize(ray.primitiveId.size()), ratios.resize(ray.primitiveId.size());
@@ -132,7 +132,7 @@ void runPhase(const std::string& phase, const Scene& scene, const Camera& camera
                             }
                     });
                     const double elapsed =
-                        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+                        millisecondsSince(start);
                     if (first == 0) first = elapsed;
                     return elapsed;
                 });
@@ -156,9 +156,9 @@ void runPhase(const std::string& phase, const Scene& scene, const Camera& camera
                 ray = rays.render(camera);
                 const RenderResult drawn = raster.render(camera);
                 const long faultsBefore = minorFaults();
-                const auto start = std::chrono::steady_clock::now();
+                const auto start = Clock::now();
                 const Comparison c = compareRoutes(scene, camera, ray, drawn);
-                const double elapsed = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+                const double elapsed = millisecondsSince(start);
                 faults.push_back(double(minorFaults() - faultsBefore));
                 return elapsed;
             });
@@ -168,9 +168,9 @@ void runPhase(const std::string& phase, const Scene& scene, const Camera& camera
         } else {
             const RenderResult drawn = raster.render(camera);
             const Stats ms = timeRepeated(repeats, [&] {
-                const auto start = std::chrono::steady_clock::now();
+                const auto start = Clock::now();
                 const Comparison c = compareRoutes(scene, camera, ray, drawn);
-                return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+                return millisecondsSince(start);
             });
             std::printf("compare %7.1f ms (best %7.1f)", ms.median, ms.best);
         }
@@ -181,9 +181,9 @@ void runPhase(const std::string& phase, const Scene& scene, const Camera& camera
 void runWorkload(const std::string& label, const std::string& sceneName, const std::string& cameraFile, int width,
                  int height, int repeats, const std::string& phase)
 {
-    const auto loadStart = std::chrono::steady_clock::now();
+    const auto loadStart = Clock::now();
     const Scene scene = loadScene(sceneName);
-    const double loadMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - loadStart).count();
+    const double loadMs = millisecondsSince(loadStart);
     CameraSpec spec = cameraFile.empty() ? scene.defaultCamera : readCameraFile(cameraFile);
     if (cameraFile.empty()) spec.width = width, spec.height = height;
     const Camera camera(spec);
@@ -202,9 +202,9 @@ void runWorkload(const std::string& label, const std::string& sceneName, const s
     });
     bool consistent = false;
     const Stats compare = timeRepeated(repeats, [&] {
-        const auto start = std::chrono::steady_clock::now();
+        const auto start = Clock::now();
         consistent = compareRoutes(scene, camera, lastRay, lastRaster).report.consistent();
-        return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        return millisecondsSince(start);
     });
 
     const double pixels = double(width) * height, triangles = double(scene.triangleCount());

@@ -375,13 +375,14 @@ int runDatasetReport(const std::vector<std::string>& files, const std::string& o
     std::vector<ResultsFile> results;
     for (const std::string& f : files) results.push_back(readResults(f));
     const DatasetSummary summary = summarizeResults(results);
+    const std::string summaryJson = datasetSummaryJson(summary) + "\n";
     if (!outDir.empty()) {
-        outputs.writeText(summaryFile, datasetSummaryJson(summary) + "\n");
+        outputs.writeText(summaryFile, summaryJson);
         const auto checkers = std::make_shared<SceneCheckers>();
         outputs.writeText(htmlFile, datasetReportHtml(summary, [&](const FrameRecord& r) { return picturesOf(r, checkers); }));
     }
     outputs.commit();
-    std::cout << (json ? datasetSummaryJson(summary) + "\n" : datasetSummaryText(summary));
+    std::cout << (json ? summaryJson : datasetSummaryText(summary));
     const bool all = summary.missing.empty() && summary.consistent == summary.frames;
     return all ? kExitConsistent : kExitInconsistent;
 }

@@ -2,13 +2,13 @@
 #include "common.h"
 
 #include "zcheck/atomic_file.h"
+#include "zcheck/detail/clock.h"
 #include "zcheck/error.h"
 #include "zcheck/report.h"
 #include "zcheck/suite.h"
 
 #include <unistd.h>
 
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -46,17 +46,17 @@ int runSuiteCommand(const SuiteOptions& o)
         if (o.filter.empty() || config.label().find(o.filter) != std::string::npos) configs.push_back(config);
     if (configs.empty()) throw Error("--filter '" + o.filter + "' matches no configuration");
     const bool terminal = ::isatty(2);
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = Clock::now();
     int failuresSoFar = 0;
     const SuiteResult result = runSuite(configs, [&](std::size_t done, std::size_t total, const ConfigOutcome& outcome) {
         for (FaultResult r : outcome.faults) failuresSoFar += r == FaultResult::Missed ? 1 : 0;
         failuresSoFar += outcome.clean.consistent() ? 0 : 1;
-        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        const double seconds = secondsSince(start);
         if (terminal || done == total || done % 25 == 0)
             std::fprintf(stderr, "%s[%zu/%zu] %.0f s, failures %d: %-70.70s%s", terminal ? "\r" : "", done, total,
                          seconds, failuresSoFar, outcome.config.label().c_str(), terminal && done < total ? "" : "\n");
     });
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double seconds = secondsSince(start);
     const std::string json = suiteReportJson(result, o.quick, seconds);
     if (!o.outDir.empty()) {
         outputs.writeText((out / "suite.json").string(), json);

@@ -103,10 +103,10 @@ CheckResult Checker::check(const Camera& camera, const CheckOptions& options) co
     CheckResult run;
     run.ray = rays_.render(camera, options.faults.ray);
     run.raster = raster_.render(camera, options.faults.raster);
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = Clock::now();
     run.comparison = compareRoutes(scene_, camera, run.ray, run.raster, options.tolerance);
     run.report.timings.compareMs =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        millisecondsSince(start);
     run.report.timings.bvhBuildMs = rays_.buildMilliseconds();
     run.report.timings.traceMs = run.ray.renderMilliseconds;
     run.report.timings.rasterMs = run.raster.renderMilliseconds;

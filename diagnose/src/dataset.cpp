@@ -1,6 +1,7 @@
 #include "zcheck/dataset.h"
 
 #include "zcheck/camera_sources.h"
+#include "zcheck/detail/clock.h"
 #include "zcheck/error.h"
 #include "zcheck/export.h"
 #include "zcheck/mesh_loader.h"
@@ -9,7 +10,6 @@
 
 #include <atomic>
 #include <charconv>
-#include <chrono>
 #include <exception>
 
 namespace zcheck {
@@ -102,7 +102,7 @@ CameraForMap frameCameraAndMap(const DatasetFrame& frame, const FramePlan& plan,
 
 FrameResult DatasetRunner::verify(std::size_t index, VerifiedMap* keep) const
 {
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = Clock::now();
     const DatasetFrame& frame = dataset_.frames.at(index);
     FrameResult result;
     result.index = index, result.of = dataset_.frames.size();
@@ -127,7 +127,7 @@ FrameResult DatasetRunner::verify(std::size_t index, VerifiedMap* keep) const
     } catch (const Error& e) {
         result.error = e.what();
     }
-    result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    result.seconds = secondsSince(start);
     return result;
 }
 

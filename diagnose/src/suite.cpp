@@ -1,9 +1,9 @@
 #include "zcheck/suite.h"
 
+#include "zcheck/detail/clock.h"
 #include "zcheck/error.h"
 #include "zcheck/mesh_loader.h"
 
-#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <memory>
@@ -206,7 +206,7 @@ SuiteResult runSuite(const std::vector<SuiteConfig>& configs,
     };
     for (std::size_t index = 0; index < configs.size(); ++index) {
         const SuiteConfig& config = configs[index];
-        const auto start = std::chrono::steady_clock::now();
+        const auto start = Clock::now();
         if (config.scenePath != loadedPath) {  // configurations come grouped by scene: build each once
             checker.reset();
             checker = std::make_unique<Checker>(loadScene(config.scenePath));
@@ -246,7 +246,7 @@ SuiteResult runSuite(const std::vector<SuiteConfig>& configs,
                 keep(config, "fault '" + mistake->name + "' (" + mistake->description + ") not detected", std::move(faulty));
             }
         }
-        outcome.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        outcome.milliseconds = millisecondsSince(start);
         result.outcomes.push_back(outcome);
         progress(index + 1, configs.size(), result.outcomes.back());
     }

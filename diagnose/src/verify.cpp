@@ -1,6 +1,7 @@
 #include "zcheck/verify.h"
 
 #include "numerics.h"
+#include "zcheck/detail/clock.h"
 #include "zcheck/drawn_polygon.h"
 #include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
@@ -9,7 +10,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <chrono>
 #include <cmath>
 #include <optional>
 #include <stdexcept>
@@ -382,10 +382,10 @@ VerifyResult verifyAgainst(const Scene& scene, const Camera& camera, const Depth
     std::vector<double> quantum, allowance;
     const PixelJudge judge(scene, camera, mapTolerance());  // reads the map, then compares with the slopes it found
     run.map = renderResultFromMap(judge, map, run.truth, neighbours, quantum, allowance);
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = Clock::now();
     run.comparison = compareRoutes(judge, run.truth, run.map,
                                    {&quantum, allowance.empty() ? nullptr : &allowance, map.accuracy.allowHoles});
-    run.report.timings.compareMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    run.report.timings.compareMs = millisecondsSince(start);
     run.report.timings.traceMs = run.truth.renderMilliseconds;
     run.report.describeInputs(scene, camera, mapTolerance());
     run.report.declared = map.accuracy;

@@ -3,6 +3,7 @@
 // binned into tiles as in Abrash's Larrabee rasterizer.
 #include "zcheck/raster_renderer.h"
 
+#include "zcheck/detail/clock.h"
 #include "zcheck/detail/streaming_stores.h"
 
 #include "raster_testing.h"
@@ -17,7 +18,6 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cstddef>
 #include <cmath>
 
@@ -789,10 +789,10 @@ RenderResult drawnFrame(const RasterFrame& frame, int W, int H)
 
 RenderResult RasterRenderer::render(const Camera& camera, const RasterFaults& faults) const
 {
-    const auto start = std::chrono::steady_clock::now();
+    const auto start = Clock::now();
     RenderResult result = drawnFrame(prepare(camera, faults), camera.width(), camera.height());
     result.renderMilliseconds =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        millisecondsSince(start);
     return result;
 }
 
