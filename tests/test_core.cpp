@@ -124,6 +124,50 @@ TEST_CASE("clipFromEye of the direct3d preset is the transposed D3DXMatrixPerspe
     requireMatrixNear(camera.clipFromEye, glm::transpose(matrixFromRows(rowVectorForm)));
 }
 
+TEST_CASE("a model's intrinsic parameters, changed by a focal scale, make the projection with eye x and y scaled", "[core]")
+{
+    // intrinsicParameters' changed values, written back into the camera, must give
+    // clipFromEye · diag(k, k, 1, 1): eye x and y scaled before the projection.
+    for (const ProjectionType type : {ProjectionType::Perspective, ProjectionType::Lens, ProjectionType::Pinhole}) {
+        INFO(toString(type));
+        CameraSpec spec = specWith("vulkan", type);
+        spec.projection.fx = 600, spec.projection.fy = 560, spec.projection.cx = 300, spec.projection.cy = 250;
+        const Camera declared(spec);
+        const double k = 1.3;
+        const std::vector<IntrinsicParameter> stated =
+            intrinsicParameters(spec.projection, IntrinsicChange::FocalScale, {k, 0.5 /* not read */}, {7, 9});
+        REQUIRE(stated.size() == (type == ProjectionType::Pinhole ? 2u : 1u));
+        for (const IntrinsicParameter& parameter : stated) {
+            const std::string key = parameter.key;
+            double& value = key == "fovy_deg" ? spec.projection.fovyDeg
+                            : key == "focal_mm" ? spec.projection.focalMm
+                            : key == "fx"       ? spec.projection.fx
+                                                : spec.projection.fy;
+            REQUIRE(parameter.declared == value);
+            value = parameter.changed;
+        }
+        requireMatrixNear(Camera(spec).clipFromEye, declared.clipFromEye * glm::dmat4(glm::dvec4(k, 0, 0, 0), glm::dvec4(0, k, 0, 0),
+                                                                                      glm::dvec4(0, 0, 1, 0), glm::dvec4(0, 0, 0, 1)),
+                          1e-12);
+    }
+    // Two scales and a moved principal point: only a pinhole states them, in fx, fy, cx, cy.
+    Projection pinhole = specWith("opencv", ProjectionType::Pinhole).projection;
+    pinhole.fx = 600, pinhole.fy = 560, pinhole.cx = 300, pinhole.cy = 250;
+    const std::vector<IntrinsicParameter> stated =
+        intrinsicParameters(pinhole, IntrinsicChange::FocalScalesAndPrincipalPoint, {1.5, 0.5}, {7, -9});
+    REQUIRE(stated.size() == 4);
+    CHECK(std::string(stated[0].key) + stated[1].key + stated[2].key + stated[3].key == "fxfycxcy");
+    CHECK((stated[0].changed == 900 && stated[1].changed == 280 && stated[2].changed == 307 && stated[3].changed == 241));
+    for (const ProjectionType type : {ProjectionType::Perspective, ProjectionType::Lens, ProjectionType::Frustum,
+                                      ProjectionType::Orthographic, ProjectionType::Oblique, ProjectionType::Matrix}) {
+        INFO(toString(type));
+        const Projection p = specWith("opengl", type).projection;
+        CHECK(intrinsicParameters(p, IntrinsicChange::FocalScalesAndPrincipalPoint, {1.5, 0.5}, {7, -9}).empty());
+        if (type != ProjectionType::Perspective && type != ProjectionType::Lens)
+            CHECK(intrinsicParameters(p, IntrinsicChange::FocalScale, {1.5, 1.5}, {0, 0}).empty());
+    }
+}
+
 TEST_CASE("projection and view agree with GLM's independent implementations", "[core][glm]")
 {
     const double fovy = glm::radians(60.0), aspect = 640.0 / 480.0, n = 0.5, f = 80;

@@ -5,6 +5,7 @@
 
 #include "zcheck/camera_file.h"
 #include "zcheck/export.h"
+#include "zcheck/fit.h"
 #include "zcheck/inverse_projection.h"
 
 #include "diagnosis_helpers.h"
@@ -317,6 +318,63 @@ TEST_CASE("a field of view off by 2 % is measured in each model's own terms, for
         default: REQUIRE(near(fitted("focal_scale"), 1 / 1.02)); break;
         }
     }
+}
+
+TEST_CASE("a fitted field of view and intrinsics are named in the camera's own parameters, with hand-computed values", "[verify][diagnose][fit]")
+{
+    // describeFit and fittedValues take the model's parameters from the camera (camera.h's
+    // intrinsicParameters); the expected words and numbers are worked out by hand:
+    // fovy' = 2·atan(tan(55°/2) / 1.25) = 45.22°, focal' = 1.25 · 50 mm, fx' = 1.25 · 500 px.
+    auto cameraWith = [](ProjectionType type) {
+        CameraSpec spec;
+        spec.projection.type = type;
+        spec.projection.fovyDeg = 55, spec.projection.focalMm = 50;
+        spec.projection.fx = 500, spec.projection.fy = 480, spec.projection.cx = 319.5, spec.projection.cy = 239.5;
+        spec.projection.left = -0.1, spec.projection.right = 0.1, spec.projection.bottom = -0.075, spec.projection.top = 0.075;
+        return Camera(spec);
+    };
+    auto names = [](const std::vector<FittedValue>& values) {
+        std::vector<std::string> out;
+        for (const FittedValue& v : values) out.push_back(v.name);
+        return out;
+    };
+    const DepthMap map;
+    FitResult wider;
+    wider.family = FitFamily::FieldOfView;
+    wider.departure.focalScale = {1.25, 1.25};
+    using Names = std::vector<std::string>;
+    const Camera perspective = cameraWith(ProjectionType::Perspective), lens = cameraWith(ProjectionType::Lens),
+                 pinhole = cameraWith(ProjectionType::Pinhole), frustum = cameraWith(ProjectionType::Frustum);
+    CHECK(describeFit(perspective, map, wider) == "a vertical field of view of 45.22° (the camera says 55°)");
+    CHECK(describeFit(lens, map, wider) == "a focal length of 62.5 mm (the camera says 50 mm)");
+    CHECK(describeFit(pinhole, map, wider) == "focal lengths fx 625, fy 600 px (the camera says 500, 480)");
+    CHECK(describeFit(frustum, map, wider) == "a view 0.8 times as wide and high as the camera says");
+    CHECK(names(fittedValues(perspective, map, wider)) == Names{"focal_scale", "fovy_deg", "residual"});
+    CHECK(names(fittedValues(lens, map, wider)) == Names{"focal_scale", "focal_mm", "residual"});
+    CHECK(names(fittedValues(pinhole, map, wider)) == Names{"focal_scale", "fx", "fy", "residual"});
+    CHECK(names(fittedValues(frustum, map, wider)) == Names{"focal_scale", "residual"});
+    const std::vector<FittedValue> lensValues = fittedValues(lens, map, wider);
+    CHECK(lensValues[1].value == 62.5);
+    CHECK(lensValues[1].declared == 50);
+
+    FitResult intrinsics;
+    intrinsics.family = FitFamily::Intrinsics;
+    intrinsics.departure.focalScale = {1.1, 0.9};
+    intrinsics.departure.principalShift = {2, -3};
+    const std::string moved = "focal lengths × (1.1, 0.9) and the principal point moved by (+2, -3) px (x right, y down)";
+    CHECK(describeFit(pinhole, map, intrinsics) == moved + ": fx 550, fy 432, cx 321.5, cy 236.5");
+    CHECK(describeFit(perspective, map, intrinsics) == moved);  // one field of view cannot state two scales
+    CHECK(describeFit(lens, map, intrinsics) == moved);
+    const Names four = {"focal_scale_x", "focal_scale_y", "principal_dx_px", "principal_dy_px"};
+    Names pinholeNames = four;
+    pinholeNames.insert(pinholeNames.end(), {"fx", "fy", "cx", "cy", "residual"});
+    CHECK(names(fittedValues(pinhole, map, intrinsics)) == pinholeNames);
+    Names perspectiveNames = four;
+    perspectiveNames.push_back("residual");
+    CHECK(names(fittedValues(perspective, map, intrinsics)) == perspectiveNames);
+    const std::vector<FittedValue> pinholeValues = fittedValues(pinhole, map, intrinsics);
+    CHECK(pinholeValues[7].value == 236.5);
+    CHECK(pinholeValues[7].declared == 239.5);
 }
 
 TEST_CASE("regression: the other NDC range was never tried for a raw-matrix camera; parallel ones are covered too", "[verify][diagnose][regression]")

@@ -29,6 +29,32 @@ bool Projection::isPerspective() const
     return type != ProjectionType::Orthographic && type != ProjectionType::Oblique;
 }
 
+std::vector<IntrinsicParameter> intrinsicParameters(const Projection& p, IntrinsicChange change,
+                                                    const glm::dvec2& focalScale, const glm::dvec2& principalShift)
+{
+    const bool oneScale = change == IntrinsicChange::FocalScale;
+    const glm::dvec2 k = oneScale ? glm::dvec2(focalScale.x) : focalScale;
+    switch (p.type) {
+    case ProjectionType::Perspective: {
+        if (!oneScale) return {};
+        const double fovyDeg = glm::degrees(2 * std::atan(std::tan(glm::radians(p.fovyDeg) / 2) / k.y));
+        return {{"fovy_deg", "vertical field of view", "°", 4, p.fovyDeg, fovyDeg}};
+    }
+    case ProjectionType::Lens:  // the sensor's width spans the image: the focal length is x's
+        if (!oneScale) return {};
+        return {{"focal_mm", "focal length", " mm", 4, p.focalMm, p.focalMm * k.x}};
+    case ProjectionType::Pinhole: {
+        std::vector<IntrinsicParameter> out = {{"fx", "focal length", " px", 6, p.fx, p.fx * k.x},
+                                               {"fy", "focal length", " px", 6, p.fy, p.fy * k.y}};
+        if (!oneScale)
+            out.push_back({"cx", "principal point", " px", 6, p.cx, p.cx + principalShift.x}),
+                out.push_back({"cy", "principal point", " px", 6, p.cy, p.cy + principalShift.y});
+        return out;
+    }
+    default: return {};
+    }
+}
+
 View View::axonometricView(const std::string& kind, const glm::dvec3& target, double distance, double azimuthDeg,
                            double elevationDeg)
 {
@@ -81,10 +107,7 @@ glm::dmat4 matrixForVectors(const glm::dmat4& m, MatrixVectors vectors)
 namespace {
 
 constexpr int kMaxImageSide = Camera::kMaxImageSide;
-// About 85 bytes per pixel across both routes, the comparison and --out: 2^25 pixels
-// (8192×4096) stay within ~3 GiB; more would risk the machine's memory instead of failing
-// cleanly.
-constexpr long long kMaxImagePixels = 1LL << 25;
+constexpr long long kMaxImagePixels = Camera::kMaxImagePixels;
 
 void requireFinite(double value, const std::string& name)
 {

@@ -45,37 +45,64 @@ std::string msaaSampleOf(const Camera& camera, const glm::dvec2& imageOffset)
 
 glm::dvec3 eyePositionOf(const glm::dmat4& eyeFromWorld) { return glm::dvec3(glm::inverse(eyeFromWorld)[3]); }
 
+// The camera's own parameters that state the fit's focal scales and principal point (camera.h),
+// empty where its model cannot: the field-of-view fit changes one focal scale, the intrinsics fit
+// both and the principal point.
+std::vector<IntrinsicParameter> statedIntrinsics(const Camera& camera, const FitResult& fit)
+{
+    const IntrinsicChange change =
+        fit.family == FitFamily::FieldOfView ? IntrinsicChange::FocalScale : IntrinsicChange::FocalScalesAndPrincipalPoint;
+    return intrinsicParameters(camera.spec().projection, change, fit.departure.focalScale, fit.departure.principalShift);
+}
+
+void appendStated(std::vector<FittedValue>& out, const std::vector<IntrinsicParameter>& stated)
+{
+    for (const IntrinsicParameter& parameter : stated) out.push_back({parameter.key, parameter.changed, parameter.declared});
+}
+
+// "fx 512.3, fy 510" (the changed values)
+std::string changedValues(const std::vector<IntrinsicParameter>& stated)
+{
+    std::string text;
+    for (const IntrinsicParameter& parameter : stated)
+        text += (text.empty() ? "" : ", ") + std::string(parameter.key) + " " + number(parameter.changed, parameter.digits);
+    return text;
+}
+
+// "a vertical field of view of 56.5° (the camera says 55°)"; parameters of one kind together:
+// "focal lengths fx 512.3, fy 510 px (the camera says 500, 500)".
+std::string changedAgainstDeclared(const std::vector<IntrinsicParameter>& stated)
+{
+    const IntrinsicParameter& first = stated.front();
+    if (stated.size() == 1)
+        return std::string("a ") + first.words + " of " + number(first.changed, first.digits) + first.unit +
+               " (the camera says " + number(first.declared, first.digits) + first.unit + ")";
+    std::string declared;
+    for (const IntrinsicParameter& parameter : stated)
+        declared += (declared.empty() ? "" : ", ") + number(parameter.declared, parameter.digits);
+    return std::string(first.words) + "s " + changedValues(stated) + first.unit + " (the camera says " + declared + ")";
+}
+
 }  // namespace
 
 std::vector<FittedValue> fittedValues(const Camera& camera, const DepthMap&, const FitResult& fit)
 {
     const Departure& d = fit.departure;
-    const Projection& p = camera.spec().projection;
     std::vector<FittedValue> out;
     switch (fit.family) {
     case FitFamily::SampleOffset:
         out = {{"sample_dx_px", d.sampleOffset.x, 0}, {"sample_dy_px", d.sampleOffset.y, 0}};
         break;
-    case FitFamily::FieldOfView: {
-        const double k = d.focalScale.x;
-        out.push_back({"focal_scale", k, 1});
-        if (p.type == ProjectionType::Perspective)
-            out.push_back({"fovy_deg", glm::degrees(2 * std::atan(std::tan(glm::radians(p.fovyDeg) / 2) / k)), p.fovyDeg});
-        if (p.type == ProjectionType::Lens) out.push_back({"focal_mm", p.focalMm * k, p.focalMm});
-        if (p.type == ProjectionType::Pinhole) out.push_back({"fx", p.fx * k, p.fx}), out.push_back({"fy", p.fy * k, p.fy});
+    case FitFamily::FieldOfView:
+        out = {{"focal_scale", d.focalScale.x, 1}};
+        appendStated(out, statedIntrinsics(camera, fit));
         break;
-    }
     case FitFamily::Intrinsics:
         out = {{"focal_scale_x", d.focalScale.x, 1},
                {"focal_scale_y", d.focalScale.y, 1},
                {"principal_dx_px", d.principalShift.x, 0},
                {"principal_dy_px", d.principalShift.y, 0}};
-        if (p.type == ProjectionType::Pinhole) {
-            out.push_back({"fx", p.fx * d.focalScale.x, p.fx});
-            out.push_back({"fy", p.fy * d.focalScale.y, p.fy});
-            out.push_back({"cx", p.cx + d.principalShift.x, p.cx});
-            out.push_back({"cy", p.cy + d.principalShift.y, p.cy});
-        }
+        appendStated(out, statedIntrinsics(camera, fit));
         break;
     case FitFamily::NearFar:
         out = {{"near", d.nearDistance > 0 ? d.nearDistance : camera.nearDistance(), camera.nearDistance()},
@@ -99,7 +126,6 @@ std::vector<FittedValue> fittedValues(const Camera& camera, const DepthMap&, con
 std::string describeFit(const Camera& camera, const DepthMap& map, const FitResult& fit)
 {
     const Departure& d = fit.departure;
-    const Projection& p = camera.spec().projection;
     switch (fit.family) {
     case FitFamily::SampleOffset: {
         const glm::dvec2 whole = glm::round(d.sampleOffset);
@@ -117,27 +143,16 @@ std::string describeFit(const Camera& camera, const DepthMap& map, const FitResu
         return text;
     }
     case FitFamily::FieldOfView: {
-        const double k = d.focalScale.x;
-        switch (p.type) {
-        case ProjectionType::Perspective:
-            return "a vertical field of view of " + number(glm::degrees(2 * std::atan(std::tan(glm::radians(p.fovyDeg) / 2) / k))) +
-                   "° (the camera says " + number(p.fovyDeg) + "°)";
-        case ProjectionType::Lens:
-            return "a focal length of " + number(p.focalMm * k) + " mm (the camera says " + number(p.focalMm) + " mm)";
-        case ProjectionType::Pinhole:
-            return "focal lengths fx " + number(p.fx * k, 6) + ", fy " + number(p.fy * k, 6) + " px (the camera says " +
-                   number(p.fx, 6) + ", " + number(p.fy, 6) + ")";
-        default:
-            return "a view " + number(1 / k) + " times as wide and high as the camera says";
-        }
+        const std::vector<IntrinsicParameter> stated = statedIntrinsics(camera, fit);
+        if (stated.empty()) return "a view " + number(1 / d.focalScale.x) + " times as wide and high as the camera says";
+        return changedAgainstDeclared(stated);
     }
     case FitFamily::Intrinsics: {
         std::string text = "focal lengths × (" + number(d.focalScale.x, 5) + ", " + number(d.focalScale.y, 5) +
                            ") and the principal point moved by (" + signedNumber(d.principalShift.x, 3) + ", " +
                            signedNumber(d.principalShift.y, 3) + ") px (x right, y down)";
-        if (p.type == ProjectionType::Pinhole)
-            text += ": fx " + number(p.fx * d.focalScale.x, 6) + ", fy " + number(p.fy * d.focalScale.y, 6) + ", cx " +
-                    number(p.cx + d.principalShift.x, 6) + ", cy " + number(p.cy + d.principalShift.y, 6);
+        if (const std::vector<IntrinsicParameter> stated = statedIntrinsics(camera, fit); !stated.empty())
+            text += ": " + changedValues(stated);
         return text;
     }
     case FitFamily::NearFar:

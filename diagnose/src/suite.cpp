@@ -80,7 +80,7 @@ CameraSpec withDepthAndConvention(CameraSpec spec, const Scene& scene, const Con
 {
     spec.convention = convention;
     spec.depth = depth;
-    if (spec.projection.type == ProjectionType::Matrix) {
+    if (isRawMatrix(spec.projection)) {
         CameraSpec perspective = scene.defaultCamera;
         perspective.width = spec.width, perspective.height = spec.height;
         perspective.convention = convention, perspective.depth = depth;
@@ -95,7 +95,7 @@ std::string SuiteConfig::label() const
 {
     return scene + " | " + model + " | " + spec.convention.name + " " + toString(spec.depth.format) +
            (spec.depth.reversed ? " reversed" : "") + " | " + std::to_string(spec.width) + "x" +
-           std::to_string(spec.height) + (spec.projection.type != ProjectionType::Matrix && !std::isinf(spec.projection.far) &&
+           std::to_string(spec.height) + (!isRawMatrix(spec.projection) && !std::isinf(spec.projection.far) &&
                                                   spec.projection.far / spec.projection.near > 1e6
                                               ? " | near/far " + formatNumber(spec.projection.far / spec.projection.near)
                                               : "");

@@ -67,8 +67,6 @@ private:
     std::optional<EyePlaneRay> planeRay_;
 };
 
-}  // namespace
-
 // Window depth of a triangle's plane where the pixel's ray meets it (NaN if it does not).
 double planeWindowDepth(const Scene& scene, const Camera& camera, std::uint32_t primitive, const EyePlaneRay& ray)
 {
@@ -78,6 +76,8 @@ double planeWindowDepth(const Scene& scene, const Camera& camera, std::uint32_t 
     const double s = glm::dot(normal, a - ray.origin) / glm::dot(normal, ray.direction);
     return std::isfinite(s) ? windowFromWorld(camera, ray.origin + s * ray.direction).z : NAN;
 }
+
+}  // namespace
 
 
 VertexNeighbours::VertexNeighbours(const Scene& scene, const RayRenderer* rays, const RasterRenderer* raster)

@@ -6,6 +6,7 @@
 // makes those files itself.
 #include "depth_formats.h"
 
+#include "zcheck/camera.h"
 #include "zcheck/error.h"
 #include "zcheck/input_file.h"
 
@@ -80,12 +81,12 @@ DepthMapFile readInProcess(const std::string& path, const DepthMapReading& readi
     H5Sget_simple_extent_dims(space.id, dims, nullptr);
     if (rank == 3 && dims[2] != 1)
         refuse("its dataset '" + map.channel + "' has " + std::to_string(dims[2]) + " channels; a depth map has 1");
-    if (dims[0] > 16384 || dims[1] > 16384)
+    if (dims[0] > hsize_t(Camera::kMaxImageSide) || dims[1] > hsize_t(Camera::kMaxImageSide))
         refuse("its dataset '" + map.channel + "' is " + std::to_string(dims[1]) + "x" + std::to_string(dims[0]) +
-               ", beyond 16384 pixels per side");
+               ", beyond " + std::to_string(Camera::kMaxImageSide) + " pixels per side");
     map.height = int(dims[0]), map.width = int(dims[1]);
     if (expectedWidth == 0 && expectedHeight == 0) {
-        if (map.width < 1 || map.height < 1 || std::int64_t(map.width) * map.height > (1LL << 25))
+        if (!Camera::isImageSize(map.width, map.height))
             refuse("its dataset is " + std::to_string(map.width) + "x" + std::to_string(map.height) +
                    ", outside the sizes a camera may have");
     } else if (map.width != expectedWidth || map.height != expectedHeight) {

@@ -5,6 +5,7 @@
 
 #include "depth_formats.h"
 #include "png_codec.h"
+#include "zcheck/camera.h"
 #include "zcheck/error.h"
 #include "zcheck/input_file.h"
 
@@ -18,16 +19,12 @@
 
 namespace zcheck {
 
-namespace {
-
-}  // namespace
-
 void requireDepthMapSize(const std::string& path, long long width, long long height, int expectedWidth, int expectedHeight)
 {
     if (expectedWidth == 0 && expectedHeight == 0) {
-        if (width < 1 || height < 1 || width > 16384 || height > 16384 || width * height > (1LL << 25))
+        if (!Camera::isImageSize(width, height))
             throw Error("depth map '" + path + "' is " + std::to_string(width) + "x" + std::to_string(height) +
-                        ", outside the 1..16384 pixels per side (2^25 in all) a camera may have");
+                        ", outside the 1.." + std::to_string(Camera::kMaxImageSide) + " pixels per side (2^25 in all) a camera may have");
         return;
     }
     if (width != expectedWidth || height != expectedHeight)

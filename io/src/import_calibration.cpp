@@ -28,6 +28,7 @@
 #include "xml_lite.h"
 #include "yaml_lite.h"
 #include "zcheck/detail/camera_json.h"
+#include "zcheck/camera.h"
 #include "zcheck/error.h"
 #include "zcheck/input_file.h"
 #include "zcheck/pose.h"
@@ -161,8 +162,8 @@ private:
     int pixels(const Node& node, const std::string& what) const
     {
         const double value = number(node, what);
-        if (value != std::floor(value) || value < 1 || value > 16384)
-            fail("'" + what + "' must be a whole number of pixels in 1..16384, got " + formatNumber(value));
+        if (!Camera::isImageSide(value))
+            fail("'" + what + "' must be a whole number of pixels in 1.." + std::to_string(Camera::kMaxImageSide) + ", got " + formatNumber(value));
         return int(value);
     }
 
@@ -299,9 +300,9 @@ private:
             width = pixels(*w, wKey), height = pixels(*h, hKey);
         } else if (const Node* size = anyOf({"image_size", "imageSize"}, &wKey)) {
             const Matrix s = shaped(*size, wKey, 1, 2);
+            if (!Camera::isImageSide(s.values[0]) || !Camera::isImageSide(s.values[1]))
+                fail("'" + wKey + "' must be two whole numbers of pixels in 1.." + std::to_string(Camera::kMaxImageSide));
             width = int(s.values[0]), height = int(s.values[1]);
-            if (s.values[0] != width || s.values[1] != height || width < 1 || height < 1 || width > 16384 || height > 16384)
-                fail("'" + wKey + "' must be two whole numbers of pixels in 1..16384");
         } else {
             fail("it has no image size (image_width and image_height)");
         }

@@ -25,6 +25,7 @@
 // refusal (camera_import.h): only the images that use it fail.
 #include "camera_importers.h"
 
+#include "zcheck/camera.h"
 #include "zcheck/error.h"
 #include "zcheck/input_file.h"
 #include "zcheck/large_buffer.h"
@@ -214,7 +215,8 @@ std::map<std::int64_t, ColmapCamera> readCamerasText(const std::string& path)
         const std::int64_t id = file.integer(i, t[0], "CAMERA_ID", 0xFFFFFFFF);
         const ModelInfo* model = modelByName(t[1]);
         if (!model) file.fail(i, "unknown camera model '" + printableExcerpt(t[1], 40) + "' (COLMAP's are " + modelNames() + ")");
-        const std::int64_t width = file.integer(i, t[2], "WIDTH", 16384, 1), height = file.integer(i, t[3], "HEIGHT", 16384, 1);
+        const std::int64_t width = file.integer(i, t[2], "WIDTH", Camera::kMaxImageSide, 1),
+                           height = file.integer(i, t[3], "HEIGHT", Camera::kMaxImageSide, 1);
         if (t.size() - 4 != paramCount(*model))
             file.fail(i, std::string("camera model ") + model->name + " takes " + std::to_string(paramCount(*model)) +
                              " parameters, the line has " + std::to_string(t.size() - 4));
@@ -319,9 +321,9 @@ std::map<std::int64_t, ColmapCamera> readCamerasBinary(const std::string& path)
             file.fail(what + " (camera " + std::to_string(id) + ") has model id " + std::to_string(modelId) +
                       ", which zcheck does not know (COLMAP's 0..16: " + modelNames() + ")");
         const std::uint64_t width = file.read<std::uint64_t>(what), height = file.read<std::uint64_t>(what);
-        if (width < 1 || width > 16384 || height < 1 || height > 16384)
+        if (width < 1 || width > std::uint64_t(Camera::kMaxImageSide) || height < 1 || height > std::uint64_t(Camera::kMaxImageSide))
             file.fail(what + " (camera " + std::to_string(id) + ") has the size " + std::to_string(width) + "x" +
-                      std::to_string(height) + ", outside 1..16384 per side");
+                      std::to_string(height) + ", outside 1.." + std::to_string(Camera::kMaxImageSide) + " per side");
         std::vector<double> params;
         for (std::size_t k = 0; k < paramCount(*model); ++k) params.push_back(file.finite(what + " parameter " + std::to_string(k)));
         if (cameras.count(id)) file.fail(what + ": camera id " + std::to_string(id) + " appears twice");

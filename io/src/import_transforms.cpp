@@ -23,6 +23,7 @@
 #include "camera_importers.h"
 
 #include "zcheck/detail/camera_json.h"
+#include "zcheck/camera.h"
 #include "zcheck/error.h"
 #include "zcheck/input_file.h"
 #include "zcheck/pose.h"
@@ -105,8 +106,8 @@ private:
     {
         if (!lookup(frame, key)) return std::nullopt;
         const double value = number(frame, key, where);
-        if (value != std::floor(value) || value < 1 || value > 16384)
-            fail("'" + keyName(frame, key, where) + "' must be a whole number of pixels in 1..16384, got " +
+        if (!Camera::isImageSide(value))
+            fail("'" + keyName(frame, key, where) + "' must be a whole number of pixels in 1.." + std::to_string(Camera::kMaxImageSide) + ", got " +
                  formatNumber(value));
         return int(value);
     }

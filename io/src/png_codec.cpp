@@ -1,5 +1,6 @@
 #include "png_codec.h"
 
+#include "zcheck/camera.h"
 #include "zcheck/error.h"
 
 #include <png.h>
@@ -99,7 +100,7 @@ Step decode(MemoryReader& reader, char* error, png_uint_32& width, png_uint_32& 
         return Step::Failed;
     }
     png_set_read_fn(png, &reader, readFromMemory);
-    png_set_user_limits(png, 16384, 16384);
+    png_set_user_limits(png, Camera::kMaxImageSide, Camera::kMaxImageSide);
     png_read_info(png, info);
     png_get_IHDR(png, info, &width, &height, &bitDepth, &colourType, &interlace, nullptr, nullptr);
     if (!rows) {

@@ -186,8 +186,19 @@ public:
     // The largest world coordinate of the eye and of the near-plane window's corners (rays
     // are traced in binary32); the constructor refuses cameras beyond it.
     static constexpr double kMaxWorldCoordinate = 1e15;
-    // The largest image side in pixels (the smallest is 1); the constructor refuses larger images.
+    // The largest image side in pixels (the smallest is 1), and the most pixels in all; the
+    // constructor refuses larger images. About 85 bytes per pixel go to both routes, the
+    // comparison and --out: 2^25 pixels (8192×4096) stay within ~3 GiB; more would risk the
+    // machine's memory instead of failing cleanly.
     static constexpr int kMaxImageSide = 16384;
+    static constexpr long long kMaxImagePixels = 1LL << 25;
+    // Whether a side as a file states it is one an image may have: a whole number in 1…kMaxImageSide.
+    static bool isImageSide(double pixels) { return pixels == std::floor(pixels) && pixels >= 1 && pixels <= kMaxImageSide; }
+    // Whether both sides are and their product is within kMaxImagePixels.
+    static bool isImageSize(long long width, long long height)
+    {
+        return width >= 1 && height >= 1 && width <= kMaxImageSide && height <= kMaxImageSide && width * height <= kMaxImagePixels;
+    }
 
 private:
     void requireRepresentable() const;
@@ -197,9 +208,33 @@ private:
     double near_ = 0, far_ = 0;
 };
 
-// Whether the camera's projection is a raw matrix (ProjectionType::Matrix): it has no parameters
-// of its own (no field of view, near or far to change), only its matrix.
-inline bool isRawMatrix(const Camera& camera) { return camera.spec().projection.type == ProjectionType::Matrix; }
+// Whether a projection is a raw matrix (ProjectionType::Matrix): it has no parameters of its own
+// (no field of view, near or far to change), only its matrix.
+inline bool isRawMatrix(const Projection& projection) { return projection.type == ProjectionType::Matrix; }
+inline bool isRawMatrix(const Camera& camera) { return isRawMatrix(camera.spec().projection); }
+
+// A change of the focal lengths and the principal point, as a fit finds one: eye x and y scaled by
+// `focalScale` before the projection (> 1 is narrower), the principal point moved by
+// `principalShift` image pixels (x right, y down).
+enum class IntrinsicChange {
+    FocalScale,                    // one scale for x and y (focalScale.x); the principal point stays
+    FocalScalesAndPrincipalPoint,  // a scale each for x and y, and the principal point moves
+};
+// One of the projection model's own parameters, with its value as declared and after a change.
+struct IntrinsicParameter {
+    const char* key;    // as the camera file names it: "fovy_deg", "focal_mm", "fx", ...
+    const char* words;  // what it is: "vertical field of view", "focal length", "principal point"
+    const char* unit;   // as printed after the value: "°", " mm", " px"
+    int digits;         // the significant digits that show it
+    double declared = 0, changed = 0;
+};
+// The model's parameters that state such a change in the camera's own terms, in the camera file's
+// order: perspective fovy_deg and lens focal_mm state one focal scale; pinhole fx, fy state one
+// scale or two, and cx, cy the moved principal point. Empty where the model cannot state the
+// change: a frustum's or box's extents, a raw matrix, a field of view or a lens's focal length
+// under two scales and a moved principal point.
+std::vector<IntrinsicParameter> intrinsicParameters(const Projection& projection, IntrinsicChange change,
+                                                    const glm::dvec2& focalScale, const glm::dvec2& principalShift);
 
 // A camera that sees a bounding sphere (centre, radius) whole, looking at it from the front
 // right and above, 640×480, near/far hugging the sphere. Used for meshes without a camera.
