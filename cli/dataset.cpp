@@ -324,7 +324,7 @@ int runDatasetVerify(const DatasetVerifyOptions& o)
 }
 
 // A failing frame verified again from its record, for the HTML report's pictures.
-FramePictures picturesOf(const FrameRecord& r, const std::shared_ptr<SceneCheckers>& checkers)
+FramePictures picturesOf(const FrameRecord& r, const std::shared_ptr<SceneVerifiers>& verifiers)
 {
     try {
         DatasetVerifyOptions source;
@@ -352,7 +352,7 @@ FramePictures picturesOf(const FrameRecord& r, const std::shared_ptr<SceneChecke
                                    [](const std::string& path, const DepthMapReading& reading, int width, int height) {
                                        return readDepthMapFile(path, reading, width, height);
                                    },
-                                   checkers);
+                                   verifiers);
         VerifiedMap kept;
         const FrameResult again = runner.verify(0, &kept);
         if (!again.error.empty()) return {{}, {}, {}, again.error};
@@ -378,8 +378,8 @@ int runDatasetReport(const std::vector<std::string>& files, const std::string& o
     const std::string summaryJson = datasetSummaryJson(summary) + "\n";
     if (!outDir.empty()) {
         outputs.writeText(summaryFile, summaryJson);
-        const auto checkers = std::make_shared<SceneCheckers>();
-        outputs.writeText(htmlFile, datasetReportHtml(summary, [&](const FrameRecord& r) { return picturesOf(r, checkers); }));
+        const auto verifiers = std::make_shared<SceneVerifiers>();
+        outputs.writeText(htmlFile, datasetReportHtml(summary, [&](const FrameRecord& r) { return picturesOf(r, verifiers); }));
     }
     outputs.commit();
     std::cout << (json ? summaryJson : datasetSummaryText(summary));

@@ -29,13 +29,13 @@ void DatasetRunOptions::parseShard(const std::string& text)
     shard = i, shards = n;
 }
 
-struct SceneCheckers::Built {
+struct SceneVerifiers::Built {
     explicit Built(Scene scene) : checker(std::move(scene)), verifier(checker) {}
     const Checker checker;
     const MapVerifier verifier;
 };
 
-const MapVerifier& SceneCheckers::operator()(const std::string& scene)
+const MapVerifier& SceneVerifiers::operator()(const std::string& scene)
 {
     const std::lock_guard<std::mutex> lock(mutex_);
     auto& built = built_[scene];
@@ -44,16 +44,16 @@ const MapVerifier& SceneCheckers::operator()(const std::string& scene)
 }
 
 DatasetRunner::DatasetRunner(Dataset dataset, DatasetRunOptions options, DepthMapReader readDepthMap,
-                             std::shared_ptr<SceneCheckers> checkers)
+                             std::shared_ptr<SceneVerifiers> verifiers)
     : dataset_(std::move(dataset)), options_(std::move(options)), readDepthMap_(std::move(readDepthMap)),
-      checkers_(checkers ? std::move(checkers) : std::make_shared<SceneCheckers>())
+      verifiers_(verifiers ? std::move(verifiers) : std::make_shared<SceneVerifiers>())
 {
     if (options_.shards < 1 || options_.shard >= options_.shards) throw Error("the shard must be I/N with 0 <= I < N");
     if (!options_.quantity.empty()) depthQuantityFromName(options_.quantity);  // a bad --quantity is the run's error
     if (!options_.miss.empty()) MissRule::parse(options_.miss);
     options_.accuracy.require("the run's options");
     if (!options_.convention.empty()) Convention::preset(options_.convention);
-    (*checkers_)(options_.scene);
+    (*verifiers_)(options_.scene);
 }
 
 DatasetRunner::~DatasetRunner() = default;
@@ -113,7 +113,7 @@ FrameResult DatasetRunner::verify(std::size_t index, VerifiedMap* keep) const
         const FramePlan plan = planFrame(frame, options_);
         result.map.quantity = plan.quantityName;
         result.map.reading = plan.reading;
-        const MapVerifier& verifier = (*checkers_)(plan.scene);
+        const MapVerifier& verifier = (*verifiers_)(plan.scene);
         CameraForMap made = frameCameraAndMap(frame, plan, verifier.checker().scene(), options_, readDepthMap_);
         const Camera camera(made.spec);
         result.map.channel = made.map.channel;

@@ -18,9 +18,9 @@ DepthMapFile readMap(const std::string& path, const DepthMapReading& reading, in
     return readDepthMap(path, reading, width, height);
 }
 
-// A dataset opened with the run's options: its runner (the scenes' checkers built once).
+// A dataset opened with the run's options: its runner (the scenes' verifiers built once).
 struct PyDataset {
-    std::shared_ptr<SceneCheckers> checkers = std::make_shared<SceneCheckers>();
+    std::shared_ptr<SceneVerifiers> verifiers = std::make_shared<SceneVerifiers>();
     std::unique_ptr<DatasetRunner> runner;
     const Dataset& dataset() const { return runner->dataset(); }
     const DatasetRunOptions& options() const { return runner->options(); }
@@ -96,7 +96,7 @@ void bindDatasets(py::module_& m)
                  Dataset dataset = openDataset(source, sourceOptions, [](const std::string& path, std::optional<CameraFormat> format) {
                      return openCameraSet(path, format);
                  });
-                 d->runner = std::make_unique<DatasetRunner>(std::move(dataset), std::move(options), readMap, d->checkers);
+                 d->runner = std::make_unique<DatasetRunner>(std::move(dataset), std::move(options), readMap, d->verifiers);
                  return d;
              }),
              py::arg("source"), py::arg("scene"), py::arg("quantity"), py::arg("depth"), py::arg("camera_format"),
@@ -117,7 +117,7 @@ void bindDatasets(py::module_& m)
                 {
                     py::gil_scoped_release release;
                     const FramePlan plan = planFrame(frame, d.options());
-                    made = frameCameraAndMap(frame, plan, (*d.checkers)(plan.scene).checker().scene(), d.options(), readMap);
+                    made = frameCameraAndMap(frame, plan, (*d.verifiers)(plan.scene).checker().scene(), d.options(), readMap);
                 }
                 return py::make_tuple(Camera(made.spec), image(made.map.value, made.map.width, made.map.height));
             },

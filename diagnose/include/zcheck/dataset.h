@@ -85,9 +85,9 @@ struct FrameResult {
 };
 
 
-// Scenes loaded and their checkers built once, by name, for any number of runners (thread-safe);
-// each with its map verifier beside it, so that every frame of a scene shares one neighbour index.
-class SceneCheckers {
+// Scenes loaded and their map verifiers (each over its checker) built once, by name, for any
+// number of runners (thread-safe), so that every frame of a scene shares one neighbour index.
+class SceneVerifiers {
 public:
     // The scene's verifier (its checker: MapVerifier::checker()), built on first use.
     const MapVerifier& operator()(const std::string& scene);
@@ -100,10 +100,10 @@ private:
 
 class DatasetRunner {
 public:
-    // Loads the run's scene and builds its checker (or finds it in `checkers`, shared with other
+    // Loads the run's scene and builds its verifier (or finds it in `verifiers`, shared with other
     // runners): an Error here (a bad mesh, a bad option) is the run's, not a frame's.
     DatasetRunner(Dataset dataset, DatasetRunOptions options, DepthMapReader readDepthMap,
-                  std::shared_ptr<SceneCheckers> checkers = nullptr);
+                  std::shared_ptr<SceneVerifiers> verifiers = nullptr);
     ~DatasetRunner();
 
     const Dataset& dataset() const { return dataset_; }
@@ -121,7 +121,7 @@ private:
     Dataset dataset_;
     DatasetRunOptions options_;
     DepthMapReader readDepthMap_;
-    std::shared_ptr<SceneCheckers> checkers_;
+    std::shared_ptr<SceneVerifiers> verifiers_;
 };
 
 }  // namespace zcheck
