@@ -199,6 +199,7 @@ TEST_CASE("broken COLMAP models are refused with the file and the line or record
     refuses("1 PINHOL 640 480 500 400 330 250\n", "line 1: unknown camera model 'PINHOL'");
     refuses("1 PINHOLE 640 480 500 nan 330 250\n", "line 1: parameter 2 'nan' is not a finite number");
     refuses("1 PINHOLE 640.5 480 500 400 330 250\n", "WIDTH '640.5' is not an integer");
+    refuses("1 PINHOLE 16385 480 500 400 330 250\n", "line 1: WIDTH '16385' is not an integer in 1..16384");
     refuses("2 PINHOLE 640 480 500 400 330 250\n", "CAMERA_ID 1 is not in the model's cameras");
     refuses("1 PINHOLE 640 480 500 400 330 250\n1 PINHOLE 640 480 500 400 330 250\n", "line 2: CAMERA_ID 1 appears twice");
 
@@ -222,6 +223,12 @@ TEST_CASE("broken COLMAP models are refused with the file and the line or record
     std::memcpy(badModel.data() + 12, &model, 4);
     writeText(bin / "cameras.bin", badModel);
     REQUIRE_THROWS_WITH(readCameraSet(bin.string(), CameraFormat::Colmap), Catch::Contains("model id 99"));
+    // A side one past Camera::kMaxImageSide (width: the u64 after the count, the id and the model).
+    std::string wide = cameras;
+    const std::uint64_t width = 16385;
+    std::memcpy(wide.data() + 16, &width, 8);
+    writeText(bin / "cameras.bin", wide);
+    REQUIRE_THROWS_WITH(readCameraSet(bin.string(), CameraFormat::Colmap), Catch::Contains("outside 1..16384 per side"));
 }
 
 TEST_CASE("a nerfstudio transforms.json is camera-to-world in OpenGL axes with centres at +0.5", "[import][nerfstudio]")

@@ -432,6 +432,26 @@ TEST_CASE("invalid cameras are refused with a message naming the parameter", "[c
     refuses(s, "projection.far");
 }
 
+TEST_CASE("an image side is a whole 1..16384 pixels and an image at most 2^25 pixels, at the bounds exactly", "[core][validation]")
+{
+    // Camera's rule, which the camera constructor and every importer and depth-map reader ask.
+    for (const double side : {1.0, 2.0, 16383.0, 16384.0}) REQUIRE(Camera::isImageSide(side));
+    for (const double side : {0.0, -1.0, 1.5, 16384.5, 16385.0, 1e300, double(NAN), double(INFINITY)})
+        REQUIRE_FALSE(Camera::isImageSide(side));
+    REQUIRE(Camera::isImageSize(8192, 4096));
+    REQUIRE(Camera::isImageSize(16384, 2048));
+    REQUIRE_FALSE(Camera::isImageSize(8192, 4097));
+    REQUIRE_FALSE(Camera::isImageSize(16385, 1));
+    REQUIRE_FALSE(Camera::isImageSize(0, 480));
+    CameraSpec spec = specWith("opengl", ProjectionType::Perspective);
+    spec.width = 16384, spec.height = 2;
+    REQUIRE_NOTHROW(Camera(spec));
+    spec.width = 16385;
+    REQUIRE_THROWS_WITH(Camera(spec), "'image.width' must be in 1..16384 pixels, got 16385");
+    spec.width = 8192, spec.height = 4097;
+    REQUIRE_THROWS_WITH(Camera(spec), "image 8192x4097 has more than 33554432 pixels (8192x4096)");
+}
+
 TEST_CASE("the camera file is read strictly", "[core][validation]")
 {
     const auto parse = [](const std::string& text) { return cameraSpecFromJson(nlohmann::json::parse(text), "test"); };

@@ -106,9 +106,6 @@ glm::dmat4 matrixForVectors(const glm::dmat4& m, MatrixVectors vectors)
 
 namespace {
 
-constexpr int kMaxImageSide = Camera::kMaxImageSide;
-constexpr long long kMaxImagePixels = Camera::kMaxImagePixels;
-
 void requireFinite(double value, const std::string& name)
 {
     if (!std::isfinite(value)) throw Error("'" + name + "' must be a finite number, got " + formatNumber(value));
@@ -238,12 +235,12 @@ void validateLookAt(const CameraSpec& spec);
 void validate(CameraSpec& spec)
 {
     for (auto [value, name] : {std::pair{spec.width, "image.width"}, {spec.height, "image.height"}})
-        if (value < 1 || value > kMaxImageSide)
-            throw Error(std::string("'") + name + "' must be in 1.." + std::to_string(kMaxImageSide) + " pixels, got " +
-                        std::to_string(value));
-    if (static_cast<long long>(spec.width) * spec.height > kMaxImagePixels)
+        if (!Camera::isImageSide(value))
+            throw Error(std::string("'") + name + "' must be in 1.." + std::to_string(Camera::kMaxImageSide) +
+                        " pixels, got " + std::to_string(value));
+    if (!Camera::isImageSize(spec.width, spec.height))  // both sides are within bounds: their product is not
         throw Error("image " + std::to_string(spec.width) + "x" + std::to_string(spec.height) + " has more than " +
-                    std::to_string(kMaxImagePixels) + " pixels (8192x4096)");
+                    std::to_string(Camera::kMaxImagePixels) + " pixels (8192x4096)");
     validateProjection(spec);
     if (spec.view.hasMatrix) {
         // A view is a rigid motion with the convention's handedness (pose.h): eye-z must be a

@@ -321,7 +321,7 @@ std::map<std::int64_t, ColmapCamera> readCamerasBinary(const std::string& path)
             file.fail(what + " (camera " + std::to_string(id) + ") has model id " + std::to_string(modelId) +
                       ", which zcheck does not know (COLMAP's 0..16: " + modelNames() + ")");
         const std::uint64_t width = file.read<std::uint64_t>(what), height = file.read<std::uint64_t>(what);
-        if (width < 1 || width > std::uint64_t(Camera::kMaxImageSide) || height < 1 || height > std::uint64_t(Camera::kMaxImageSide))
+        if (!Camera::isImageSide(double(width)) || !Camera::isImageSide(double(height)))
             file.fail(what + " (camera " + std::to_string(id) + ") has the size " + std::to_string(width) + "x" +
                       std::to_string(height) + ", outside 1.." + std::to_string(Camera::kMaxImageSide) + " per side");
         std::vector<double> params;

@@ -194,7 +194,7 @@ public:
     static constexpr long long kMaxImagePixels = 1LL << 25;
     // Whether a side as a file states it is one an image may have: a whole number in 1…kMaxImageSide.
     static bool isImageSide(double pixels) { return pixels == std::floor(pixels) && pixels >= 1 && pixels <= kMaxImageSide; }
-    // Whether both sides are and their product is within kMaxImagePixels.
+    // Whether both sides are image sides and their product is at most kMaxImagePixels.
     static bool isImageSize(long long width, long long height)
     {
         return width >= 1 && height >= 1 && width <= kMaxImageSide && height <= kMaxImageSide && width * height <= kMaxImagePixels;
