@@ -188,7 +188,8 @@ void addDepthMapOptions(CLI::App* command, DepthMapOptions& options)
     addAccuracyOptions(command, options.accuracy);
     command->add_option("--sidecar", options.sidecar,
                         "a JSON file describing the map: {\"miss\": 65535 or \">=1e9\", \"scale\": 1000, \"offset\": 0,\n"
-                        "\"channel\": \"Z\", \"quantum\": 0.001, \"rel_tolerance\": 0, \"abs_tolerance\": 0, \"allow_holes\": false};\n"
+                        "\"channel\": \"Z\", \"quantum\": 0.001, \"rel_tolerance\": 0, \"abs_tolerance\": 0, \"noise_model\": \"kinect\",\n"
+                        "\"allow_holes\": false};\n"
                         "other keys are ignored; the options above win over it")
         ->check(kNonEmptyPath);
 }
@@ -199,7 +200,9 @@ void addAccuracyOptions(CLI::App* command, MapAccuracy& accuracy)
     command->add_option("--quantum", accuracy.quantum,
                         "the map's values were rounded to multiples of Q (map units, after --scale): each pixel's\n"
                         "tolerance includes that step (0.001 for millimetres held as float metres). Half floats carry\n"
-                        "their own step without it")
+                        "their own step without it. The values must lie on that grid, and every declared accuracy\n"
+                        "is judged as a whole too: the map's median error must stay within a quarter of it (rounding\n"
+                        "and noise are unbiased), and it must be under a tenth of the depths")
         ->check(kPositiveFinite)
         ->group(group);
     command->add_option("--rel-tolerance", accuracy.relative,
@@ -211,6 +214,12 @@ void addAccuracyOptions(CLI::App* command, MapAccuracy& accuracy)
                         "values are good only to this many map units (a sensor's noise: 0.01 m); added to every\n"
                         "pixel's tolerance")
         ->check(kPositiveFinite)
+        ->group(group);
+    command->add_option_function<std::string>(
+               "--noise-model", [&accuracy](const std::string& text) { accuracy.noise = NoiseModel::parse(text); },
+               "a sensor's noise σ(z) in map units, z the map's own value at the pixel (eye-z, or range for a\n"
+               "distance map): kinect (0.0012+0.0019*(z-0.4)^2, metres), A+B*z^2 or A+B*(z-C)^2. Each pixel may\n"
+               "be off by 6σ(z); the map's errors must still be unbiased (see --quantum)")
         ->group(group);
     command->add_flag("--allow-holes", accuracy.allowHoles,
                       "a pixel without a value where the surface is hit is a hole (counted and reported), not a\n"

@@ -255,6 +255,7 @@ std::vector<std::string> verifyArgumentsOf(const DatasetVerifyOptions& o)
     };
     addDeclared("--quantum", o.accuracy.quantum), addDeclared("--rel-tolerance", o.accuracy.relative);
     addDeclared("--abs-tolerance", o.accuracy.absolute);
+    if (o.accuracy.noise.any()) args.insert(args.end(), {"--noise-model", o.accuracy.noise.text()});
     if (o.accuracy.allowHoles) args.push_back("--allow-holes");
     if (o.diagnose) args.push_back("--diagnose");
     if (o.threads > 0) args.insert(args.end(), {"--threads", std::to_string(o.threads)});

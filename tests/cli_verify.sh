@@ -118,7 +118,7 @@ echo '{"quantum": 0.001, "allow_holes": true}' > declared.json
 "$zcheck" verify --depth-map mm.pfm --quantity eye-z --sidecar declared.json --json | python3 -c "
 import json, sys; d = json.load(sys.stdin)
 assert d['consistent'] and d['depth_map']['declared'] == {'quantum': 0.001, 'rel_tolerance': 0, 'abs_tolerance': 0,
-                                                           'allow_holes': True}, d['depth_map']
+                                                           'noise_model': None, 'allow_holes': True}, d['depth_map']
 assert d['tolerance']['declared']['quantum'] == 0.001 and d['pixels']['holes'] == 0"
 echo '{"rel_tolerance": 2}' > bad_rel.json
 expect_error 2 "sidecar 'bad_rel.json': \"rel_tolerance\" must be below 1" verify --depth-map mm.pfm --quantity eye-z --sidecar bad_rel.json

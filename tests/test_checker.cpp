@@ -1151,7 +1151,7 @@ TEST_CASE("a comparison through a judge of the caller's, asked before, reports w
         report.comparison = c.report;
         return checkReportJson(report);
     };
-    for (const ToleranceModel& tolerance : {ToleranceModel{}, mapTolerance()}) {
+    for (const ToleranceModel& tolerance : {ToleranceModel{}, mapTolerance(DepthMap{}), mapTolerance(DepthMap::exact(1, 1, DepthQuantity::EyeZ, {1.0}))}) {
         const PixelJudge shared(checker.scene(), camera, tolerance);
         for (const CheckOptions& options : cleanFlippedAndBiased()) {
             const RenderResult ray = checker.renderRay(camera, options.faults.ray);

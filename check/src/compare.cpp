@@ -162,7 +162,7 @@ PixelJudge::PixelJudge(const Scene& scene, const Camera& camera, const Tolerance
     : scene_(scene),
       camera_(camera),
       tolerance_(tolerance),
-      terms_{ToleranceModel::constantQuanta(camera.depth()), tolerance.snapPixels(),
+      terms_{tolerance.constantFor(camera.depth()), tolerance.snapPixels(),
              16 * std::ldexp(1.0, -52) * std::max(std::abs(camera.depth().rangeMin), std::abs(camera.depth().rangeMax))},
       avx512_(useAvx512Form("ZCHECK_COMPARE_KERNEL", "baseline")),
       slopeFrame_(camera, tolerance.slopeCredit)

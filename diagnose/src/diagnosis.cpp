@@ -150,6 +150,9 @@ Hypothesis Diagnosis::judge(Hypothesis h, const Camera& hypothesisCamera, const 
         const ComparisonReport& r = run.comparison.report;
         h.consistent = r.consistent() && r.bothHit > 0, h.unexplained = r.unexplained();
         h.compared = r.bothHit + r.rayOnly + r.rasterOnly;
+        // A declaration the map's errors refuse as a whole (a bias it would absorb) explains none
+        // of its pixels: such a reading is never offered, not even as the closest.
+        if (!r.declaredAccuracyRefused.empty()) h.unexplained = std::max(h.unexplained, h.compared);
         if (!h.consistent && !r.depthBias) {
             const EdgeTally edges = tallyEdges(hypothesisCamera, run.truth, run.map, run.comparison);
             h.unexplainedAtEdges = edges.atEdges, h.blendsAtEdges = edges.blends;

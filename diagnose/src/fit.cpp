@@ -237,11 +237,13 @@ std::vector<Sample> withTolerances(const Scene& scene, const Camera& declared, c
                                    std::vector<Sample> samples)
 {
     const Camera departed(departedCameraSpec(declared, d));
-    const PixelJudge judge(scene, departed, mapTolerance(), SlopeSource::EachCall);  // ~16,000 samples
+    const PixelJudge judge(scene, departed, mapTolerance(map), SlopeSource::EachCall);  // ~16,000 samples
     tbb::parallel_for(std::size_t(0), samples.size(), [&](std::size_t k) {
         Sample& s = samples[k];
         ValueAccuracy accuracy = map.accuracyAt(std::size_t(s.row) * map.width + s.col);
-        accuracy.step /= std::abs(d.valueScale), accuracy.absolute /= std::abs(d.valueScale);
+        // What the map declares at its value, in the departed reading's units.
+        accuracy.absolute = (accuracy.declaredAt(s.mapValue) - accuracy.relative * std::abs(s.mapValue)) / std::abs(d.valueScale);
+        accuracy.step /= std::abs(d.valueScale), accuracy.grid = 0, accuracy.noise = {};
         const MapPixel pixel = mapPixelDepth(departed, map.quantity, (s.mapValue - d.valueOffset) / d.valueScale, accuracy,
                                              s.col, s.row, NAN);
         const glm::dvec2 pWindow = windowFromPixelCentre(departed, s.col, s.row);

@@ -93,8 +93,21 @@ MapReader::MapReader(const PixelJudge& judge, const DepthMap& map, const RenderR
                      const VertexNeighbours& neighbours)
     : scene_(judge.scene()), camera_(judge.camera()), map_(map), truth_(truth), neighbours_(neighbours), judge_(judge)
 {
-    if (judge.tolerance() != mapTolerance())
-        throw std::logic_error("MapReader: the judge was not made with mapTolerance()");
+    if (judge.tolerance() != mapTolerance(map))
+        throw std::logic_error("MapReader: the judge was not made with mapTolerance(map)");
+}
+
+double linearizedBufferStep(const Camera& camera, double eyeZ)
+{
+    const double n = camera.nearDistance(), f = camera.farDistance();
+    double u, slope;  // the buffer's value at eyeZ in [0, 1], and its derivative in eye-z
+    if (camera.spec().projection.isPerspective()) {
+        const double span = 1 / n - (std::isinf(f) ? 0.0 : 1 / f);
+        u = (1 / n - 1 / eyeZ) / span, slope = 1 / (eyeZ * eyeZ * span);
+    } else {
+        u = (eyeZ - n) / (f - n), slope = 1 / (f - n);
+    }
+    return storageQuantum(DepthFormat::Float32, std::clamp(u, 0.0, 1.0)) / slope;
 }
 
 MapPixel mapPixelDepth(const Camera& camera, const DepthMap& map, int col, int row, double truthDepth)
@@ -112,19 +125,29 @@ MapPixel mapPixelDepth(const Camera& camera, DepthQuantity quantity, double valu
     const double depth = out.depth;
     // The storage step, carried into window units through the quantity's mapping.
     const double reference = std::isfinite(depth) ? depth : truthDepth;
-    if (quantity == DepthQuantity::Window && accuracy.step == 0) {
-        out.quantum = storageQuantum(camera.depth().format, reference);
-    } else if (std::isfinite(depth)) {
+    const bool linear = quantity == DepthQuantity::EyeZ || quantity == DepthQuantity::Distance;
+    out.quantum = storageQuantum(camera.depth().format, reference);
+    if (std::isfinite(depth) && (linear || accuracy.step > 0)) {
         const double step = accuracy.step > 0 ? accuracy.step
                                               : double(std::nextafter(float(std::abs(value)), INFINITY)) - std::abs(double(float(value)));
-        const double other = windowDepthOf(value + step);
-        out.quantum = std::isfinite(other) ? std::max(std::abs(other - depth), storageQuantum(DepthFormat::Float32, depth))
-                                           : storageQuantum(camera.depth().format, depth);
-    } else {
-        out.quantum = storageQuantum(camera.depth().format, reference);
+        double other = windowDepthOf(value + step);
+        if (!std::isfinite(other)) other = windowDepthOf(value - step);
+        // A window or NDC value's step is at least binary32's at its window depth; a linear map's
+        // is at least a linearized depth buffer's (linearizedBufferStep), whatever the camera's own.
+        if (std::isfinite(other)) {
+            out.quantum = std::abs(other - depth);
+            if (!linear) {
+                out.quantum = std::max(out.quantum, storageQuantum(DepthFormat::Float32, depth));
+            } else {
+                const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
+                const double z = eyeZFromWindowDepth(camera, pWindow, depth);
+                const double buffer = windowDepthFromEyeZ(camera, pWindow, z + linearizedBufferStep(camera, z));
+                if (std::isfinite(buffer)) out.quantum = std::max(out.quantum, std::abs(buffer - depth));
+            }
+        }
     }
     // The declared accuracy, the larger window change of the two sides that are depths.
-    const double declared = accuracy.absolute + accuracy.relative * std::abs(value);
+    const double declared = accuracy.declaredAt(value);
     if (declared > 0 && std::isfinite(depth))
         for (const double side : {value - declared, value + declared})
             if (const double there = windowDepthOf(side); std::isfinite(there))
@@ -250,7 +273,7 @@ RenderResult renderResultFromMap(const PixelJudge& judge, const DepthMap& map, c
     const int W = camera.width(), H = camera.height();
     RenderResult out = RenderResult::cleared(W, H, camera.clearDepth());
     quantum.assign(std::size_t(W) * H, 0.0);
-    const bool declared = map.accuracy.relative > 0 || map.accuracy.absolute > 0;
+    const bool declared = map.accuracy.anyAccuracy();
     allowance.assign(declared ? std::size_t(W) * H : 0, 0.0);
     const MapReader reader(judge, map, truth, neighbours);
     // Rows in parallel: each pixel's choice reads only the truth and the map.
@@ -287,7 +310,7 @@ std::optional<std::int64_t> screenUnexplained(const Scene& scene, const Camera& 
     constexpr std::int64_t kEnough = 64;
     constexpr int kStride = 4;
     const int W = camera.width(), H = camera.height();
-    const PixelJudge judge(scene, camera, mapTolerance(), SlopeSource::EachCall);  // a sixteenth of the pixels
+    const PixelJudge judge(scene, camera, mapTolerance(map), SlopeSource::EachCall);  // a sixteenth of the pixels
     const MapReader reader(judge, map, truth, neighbours);
     std::vector<std::vector<std::uint32_t>> suspectsOfRow(static_cast<std::size_t>(H));
     tbb::parallel_for(0, H, [&](int row) {
@@ -329,7 +352,7 @@ Probe probeAgreement(const Scene& scene, const RayRenderer& rays, const Camera& 
 {
     constexpr int kGrid = 16;
     const int W = camera.width(), H = camera.height();
-    const PixelJudge judge(scene, camera, mapTolerance(), SlopeSource::EachCall);  // 256 pixels
+    const PixelJudge judge(scene, camera, mapTolerance(map), SlopeSource::EachCall);  // 256 pixels
     std::atomic<int> agree{0}, seen{0};
     tbb::parallel_for(0, kGrid * kGrid, [&](int k) {
         const int col = (2 * (k % kGrid) + 1) * W / (2 * kGrid), row = (2 * (k / kGrid) + 1) * H / (2 * kGrid);
@@ -380,20 +403,132 @@ VerifyResult verifyAgainst(const Scene& scene, const Camera& camera, const Depth
     VerifyResult run;
     run.truth = std::move(truth);
     std::vector<double> quantum, allowance;
-    const PixelJudge judge(scene, camera, mapTolerance());  // reads the map, then compares with the slopes it found
+    const PixelJudge judge(scene, camera, mapTolerance(map));  // reads the map, then compares with the slopes it found
     run.map = renderResultFromMap(judge, map, run.truth, neighbours, quantum, allowance);
     const auto start = Clock::now();
     run.comparison = compareRoutes(judge, run.truth, run.map,
                                    {&quantum, allowance.empty() ? nullptr : &allowance, map.accuracy.allowHoles});
     run.report.timings.compareMs = millisecondsSince(start);
     run.report.timings.traceMs = run.truth.renderMilliseconds;
-    run.report.describeInputs(scene, camera, mapTolerance());
+    run.report.describeInputs(scene, camera, mapTolerance(map));
     run.report.declared = map.accuracy;
     run.report.secondRoute = "map";
     run.report.outOfRangeRule = toString(map.quantity) + " map holds values in " + depthValueRange(camera, map.quantity);
     countOutOfRange(camera, map, run.comparison.report);
+    judgeDeclaredAccuracy(judge, map, run.truth, quantum, run.comparison);
     run.report.comparison = run.comparison.report;
     return run;
+}
+
+void judgeDeclaredAccuracy(const PixelJudge& judge, const DepthMap& map, const RenderResult& truth,
+                           const std::vector<double>& quantum, Comparison& comparison)
+{
+    ComparisonReport& report = comparison.report;
+    report.declaredAccuracyRefused.clear();
+    if (!map.accuracy.anyAccuracy()) return;
+    const Camera& camera = judge.camera();
+    const int W = camera.width(), H = camera.height();
+    const DepthQuantity quantity = map.quantity;
+    const double Q = map.accuracy.quantum;
+    // One compared pixel, in the map's units.
+    struct Compared {
+        double error;          // map − truth
+        double intrinsic;      // C·q + S·m + E, the tolerance of a map declaring nothing
+        double declared;       // ValueAccuracy::declaredAt
+        double relativeEyeZ;   // the declared accuracy as a fraction of the pixel's eye-z
+        bool onGrid;
+        int col, row;
+        double value;
+    };
+    std::vector<std::vector<Compared>> rows(static_cast<std::size_t>(H));
+    tbb::parallel_for(0, H, [&](int row) {
+        for (int col = 0; col < W; ++col) {
+            const std::size_t i = std::size_t(row) * W + col;
+            const PixelClass c = comparison.pixelClass[i];
+            const double v = map.value[i];
+            if ((c != PixelClass::Agree && c != PixelClass::DepthError) || !truth.hit(i) ||
+                kindOfDepthValue(camera, quantity, v) != DepthValueKind::Depth)
+                continue;
+            const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
+            const double truthWindow = truth.windowDepth.value[i];
+            const double trueEyeZ = eyeZFromWindowDepth(camera, pWindow, truthWindow);
+            // The map's value of a window depth at this pixel, and the eye-z of a map value.
+            auto valueOfWindow = [&](double d) {
+                return depthValueFromEyeZ(camera, pWindow, eyeZFromWindowDepth(camera, pWindow, d), quantity);
+            };
+            auto eyeZOfValue = [&](double value) -> double {
+                switch (quantity) {
+                case DepthQuantity::Window: return eyeZFromWindowDepth(camera, pWindow, value);
+                case DepthQuantity::Ndc: return eyeZFromWindowDepth(camera, pWindow, camera.windowDepthFromNdcZ(value));
+                case DepthQuantity::EyeZ: return value;
+                case DepthQuantity::Distance: return eyeZFromDistance(camera, pWindow, value);
+                }
+                return NAN;
+            };
+            const double trueValue = depthValueFromEyeZ(camera, pWindow, trueEyeZ, quantity);
+            const double tolerance = judge.surfaceTolerance(truth.primitiveId[i], quantum[i]);
+            double intrinsic = 0;
+            for (const double side : {truthWindow - tolerance, truthWindow + tolerance})
+                if (const double there = valueOfWindow(side); std::isfinite(there))
+                    intrinsic = std::max(intrinsic, std::abs(there - trueValue));
+            const double declared = map.accuracyAt(i).declaredAt(v);
+            double relativeEyeZ = 0;
+            for (const double side : {trueValue - declared, trueValue + declared}) {
+                const double z = eyeZOfValue(side);
+                relativeEyeZ = std::max(relativeEyeZ, std::isfinite(z) && z > 0 ? std::abs(z - trueEyeZ) / trueEyeZ : INFINITY);
+            }
+            bool onGrid = true;
+            if (Q > 0) {
+                const double u = v - map.offset;
+                const float f = float(std::abs(v));
+                const double spacing = double(std::nextafter(f, INFINITY)) - double(f);
+                onGrid = std::abs(u / Q - std::round(u / Q)) * Q <= std::max(1e-3 * Q, 4 * spacing);
+            }
+            rows[std::size_t(row)].push_back({v - trueValue, intrinsic, declared, relativeEyeZ, onGrid, col, row, v});
+        }
+    });
+    std::vector<Compared> all;
+    for (auto& r : rows) all.insert(all.end(), r.begin(), r.end());
+    if (all.empty()) return;
+    auto medianOfField = [&](double Compared::*field) {
+        std::vector<double> values;
+        values.reserve(all.size());
+        for (const Compared& c : all) values.push_back(c.*field);
+        return medianOf(std::move(values));
+    };
+    auto percent = [](double fraction) { return formatNumber(std::round(fraction * 1000) / 10) + "%"; };
+    if (Q > 0) {
+        const auto off = std::count_if(all.begin(), all.end(), [](const Compared& c) { return !c.onGrid; });
+        if (off * 100 > std::int64_t(all.size())) {
+            const Compared& first = *std::find_if(all.begin(), all.end(), [](const Compared& c) { return !c.onGrid; });
+            report.declaredAccuracyRefused =
+                "the declared quantum " + formatNumber(Q) + " is not the map's grid: " + percent(double(off) / double(all.size())) +
+                " of the values compared lie off its multiples (pixel (" + std::to_string(first.col) + ", " +
+                std::to_string(first.row) + ") holds " + formatNumber(first.value) +
+                "); --quantum states the step the values were rounded to";
+            return;
+        }
+    }
+    const double relative = medianOfField(&Compared::relativeEyeZ);
+    if (!(relative <= 0.1)) {
+        report.declaredAccuracyRefused = "the declared accuracy is as coarse as the depths: ±" +
+                                         formatNumber(medianOfField(&Compared::declared)) + " at the median pixel, " +
+                                         (std::isfinite(relative) ? percent(relative) : std::string("beyond the far plane")) +
+                                         " of its eye-z (a declaration zcheck can judge is under a tenth of the depth); a "
+                                         "map of the wrong scale or quantity would pass it";
+        return;
+    }
+    if (all.size() >= 16) {
+        const double bias = medianOfField(&Compared::error);
+        const double exact = medianOfField(&Compared::intrinsic), declared = medianOfField(&Compared::declared);
+        const double allowed = exact + 0.25 * declared;
+        if (!(std::abs(bias) <= allowed))
+            report.declaredAccuracyRefused =
+                "the map's errors are systematic: the median of map - truth is " + formatNumber(bias) +
+                " (map units), beyond the ±" + formatNumber(allowed) + " an unbiased map may show (an exact map's " +
+                formatNumber(exact) + ", plus a quarter of the declared ±" + formatNumber(declared) +
+                " at the median pixel); rounding and noise are unbiased, a wrong scale, quantity or pose is not";
+    }
 }
 
 void measureMapErrors(const Camera& camera, const DepthMap& map, VerifyResult& run)

@@ -118,7 +118,8 @@ private:
         if (!object.is_object()) throw Error(where + ": a frame is a JSON object");
         static const std::set<std::string> known = {"frame", "camera", "depth", "quantity", "scale", "offset",
                                                     "miss", "channel", "scene", "near", "far", "quantum",
-                                                    "rel_tolerance", "abs_tolerance", "allow_holes", "sidecar"};
+                                                    "rel_tolerance", "abs_tolerance", "noise_model", "allow_holes",
+                                                    "sidecar"};
         for (const auto& item : object.items())
             if (!known.count(item.key())) throw Error(where + ": unknown key '" + printableExcerpt(item.key(), 40) + "'");
         auto text = [&](const char* key) -> std::optional<std::string> {
@@ -280,6 +281,7 @@ std::string manifestLine(const DatasetFrame& frame, const std::string& cameraRef
     if (frame.accuracy.quantum > 0) line["quantum"] = frame.accuracy.quantum;
     if (frame.accuracy.relative > 0) line["rel_tolerance"] = frame.accuracy.relative;
     if (frame.accuracy.absolute > 0) line["abs_tolerance"] = frame.accuracy.absolute;
+    if (frame.accuracy.noise.any()) line["noise_model"] = frame.accuracy.noise.text();
     if (frame.accuracy.allowHoles) line["allow_holes"] = true;
     return line.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }

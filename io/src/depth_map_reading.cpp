@@ -115,6 +115,56 @@ void MapAccuracy::require(const std::string& where) const
     requireDeclared(absolute, where + ": absolute tolerance", false);
 }
 
+NoiseModel NoiseModel::parse(const std::string& text, const std::string& name)
+{
+    auto refuse = [&]() -> NoiseModel {
+        throw Error(name + " must be kinect, A+B*z^2 or A+B*(z-C)^2 with finite A, B >= 0 (not both 0) and C, got '" +
+                    text + "'");
+    };
+    std::string t;
+    for (char c : text)
+        if (!std::isspace(static_cast<unsigned char>(c))) t += char(std::tolower(static_cast<unsigned char>(c)));
+    if (t == "kinect") return {0.0012, 0.0019, 0.4};
+    // A number at the front of `rest`, consumed; nullopt without one.
+    auto number = [](std::string& rest) -> std::optional<double> {
+        std::size_t used = 0;
+        double v = 0;
+        try {
+            v = std::stod(rest, &used);
+        } catch (const std::exception&) {
+            return std::nullopt;
+        }
+        rest = rest.substr(used);
+        return v;
+    };
+    std::string rest = t;
+    NoiseModel out;
+    const std::optional<double> a = number(rest);
+    if (!a || rest.empty() || rest[0] != '+') return refuse();
+    rest = rest.substr(1);
+    const std::optional<double> b = number(rest);
+    if (!b) return refuse();
+    if (rest == "*z^2") {
+        out = {*a, *b, 0};
+    } else if (rest.rfind("*(z-", 0) == 0) {
+        rest = rest.substr(4);
+        const std::optional<double> c = number(rest);
+        if (!c || rest != ")^2") return refuse();
+        out = {*a, *b, *c};
+    } else {
+        return refuse();
+    }
+    if (!(out.a >= 0 && out.b >= 0 && std::isfinite(out.a) && std::isfinite(out.b) && std::isfinite(out.z0)) || !out.any())
+        return refuse();
+    return out;
+}
+
+std::string NoiseModel::text() const
+{
+    if (!any()) return "";
+    return formatNumber(a) + "+" + formatNumber(b) + (z0 == 0 ? "*z^2" : "*(z-" + formatNumber(z0) + ")^2");
+}
+
 void DepthMapReading::requireScale(double scale, const std::string& name)
 {
     if (!(scale > 0 && std::isfinite(scale))) throw Error(name + " must be a positive finite number, got " + formatNumber(scale));
@@ -143,6 +193,7 @@ std::string MapAccuracy::options() const
     if (quantum > 0) add("--quantum " + formatNumber(quantum));
     if (relative > 0) add("--rel-tolerance " + formatNumber(relative));
     if (absolute > 0) add("--abs-tolerance " + formatNumber(absolute));
+    if (noise.any()) add("--noise-model '" + noise.text() + "'");
     if (allowHoles) add("--allow-holes");
     return out;
 }
@@ -153,6 +204,7 @@ MapAccuracy MapAccuracy::over(const MapAccuracy& fallback) const
     if (!(out.quantum > 0)) out.quantum = fallback.quantum;
     if (!(out.relative > 0)) out.relative = fallback.relative;
     if (!(out.absolute > 0)) out.absolute = fallback.absolute;
+    if (!out.noise.any()) out.noise = fallback.noise;
     out.allowHoles = out.allowHoles || fallback.allowHoles;
     return out;
 }
@@ -172,6 +224,11 @@ MapAccuracy accuracyFromJson(const nlohmann::json& object, const std::string& wh
     number("rel_tolerance", out.relative);
     number("abs_tolerance", out.absolute);
     if (out.relative >= 1) throw Error(where + ": \"rel_tolerance\" must be below 1");
+    if (given("noise_model")) {
+        if (!object["noise_model"].is_string())
+            throw Error(where + ": \"noise_model\" must be a string (kinect, A+B*z^2 or A+B*(z-C)^2)");
+        out.noise = NoiseModel::parse(object["noise_model"].get<std::string>(), where + ": \"noise_model\"");
+    }
     if (given("allow_holes")) {
         if (!object["allow_holes"].is_boolean()) throw Error(where + ": \"allow_holes\" must be true or false");
         out.allowHoles = object["allow_holes"].get<bool>();
@@ -184,6 +241,7 @@ nlohmann::json toJson(const MapAccuracy& accuracy)
     return {{"quantum", accuracy.quantum},
             {"rel_tolerance", accuracy.relative},
             {"abs_tolerance", accuracy.absolute},
+            {"noise_model", accuracy.noise.any() ? nlohmann::json(accuracy.noise.text()) : nlohmann::json(nullptr)},
             {"allow_holes", accuracy.allowHoles}};
 }
 

@@ -167,7 +167,7 @@ nlohmann::json toJson(const CheckReport& report)
         {"camera", toJson(report.camera)},
         {"tolerance",
          {{"subpixel_bits", report.tolerance.subpixelBits},
-          {"constant_quanta", ToleranceModel::constantQuanta(report.camera.depth)},
+          {"constant_quanta", report.tolerance.constantFor(report.camera.depth)},
           {"slope_credit", report.tolerance.slopeCredit == SlopeCredit::SampleOffset ? "sample-offset" : "vertex-snapping"},
           {"declared", toJson(report.declared)},
           {"rule", report.tolerance.slopeCredit == SlopeCredit::SampleOffset
@@ -213,7 +213,7 @@ std::string formatSummary(const CheckReport& report, const std::string& comparin
     out << line;
     std::snprintf(line, sizeof line, "depth      %s%s, range [%g, %g]; tolerance C = %g q, S = 2^-%d px\n",
                   toString(cam.depth.format).c_str(), cam.depth.reversed ? ", reversed-Z" : "", cam.depth.rangeMin,
-                  cam.depth.rangeMax, ToleranceModel::constantQuanta(cam.depth), report.tolerance.subpixelBits);
+                  cam.depth.rangeMax, report.tolerance.constantFor(cam.depth), report.tolerance.subpixelBits);
     out << line;
     if (const MapAccuracy& d = report.declared; d.any()) {
         std::string declared;

@@ -43,6 +43,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 namespace zcheck {
@@ -78,14 +79,23 @@ enum class SlopeCredit {
 struct ToleranceModel {
     int subpixelBits = 8;  // S = 2^−subpixelBits pixels
     SlopeCredit slopeCredit = SlopeCredit::VertexSnapping;
+    // C, in storage quanta, when the compared side's own storage states it (a map of eye-z or
+    // distance: its file's, never the camera's depth buffer's); 0: the camera's depth format's.
+    double storageConstant = 0;
 
     double snapPixels() const { return 1.0 / double(1 << subpixelBits); }
-    // C, in storage quanta.
+    // C, in storage quanta, for a depth buffer of these settings.
     static double constantQuanta(const DepthSettings& depth);
+    // C as this model applies it to a camera of these settings.
+    double constantFor(const DepthSettings& depth) const
+    {
+        return storageConstant > 0 ? storageConstant : constantQuanta(depth);
+    }
 
     bool operator==(const ToleranceModel& other) const
     {
-        return subpixelBits == other.subpixelBits && slopeCredit == other.slopeCredit;
+        return subpixelBits == other.subpixelBits && slopeCredit == other.slopeCredit &&
+               storageConstant == other.storageConstant;
     }
     bool operator!=(const ToleranceModel& other) const { return !(*this == other); }
 };
@@ -143,8 +153,16 @@ struct ComparisonReport {
     int outOfRangeCol = -1, outOfRangeRow = -1;
     double outOfRangeValue = 0;
 
+    // A verified map's declared accuracy judged as a whole (diagnose/verify.h,
+    // judgeDeclaredAccuracy): why it cannot stand — a bias it would absorb, a grid the values do
+    // not lie on, an accuracy as coarse as the depths — or "" when it stands (or none was declared).
+    std::string declaredAccuracyRefused;
+
     std::int64_t unexplained() const { return depthErrors + coverageUnexplained; }
-    bool consistent() const { return unexplained() == 0 && !depthBias && outOfRange == 0; }
+    bool consistent() const
+    {
+        return unexplained() == 0 && !depthBias && outOfRange == 0 && declaredAccuracyRefused.empty();
+    }
 };
 
 struct Comparison {

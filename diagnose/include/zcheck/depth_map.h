@@ -12,18 +12,26 @@
 #include "zcheck/quantity.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <utility>
 #include <vector>
 
 namespace zcheck {
 
-// How one value of a map is judged (value units): the step it was stored or rounded with (0:
-// binary32's own spacing at the value), and the accuracy its producer declares, ± (absolute +
-// relative·|value|).
+// How one value of a map is judged (value units): the step it was stored with (0: binary32's own
+// spacing at the value), and the accuracy its producer declares, ± declaredAt(value): the grid
+// it was rounded to (its step: half for the rounding, half for the computation before it, as a
+// unorm16 depth buffer's one quantum), absolute + relative·|value|, and the noise model's 6σ.
 struct ValueAccuracy {
     double step = 0;
+    double grid = 0;
     double relative = 0, absolute = 0;
+    NoiseModel noise;
+    double declaredAt(double value) const
+    {
+        return grid + absolute + relative * std::abs(value) + noise.allowance(std::abs(value));
+    }
 };
 
 // A depth map rendered elsewhere, as read: values per pixel in one depth quantity.
@@ -52,12 +60,14 @@ struct DepthMap {
     }
     // A value as the file stored it (before scale and offset).
     double storedOf(double v) const { return (v - offset) * (scale > 0 ? scale : 1.0); }
-    // Value i's: its step (its own, the file's, at least the declared quantum) and the declared accuracy.
+    // Value i's: its storage step (its own or the file's) and the declared accuracy.
     ValueAccuracy accuracyAt(std::size_t i) const
     {
-        const double own = valueStep.empty() ? valueQuantum : double(valueStep[i]);
-        return {std::max(own, accuracy.quantum), accuracy.relative, accuracy.absolute};
+        return {valueStep.empty() ? valueQuantum : double(valueStep[i]), accuracy.quantum, accuracy.relative,
+                accuracy.absolute, accuracy.noise};
     }
+    // Whether the values were stored as integers (a 16-bit PNG or TIFF: valueQuantum is 1/scale).
+    bool integerStorage() const { return valueQuantum > 0 && valueStep.empty(); }
 };
 
 }  // namespace zcheck

@@ -71,11 +71,16 @@ private:
 };
 
 // The tolerance a map rendered elsewhere is judged with: the default, its slope credit for a
-// depth sampled up to S off the pixel centre in each axis (compare.h).
-inline ToleranceModel mapTolerance()
+// depth sampled up to S off the pixel centre in each axis (compare.h), and for a map of eye-z or
+// distance the constant C of its own storage — 4 for floating point (binary32 or binary16, as a
+// float32 depth buffer), 1 for integers (a rounded value, as a unorm16 buffer) — never the
+// camera's depth format or reversal, which concern window and NDC maps only.
+inline ToleranceModel mapTolerance(const DepthMap& map)
 {
     ToleranceModel model;
     model.slopeCredit = SlopeCredit::SampleOffset;
+    if (map.quantity == DepthQuantity::EyeZ || map.quantity == DepthQuantity::Distance)
+        model.storageConstant = map.integerStorage() ? 1.0 : 4.0;
     return model;
 }
 
@@ -87,11 +92,19 @@ struct MapPixel {
     std::uint32_t primitive = kNoPrimitive;    // the surface chosen (above); kNoPrimitive for a miss
 };
 
+// The eye-z step of a standard binary32 depth buffer (near → 0, far → 1, not reversed) of the
+// camera's near and far planes at `eyeZ`: the precision of an eye-z or distance map linearized
+// from a renderer's depth buffer, which such a map is allowed besides its own storage step —
+// the same whatever the camera's depth format, range and reversal, which no linear map depends on.
+double linearizedBufferStep(const Camera& camera, double eyeZ);
+
 // The pixel's window depth, storage step and allowance as the comparison reads them (its
 // surface left kNoPrimitive); `truthDepth` is the truth's window depth there, the reference for
 // a miss. The value's step and declared accuracy are carried into window units through the
-// quantity's mapping at the pixel: the larger window change of value ± step (at least binary32's
-// spacing at the window depth), and of value ± (absolute + relative·|value|).
+// quantity's mapping at the pixel: the larger window change of value ± step, and of value ±
+// ValueAccuracy::declaredAt(value). A window map's step is the camera's depth format's unless
+// the file states one (then at least binary32's spacing at the window depth); an eye-z or
+// distance map's is at least linearizedBufferStep.
 MapPixel mapPixelDepth(const Camera& camera, const DepthMap& map, int col, int row, double truthDepth);
 // The same for one value of `quantity` judged by `accuracy` (a step of 0: binary32, or for a
 // window map the camera's depth format).
@@ -101,7 +114,7 @@ MapPixel mapPixelDepth(const Camera& camera, DepthQuantity quantity, double valu
 // Reads a map pixel by pixel against an already rendered truth: the per-pixel rule of
 // renderResultFromMap, and the comparison's class for one pixel, so that a diagnosis can
 // judge a sample of pixels without reading the whole map. Holds references; thread-safe.
-// `judge`: made for the scene and camera with mapTolerance() (std::logic_error otherwise);
+// `judge`: made for the scene and camera with mapTolerance(map) (std::logic_error otherwise);
 // SlopeSource::TableOfSeen for reading every pixel, EachCall for a sample.
 class MapReader {
 public:
@@ -187,6 +200,20 @@ struct EdgeTally {
     std::int64_t atEdges = 0, blends = 0;
 };
 EdgeTally tallyEdges(const Camera& camera, const RenderResult& truth, const RenderResult& map, const Comparison& comparison);
+
+// A map's declared accuracy (MapAccuracy::anyAccuracy) judged as a whole, over the pixels a
+// comparison compared on depth (Agree, DepthError), in the map's own units: what no pixel's
+// tolerance can see. Sets report.declaredAccuracyRefused, which makes the map inconsistent:
+//   grid    a declared quantum Q is the grid the values were rounded to: ≥ 99 % of them (less
+//           the offset) lie within 1/1000 of Q (or four binary32 spacings) of a multiple of Q;
+//   coarse  the declared accuracy at the median pixel is under a tenth of its depth (in eye-z):
+//           a grid or tolerance as coarse as the depths accepts any map of the right order;
+//   bias    rounding and noise are unbiased: with 16 pixels or more, |median(map − truth)| is
+//           within median(C·q + S·m + E) — the tolerance a map declaring nothing has, which a
+//           consistent one's median never exceeds — plus a quarter of the median declared accuracy.
+// A map declaring no accuracy is left as it is: its per-pixel tolerance bounds its median.
+void judgeDeclaredAccuracy(const PixelJudge& judge, const DepthMap& map, const RenderResult& truth,
+                           const std::vector<double>& quantum, Comparison& comparison);
 
 // The map's errors in its own units (report.mapErrors, mapError per pixel), from a comparison
 // of it: MapVerifier::verify's last step (a diagnosis's readings skip it).

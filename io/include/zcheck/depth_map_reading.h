@@ -30,6 +30,24 @@ private:
     std::string written_;
 };
 
+// A sensor's noise as its depth grows: standard deviation σ(z) = a + b·(z − z0)² in map units, z
+// the map's own value at the pixel (eye-z, or range for a distance map). Written "kinect" (the
+// Kinect v1 model of Nguyen et al. 2012 in metres: 0.0012 + 0.0019·(z − 0.4)²), "A+B*z^2" or
+// "A+B*(z-C)^2". A map declaring it is allowed kSigmas·σ(z) at each pixel.
+struct NoiseModel {
+    static constexpr double kSigmas = 6;
+    double a = 0, b = 0, z0 = 0;
+
+    bool any() const { return a > 0 || b > 0; }
+    double sigma(double z) const { return a + b * (z - z0) * (z - z0); }
+    double allowance(double z) const { return any() ? kSigmas * sigma(z) : 0.0; }
+    // Throws Error naming `name`, the text and the accepted forms.
+    static NoiseModel parse(const std::string& text, const std::string& name = "--noise-model");
+    // "0.0012+0.0019*(z-0.4)^2", "0.001+0.002*z^2": what parse reads back; "" for none.
+    std::string text() const;
+    bool operator==(const NoiseModel& o) const { return a == o.a && b == o.b && z0 == o.z0; }
+};
+
 // What a map's producer declares of its values, beyond how to read them: judged with, never
 // applied to the values (a map is never "fixed"). Nothing declared: every value is exact to its
 // storage (binary32, binary16, or an integer file's step) and every pixel where the surface is
@@ -38,9 +56,13 @@ struct MapAccuracy {
     double quantum = 0;    // values rounded to multiples of this (map units, after scale); 0: none
     double relative = 0;   // values good to ± (absolute + relative·|value|) (map units) ...
     double absolute = 0;
+    NoiseModel noise;         // ... and ± NoiseModel::kSigmas·σ(value) (map units)
     bool allowHoles = false;  // ... and a missing value where the surface is hit is a hole, not a failure
 
-    bool any() const { return quantum > 0 || relative > 0 || absolute > 0 || allowHoles; }
+    bool any() const { return quantum > 0 || relative > 0 || absolute > 0 || noise.any() || allowHoles; }
+    // Whether any number is declared (all but allowHoles): the accuracy verify judges as a whole
+    // (a bias it may not absorb, a grid the values must lie on, at most a tenth of the depth).
+    bool anyAccuracy() const { return quantum > 0 || relative > 0 || absolute > 0 || noise.any(); }
     // The rule each declared number keeps, whoever declares it: finite and ≥ 0, and below 1 for
     // the relative tolerance. Returns `value`, or throws Error "<name> must be a finite number
     // >= 0[ and below 1], got <value>", `name` as the caller calls it ("rel_tolerance").
@@ -53,7 +75,8 @@ struct MapAccuracy {
     MapAccuracy over(const MapAccuracy& fallback) const;
     bool operator==(const MapAccuracy& o) const
     {
-        return quantum == o.quantum && relative == o.relative && absolute == o.absolute && allowHoles == o.allowHoles;
+        return quantum == o.quantum && relative == o.relative && absolute == o.absolute && noise == o.noise &&
+               allowHoles == o.allowHoles;
     }
 };
 
