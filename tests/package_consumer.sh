@@ -22,6 +22,26 @@ test ! -e "$tmp/prefix/include/zcheck/version.h.in"
 cmake -S "$source_dir/examples/cpp" -B "$tmp/example" -DCMAKE_PREFIX_PATH="$tmp/prefix" > "$tmp/configure.log" 2>&1 ||
     { cat "$tmp/configure.log" >&2; exit 1; }
 cmake --build "$tmp/example" > "$tmp/build.log" 2>&1 || { cat "$tmp/build.log" >&2; exit 1; }
+# Every installed header at once, in one translation unit of a consumer, linked against the
+# package: no name is defined twice (regression: zcheck::ClipPlanes was, in camera_sources.h and clip.h).
+mkdir -p "$tmp/all_headers"
+{
+    for header in "$tmp/prefix/include/zcheck/"*.h; do echo "#include <zcheck/$(basename "$header")>"; done
+    echo 'int main() { return zcheck::Camera(zcheck::CameraSpec{}).width() > 0 ? 0 : 1; }'
+} > "$tmp/all_headers/all_headers.cpp"
+cat > "$tmp/all_headers/CMakeLists.txt" << 'CMAKE'
+cmake_minimum_required(VERSION 3.16)
+project(all_headers CXX)
+set(CMAKE_CXX_STANDARD 17)
+find_package(zcheck REQUIRED)
+add_executable(all_headers all_headers.cpp)
+target_link_libraries(all_headers PRIVATE zcheck::zcheck)
+CMAKE
+[[ $(grep -c '#include' "$tmp/all_headers/all_headers.cpp") -ge 30 ]]
+cmake -S "$tmp/all_headers" -B "$tmp/all_headers/build" -DCMAKE_PREFIX_PATH="$tmp/prefix" > "$tmp/all_configure.log" 2>&1 ||
+    { cat "$tmp/all_configure.log" >&2; exit 1; }
+cmake --build "$tmp/all_headers/build" > "$tmp/all_build.log" 2>&1 || { cat "$tmp/all_build.log" >&2; exit 1; }
+"$tmp/all_headers/build/all_headers"
 "$tmp/example/consistency_gate" > "$tmp/out.txt"
 [[ $(grep -c "CONSISTENT" "$tmp/out.txt") -eq 5 ]]
 ! grep -q "INCONSISTENT" "$tmp/out.txt"

@@ -407,7 +407,7 @@ TEST_CASE("near and far hug the scene as the camera sees it", "[import][clip]")
     CameraSpec spec;
     spec.projection = Projection::perspective(60, kPlaceholderNear, kPlaceholderFar);
     spec.view = View::lookAt({0, 0, 0}, {0, 0, -1}, {0, 1, 0});
-    const ClipPlanes planes = clipPlanesFor(scene, spec);
+    const SceneNearFar planes = sceneNearFar(scene, spec);
     REQUIRE(planes.near == Approx(4 * 0.99));
     REQUIRE(planes.far == Approx(9 * 1.01));
 
@@ -422,7 +422,7 @@ TEST_CASE("near and far hug the scene as the camera sees it", "[import][clip]")
     REQUIRE(given.projection.far == 50.0);
 
     spec.view = View::lookAt({0, 0, 40}, {0, 0, 41}, {0, 1, 0});  // beyond them all, looking away
-    REQUIRE_THROWS_WITH(clipPlanesFor(scene, spec), Catch::Contains("sees none of scene 'squares'"));
+    REQUIRE_THROWS_WITH(sceneNearFar(scene, spec), Catch::Contains("sees none of scene 'squares'"));
 }
 
 TEST_CASE("a camera written as COLMAP, nerfstudio, OpenCV or zcheck reads back as the same camera", "[import][roundtrip]")
@@ -518,11 +518,11 @@ TEST_CASE("near and far from the scene's triangle chunks equal a clip of every t
         spec.view = View::lookAt({along(random), up(random), along(random)}, {along(random) / 4, 0, along(random) / 4}, {0, 1, 0});
         const auto [lo, hi] = bruteForceEyeZRange(scene, Camera(spec));
         if (!(hi > 0)) {
-            REQUIRE_THROWS_WITH(clipPlanesFor(scene, spec), Catch::Contains("sees none of scene"));
+            REQUIRE_THROWS_WITH(sceneNearFar(scene, spec), Catch::Contains("sees none of scene"));
             continue;
         }
         ++seen;
-        const ClipPlanes planes = clipPlanesFor(scene, spec);
+        const SceneNearFar planes = sceneNearFar(scene, spec);
         INFO("camera " << i);
         REQUIRE(planes.far == Approx(hi * 1.01).epsilon(1e-9));
         REQUIRE(planes.near == Approx(std::max(lo * 0.99, planes.far * 1e-7)).epsilon(1e-9));

@@ -188,29 +188,6 @@ TEST_CASE("holes are failures unless allowed; allowed, they are counted and a fl
     REQUIRE(bestConsistent(verifier, camera, flipped) == "y-flip");
 }
 
-TEST_CASE("a map good only to a stated accuracy: accepted with it, and its option is named", "[declared]")
-{
-    const Room room;
-    const Checker checker(room.scene);
-    const MapVerifier verifier(checker);
-    const Camera camera(room.spec);
-    DepthMap map = truthMap(checker, camera, ExportQuantity::EyeZ);
-    for (double& v : map.value) v *= 1 - 4e-4;  // Eevee's Z pass: 4·10⁻⁴ short everywhere
-    REQUIRE_FALSE(consistent(verifier, camera, map));
-    bool named = false;
-    for (const Hypothesis& h : verifier.diagnose(camera, map))
-        named |= h.consistent && h.name == "tolerance" && h.explanation.find("--rel-tolerance 0.0005") != std::string::npos;
-    REQUIRE(named);
-    DepthMap declared = map;
-    declared.accuracy.relative = 5e-4;
-    REQUIRE(consistent(verifier, camera, declared));
-    declared.accuracy.relative = 3e-4;  // less than the map's error
-    REQUIRE_FALSE(consistent(verifier, camera, declared));
-    DepthMap absolute = map;
-    absolute.accuracy.absolute = 0.002;  // 4e-4 × 3.7 m = 1.5 mm at the farthest
-    REQUIRE(consistent(verifier, camera, absolute));
-}
-
 TEST_CASE("a noisy, quantized, holed RGB-D map: accepted with its options; flipped, distance or moved: rejected and named",
           "[declared]")
 {

@@ -157,6 +157,78 @@ std::optional<MapAccuracy> toleranceFinding(const Camera& camera, const DepthMap
     return out;
 }
 
+std::optional<NoiseFinding> noiseFinding(const Camera& camera, const DepthMap& map, const RenderResult& truth)
+{
+    if (map.quantity != DepthQuantity::EyeZ && map.quantity != DepthQuantity::Distance) return std::nullopt;
+    const int W = map.width, H = map.height;
+    std::vector<double> error(std::size_t(W) * H, NAN);
+    std::vector<double> z, e;  // the compared pixels' values and errors
+    for (int row = 0; row < H; ++row)
+        for (int col = 0; col < W; ++col) {
+            const std::size_t i = std::size_t(row) * W + col;
+            if (!truth.hit(i) || kindOfDepthValue(camera, map.quantity, map.value[i]) != DepthValueKind::Depth) continue;
+            const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
+            const double expected = depthValueFromEyeZ(
+                camera, pWindow, eyeZFromWindowDepth(camera, pWindow, truth.windowDepth.value[i]), map.quantity);
+            error[i] = map.value[i] - expected;
+            z.push_back(map.value[i]), e.push_back(error[i]);
+        }
+    if (e.size() < 256) return std::nullopt;
+    // Unbiased: the median well inside the robust spread.
+    const double centre = medianOf(e);
+    std::vector<double> deviation(e.size());
+    for (std::size_t k = 0; k < e.size(); ++k) deviation[k] = std::abs(e[k] - centre);
+    const double spread = 1.4826 * medianOf(deviation);
+    if (!(spread > 0) || !(std::abs(centre) <= 0.1 * spread)) return std::nullopt;
+    // Uncorrelated: each pixel's error against its right-hand neighbour's.
+    double both = 0, left = 0, right = 0;
+    for (int row = 0; row < H; ++row)
+        for (int col = 0; col + 1 < W; ++col) {
+            const double a = error[std::size_t(row) * W + col], b = error[std::size_t(row) * W + col + 1];
+            if (!std::isfinite(a) || !std::isfinite(b)) continue;
+            both += a * b, left += a * a, right += b * b;
+        }
+    NoiseFinding out;
+    out.correlation = left > 0 && right > 0 ? both / std::sqrt(left * right) : 1.0;
+    if (!(std::abs(out.correlation) < 0.3)) return std::nullopt;
+    // σ of eight bins of depth, and a + b·z² fitted to them by least squares with a, b ≥ 0.
+    std::vector<std::size_t> order(z.size());
+    for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return z[a] < z[b]; });
+    constexpr int kBins = 8;
+    std::vector<double> binZ2, binSigma;
+    for (int bin = 0; bin < kBins; ++bin) {
+        const std::size_t from = order.size() * bin / kBins, to = order.size() * (bin + 1) / kBins;
+        std::vector<double> zs, magnitudes;
+        for (std::size_t k = from; k < to; ++k) zs.push_back(z[order[k]]), magnitudes.push_back(std::abs(e[order[k]]));
+        const double zMedian = medianOf(zs);
+        binZ2.push_back(zMedian * zMedian), binSigma.push_back(1.4826 * medianOf(magnitudes));
+    }
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    for (int bin = 0; bin < kBins; ++bin)
+        sx += binZ2[bin], sy += binSigma[bin], sxx += binZ2[bin] * binZ2[bin], sxy += binZ2[bin] * binSigma[bin];
+    const double det = kBins * sxx - sx * sx;
+    double a = det > 0 ? (sxx * sy - sx * sxy) / det : sy / kBins, b = det > 0 ? (kBins * sxy - sx * sy) / det : 0;
+    if (b < 0) b = 0, a = sy / kBins;
+    if (a < 0) a = 0, b = sxx > 0 ? sxy / sxx : 0;
+    NoiseModel model{a, b, 0};
+    if (!model.any()) return std::nullopt;
+    // Scaled until 6σ bounds every pixel; noise has no outliers far beyond that.
+    double worst = 0;
+    for (std::size_t k = 0; k < e.size(); ++k) worst = std::max(worst, std::abs(e[k]) / model.allowance(std::abs(z[k])));
+    if (!(worst <= 1.5)) return std::nullopt;
+    const double factor = std::max(1.0, worst * 1.05);
+    auto roundedUp2 = [](double x) {  // two significant digits, up
+        if (!(x > 0)) return 0.0;
+        const double unit = std::pow(10.0, std::floor(std::log10(x)) - 1);
+        return std::ceil(x / unit * (1 - 1e-12)) * unit;
+    };
+    out.model = {roundedUp2(a * factor), roundedUp2(b * factor), 0};
+    std::sort(z.begin(), z.end());
+    out.zNear = z[z.size() / 20], out.zFar = z[z.size() - 1 - z.size() / 20];
+    return out;
+}
+
 std::string describeFindings(const ReadingFindings& f, const Declared& use)
 {
     std::string out;

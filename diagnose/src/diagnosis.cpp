@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <optional>
 #include <string>
 #include <utility>
@@ -63,6 +64,15 @@ public:
         judgeDeclaredReadings();
         if (std::none_of(out_.begin(), out_.end(), [](const Hypothesis& h) { return h.consistent; }))
             fitDepartures(map_, nullptr);
+        // What the map's values say it should have declared (its miss value, say) and a departure
+        // at once: Eevee's 65504 where nothing is hit and its Z pass 3.6·10⁻⁴ short.
+        if (!anyExplains() && found_.any()) {
+            const Declared alone{found_.missValue, found_.grid, false};
+            if (alone.any()) {
+                const ReadingLabel label{alone.name(), "", "consistent if read as declared: " + describeFindings(findings_, alone)};
+                fitDepartures(declaredReading(map_, findings_, alone), &label);
+            }
+        }
         const bool explained = anyExplains();
         if (!explained) {
             judgeReadingPairs();
@@ -88,7 +98,11 @@ private:
     // The continuous families (fit.h), fitted side by side, each confirmed by a full comparison;
     // not needed where a mistake of the catalogue explains the map whole. `reading` (a
     // catalogue reading of the map, or none) names the map fitted.
-    void fitDepartures(const DepthMap& fittedMap, const Candidate* reading);
+    // A re-reading's name, variant and explanation, for the hypotheses made on top of it.
+    struct ReadingLabel {
+        std::string name, variant, explanation;
+    };
+    void fitDepartures(const DepthMap& fittedMap, const ReadingLabel* reading);
     // Two mistakes at once (flipped and reversed, say), when no single one, no fit and no
     // edge-only reading explains the map: a reading of the map composed with a reading of the
     // map or of the camera, judged against the truth rendered for the latter.
@@ -252,7 +266,7 @@ void Diagnosis::judgeDeclaredReadings()
     out_.insert(out_.end(), judged.begin(), judged.end());
 }
 
-void Diagnosis::fitDepartures(const DepthMap& fittedMap, const Candidate* reading)
+void Diagnosis::fitDepartures(const DepthMap& fittedMap, const ReadingLabel* reading)
 {
     const TruthRender render = [&](const Camera& c, const RayFaults& faults) { return checker_.renderRay(c, faults); };
     const std::vector<FitFamily> families = fitFamilies(camera_, fittedMap);
@@ -266,8 +280,8 @@ void Diagnosis::fitDepartures(const DepthMap& fittedMap, const Candidate* readin
             // the map's rounding, far under half those under the declared camera.
             if (reading && !(fit.residual <= 0.5 * fit.initialResidual)) return;
             const Camera fittedCamera(departedCameraSpec(camera_, fit.departure));
-            Hypothesis h = reading ? hypothesis(reading->mistake->name + " + " + toString(families[k]), reading->reading.variant,
-                                                reading->reading.explanation + ", and with " + describeFit(camera_, fittedMap, fit))
+            Hypothesis h = reading ? hypothesis(reading->name + " + " + toString(families[k]), reading->variant,
+                                                reading->explanation + ", and with " + describeFit(camera_, fittedMap, fit))
                                    : hypothesis(toString(families[k]), "", "consistent with " + describeFit(camera_, fittedMap, fit));
             h.fitted = fittedValues(camera_, fittedMap, fit);
             fitted[k] = judge(std::move(h), fittedCamera, departedReading(camera_, fittedMap, fit.departure),
@@ -410,7 +424,8 @@ void Diagnosis::fitAfterClosestReading()
     const auto closest = std::min_element(residual.begin(), residual.end());
     if (closest != residual.end() && *closest < 0.5 * medianResidual(scene_, camera_, map_, truth_)) {
         const Candidate& reading = candidates_[std::size_t(closest - residual.begin())];
-        fitDepartures(*reading.reading.map, &reading);
+        const ReadingLabel label{reading.mistake->name, reading.reading.variant, reading.reading.explanation};
+        fitDepartures(*reading.reading.map, &label);
     }
 }
 
@@ -422,6 +437,27 @@ void Diagnosis::suggestTolerance()
     if (std::any_of(out_.begin(), out_.end(), [](const Hypothesis& h) { return explains(h) && h.name != "depth-scale"; }))
         return;
     const DepthMap read = declaredReading(map_, findings_, found_);
+    if (const std::optional<NoiseFinding> noise = noiseFinding(camera_, read, truth_)) {
+        DepthMap declared = read;
+        declared.accuracy.noise = noise->model;
+        auto sigma = [&](double z) {
+            char text[64];
+            std::snprintf(text, sizeof text, "%.3g at %.3g", noise->model.sigma(z), z);
+            return std::string(text);
+        };
+        Hypothesis h = judgeReading(
+            found_, declared,
+            "its errors are noise (unbiased, uncorrelated from pixel to pixel) with σ from " + sigma(noise->zNear) +
+                " to " + sigma(noise->zFar) + " (map units, z the map's value): pass --noise-model '" +
+                noise->model.text() + "' if that is your sensor's noise (each pixel may be off by 6σ(z); a noise model is "
+                "for noise, never for a convention mistake)");
+        h.name = h.name.empty() ? "noise" : h.name + " + noise";
+        h.fitted.push_back({"noise_a", noise->model.a, map_.accuracy.noise.a});
+        h.fitted.push_back({"noise_b", noise->model.b, map_.accuracy.noise.b});
+        const bool accepted = h.consistent;
+        out_.push_back(std::move(h));
+        if (accepted) return;
+    }
     const std::optional<MapAccuracy> accuracy = toleranceFinding(camera_, read, truth_);
     if (!accuracy) return;
     DepthMap declared = read;

@@ -94,6 +94,11 @@ DepthMapReading readingOf(const ReadingArguments& a)
     d.quantum = declared(a.quantum, "quantum", false);
     d.relative = declared(a.relTolerance, "rel_tolerance", true);
     d.absolute = declared(a.absTolerance, "abs_tolerance", false);
+    if (!a.noiseModel.is_none()) {
+        if (!py::isinstance<py::str>(a.noiseModel))
+            fail("noise_model must be a string: \"kinect\", \"A+B*z^2\" or \"A+B*(z-C)^2\"");
+        d.noise = NoiseModel::parse(a.noiseModel.cast<std::string>(), "noise_model");
+    }
     if (!a.allowHoles.is_none()) {
         if (!py::isinstance<py::bool_>(a.allowHoles)) fail("allow_holes must be True or False");
         d.allowHoles = a.allowHoles.cast<bool>();

@@ -68,12 +68,13 @@ std::optional<double> numberArgument(const py::object& value, const char* name);
 std::optional<int> sizeArgument(const py::object& value, const char* name);
 
 // The keyword arguments a map is read with, as a reading (depth_map_reading.h), checked as the
-// command line checks --miss, --scale, --offset, --quantum, --rel-tolerance, --abs-tolerance and
-// --allow-holes; a wrong type or value is a zcheck.Error naming the argument. `miss` is None, a
+// command line checks --miss, --scale, --offset, --quantum, --rel-tolerance, --abs-tolerance,
+// --allow-holes and --noise-model; a wrong type or value is a zcheck.Error naming the argument. `miss` is None, a
 // number, or a string ("65535", "nan", ">=1e9").
 struct ReadingArguments {
     py::object miss = py::none(), scale = py::none(), offset = py::none();
     py::object quantum = py::none(), relTolerance = py::none(), absTolerance = py::none(), allowHoles = py::none();
+    py::object noiseModel = py::none();  // a string: NoiseModel::parse's forms
 };
 DepthMapReading readingOf(const ReadingArguments& arguments);
 // The quantity argument: a required depth quantity's name (a zcheck.Error when None or not one).

@@ -77,10 +77,11 @@ MapArgument mapArgument(const Camera& camera, const py::object& depth, const py:
 std::unique_ptr<PyReport> verify(const PyChecker& self, const Camera& camera, py::object depth, const py::object& quantity,
                                  const py::object& miss, const py::object& scale, const py::object& offset,
                                  const py::object& quantum, const py::object& relTolerance, const py::object& absTolerance,
-                                 const py::object& allowHoles, bool diagnose, std::optional<int> threads)
+                                 const py::object& allowHoles, const py::object& noiseModel, bool diagnose,
+                                 std::optional<int> threads)
 {
     const MapArgument given =
-        mapArgument(camera, depth, quantity, {miss, scale, offset, quantum, relTolerance, absTolerance, allowHoles});
+        mapArgument(camera, depth, quantity, {miss, scale, offset, quantum, relTolerance, absTolerance, allowHoles, noiseModel});
     auto r = std::make_unique<PyReport>();
     r->verify = true;
     py::gil_scoped_release release;
@@ -93,10 +94,10 @@ std::unique_ptr<PyReport> verify(const PyChecker& self, const Camera& camera, py
 py::list diagnose(const PyChecker& self, const Camera& camera, py::object depth, const py::object& quantity,
                   const py::object& miss, const py::object& scale, const py::object& offset, const py::object& quantum,
                   const py::object& relTolerance, const py::object& absTolerance, const py::object& allowHoles,
-                  std::optional<int> threads)
+                  const py::object& noiseModel, std::optional<int> threads)
 {
     const MapArgument given =
-        mapArgument(camera, depth, quantity, {miss, scale, offset, quantum, relTolerance, absTolerance, allowHoles});
+        mapArgument(camera, depth, quantity, {miss, scale, offset, quantum, relTolerance, absTolerance, allowHoles, noiseModel});
     std::vector<Hypothesis> hypotheses;
     {
         py::gil_scoped_release release;
@@ -113,7 +114,8 @@ void bindMapQuestions(py::class_<PyChecker>& checker)
         .def("verify", &verify, py::arg("camera"), py::arg("depth"), py::arg("quantity") = py::none(), py::kw_only(),
              py::arg("miss") = py::none(), py::arg("scale") = py::none(), py::arg("offset") = py::none(),
              py::arg("quantum") = py::none(), py::arg("rel_tolerance") = py::none(), py::arg("abs_tolerance") = py::none(),
-             py::arg("allow_holes") = py::none(), py::arg("diagnose") = false, py::arg("threads") = py::none(),
+             py::arg("allow_holes") = py::none(), py::arg("noise_model") = py::none(), py::arg("diagnose") = false,
+             py::arg("threads") = py::none(),
              R"doc(A depth map rendered elsewhere against the ray route's ground truth: what `zcheck verify` does.
 
 depth:    (camera.height, camera.width) array, row 0 at the top, any float or integer dtype.
@@ -132,13 +134,18 @@ quantum:  the values were rounded to multiples of this (map units, after scale):
 rel_tolerance, abs_tolerance: the map is good only to ±(abs + rel·|value|) (map units): a
           rasterizer's reconstructed Z pass, a sensor; added to every pixel's tolerance.
 allow_holes: a pixel without a value where the surface is hit is a hole, counted in
-          report.to_dict()["pixels"]["holes"], not a failure.
+          report.to_dict()["pixels"]["holes"], not a failure (at most half of the surface).
+noise_model: a sensor's noise σ(z), z the map's value: "kinect", "A+B*z^2" or "A+B*(z-C)^2"
+          (map units); each pixel may be off by 6σ(z).
+What is declared absorbs rounding and noise, never a systematic error: the map's mean error must
+stay unbiased, a quantum must be the values' grid, and the accuracy under a tenth of the depth
+(docs/verify.md); a map that fails is inconsistent, to_dict()["declared_accuracy_refused"] says why.
 diagnose: when inconsistent, also run diagnose() and put it in the report (`--diagnose`).
 Returns a Report whose to_dict() is `zcheck verify --json`'s document (depth_map.file "<array>").)doc")
         .def("diagnose", &diagnose, py::arg("camera"), py::arg("depth"), py::arg("quantity") = py::none(), py::kw_only(),
              py::arg("miss") = py::none(), py::arg("scale") = py::none(), py::arg("offset") = py::none(),
              py::arg("quantum") = py::none(), py::arg("rel_tolerance") = py::none(), py::arg("abs_tolerance") = py::none(),
-             py::arg("allow_holes") = py::none(), py::arg("threads") = py::none(),
+             py::arg("allow_holes") = py::none(), py::arg("noise_model") = py::none(), py::arg("threads") = py::none(),
              R"doc(Every hypothesis of the mistake catalogue that applies to this camera and map, then every
 fitted family (sample-offset, field-of-view, near-far, depth-scale, intrinsics, pose), ranked:
 consistent ones first, then by unexplained pixels. Dicts {hypothesis, variant, explanation,

@@ -35,6 +35,7 @@ DatasetRunOptions runOptions(const std::string& scene, std::optional<std::string
     ReadingArguments arguments;
     arguments.quantum = declared["quantum"], arguments.relTolerance = declared["rel_tolerance"];
     arguments.absTolerance = declared["abs_tolerance"], arguments.allowHoles = declared["allow_holes"];
+    arguments.noiseModel = declared["noise_model"];
     o.accuracy = readingOf(arguments).accuracy;
     o.scene = scene;
     o.quantity = quantity.value_or("");
@@ -65,6 +66,7 @@ py::dict frameDict(const PyDataset& d, std::size_t index)
         if (declared.quantum > 0) reading["quantum"] = declared.quantum;
         if (declared.relative > 0) reading["rel_tolerance"] = declared.relative;
         if (declared.absolute > 0) reading["abs_tolerance"] = declared.absolute;
+        if (declared.noise.any()) reading["noise_model"] = declared.noise.text();
         if (declared.allowHoles) reading["allow_holes"] = true;
         out["quantity"] = plan.quantityName, out["reading"] = reading, out["scene"] = plan.scene;
         out["notes"] = plan.notes;

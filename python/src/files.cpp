@@ -23,13 +23,14 @@ PYBIND11_MODULE(_zcheck_files, m)
         [](const PyChecker& self, const Camera& camera, const std::string& path, const py::object& quantityArg,
            std::optional<std::string> channel, const py::object& miss, const py::object& scale, const py::object& offset,
            std::optional<std::string> sidecar, const py::object& quantum, const py::object& relTolerance,
-           const py::object& absTolerance, const py::object& allowHoles, bool diagnose, std::optional<int> threads) {
+           const py::object& absTolerance, const py::object& allowHoles, const py::object& noiseModel, bool diagnose,
+           std::optional<int> threads) {
             // Exactly `zcheck verify --depth-map PATH --quantity Q [--channel C] [--scale S]
             // [--offset O] [--miss M] [--quantum Q] [--rel-tolerance R] [--abs-tolerance A]
-            // [--allow-holes] [--diagnose]` (cli/verify.cpp).
+            // [--allow-holes] [--noise-model M] [--diagnose]` (cli/verify.cpp).
             std::string quantityName;
             const DepthQuantity quantity = quantityArgument(quantityArg, quantityName);
-            DepthMapReading reading = readingOf({miss, scale, offset, quantum, relTolerance, absTolerance, allowHoles});
+            DepthMapReading reading = readingOf({miss, scale, offset, quantum, relTolerance, absTolerance, allowHoles, noiseModel});
             reading.channel = channel ? *channel : "";
             reading.quantityChannel = channelNameOf(exportQuantityOf(quantity));
             if (sidecar) reading = withSidecar(reading, *sidecar);
@@ -49,7 +50,7 @@ PYBIND11_MODULE(_zcheck_files, m)
         py::arg("channel") = py::none(), py::arg("miss") = py::none(), py::arg("scale") = py::none(),
         py::arg("offset") = py::none(), py::arg("sidecar") = py::none(), py::arg("quantum") = py::none(),
         py::arg("rel_tolerance") = py::none(), py::arg("abs_tolerance") = py::none(), py::arg("allow_holes") = py::none(),
-        py::arg("diagnose") = false,
+        py::arg("noise_model") = py::none(), py::arg("diagnose") = false,
         py::arg("threads") = py::none(), R"doc(See zcheck.Checker.verify_file.)doc");
 
     m.def(

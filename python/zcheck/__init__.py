@@ -154,19 +154,20 @@ sidecar:  a JSON file whose "channel", "miss", "scale" and "offset" keys apply w
 
 
 def _verify_file(self, camera, path, quantity=None, *, channel=None, scale=None, offset=None, miss=None, sidecar=None,
-                 quantum=None, rel_tolerance=None, abs_tolerance=None, allow_holes=None, diagnose=False, threads=None):
+                 quantum=None, rel_tolerance=None, abs_tolerance=None, allow_holes=None, noise_model=None, diagnose=False,
+                 threads=None):
     """A depth map file against the ground truth, exactly as `zcheck verify --depth-map PATH --quantity Q
 [--channel C] [--scale S] [--offset O] [--miss M] [--sidecar F] [--quantum Q] [--rel-tolerance R]
-[--abs-tolerance A] [--allow-holes] [--diagnose]` does it: the file read as read_depth_map reads it
+[--abs-tolerance A] [--allow-holes] [--noise-model M] [--diagnose]` does it: the file read as read_depth_map reads it
 (channel, scale, offset, miss, sidecar), with the file's storage quantum (1/scale for integer files,
 binary16's or binary32's own step for float files) and what the map declares (quantum, rel_tolerance,
-abs_tolerance, allow_holes: see Checker.verify). to_dict() equals `zcheck verify --json`'s document but
+abs_tolerance, allow_holes, noise_model: see Checker.verify). to_dict() equals `zcheck verify --json`'s document but
 for timings; its depth_map entry names the channel read.
     """
     return _files().verify_file(self, camera, str(path), quantity, channel=channel, miss=miss, scale=scale,
                                 offset=offset, sidecar=None if sidecar is None else str(sidecar), quantum=quantum,
                                 rel_tolerance=rel_tolerance, abs_tolerance=abs_tolerance, allow_holes=allow_holes,
-                                diagnose=diagnose, threads=threads)
+                                noise_model=noise_model, diagnose=diagnose, threads=threads)
 
 
 _verify_file.__name__ = _verify_file.__qualname__ = "verify_file"

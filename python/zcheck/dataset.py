@@ -34,8 +34,8 @@ def _files():
 
 
 _OPTIONS = ("quantity", "depth", "camera_format", "scale", "offset", "miss", "channel", "near", "far", "convention",
-            "quantum", "rel_tolerance", "abs_tolerance", "allow_holes")
-_DECLARED = ("quantum", "rel_tolerance", "abs_tolerance", "allow_holes")
+            "quantum", "rel_tolerance", "abs_tolerance", "noise_model", "allow_holes")
+_DECLARED = ("quantum", "rel_tolerance", "abs_tolerance", "noise_model", "allow_holes")
 
 
 class Frame:
@@ -47,7 +47,7 @@ class Frame:
     quantity     "window", "ndc", "eye-z" or "distance"
     reading      the keyword arguments Checker.verify_file and read_depth_map take for it
                  (channel, scale, offset, miss, and what the map declares: quantum, rel_tolerance,
-                 abs_tolerance, allow_holes), as the frame reads its map
+                 abs_tolerance, noise_model, allow_holes), as the frame reads its map
     scene        the scene's name or path
     error        why the frame cannot be verified ("" when it can): a camera the file refused,
                  a malformed manifest line

@@ -38,6 +38,7 @@ std::string frameRecordJson(const FrameResult& r)
         record["depth_error"] = reportjson::depthErrorJson(r.report);
         record["map_errors"] = reportjson::mapErrorsJson(r.report);
         record["out_of_range"] = reportjson::outOfRangeJson(r.report);
+        record["declared_accuracy_refused"] = reportjson::declaredRefusedJson(r.report);
         record["unexplained"] = reportjson::unexplainedJson(r.report, false);
         record["warnings"] = r.report.warnings;
     }
@@ -113,6 +114,8 @@ FrameRecord recordFrom(const json& j, const std::string& where)
         r.p99RelativeEyeZ = number(e, "p99_relative_eye_z");
     }
     if (j.contains("unexplained")) r.unexplained = std::int64_t(number(j["unexplained"], "count"));
+    if (j.contains("declared_accuracy_refused") && j["declared_accuracy_refused"].is_string())
+        r.declaredRefused = j["declared_accuracy_refused"].get<std::string>();
     if (j.contains("diagnosis") && j["diagnosis"].is_array())
         for (const json& h : j["diagnosis"])
             if (h.is_object() && h.contains("hypothesis") && h["hypothesis"].is_string()) {
@@ -194,7 +197,7 @@ DatasetSummary summarizeResults(const std::vector<ResultsFile>& files)
     // The dataset's verdict, once, when most frames fail the same way.
     for (const auto& [name, count] : s.byMistake)
         if (2 * count > s.recorded) {
-            s.verdict = std::to_string(count) + " of " + std::to_string(s.recorded) + " frames " +
+            s.diagnosis = std::to_string(count) + " of " + std::to_string(s.recorded) + " frames " +
                         (explanationOf[name].empty() ? "are explained by " + name : explanationOf[name]) + " (" + name + ")";
         }
     std::vector<FrameRecord> failing;
@@ -239,12 +242,18 @@ std::string datasetSummaryText(const DatasetSummary& s)
                           r.explainedBy.empty() ? "" : "; consistent if ",
                           r.explainedBy.empty() ? "" : r.explainedBy.front().c_str());
             out << line;
+            if (!r.declaredRefused.empty()) out << "           declared accuracy refused: " << r.declaredRefused << "\n";
         }
     }
-    if (!s.verdict.empty()) out << "diagnosis  " << s.verdict << "\n";
-    const bool all = s.missing.empty() && s.consistent == s.frames;
-    out << "verdict    " << (all ? "CONSISTENT (every frame)" : s.missing.empty() ? "INCONSISTENT" : "INCOMPLETE") << "\n";
+    if (!s.diagnosis.empty()) out << "diagnosis  " << s.diagnosis << "\n";
+    out << "verdict    " << datasetVerdict(s) << (datasetVerdict(s) == "CONSISTENT" ? " (every frame)" : "") << "\n";
     return out.str();
+}
+
+std::string datasetVerdict(const DatasetSummary& s)
+{
+    if (!s.missing.empty()) return "INCOMPLETE";
+    return s.frames > 0 && s.consistent == s.frames ? "CONSISTENT" : "INCONSISTENT";
 }
 
 std::string datasetSummaryJson(const DatasetSummary& s)
@@ -265,7 +274,8 @@ std::string datasetSummaryJson(const DatasetSummary& s)
                        {"missing", s.missing},
                        {"duplicates", s.duplicates},
                        {"by_mistake", byMistake},
-                       {"verdict", s.verdict.empty() ? json(nullptr) : json(s.verdict)},
+                       {"verdict", datasetVerdict(s)},
+                       {"diagnosis", s.diagnosis.empty() ? json(nullptr) : json(s.diagnosis)},
                        {"worst", worst}});
 }
 
@@ -343,7 +353,7 @@ std::string datasetReportHtml(const DatasetSummary& s, const FramePictureMaker& 
     html << "<h1>zcheck dataset report</h1>\n<p>" << escaped(s.source) << ": " << s.frames << " frames</p>\n";
     html << "<h2 class='" << (all ? "good'>CONSISTENT: every frame" : s.missing.empty() ? "bad'>INCONSISTENT" : "bad'>INCOMPLETE")
          << "</h2>\n";
-    if (!s.verdict.empty()) html << "<p><b>" << escaped(s.verdict) << "</b></p>\n";
+    if (!s.diagnosis.empty()) html << "<p><b>" << escaped(s.diagnosis) << "</b></p>\n";
     html << "<table><tr><th>frames recorded</th><td>" << s.recorded << "</td></tr><tr><th>consistent</th><td>" << s.consistent
          << "</td></tr><tr><th>inconsistent</th><td>" << s.inconsistent << "</td></tr><tr><th>not verified (errors)</th><td>"
          << s.errors << "</td></tr><tr><th>missing</th><td>" << s.missing.size() << "</td></tr><tr><th>recorded twice</th><td>"

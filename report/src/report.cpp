@@ -120,6 +120,12 @@ nlohmann::json mapErrorsJson(const CheckReport& r)
             {"worst_pixel", {{"col", e.worstCol}, {"row", e.worstRow}, {"map", e.worstMap}, {"true", e.worstTrue}}}};
 }
 
+nlohmann::json declaredRefusedJson(const CheckReport& r)
+{
+    const std::string& why = r.comparison.declaredAccuracyRefused;
+    return why.empty() ? nlohmann::json(nullptr) : nlohmann::json(why);
+}
+
 nlohmann::json outOfRangeJson(const CheckReport& r)
 {
     const ComparisonReport& c = r.comparison;
@@ -134,7 +140,7 @@ nlohmann::json depthMapJson(const DepthMapSource& source)
     return {{"file", source.file},
             {"quantity", source.quantity},
             {"channel", source.channel},
-            {"scale", r.scale},
+            {"scale", r.scale > 0 ? nlohmann::json(r.scale) : nlohmann::json(nullptr)},  // null: none given
             {"offset", r.offset},
             {"miss", r.miss.given() ? nlohmann::json(r.miss.text()) : nlohmann::json(nullptr)},
             {"declared", toJson(r.accuracy)}};
@@ -189,6 +195,7 @@ nlohmann::json toJson(const CheckReport& report)
         document["timings_ms"].erase("tile_by_tile");
         document["map_errors"] = mapErrorsJson(report);
         document["out_of_range"] = outOfRangeJson(report);
+        document["declared_accuracy_refused"] = declaredRefusedJson(report);
     }
     return document;
 }
@@ -211,9 +218,15 @@ std::string formatSummary(const CheckReport& report, const std::string& comparin
                   toString(cam.projection.type).c_str(), cam.width, cam.height, cam.projection.near,
                   cam.projection.far);
     out << line;
-    std::snprintf(line, sizeof line, "depth      %s%s, range [%g, %g]; tolerance C = %g q, S = 2^-%d px\n",
-                  toString(cam.depth.format).c_str(), cam.depth.reversed ? ", reversed-Z" : "", cam.depth.rangeMin,
-                  cam.depth.rangeMax, report.tolerance.constantFor(cam.depth), report.tolerance.subpixelBits);
+    if (report.tolerance.storageConstant > 0)  // an eye-z or distance map: its own storage, not the camera's buffer
+        std::snprintf(line, sizeof line,
+                      "depth      the map's own storage (and a linearized binary32 buffer's step); tolerance C = %g q, "
+                      "S = 2^-%d px\n",
+                      report.tolerance.storageConstant, report.tolerance.subpixelBits);
+    else
+        std::snprintf(line, sizeof line, "depth      %s%s, range [%g, %g]; tolerance C = %g q, S = 2^-%d px\n",
+                      toString(cam.depth.format).c_str(), cam.depth.reversed ? ", reversed-Z" : "", cam.depth.rangeMin,
+                      cam.depth.rangeMax, report.tolerance.constantFor(cam.depth), report.tolerance.subpixelBits);
     out << line;
     if (const MapAccuracy& d = report.declared; d.any()) {
         std::string declared;
@@ -221,6 +234,7 @@ std::string formatSummary(const CheckReport& report, const std::string& comparin
         if (d.quantum > 0) add("values rounded to " + formatNumber(d.quantum));
         if (d.relative > 0 || d.absolute > 0)
             add("good to ±(" + formatNumber(d.absolute) + " + " + formatNumber(d.relative) + "·|value|), added to each tolerance");
+        if (d.noise.any()) add("noise σ(z) = " + d.noise.text() + ", 6σ added to each tolerance");
         if (d.allowHoles) add("holes allowed");
         out << "declared   " << declared << " (" << d.options() << ")\n";
     }
@@ -279,6 +293,8 @@ std::string formatSummary(const CheckReport& report, const std::string& comparin
                       e.worstMap, e.worstTrue);
         out << line;
     }
+    if (!c.declaredAccuracyRefused.empty())
+        out << "\ndeclared accuracy REFUSED: " << c.declaredAccuracyRefused << "\n";
     if (c.unexplained() > 0) {
         std::snprintf(line, sizeof line, "\nunexplained pixels: %lld within cols %d..%d, rows %d..%d; first:\n",
                       static_cast<long long>(c.unexplained()), c.unexplainedMinCol, c.unexplainedMaxCol,

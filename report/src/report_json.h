@@ -16,6 +16,7 @@ nlohmann::json depthErrorJson(const CheckReport& r);                  // "depth_
 nlohmann::json unexplainedJson(const CheckReport& r, bool samples);  // "unexplained": count, box[, samples]
 nlohmann::json mapErrorsJson(const CheckReport& r);                   // "map_errors" (verify; null: nothing compared)
 nlohmann::json outOfRangeJson(const CheckReport& r);                  // "out_of_range" (verify)
+nlohmann::json declaredRefusedJson(const CheckReport& r);             // "declared_accuracy_refused" (verify): why, or null
 nlohmann::json depthMapJson(const DepthMapSource& source);                 // "depth_map"
 nlohmann::json hypothesisJson(const Hypothesis& h);                        // one entry of "diagnosis"
 

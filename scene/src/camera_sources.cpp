@@ -75,7 +75,7 @@ bool clippedRange(const ClipVertex (&corner)[3], double& lo, double& hi)
 
 }  // namespace
 
-ClipPlanes clipPlanesFor(const Scene& scene, const CameraSpec& spec)
+SceneNearFar sceneNearFar(const Scene& scene, const CameraSpec& spec)
 {
     const Camera camera(spec);  // its near and far may be placeholders: the side planes do not depend on them
     const glm::dmat4 clipFromWorld = camera.clipFromEye * camera.eyeFromWorld;
@@ -149,7 +149,7 @@ ClipPlanes clipPlanesFor(const Scene& scene, const CameraSpec& spec)
     if (!(hi > 0))
         throw Error("the camera sees none of scene '" + scene.name +
                     "', so near and far cannot be taken from it (is the pose inverted, or in other axes?)");
-    ClipPlanes planes;
+    SceneNearFar planes;
     planes.far = hi * 1.01;
     planes.near = lo * 0.99;
     const double floor = planes.far * 1e-7;
@@ -189,11 +189,11 @@ CameraSpec completeCamera(const ImportedCamera& camera, const Scene* scene, cons
             if (!scene && !given.mapEyeZ)
                 throw Error("camera '" + camera.name +
                             "' has no near and far in its file, and there is no scene to take them from: give near and far");
-            std::optional<ClipPlanes> planes;
+            std::optional<SceneNearFar> planes;
             std::string sceneFailure;
             if (scene) {
                 try {
-                    planes = clipPlanesFor(*scene, spec);
+                    planes = sceneNearFar(*scene, spec);
                 } catch (const Error& e) {
                     sceneFailure = e.what();
                 }
@@ -203,7 +203,7 @@ CameraSpec completeCamera(const ImportedCamera& camera, const Scene* scene, cons
             std::string from = "the scene as the camera sees it";
             if (given.mapEyeZ) {  // the map's depths too: what the renderer saw must not be clipped
                 const double lo = given.mapEyeZ->first * 0.99, hi = given.mapEyeZ->second * 1.01;
-                ClipPlanes widened = planes.value_or(ClipPlanes{lo, hi, ""});
+                SceneNearFar widened = planes.value_or(SceneNearFar{lo, hi, ""});
                 widened.near = std::max(std::min(widened.near, lo), hi * 1e-7);
                 widened.far = std::max(widened.far, hi);
                 planes = widened;

@@ -17,9 +17,9 @@ def test_ray_render_verifies_and_its_flip_does_not(default_checker, small_camera
     report = default_checker.verify(small_camera, z, "eye-z")
     assert report.consistent and report.unexplained == 0 and report.both_hit > 0.5 * W * H
     doc = report.to_dict()
-    assert doc["depth_map"] == {"file": "<array>", "quantity": "eye-z", "channel": "", "scale": 0.0, "offset": 0.0,
+    assert doc["depth_map"] == {"file": "<array>", "quantity": "eye-z", "channel": "", "scale": None, "offset": 0.0,
                                 "miss": None, "declared": {"quantum": 0.0, "rel_tolerance": 0.0, "abs_tolerance": 0.0,
-                                                           "allow_holes": False}}
+                                                           "noise_model": None, "allow_holes": False}}
     assert "diagnosis" not in doc
 
     flipped = z[::-1]
@@ -223,9 +223,45 @@ def test_declared_reading_accepts_real_world_maps_and_the_diagnosis_names_the_op
     hole = zcheck.pixel_classes.index("hole")
     assert (allowed.pixel_classes == hole).sum() == allowed.to_dict()["pixels"]["holes"]
 
+    # A uniform scale is systematic: no tolerance absorbs it; unbiased errors of its size are an accuracy.
     short = z * (1 - 4e-4)
-    assert default_checker.verify(small_camera, short, "eye-z", rel_tolerance=5e-4).consistent
-    assert not default_checker.verify(small_camera, short, "eye-z", rel_tolerance=2e-4).consistent
+    refused = default_checker.verify(small_camera, short, "eye-z", rel_tolerance=5e-4)
+    assert not refused.consistent and "systematic" in refused.to_dict()["declared_accuracy_refused"]
+    jitter = z * (1 + np.random.default_rng(3).uniform(-4e-4, 4e-4, z.shape))
+    assert default_checker.verify(small_camera, jitter, "eye-z", rel_tolerance=5e-4).consistent
+    assert default_checker.verify(small_camera, jitter, "eye-z", rel_tolerance=5e-4).to_dict()[
+        "declared_accuracy_refused"] is None
+    assert not default_checker.verify(small_camera, jitter, "eye-z", rel_tolerance=2e-4).consistent
+
+
+def test_regression_quantum_5_accepted_metres_read_as_millimetres(default_checker, small_camera):
+    """nerfstudio's default scale 1000 on a float map in metres, and the --quantum 5 the diagnosis
+    used to suggest for it: every keyword declaration goes through the one acceptance rule."""
+    z = default_checker.render(small_camera, "eye-z")
+    tiny = z / 1000
+    for declared in ({"quantum": 5}, {"quantum": 1}, {"abs_tolerance": 5}, {"rel_tolerance": 0.9},
+                     {"noise_model": "5+0*z^2"}, {"quantum": 5, "allow_holes": True}):
+        report = default_checker.verify(small_camera, tiny, "eye-z", **declared)
+        assert not report.consistent, declared
+        assert report.to_dict()["declared_accuracy_refused"], declared
+    for h in default_checker.diagnose(small_camera, tiny, "eye-z"):
+        assert not (h["consistent"] and any(part in h["hypothesis"] for part in ("quantum", "tolerance", "noise")))
+
+
+def test_noise_model_accepts_a_noisy_map_and_not_its_flip_or_its_scale(default_checker, small_camera):
+    z = default_checker.render(small_camera, "eye-z").astype(np.float64)
+    sigma = 0.002 + 0.0001 * z ** 2  # a sensor's noise growing with depth (map units)
+    noisy = z + sigma * np.random.default_rng(7).standard_normal(z.shape)
+    assert not default_checker.verify(small_camera, noisy, "eye-z").consistent
+    model = "0.002+0.0001*z^2"
+    report = default_checker.verify(small_camera, noisy, "eye-z", noise_model=model)
+    assert report.consistent and report.to_dict()["depth_map"]["declared"]["noise_model"] == model
+    assert not default_checker.verify(small_camera, noisy[::-1], "eye-z", noise_model=model).consistent
+    scaled = default_checker.verify(small_camera, noisy * 1.01, "eye-z", noise_model=model)
+    assert not scaled.consistent and "systematic" in scaled.to_dict()["declared_accuracy_refused"]
+    # undeclared, the diagnosis answers it with a noise model, first
+    best = default_checker.diagnose(small_camera, noisy, "eye-z")[0]
+    assert best["consistent"] and best["hypothesis"] == "noise" and "--noise-model '" in best["explanation"]
 
 
 @pytest.mark.parametrize("call, message", [
@@ -236,6 +272,8 @@ def test_declared_reading_accepts_real_world_maps_and_the_diagnosis_names_the_op
     (lambda c, cam, z: c.verify(cam, z, "eye-z", quantum=-1), "quantum must be a finite number >= 0"),
     (lambda c, cam, z: c.verify(cam, z, "eye-z", rel_tolerance=1.5), "rel_tolerance must be a finite number >= 0 and below 1"),
     (lambda c, cam, z: c.verify(cam, z, "eye-z", allow_holes=1), "allow_holes must be True or False"),
+    (lambda c, cam, z: c.verify(cam, z, "eye-z", noise_model=0.01), "noise_model must be a string"),
+    (lambda c, cam, z: c.verify(cam, z, "eye-z", noise_model="gauss"), "noise_model must be kinect, A+B*z^2"),
     (lambda c, cam, z: c.diagnose(cam, z), "quantity is required"),
 ])
 def test_wrong_arguments_raise_one_line_naming_the_argument(default_checker, small_camera, call, message):

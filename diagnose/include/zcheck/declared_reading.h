@@ -17,7 +17,14 @@
 //   holes       pixels without a value where the truth hits that the comparison leaves
 //               unexplained once the miss value above is read as one (MapVerifier::diagnose
 //               counts them).
-//   tolerance   only where no convention explains the map (MapVerifier::diagnose asks last): an
+//   noise       only where no convention explains the map (MapVerifier::diagnose asks last): an
+//               eye-z or distance map whose errors (map − truth, 256 pixels or more) are noise —
+//               unbiased (|median| ≤ 0.1 of their robust spread, 1.4826·MAD), uncorrelated from
+//               each pixel to its right-hand neighbour (correlation under 0.3) and, within 1.5 ×,
+//               bounded by 6 σ(z) of a model σ(z) = a + b·z² (z the map's value) fitted to the
+//               spread of eight depth bins; the model is scaled up until it bounds every pixel
+//               and suggested as --noise-model, two significant digits rounded up.
+//   tolerance   where the errors are not noise, likewise: an
 //               eye-z or distance map whose values where both see a surface lie within a small
 //               relative (≤ 1 %) or absolute error of the truth; the more uniform of the two
 //               (largest over median) is suggested, rounded up to one significant digit.
@@ -59,6 +66,14 @@ DepthMap declaredReading(const DepthMap& map, const ReadingFindings& findings, c
 // A stated accuracy that would accept `map` (relative or absolute, the other 0), or nothing:
 // see above. `truth` is the declared camera's.
 std::optional<MapAccuracy> toleranceFinding(const Camera& camera, const DepthMap& map, const RenderResult& truth);
+
+// A sensor's noise in the map's errors, as above, or nothing.
+struct NoiseFinding {
+    NoiseModel model;
+    double zNear = 0, zFar = 0;      // the 5th and 95th percentiles of the map's values compared
+    double correlation = 0;          // of neighbouring pixels' errors
+};
+std::optional<NoiseFinding> noiseFinding(const Camera& camera, const DepthMap& map, const RenderResult& truth);
 
 // "the map holds 1e10 at all 54,155 pixels where nothing is hit: its miss value (pass --miss '>=1e9')",
 // and likewise for the grid and holes: one clause per finding `use` names.

@@ -201,19 +201,25 @@ struct EdgeTally {
 };
 EdgeTally tallyEdges(const Camera& camera, const RenderResult& truth, const RenderResult& map, const Comparison& comparison);
 
-// A map's declared accuracy (MapAccuracy::anyAccuracy) judged as a whole, over the pixels a
-// comparison compared on depth (Agree, DepthError), in the map's own units: what no pixel's
+// A map's declarations (MapAccuracy) judged as a whole, over the pixels a
+// comparison compared on depth (Agree, DepthError), in the map's own units (`mapRender`: the
+// map as renderResultFromMap read it, the surface each pixel saw): what no pixel's
 // tolerance can see. Sets report.declaredAccuracyRefused, which makes the map inconsistent:
+//   holes   where holes are allowed, they are at most half the pixels where the truth sees a surface;
 //   grid    a declared quantum Q is the grid the values were rounded to: ≥ 99 % of them (less
 //           the offset) lie within 1/1000 of Q (or four binary32 spacings) of a multiple of Q;
 //   coarse  the declared accuracy at the median pixel is under a tenth of its depth (in eye-z):
 //           a grid or tolerance as coarse as the depths accepts any map of the right order;
-//   bias    rounding and noise are unbiased: with 16 pixels or more, |median(map − truth)| is
-//           within median(C·q + S·m + E) — the tolerance a map declaring nothing has, which a
-//           consistent one's median never exceeds — plus a quarter of the median declared accuracy.
+//   bias    rounding and noise are unbiased: over the pixels where the map shows the truth's own
+//           surface (256 or more), |mean(map − truth)| — the truth rounded to the declared grid,
+//           if any, so that a rounding's own error is no bias — is within the median of C·q + S·m
+//           + E (the tolerance of a map declaring nothing) plus six times the mean's sampling
+//           error (the spread of the means of 16 interleaved samples, over 4). A declared
+//           tolerance or noise absorbs no bias: a map 4·10⁻⁴ short everywhere is a scale mistake
+//           whatever --rel-tolerance says, and one a centimetre far is an offset under any grid.
 // A map declaring no accuracy is left as it is: its per-pixel tolerance bounds its median.
 void judgeDeclaredAccuracy(const PixelJudge& judge, const DepthMap& map, const RenderResult& truth,
-                           const std::vector<double>& quantum, Comparison& comparison);
+                           const RenderResult& mapRender, const std::vector<double>& quantum, Comparison& comparison);
 
 // The map's errors in its own units (report.mapErrors, mapError per pixel), from a comparison
 // of it: MapVerifier::verify's last step (a diagnosis's readings skip it).

@@ -45,6 +45,7 @@ struct FrameRecord {
     std::vector<std::string> explainedBy;    // hypothesis names that make it consistent, best first
     std::vector<std::string> explanations;   // their explanations
     std::string closest;                     // the best hypothesis when none explains it
+    std::string declaredRefused;             // why the reading's declarations were refused ("" if not)
     double seconds = 0;
     std::string file;                        // the results file and line it was read from
     std::size_t line = 0;
@@ -71,7 +72,7 @@ struct DatasetSummary {
     std::vector<std::size_t> missing;                  // indices without a record
     std::vector<std::string> duplicates;               // "frame 'x' (index 3): a.jsonl line 4, b.jsonl line 9"
     std::map<std::string, std::size_t> byMistake;      // best explaining hypothesis → inconsistent frames
-    std::string verdict;                               // one sentence when most frames fail the same way; ""
+    std::string diagnosis;                             // one sentence when most frames fail the same way; ""
     std::vector<FrameRecord> worst;                    // failing frames, worst first (at most 12)
     std::vector<FrameRecord> all;                      // every counted record, by index
     double seconds = 0;                                // the frames' wall time, summed
@@ -80,8 +81,10 @@ struct DatasetSummary {
 DatasetSummary summarizeResults(const std::vector<ResultsFile>& files);
 
 std::string datasetSummaryText(const DatasetSummary& summary);
+// "CONSISTENT" (every frame of a non-empty dataset), "INCONSISTENT", or "INCOMPLETE" (frames missing).
+std::string datasetVerdict(const DatasetSummary& summary);
 // source, frames, recorded, consistent, inconsistent, errors, missing, duplicates, by_mistake,
-// verdict, worst: what the results say, not how long they took (so that a sharded run and a
+// verdict (datasetVerdict), diagnosis (the sentence, or null), worst: what the results say, not how long they took (so that a sharded run and a
 // single process give the same document).
 std::string datasetSummaryJson(const DatasetSummary& summary);
 

@@ -11,7 +11,7 @@
 // only to clip (and to map window depth), so, unless given, they hug the scene as seen from
 // the camera: near and far are the smallest and largest eye-z of the scene's triangles
 // clipped to the camera's view (its four side planes and the eye plane), less and more 1 %
-// (clipPlanesFor). A window or NDC map depends on near and far: give the renderer's.
+// (sceneNearFar). A window or NDC map depends on near and far: give the renderer's.
 #include "zcheck/camera_import.h"
 #include "zcheck/image_io.h"
 #include "zcheck/quantity.h"
@@ -35,13 +35,13 @@ CameraSet openCameraSet(const std::string& path, std::optional<CameraFormat> for
 // "nodes[i]"; the camera's own name is an alias.
 CameraSet readGltfCameras(const std::string& path);
 
-struct ClipPlanes {
+struct SceneNearFar {
     double near = 0, far = 0;
     std::string note;  // what was assumed, for the report ("" when the scene decided alone)
 };
 // Near and far hugging `scene` as `spec`'s camera sees it (the header's rule); near is held at
 // far·1e-7 or more. Throws Error when the camera sees none of the scene.
-ClipPlanes clipPlanesFor(const Scene& scene, const CameraSpec& spec);
+SceneNearFar sceneNearFar(const Scene& scene, const CameraSpec& spec);
 
 // What the user gives beside a camera file (--near, --far, --width, --height, a depth map's size),
 // and the eye-z range a depth map holds (its eye-z values, or its distances times the cosine of
@@ -57,7 +57,7 @@ ImportedCamera importCamera(const std::string& reference, std::optional<CameraFo
 
 // An imported camera made usable: the image size (`given`'s — a depth map's, --width and
 // --height — else the file's, else a default of 640 wide, noted), near and far (`given`'s,
-// else the file's, else clipPlanesFor `scene` widened to the map's eye-z range; only the map's
+// else the file's, else sceneNearFar `scene` widened to the map's eye-z range; only the map's
 // when the camera sees none of the scene, as a wrong pose does), each assumption added to its
 // notes. Throws Error for a camera the file refused (ImportedCamera::refusal), one whose near
 // and far are unknown (no scene, or one it does not see, and no map), and one that cannot be built.

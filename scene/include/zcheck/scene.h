@@ -36,7 +36,7 @@ struct PolygonPlanarity {
 };
 
 // Bounding boxes of runs of consecutive triangles (meshes keep neighbours close), so that a
-// question about the whole scene seen from a camera (camera_sources.h's clipPlanesFor) can skip
+// question about the whole scene seen from a camera (camera_sources.h's sceneNearFar) can skip
 // what cannot change its answer. Made once per scene (indexTriangleChunks).
 struct TriangleChunks {
     static constexpr std::size_t kSize = 1024;  // triangles per chunk; the last may hold fewer
