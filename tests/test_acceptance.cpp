@@ -11,6 +11,7 @@
 #include "zcheck/inverse_projection.h"
 
 #include "diagnosis_helpers.h"
+#include "room.h"
 
 #include <catch2/catch.hpp>
 
@@ -22,23 +23,9 @@
 
 using namespace zcheck;
 using testing::mapOf;
+using testing::RoomVerifier;
 
 namespace {
-
-// The builtin scene shrunk ten times (0.36 .. 3.7 m from the eye), 200×150: a room an RGB-D
-// sensor sees.
-struct Room {
-    Scene scene = builtinScene("builtin:default");
-    CameraSpec spec;
-    Room()
-    {
-        for (glm::vec3& p : scene.positions) p *= 0.1f;
-        spec = scene.defaultCamera;
-        spec.view.eye *= 0.1, spec.view.target *= 0.1;
-        spec.projection.near *= 0.1, spec.projection.far *= 0.1;
-        spec.width = 200, spec.height = 150;
-    }
-};
 
 const ComparisonReport& verdictOf(const VerifyResult& run) { return run.comparison.report; }
 
@@ -52,6 +39,16 @@ DepthMap rounded(DepthMap map, double q)
 {
     for (double& v : map.value)
         if (std::isfinite(v)) v = double(float(std::round(v / q) * q));
+    return map;
+}
+
+// Each value off by a uniform error in ±amplitude, or ±amplitude·|value| when `relative`.
+DepthMap uniformlyOff(DepthMap map, double amplitude, bool relative, unsigned seed)
+{
+    std::mt19937 random(seed);
+    std::uniform_real_distribution<double> uniform(-amplitude, amplitude);
+    for (double& v : map.value)
+        if (std::isfinite(v)) v += uniform(random) * (relative ? std::abs(v) : 1.0);
     return map;
 }
 
@@ -83,11 +80,10 @@ bool isDeclaration(const std::string& name)
 
 TEST_CASE("regression: --quantum 5 accepted a float map in metres read with nerfstudio's scale 1000", "[acceptance]")
 {
-    const Room room;
-    const Checker checker(room.scene);
-    const MapVerifier verifier(checker);
-    const Camera camera(room.spec);
-    DepthMap map = mapOf(checker.scene(), camera, checker.renderRay(camera), ExportQuantity::EyeZ);
+    const RoomVerifier room;
+    const MapVerifier& verifier = room.verifier;
+    const Camera& camera = room.camera;
+    DepthMap map = room.truth(ExportQuantity::EyeZ);
     REQUIRE(accepted(verifier, camera, map));
     for (double& v : map.value) v /= 1000;  // metres read as millimetres
     REQUIRE_FALSE(accepted(verifier, camera, map));
@@ -110,11 +106,10 @@ TEST_CASE("regression: --quantum 5 accepted a float map in metres read with nerf
 
 TEST_CASE("regression: --quantum 0.1 accepted a distance map declared as eye-z", "[acceptance]")
 {
-    const Room room;
-    const Checker checker(room.scene);
-    const MapVerifier verifier(checker);
-    const Camera camera(room.spec);
-    DepthMap distance = mapOf(checker.scene(), camera, checker.renderRay(camera), ExportQuantity::Distance);
+    const RoomVerifier room;
+    const MapVerifier& verifier = room.verifier;
+    const Camera& camera = room.camera;
+    DepthMap distance = room.truth(ExportQuantity::Distance);
     distance.quantity = DepthQuantity::EyeZ;  // declared eye-z, holds distance
     REQUIRE_FALSE(accepted(verifier, camera, distance));
     DepthMap declared = distance;
@@ -133,26 +128,20 @@ TEST_CASE("regression: --quantum 0.1 accepted a distance map declared as eye-z",
 
 TEST_CASE("regression: an eye-z map's tolerance depended on the camera's depth format and reversal", "[acceptance]")
 {
-    const Room room;
-    const Checker checker(room.scene);
-    const MapVerifier verifier(checker);
-    const Camera camera(room.spec);
-    const DepthMap exact = mapOf(checker.scene(), camera, checker.renderRay(camera), ExportQuantity::EyeZ);
-    // ±7 mm of uniform error.
-    DepthMap off = exact;
-    std::mt19937 random(5);
-    std::uniform_real_distribution<double> uniform(-0.007, 0.007);
-    for (double& v : off.value)
-        if (std::isfinite(v)) v += uniform(random);
+    const RoomVerifier room;
+    const MapVerifier& verifier = room.verifier;
+    const Camera& camera = room.camera;
+    const DepthMap exact = room.truth(ExportQuantity::EyeZ);
+    const DepthMap off = uniformlyOff(exact, 0.007, false, 5);  // ±7 mm
     for (const ExportQuantity quantity : {ExportQuantity::EyeZ, ExportQuantity::Distance}) {
-        const DepthMap right = mapOf(checker.scene(), camera, checker.renderRay(camera), quantity);
+        const DepthMap right = room.truth(quantity);
         DepthMap wrong = right;
         for (std::size_t i = 0; i < wrong.value.size(); ++i)
             if (std::isfinite(wrong.value[i])) wrong.value[i] += off.value[i] - exact.value[i];
         std::optional<std::int64_t> unexplainedBefore;
         for (const DepthFormat format : {DepthFormat::Float32, DepthFormat::Unorm24, DepthFormat::Unorm16})
             for (const bool reversed : {false, true}) {
-                CameraSpec spec = room.spec;
+                CameraSpec spec = room.room.spec;
                 spec.depth.format = format, spec.depth.reversed = reversed;
                 const Camera variant(spec);
                 INFO(toString(quantity) << " " << toString(format) << (reversed ? " reversed" : ""));
@@ -179,11 +168,10 @@ TEST_CASE("regression: an eye-z map's tolerance depended on the camera's depth f
 
 TEST_CASE("regression: a uniform scale 4e-4 short was accepted as --rel-tolerance 5e-4", "[acceptance]")
 {
-    const Room room;
-    const Checker checker(room.scene);
-    const MapVerifier verifier(checker);
-    const Camera camera(room.spec);
-    const DepthMap exact = mapOf(checker.scene(), camera, checker.renderRay(camera), ExportQuantity::EyeZ);
+    const RoomVerifier room;
+    const MapVerifier& verifier = room.verifier;
+    const Camera& camera = room.camera;
+    const DepthMap exact = room.truth(ExportQuantity::EyeZ);
     DepthMap scaled = exact;
     for (double& v : scaled.value) v *= 1 - 4e-4;
     for (const double relative : {5e-4, 1e-3, 0.05}) {
@@ -203,10 +191,7 @@ TEST_CASE("regression: a uniform scale 4e-4 short was accepted as --rel-toleranc
     }
     REQUIRE(scale);
     // Unbiased errors of the same size are an accuracy: accepted with it, and the option is named.
-    DepthMap jittered = exact;
-    std::mt19937 random(3);
-    std::uniform_real_distribution<double> uniform(-4e-4, 4e-4);
-    for (double& v : jittered.value) v *= 1 + uniform(random);
+    const DepthMap jittered = uniformlyOff(exact, 4e-4, true, 3);
     REQUIRE_FALSE(accepted(verifier, camera, jittered));
     DepthMap declared = jittered;
     declared.accuracy.relative = 5e-4;
@@ -219,11 +204,10 @@ TEST_CASE("regression: a uniform scale 4e-4 short was accepted as --rel-toleranc
 
 TEST_CASE("regression: Kinect-like noise was blamed on a convention; it is answered with a noise model", "[acceptance]")
 {
-    const Room room;
-    const Checker checker(room.scene);
-    const MapVerifier verifier(checker);
-    const Camera camera(room.spec);
-    const DepthMap exact = mapOf(checker.scene(), camera, checker.renderRay(camera), ExportQuantity::EyeZ);
+    const RoomVerifier room;
+    const MapVerifier& verifier = room.verifier;
+    const Camera& camera = room.camera;
+    const DepthMap exact = room.truth(ExportQuantity::EyeZ);
     const DepthMap noisy = kinectNoise(exact, 17);
     REQUIRE_FALSE(accepted(verifier, camera, noisy));
     // The diagnosis: noise, first, with a model that accepts it.
@@ -247,7 +231,7 @@ TEST_CASE("regression: Kinect-like noise was blamed on a convention; it is answe
         std::copy_n(declared.value.begin() + std::ptrdiff_t(declared.height - 1 - row) * declared.width, declared.width,
                     flipped.value.begin() + std::ptrdiff_t(row) * declared.width);
     REQUIRE_FALSE(accepted(verifier, camera, flipped));
-    DepthMap distance = kinectNoise(mapOf(checker.scene(), camera, checker.renderRay(camera), ExportQuantity::Distance), 18);
+    DepthMap distance = kinectNoise(room.truth(ExportQuantity::Distance), 18);
     distance.quantity = DepthQuantity::EyeZ, distance.accuracy.noise = NoiseModel::parse("kinect");
     REQUIRE_FALSE(accepted(verifier, camera, distance));
     DepthMap far = declared;
@@ -277,10 +261,9 @@ TEST_CASE("noise models: kinect, A+B*z^2 and A+B*(z-C)^2, each read back from it
 TEST_CASE("property: no mistake of the catalogue is accepted under any declaration or any suggestion of the diagnosis",
           "[acceptance]")
 {
-    const Room room;
-    const Checker checker(room.scene);
-    const MapVerifier verifier(checker);
-    const Camera camera(room.spec);
+    const RoomVerifier room;
+    const MapVerifier& verifier = room.verifier;
+    const Camera& camera = room.camera;
     // Each declaration a user might give, applied to the mistaken map as that user would hold it.
     struct Declaration {
         std::string name;
@@ -311,9 +294,9 @@ TEST_CASE("property: no mistake of the catalogue is accepted under any declarati
         RouteFaults faults;
         if (!mistake->inject(camera, faults)) continue;
         ++mistakes;
-        const RenderResult render = checker.render(camera, mistake->route, faults);
+        const RenderResult render = room.checker.render(camera, mistake->route, faults);
         for (const ExportQuantity quantity : {ExportQuantity::EyeZ, ExportQuantity::Distance}) {
-            const DepthMap wrong = mapOf(checker.scene(), camera, render, quantity);
+            const DepthMap wrong = mapOf(room.checker.scene(), camera, render, quantity);
             INFO(mistake->name << ", " << toString(quantity));
             // A mistake that leaves this quantity as it is (reversed-Z in an eye-z map) makes no wrong map.
             if (accepted(verifier, camera, wrong)) continue;
@@ -329,18 +312,18 @@ TEST_CASE("property: no mistake of the catalogue is accepted under any declarati
         }
     }
     // Mistakes made with the files rather than the chain: another quantity, other units.
-    const RenderResult truth = checker.renderRay(camera);
+    const RenderResult truth = room.checker.renderRay(camera);
     for (const auto& [name, make] : std::vector<std::pair<std::string, std::function<DepthMap()>>>{
              {"distance-as-eye-z",
-              [&] { DepthMap m = mapOf(checker.scene(), camera, truth, ExportQuantity::Distance); m.quantity = DepthQuantity::EyeZ; return m; }},
+              [&] { DepthMap m = mapOf(room.checker.scene(), camera, truth, ExportQuantity::Distance); m.quantity = DepthQuantity::EyeZ; return m; }},
              {"eye-z-as-distance",
-              [&] { DepthMap m = mapOf(checker.scene(), camera, truth, ExportQuantity::EyeZ); m.quantity = DepthQuantity::Distance; return m; }},
+              [&] { DepthMap m = mapOf(room.checker.scene(), camera, truth, ExportQuantity::EyeZ); m.quantity = DepthQuantity::Distance; return m; }},
              {"metres read as millimetres",
-              [&] { DepthMap m = mapOf(checker.scene(), camera, truth, ExportQuantity::EyeZ); for (double& v : m.value) v /= 1000; return m; }},
+              [&] { DepthMap m = mapOf(room.checker.scene(), camera, truth, ExportQuantity::EyeZ); for (double& v : m.value) v /= 1000; return m; }},
              {"inches read as metres",
-              [&] { DepthMap m = mapOf(checker.scene(), camera, truth, ExportQuantity::EyeZ); for (double& v : m.value) v *= 39.37; return m; }},
+              [&] { DepthMap m = mapOf(room.checker.scene(), camera, truth, ExportQuantity::EyeZ); for (double& v : m.value) v *= 39.37; return m; }},
              {"a centimetre too far",
-              [&] { DepthMap m = mapOf(checker.scene(), camera, truth, ExportQuantity::EyeZ); for (double& v : m.value) v += 0.01; return m; }},
+              [&] { DepthMap m = mapOf(room.checker.scene(), camera, truth, ExportQuantity::EyeZ); for (double& v : m.value) v += 0.01; return m; }},
          }) {
         const DepthMap wrong = make();
         INFO(name);

@@ -8,6 +8,7 @@
 #include "zcheck/inverse_projection.h"
 
 #include "diagnosis_helpers.h"
+#include "room.h"
 
 #include <catch2/catch.hpp>
 
@@ -17,23 +18,9 @@
 
 using namespace zcheck;
 using testing::mapOf;
+using testing::Room;
 
 namespace {
-
-// The builtin scene shrunk ten times (0.36 .. 3.7 m from the eye): a room an RGB-D sensor sees.
-struct Room {
-    Scene scene = builtinScene("builtin:default");
-    CameraSpec spec;
-    explicit Room(const std::string& convention = "opengl")
-    {
-        for (glm::vec3& p : scene.positions) p *= 0.1f;
-        spec = scene.defaultCamera;
-        spec.view.eye *= 0.1, spec.view.target *= 0.1;
-        spec.projection.near *= 0.1, spec.projection.far *= 0.1;
-        spec.width = 200, spec.height = 150;
-        spec.convention = Convention::preset(convention);
-    }
-};
 
 // The truth's eye-z (or distance) map, exact to binary32 (misses: +inf).
 DepthMap truthMap(const Checker& checker, const Camera& camera, ExportQuantity quantity)
