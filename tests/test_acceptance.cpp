@@ -116,6 +116,9 @@ TEST_CASE("regression: --quantum 0.1 accepted a distance map declared as eye-z",
     declared.accuracy.quantum = 0.1;  // the values are not on that grid
     VerifyResult run = verifier.verify(camera, declared);
     REQUIRE_FALSE(verdictOf(run).consistent());
+    REQUIRE_FALSE(verdictOf(run).declaredAccuracyRefused.empty());  // as coarse as the room's depths, and not its grid
+    declared.accuracy.quantum = 0.01;
+    run = verifier.verify(camera, declared);
     REQUIRE(verdictOf(run).declaredAccuracyRefused.find("is not the map's grid") != std::string::npos);
     // Rounded to the grid it declares, the same mistake is still refused: its errors are one-sided.
     for (const double q : {0.001, 0.01, 0.05}) {

@@ -514,6 +514,15 @@ void judgeDeclaredAccuracy(const PixelJudge& judge, const DepthMap& map, const R
         std::snprintf(text, sizeof text, "%.4g", v);
         return std::string(text);
     };
+    const double relative = medianOfField(&Compared::relativeEyeZ);
+    if (!(relative <= 0.1)) {
+        report.declaredAccuracyRefused = "the declared accuracy is as coarse as the depths: ±" +
+                                         number(medianOfField(&Compared::declared)) + " at the median pixel, " +
+                                         (std::isfinite(relative) ? percent(relative) : std::string("beyond the far plane")) +
+                                         " of its eye-z (a declaration zcheck can judge is under a tenth of the depth); a "
+                                         "map of the wrong scale or quantity would pass it";
+        return;
+    }
     if (Q > 0) {
         const auto off = std::count_if(all.begin(), all.end(), [](const Compared& c) { return !c.onGrid; });
         if (off * 100 > std::int64_t(all.size())) {
@@ -525,15 +534,6 @@ void judgeDeclaredAccuracy(const PixelJudge& judge, const DepthMap& map, const R
                 "); --quantum states the step the values were rounded to";
             return;
         }
-    }
-    const double relative = medianOfField(&Compared::relativeEyeZ);
-    if (!(relative <= 0.1)) {
-        report.declaredAccuracyRefused = "the declared accuracy is as coarse as the depths: ±" +
-                                         number(medianOfField(&Compared::declared)) + " at the median pixel, " +
-                                         (std::isfinite(relative) ? percent(relative) : std::string("beyond the far plane")) +
-                                         " of its eye-z (a declaration zcheck can judge is under a tenth of the depth); a "
-                                         "map of the wrong scale or quantity would pass it";
-        return;
     }
     if (all.size() >= 256) {
         // The mean's own sampling error, from the means of 16 interleaved samples (pixel
@@ -547,6 +547,7 @@ void judgeDeclaredAccuracy(const PixelJudge& judge, const DepthMap& map, const R
         std::vector<double> means;
         for (std::size_t k = 0; k < sum.size(); ++k)
             if (count[k] > 0) means.push_back(sum[k] / count[k]);
+        if (means.size() < 2) return;  // one sample (an image one pixel wide and tall): no spread to judge by
         double centre = 0, squares = 0;
         for (double m : means) centre += m / double(means.size());
         for (double m : means) squares += (m - centre) * (m - centre);

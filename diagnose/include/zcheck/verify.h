@@ -206,10 +206,10 @@ EdgeTally tallyEdges(const Camera& camera, const RenderResult& truth, const Rend
 // map as renderResultFromMap read it, the surface each pixel saw): what no pixel's
 // tolerance can see. Sets report.declaredAccuracyRefused, which makes the map inconsistent:
 //   holes   where holes are allowed, they are at most half the pixels where the truth sees a surface;
-//   grid    a declared quantum Q is the grid the values were rounded to: ≥ 99 % of them (less
-//           the offset) lie within 1/1000 of Q (or four binary32 spacings) of a multiple of Q;
 //   coarse  the declared accuracy at the median pixel is under a tenth of its depth (in eye-z):
 //           a grid or tolerance as coarse as the depths accepts any map of the right order;
+//   grid    a declared quantum Q is the grid the values were rounded to: ≥ 99 % of them (less
+//           the offset) lie within 1/1000 of Q (or four binary32 spacings) of a multiple of Q;
 //   bias    rounding and noise are unbiased: over the pixels where the map shows the truth's own
 //           surface (256 or more), |mean(map − truth)| — the truth rounded to the declared grid,
 //           if any, so that a rounding's own error is no bias — is within the median of C·q + S·m
