@@ -8,7 +8,9 @@
 
 #include <tbb/parallel_for_each.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cstdlib>
 #include <charconv>
 #include <exception>
 
@@ -117,8 +119,16 @@ FrameResult DatasetRunner::verify(std::size_t index, VerifiedMap* keep) const
         CameraForMap made = frameCameraAndMap(frame, plan, verifier.checker().scene(), options_, readDepthMap_);
         const Camera camera(made.spec);
         result.map.channel = made.map.channel;
+        const DepthMapFile file = made.map;  // for the other frames' cameras, if the map needs them
         const DepthMap map = DepthMap::of(std::move(made.map), plan.quantity, plan.reading);
-        VerifiedMap verified = verifyMap(verifier, camera, map, options_.diagnose, result.map.name());
+        VerifiedMap verified = verifyMap(verifier, camera, map, false, result.map.name());
+        if (options_.diagnose && !verified.run.comparison.report.consistent()) {
+            verified.diagnosed = true;
+            if (std::optional<Hypothesis> other = otherFrameCamera(index, plan, verifier, file, camera, map))
+                verified.diagnosis = {std::move(*other)};
+            else
+                verified.diagnosis = verifier.diagnose(camera, map);
+        }
         result.verified = true;
         result.report = verified.run.report;
         result.diagnosed = verified.diagnosed;
@@ -129,6 +139,106 @@ FrameResult DatasetRunner::verify(std::size_t index, VerifiedMap* keep) const
     }
     result.seconds = secondsSince(start);
     return result;
+}
+
+namespace {
+
+struct OtherFrame {
+    long offset;
+    const char *name, *phrase, *whose;
+};
+constexpr OtherFrame kOtherFrames[] = {
+    {-1, "previous-frame-camera", "consistent with the previous frame's camera", "the previous frame's"},
+    {+1, "next-frame-camera", "consistent with the next frame's camera", "the next frame's"},
+    {-2, "camera-2-frames-back", "consistent with the camera of two frames before", "two frames before"},
+    {+2, "camera-2-frames-ahead", "consistent with the camera of two frames after", "two frames after"},
+    {0, "another-frame-camera", "consistent with another frame's camera (the frames' order is not the cameras')",
+     "another frame's"},
+};
+
+const OtherFrame& otherFrame(long offset)
+{
+    for (const OtherFrame& f : kOtherFrames)
+        if (f.offset == offset) return f;
+    return kOtherFrames[4];
+}
+
+}  // namespace
+
+std::string otherFrameHypothesisName(long offset) { return otherFrame(offset).name; }
+
+std::optional<std::string> datasetPhraseOf(const std::string& hypothesisName)
+{
+    for (const OtherFrame& f : kOtherFrames)
+        if (hypothesisName == f.name) return std::string(f.phrase);
+    return std::nullopt;
+}
+
+std::optional<Hypothesis> DatasetRunner::otherFrameCamera(std::size_t index, const FramePlan& plan,
+                                                          const MapVerifier& verifier, const DepthMapFile& file,
+                                                          const Camera& camera, const DepthMap& map) const
+{
+    const Scene& scene = verifier.checker().scene();
+    // Frame j's camera for this map (its size, near and far from this scene and map); none where
+    // frame j cannot give one or it images the world as this frame's own does.
+    auto cameraOf = [&](std::size_t j) -> std::optional<Camera> {
+        const DatasetFrame& other = dataset_.frames[j];
+        if (j == index || !other.camera || !other.error.empty() || other.scene.value_or(options_.scene) != plan.scene)
+            return std::nullopt;
+        try {
+            CameraForMap made = completeCameraForMap(*other.camera, &scene, plan.given, plan.quantity,
+                                                     [&](int, int) { return file; });
+            if (!options_.convention.empty()) made.spec.convention = Convention::preset(options_.convention);
+            Camera c(made.spec);
+            if (c.worldFromClip == camera.worldFromClip) return std::nullopt;
+            return c;
+        } catch (const Error&) {
+            return std::nullopt;
+        }
+    };
+    auto hypothesisFor = [&](std::size_t j, const VerifyResult& run) {
+        const long offset = long(j) - long(index);
+        const OtherFrame& f = otherFrame(offset);
+        Hypothesis h;
+        h.name = f.name;
+        h.explanation = std::string(f.phrase) + ": frame '" + dataset_.frames[index].name + "''s map matches frame '" +
+                        dataset_.frames[j].name + "''s camera (" + f.whose + ", " + (offset > 0 ? "+" : "") +
+                        std::to_string(offset) + "): the cameras and the maps are paired wrongly (a frame number "
+                        "off by one, Blender's frame_current against the frame rendered, a list shifted or shuffled)";
+        h.consistent = true;
+        const ComparisonReport& r = run.comparison.report;
+        h.compared = r.bothHit + r.rayOnly + r.rasterOnly;
+        h.fitted.push_back({"camera_frame_offset", double(offset), 0});
+        return h;
+    };
+    const RayRenderer& rays = verifier.checker().rayRenderer();
+    auto judge = [&](std::size_t j, const Camera& c) -> std::optional<Hypothesis> {
+        if (probeAgreement(scene, rays, c, map).rulesOut()) return std::nullopt;
+        const VerifyResult run = verifier.verify(c, map);
+        if (!run.comparison.report.consistent() || run.comparison.report.bothHit == 0) return std::nullopt;
+        return hypothesisFor(j, run);
+    };
+    const long n = long(dataset_.frames.size());
+    for (const long offset : {-1L, +1L, -2L, +2L}) {
+        const long j = long(index) + offset;
+        if (j < 0 || j >= n) continue;
+        if (const std::optional<Camera> c = cameraOf(std::size_t(j)))
+            if (std::optional<Hypothesis> h = judge(std::size_t(j), *c)) return h;
+    }
+    // Shuffled: every other frame probed, the three closest judged in full.
+    std::vector<std::pair<double, std::size_t>> probed;
+    for (long j = 0; j < n; ++j) {
+        if (std::labs(j - long(index)) <= 2) continue;
+        if (const std::optional<Camera> c = cameraOf(std::size_t(j))) {
+            const Probe probe = probeAgreement(scene, rays, *c, map);
+            if (!probe.rulesOut()) probed.emplace_back(probe.agreeing, std::size_t(j));
+        }
+    }
+    std::sort(probed.begin(), probed.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+    for (std::size_t k = 0; k < probed.size() && k < 3; ++k)
+        if (const std::optional<Camera> c = cameraOf(probed[k].second))
+            if (std::optional<Hypothesis> h = judge(probed[k].second, *c)) return h;
+    return std::nullopt;
 }
 
 void DatasetRunner::run(const std::vector<std::size_t>& frames, const std::function<void(FrameResult&&)>& done) const

@@ -1,5 +1,7 @@
 #include "zcheck/dataset_report.h"
 
+#include "zcheck/dataset.h"
+
 #include "report_json.h"
 #include "zcheck/detail/camera_json.h"
 #include "zcheck/error.h"
@@ -190,7 +192,9 @@ DatasetSummary summarizeResults(const std::vector<ResultsFile>& files)
         else ++s.inconsistent;
         if (r->error.empty() && !r->consistent && !r->explainedBy.empty()) {
             ++s.byMistake[r->explainedBy.front()];
-            explanationOf.emplace(r->explainedBy.front(), r->explanations.front());
+            // A frame's own words, or what the hypothesis says of any frame (another frame's camera).
+            explanationOf.emplace(r->explainedBy.front(),
+                                  datasetPhraseOf(r->explainedBy.front()).value_or(r->explanations.front()));
         }
     }
     s.recorded = first.size();

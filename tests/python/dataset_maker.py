@@ -192,15 +192,19 @@ class DatasetMaker:
         return folder
 
     # ---- nerfstudio -------------------------------------------------------------------------
-    def transforms(self, name="transforms.json", broken=None, missing=(), per_unit=1000.0):
+    def transforms(self, name="transforms.json", broken=None, missing=(), per_unit=1000.0, camera_of=None):
         """transforms.json with 16-bit millimetre PNGs. `broken` maps a frame to how it breaks:
-        "y-flip", "inverted-extrinsic", "opencv-axes", "distance", "centimetres"."""
+        "y-flip", "inverted-extrinsic", "opencv-axes", "distance", "centimetres". `camera_of(i)`, when
+        given, is the frame whose camera frame i's entry lists (its map stays frame i's): a list
+        shifted by one, or shuffled."""
         broken = broken or {}
         depth_dir = self.root / (Path(name).stem + "_depth")
         depth_dir.mkdir(parents=True, exist_ok=True)
         frames = []
         for i, (pose, image) in enumerate(zip(self.trajectory.poses, self.trajectory.names)):
             how = broken.get(i)
+            if camera_of is not None:
+                pose = self.trajectory.poses[camera_of(i)]
             c2w_gl = np.linalg.inv(pose) @ OPENCV_TO_OPENGL  # camera-to-world, OpenGL camera axes
             matrix = {"inverted-extrinsic": np.linalg.inv(c2w_gl), "opencv-axes": np.linalg.inv(pose)}.get(how, c2w_gl)
             depth = self.distance(i) if how == "distance" else self.eye_z(i)

@@ -93,6 +93,43 @@ def test_broken_transforms_flags_exactly_the_broken_frames_and_names_them(made):
     assert scale and abs(scale[0]["value"] - 0.1) < 0.003
 
 
+def test_cameras_one_frame_behind_the_maps_are_named_per_frame_and_once_for_the_dataset(made):
+    m, _ = made
+    # frame i's entry lists frame i-1's camera (frame 0 its own): the map of frame i matches the
+    # camera listed for frame i+1; the last map's camera is listed nowhere.
+    path = m.transforms("shifted.json", camera_of=lambda i: max(i - 1, 0))
+    code, records, out, _ = verify(made, path, "--diagnose", rc=1)
+    bad = failing(records)
+    assert set(bad) == set(range(1, FRAMES)), out
+    for i in range(1, FRAMES - 1):
+        first = bad[i]["diagnosis"][0]
+        assert first["hypothesis"] == "next-frame-camera" and first["consistent"], (i, first)
+        assert f"'{records_by_index(records)[i + 1]['frame']}''s camera" in first["explanation"], first
+        assert [v["value"] for v in first["fitted"] if v["name"] == "camera_frame_offset"] == [1.0]
+    assert not any(h["hypothesis"].endswith("frame-camera") for h in bad[FRAMES - 1].get("diagnosis", []))
+    assert f"{FRAMES - 2} of {FRAMES} frames consistent with the next frame's camera (next-frame-camera)" in out, out
+
+
+def test_shuffled_cameras_are_each_matched_with_the_frame_whose_camera_made_the_map(made):
+    m, _ = made
+    order = list(np.random.default_rng(4).permutation(FRAMES))
+    path = m.transforms("shuffled.json", camera_of=lambda i: int(order[i]))
+    code, records, out, _ = verify(made, path, "--diagnose", rc=1)
+    bad = failing(records)
+    assert set(bad) == {i for i in range(FRAMES) if order[i] != i}, out
+    for i, r in bad.items():
+        first = r["diagnosis"][0]
+        listed_at = order.index(i)  # the frame whose entry lists frame i's camera
+        offset = [v["value"] for v in first["fitted"] if v["name"] == "camera_frame_offset"]
+        assert first["consistent"] and first["hypothesis"].endswith("frame-camera") or \
+            first["hypothesis"].startswith("camera-2-frames"), (i, first)
+        assert offset == [float(listed_at - i)], (i, listed_at, first)
+
+
+def records_by_index(records):
+    return {r["index"]: r for r in records}
+
+
 def test_an_opencv_principal_point_in_colmap_coordinates_is_half_a_pixel(made):
     _, p = made
     code, records, _, _ = verify(made, p["broken_colmap"], "--depth", str(p["colmap_depth"]) + "/{name}.geometric.bin",

@@ -69,6 +69,19 @@ FramePlan planFrame(const DatasetFrame& frame, const DatasetRunOptions& options)
 CameraForMap frameCameraAndMap(const DatasetFrame& frame, const FramePlan& plan, const Scene& scene,
                                const DatasetRunOptions& options, const DepthMapReader& readDepthMap);
 
+// A frame's map made with another frame's camera (the commonest animation bug: Blender's
+// frame_current against the frame rendered, a glTF export of frame_start, a list shifted by one).
+// `dataset verify --diagnose` tries, for an inconsistent frame i, the cameras of frames i−1, i+1,
+// i−2 and i+2, then of every other frame of the same scene (a probe of single rays first, the
+// three that come closest judged in full), and names the first that makes the map consistent;
+// the full diagnosis runs only when none does. Cameras equal to the frame's own are skipped.
+// The hypothesis's name for an offset j − i: "previous-frame-camera" (−1), "next-frame-camera"
+// (+1), "camera-2-frames-back" (−2), "camera-2-frames-ahead" (+2), "another-frame-camera".
+std::string otherFrameHypothesisName(long offset);
+// What a dataset's summary says of its frames for such a hypothesis ("consistent with the
+// previous frame's camera"); nullopt for any other hypothesis.
+std::optional<std::string> datasetPhraseOf(const std::string& hypothesisName);
+
 // The result of one frame.
 struct FrameResult {
     std::size_t index = 0, of = 0;     // the frame's index in the dataset, and the dataset's size
@@ -118,6 +131,10 @@ public:
     void run(const std::vector<std::size_t>& frames, const std::function<void(FrameResult&&)>& done) const;
 
 private:
+    // The other frame whose camera makes frame `index`'s map consistent (above), as a hypothesis.
+    std::optional<Hypothesis> otherFrameCamera(std::size_t index, const FramePlan& plan, const MapVerifier& verifier,
+                                               const DepthMapFile& file, const Camera& camera, const DepthMap& map) const;
+
     Dataset dataset_;
     DatasetRunOptions options_;
     DepthMapReader readDepthMap_;
