@@ -184,6 +184,55 @@ TEST_CASE("a transposed rotation is named, with t kept or the eye kept", "[diagn
     }
 }
 
+TEST_CASE("transposes as people make them: a matrix_world's 3×3 in OpenGL axes, and a whole 4×4 read in the other layout",
+          "[diagnose][vision]")
+{
+    const glm::dmat3 f(1, 0, 0, 0, -1, 0, 0, 0, -1);  // OpenGL camera axes from OpenCV's, and back
+    {
+        const Checker checker(builtinScene("builtin:default"));
+        const MapVerifier verifier(checker);
+        for (const char* convention : {"opengl", "opencv"}) {
+            const CameraSpec base = smallSpec(checker.scene(), convention);
+            const glm::dmat3 r = rotationOf(0.82, 0.21, -0.43, 0.31);
+            const CameraSpec renderer = aimed(base, r);
+            const glm::dmat4 cv = cvFromEyeAxes(renderer.convention) * renderer.view.eyeFromWorld;
+            const glm::dvec3 t(cv[3]), eye = -(glm::transpose(r) * t);
+            // The file's camera-to-world in OpenGL axes, [Rᵀ·F | eye], with its 3×3 transposed:
+            // F·R, whose world-to-camera in OpenCV axes is (F·R·F)ᵀ... written from the matrices.
+            const glm::dmat3 c2wGl = glm::transpose(r) * f;
+            const glm::dmat3 declaredR = glm::transpose(glm::transpose(c2wGl) * f);
+            requireNamed(verifier, renderer, withPose(base, declaredR, -(declaredR * eye)), ExportQuantity::EyeZ,
+                         {"transposed-rotation", "OpenGL axes, eye kept"});
+        }
+    }
+    {
+        // The renderer at the world origin (the scene moved so that its camera's eye is there),
+        // having read the file's 4×4 transposed; the file's own pose is elsewhere.
+        Scene scene = builtinScene("builtin:default");
+        const glm::vec3 eye0 = glm::vec3(scene.defaultCamera.view.eye);
+        for (glm::vec3& p : scene.positions) p -= eye0;
+        scene.defaultCamera.view.eye -= glm::dvec3(eye0), scene.defaultCamera.view.target -= glm::dvec3(eye0);
+        const Checker checker(std::move(scene));
+        const MapVerifier verifier(checker);
+        for (const char* convention : {"opengl", "vulkan"}) {
+            const CameraSpec base = smallSpec(checker.scene(), convention);
+            const glm::dmat4 cv = cvFromEyeAxes(base.convention) * Camera(base).eyeFromWorld;
+            const glm::dmat3 r(cv);  // world-to-camera at the origin, OpenCV axes
+            const CameraSpec renderer = withPose(base, r, glm::dvec3(0));
+            const glm::dvec3 fileEye(0.7, 1.9, 2.4);
+            // Camera-to-world 4×4 in OpenCV axes as the file holds it: [Rf | fileEye], read
+            // transposed: the renderer's rotation Rfᵀ, so Rf = rᵀ... its world-to-camera Rfᵀ = r.
+            const glm::dmat3 fileWorldToCameraCv = glm::transpose(r);
+            requireNamed(verifier, renderer, withPose(base, fileWorldToCameraCv, -(fileWorldToCameraCv * fileEye)),
+                         ExportQuantity::EyeZ, {"transposed-4x4", "OpenCV axes"});
+            // The same file in OpenGL axes (Blender's matrix_world): [Rgl | fileEye] read transposed.
+            const glm::dmat3 fileWorldToCameraGl = f * glm::transpose(r) * f;
+            requireNamed(verifier, renderer, withPose(base, fileWorldToCameraGl, -(fileWorldToCameraGl * fileEye)),
+                         ExportQuantity::Distance, {"transposed-4x4", "OpenGL axes"});
+        }
+    }
+}
+
 TEST_CASE("a quaternion read in the other order is named, world-to-camera and camera-to-world", "[diagnose][vision]")
 {
     const Checker checker(builtinScene("builtin:default"));

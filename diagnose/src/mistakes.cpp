@@ -200,6 +200,9 @@ std::string factorText(double k) { return k >= 1 ? "× " + formatNumber(k) : "/ 
 
 // A camera's pose as files store it: world-to-camera [R | t] in OpenCV axes, the eye at −Rᵀt;
 // and views back in the camera's own axes from such a rotation with a translation or an eye.
+// OpenCV camera axes from OpenGL's (x kept, y and z turned round), its own inverse.
+const glm::dmat3 kCvFromGl(1, 0, 0, 0, -1, 0, 0, 0, -1);
+
 struct FilePose {
     glm::dmat4 cvFromEyeAxes;
     glm::dmat3 r;
@@ -282,12 +285,36 @@ std::vector<Mistake> buildCatalogue()
                                "camera-to-world rotation used as world-to-camera)",
         [](const Camera& camera) {
             const FilePose pose = FilePose::of(camera);
-            const glm::dmat3 rt = glm::transpose(pose.r);
+            const glm::dmat3 rt = glm::transpose(pose.r), glRt = kCvFromGl * rt * kCvFromGl;
             return std::vector<ViewVariant>{
                 {"translation kept", "consistent if the pose's rotation is transposed (R used as Rᵀ) and t kept: a "
                                      "row- vs column-major rotation", pose.withT(rt, pose.t)},
                 {"eye kept", "consistent if the pose's rotation is transposed (R used as Rᵀ) with the eye where it "
-                             "is: a camera-to-world rotation used as world-to-camera", pose.withEye(rt, pose.eye)}};
+                             "is: a camera-to-world rotation used as world-to-camera", pose.withEye(rt, pose.eye)},
+                // The same in OpenGL camera axes (x right, y up, z back: Blender's matrix_world,
+                // nerfstudio, a zcheck world_from_eye): R_gl = F·R with F = diag(1, −1, −1), so R_glᵀ
+                // read back into OpenCV axes is F·Rᵀ·F.
+                {"OpenGL axes, eye kept", "consistent if the camera-to-world rotation in OpenGL axes (Blender's matrix_world, "
+                                          "nerfstudio's transform_matrix, a world_from_eye) is transposed with the eye where it is",
+                 pose.withEye(glRt, pose.eye)},
+                {"OpenGL axes, translation kept", "consistent if the world-to-camera rotation in OpenGL axes (a view "
+                                                  "matrix) is transposed and its translation kept",
+                 pose.withT(glRt, pose.t)}};
+        }));
+    all.push_back(otherViews(
+        "transposed-4x4", "a 4×4 pose matrix read in the other layout (row- vs column-major): its rotation transposed, "
+                          "and its translation, now in the bottom row, lost",
+        [](const Camera& camera) {
+            const FilePose pose = FilePose::of(camera);
+            const glm::dmat3 rt = glm::transpose(pose.r), glRt = kCvFromGl * rt * kCvFromGl;
+            return std::vector<ViewVariant>{
+                {"OpenCV axes", "consistent if the 4×4 pose (OpenCV axes, either direction) was read transposed: rotation "
+                                "Rᵀ, the translation in the bottom row lost (the eye at the world origin)",
+                 pose.withEye(rt, glm::dvec3(0))},
+                {"OpenGL axes", "consistent if the 4×4 pose in OpenGL axes (Blender's matrix_world, nerfstudio's "
+                                "transform_matrix, a view matrix) was read transposed: rotation transposed, the translation "
+                                "in the bottom row lost (the eye at the world origin)",
+                 pose.withEye(glRt, glm::dvec3(0))}};
         }));
     all.push_back(otherViews(
         "quaternion-order", "a pose's quaternion read in the other component order (x y z w as w x y z, or the reverse)",
