@@ -233,6 +233,36 @@ TEST_CASE("transposes as people make them: a matrix_world's 3×3 in OpenGL axes,
     }
 }
 
+TEST_CASE("a lens shift dropped is named as dropped, in x, in y, and in both", "[diagnose][vision]")
+{
+    // The file's camera has its principal point 32 px right of centre (Blender's shift_x = 0.1 at
+    // 320 px), or also 20 px up; the renderer drew a centred image.
+    const Checker checker(builtinScene("builtin:default"));
+    const MapVerifier verifier(checker);
+    for (const char* convention : {"opengl", "opencv"}) {
+        CameraSpec centred = smallSpec(checker.scene(), convention, 320, 240);
+        centred.projection.type = ProjectionType::Pinhole;
+        centred.projection.fx = centred.projection.fy = 300;
+        centred.projection.cx = 159.5, centred.projection.cy = 119.5;  // the top-left pixel's centre is 0
+        CameraSpec shifted = centred;
+        shifted.projection.cx += 32;
+        requireNamed(verifier, centred, shifted, ExportQuantity::EyeZ, {"lens-shift-dropped", "x"});
+        shifted.projection.cy -= 20;
+        requireNamed(verifier, centred, shifted, ExportQuantity::Window, {"lens-shift-dropped", "x and y"});
+        CameraSpec onlyY = shifted;  // dropped in y only: x's shift drawn
+        onlyY.projection.cy = centred.projection.cy;
+        requireNamed(verifier, onlyY, shifted, ExportQuantity::EyeZ, {"lens-shift-dropped", "y only"});
+        // Not "Blender's shift_x read with the wrong sign".
+        const Camera rendering(centred);
+        shifted.projection.cy = centred.projection.cy;
+        const DepthMap map = mapOf(checker.scene(), rendering, checker.renderRay(rendering), ExportQuantity::EyeZ);
+        for (const Hypothesis& h : verifier.diagnose(Camera(shifted), map)) {
+            INFO(h.name << " [" << h.variant << "]");
+            REQUIRE_FALSE((h.consistent && h.name == "principal-point-mirrored"));
+        }
+    }
+}
+
 TEST_CASE("a quaternion read in the other order is named, world-to-camera and camera-to-world", "[diagnose][vision]")
 {
     const Checker checker(builtinScene("builtin:default"));

@@ -496,6 +496,47 @@ std::vector<Mistake> buildCatalogue()
         return out;
     };
     all.push_back(mirroredPrincipal);
+    // ... or dropped: the renderer drew a centred image where the camera has an off-centre
+    // principal point (Blender's lens shift, an asymmetric frustum, cx and cy ignored): the
+    // offset terms of the x and y rows set to zero.
+    auto principalCentred = [](const Camera& camera, glm::dmat4& m, std::initializer_list<int> rows) {
+        m = camera.clipFromEye;
+        for (int c : {2, 3})
+            for (int r : rows) m[c][r] = 0;
+        return differ(m, camera.clipFromEye);
+    };
+    Mistake droppedShift = wrongProjection(
+        "lens-shift-dropped",
+        "an off-centre principal point dropped (Blender's shift_x and shift_y, an asymmetric frustum, cx and cy "
+        "ignored): the image drawn centred",
+        "consistent if the principal point's offset from the image centre was dropped in x and y (a lens shift "
+        "ignored: the image drawn centred)",
+        [principalCentred](const Camera& camera, glm::dmat4& m) { return principalCentred(camera, m, {0, 1}); });
+    droppedShift.reread = [both = droppedShift.reread, principalCentred](const Camera& camera, const DepthMap& map) {
+        Rereadings out = both(camera, map);
+        glm::dmat4 xOnly, yOnly;
+        const bool x = principalCentred(camera, xOnly, {0}), y = principalCentred(camera, yOnly, {1});
+        for (auto& r : out) {
+            r.variant = x && y ? "x and y" : x ? "x" : "y";
+            if (!(x && y)) r.explanation = "consistent if the principal point's offset in " + r.variant + " was dropped (a lens "
+                                           "shift ignored: the image drawn centred)";
+        }
+        for (const auto& [row, axis] : {std::pair{0, "x"}, std::pair{1, "y"}}) {
+            glm::dmat4 m;
+            if (!(x && y) || !principalCentred(camera, m, {row})) continue;
+            CameraSpec spec = camera.spec();
+            spec.projection.type = ProjectionType::Matrix;
+            spec.projection.clipFromEye = m;
+            const std::string shift = row == 0 ? "shift_x" : "shift_y";
+            out.push_back({std::string(axis) + " only",
+                           "consistent if the principal point's offset in " + std::string(axis) +
+                               " was dropped (Blender's " + shift + " ignored: the image drawn centred in " +
+                               std::string(axis) + ")",
+                           spec, {}, {}});
+        }
+        return out;
+    };
+    all.push_back(droppedShift);
     all.push_back(wrongProjection("transposed", "the projection matrix transposed (row- vs column-major confusion)",
                                   "consistent if the projection matrix is transposed (row- vs column-major)",
                                   [](const Camera& camera, glm::dmat4& m) {
