@@ -233,6 +233,28 @@ TEST_CASE("transposes as people make them: a matrix_world's 3×3 in OpenGL axes,
     }
 }
 
+TEST_CASE("an eye displaced along the viewing direction is named a pose error, on the bunny and the default scene",
+          "[diagnose][vision]")
+{
+    for (const bool onBunny : {true, false}) {
+        const Checker checker(onBunny ? Scene(bunny()) : builtinScene("builtin:default"));
+        const MapVerifier verifier(checker);
+        for (const char* convention : {"opencv", "opengl"})
+            for (const double nearer : {0.01, -0.01}) {  // 1 % nearer the target, and 1 % farther
+                const CameraSpec declared = smallSpec(checker.scene(), convention);
+                CameraSpec renderer = declared;
+                renderer.view.eye = declared.view.eye + nearer * (declared.view.target - declared.view.eye);
+                requireNamed(verifier, renderer, declared, ExportQuantity::EyeZ, {"pose", ""});
+                // ... and first: not a depth scale or a field of view, which a move along the view mimics.
+                const Camera rendering(renderer);
+                const DepthMap map = mapOf(checker.scene(), rendering, checker.renderRay(rendering), ExportQuantity::EyeZ);
+                const std::vector<Hypothesis> hypotheses = verifier.diagnose(Camera(declared), map);
+                INFO(hypotheses.front().name << ": " << hypotheses.front().explanation);
+                CHECK(hypotheses.front().name == "pose");
+            }
+    }
+}
+
 TEST_CASE("a lens shift dropped is named as dropped, in x, in y, and in both", "[diagnose][vision]")
 {
     // The file's camera has its principal point 32 px right of centre (Blender's shift_x = 0.1 at
