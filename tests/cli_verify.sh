@@ -14,6 +14,15 @@ grep -q "verdict    CONSISTENT" ok.txt
 "$zcheck" verify --depth-map render_mm.png --scale 1000 --quantity eye-z > ok_png.txt
 grep -q "verdict    CONSISTENT" ok_png.txt
 
+# Eye-z values declared as window depth hold no window depth: refused (exit 2), and with
+# --diagnose the refusal says what they are (regression: it said nothing more under --diagnose).
+oiiotool render.exr --ch Z -o eyez_only.exr
+expect_error 2 "holds no window depth .*is the quantity right\?$" verify --depth-map eyez_only.exr --quantity window
+expect_error 2 "holds no window depth .*--diagnose: its values are consistent read as eye-z \(pass --quantity eye-z\)$" \
+    verify --depth-map eyez_only.exr --quantity window --diagnose
+expect_error 2 "--diagnose: its values are consistent read as distance" verify --depth-map render.exr --channel distance \
+    --quantity ndc --diagnose
+
 # The classic mistake: ray distance delivered as if it were eye-z.
 oiiotool render.exr --ch distance -o distance.exr
 set +e

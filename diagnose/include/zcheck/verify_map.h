@@ -39,7 +39,9 @@ struct VerifiedMap {
 // (Error beginning with `name`, requireDepthsInRange); then MapVerifier::verify; then a
 // comparison with nothing in it is refused (Error "nothing to compare",
 // requireSomethingCompared); then, when `diagnose` and the map is inconsistent,
-// MapVerifier::diagnose.
+// MapVerifier::diagnose. With `diagnose`, the refusal of a map holding nothing of its quantity
+// says which other quantity reads its values consistently ("…; --diagnose: its values are
+// consistent read as eye-z (pass --quantity eye-z)"), or that none does.
 VerifiedMap verifyMap(const MapVerifier& verifier, const Camera& camera, const DepthMap& map, bool diagnose,
                       const std::string& name = "the depth map");
 
