@@ -305,14 +305,7 @@ int runDatasetVerify(const DatasetVerifyOptions& o)
         sink.write(frameRecordJson(result));
         allConsistent = allConsistent && result.consistent();
         progress.frameDone(!result.consistent());
-        FrameRecord r;
-        r.index = result.index, r.of = result.of, r.frame = result.frame, r.source = result.source, r.scene = result.scene;
-        r.consistent = result.consistent(), r.error = result.error, r.seconds = result.seconds;
-        r.unexplained = result.verified ? result.report.comparison.unexplained() : 0;
-        r.depthErrors = result.verified ? result.report.comparison.depthErrors : 0;
-        r.maxOverTolerance = result.verified ? result.report.comparison.maxErrorOverTolerance : 0;
-        for (const Hypothesis& h : result.diagnosis)
-            if (h.consistent || h.consistentExceptEdges()) r.explainedBy.push_back(h.name), r.explanations.push_back(h.explanation);
+        FrameRecord r = frameRecordOf(result);  // as `dataset report` reads the line just written
         r.file = output;
         thisRun.records.push_back(r);
     });

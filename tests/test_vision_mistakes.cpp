@@ -464,6 +464,10 @@ TEST_CASE("held out: the vision mistakes on other scenes, conventions, quantitie
         const bool named = names(verifier, camera, map, {"mesh-up-axis", ""}, seen);
         INFO(seen);
         CHECK(named);
+        // ... saying what to type in Blender.
+        for (const Hypothesis& h : verifier.diagnose(camera, map))
+            if (h.consistent && h.name == "mesh-up-axis")
+                CHECK(h.explanation.find("bpy.ops.wm.obj_export(forward_axis='Y', up_axis='Z')") != std::string::npos);
     }
     {  // cx and cy exchanged off centre, 320×240, a window map, Metal
         const Checker checker(spot);

@@ -124,7 +124,9 @@ FrameResult DatasetRunner::verify(std::size_t index, VerifiedMap* keep) const
         VerifiedMap verified = verifyMap(verifier, camera, map, false, result.map.name());
         if (options_.diagnose && !verified.run.comparison.report.consistent()) {
             verified.diagnosed = true;
-            if (std::optional<Hypothesis> other = otherFrameCamera(index, plan, verifier, file, camera, map))
+            if (std::optional<Hypothesis> unscaled = impliedScaleOnFloat(frame, plan, verifier, file, camera, map))
+                verified.diagnosis = {std::move(*unscaled)};
+            else if (std::optional<Hypothesis> other = otherFrameCamera(index, plan, verifier, file, camera, map))
                 verified.diagnosis = {std::move(*other)};
             else
                 verified.diagnosis = verifier.diagnose(camera, map);
@@ -172,6 +174,32 @@ std::optional<std::string> datasetPhraseOf(const std::string& hypothesisName)
     for (const OtherFrame& f : kOtherFrames)
         if (hypothesisName == f.name) return std::string(f.phrase);
     return std::nullopt;
+}
+
+std::optional<Hypothesis> DatasetRunner::impliedScaleOnFloat(const DatasetFrame& frame, const FramePlan& plan,
+                                                             const MapVerifier& verifier, const DepthMapFile& file,
+                                                             const Camera& camera, const DepthMap& map) const
+{
+    // Only where the implied scale was used (no --scale, no manifest scale) on a float file.
+    if (frame.scale || options_.scale || !frame.impliedScale || file.valueQuantum > 0 || !(plan.reading.scale > 0))
+        return std::nullopt;
+    DepthMap asStored = map;
+    for (double& v : asStored.value) v = (v - plan.reading.offset) * plan.reading.scale + plan.reading.offset;
+    asStored.scale = 0;
+    for (float& step : asStored.valueStep) step = float(step * plan.reading.scale);
+    const VerifyResult run = verifier.verify(camera, asStored);
+    if (!run.comparison.report.consistent() || run.comparison.report.bothHit == 0) return std::nullopt;
+    Hypothesis h;
+    h.name = "implied-scale-on-float";
+    h.explanation = "consistent read as stored: the map holds floats already in scene units, which the camera file's "
+                    "implied depth scale (" + frame.impliedScaleNote + ") divided by " + formatNumber(plan.reading.scale) +
+                    ": pass --scale 1 (nerfstudio applies depth_unit_scale_factor to .npy and float files too, so write "
+                    "\"depth_unit_scale_factor\": 1 into the file for nerfstudio as well)";
+    h.consistent = true;
+    const ComparisonReport& r = run.comparison.report;
+    h.compared = r.bothHit + r.rayOnly + r.rasterOnly;
+    h.fitted.push_back({"value_scale", 1.0, plan.reading.scale});
+    return h;
 }
 
 std::optional<Hypothesis> DatasetRunner::otherFrameCamera(std::size_t index, const FramePlan& plan,

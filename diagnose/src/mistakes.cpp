@@ -363,7 +363,10 @@ std::vector<Mistake> buildCatalogue()
                 const glm::dmat4 turned = glm::rotate(glm::dmat4(1.0), glm::radians(degrees), glm::dvec3(1, 0, 0));
                 const std::string by = (degrees < 0 ? "−" : "+") + formatNumber(std::abs(degrees)) + "° about x";
                 out.push_back({by, "consistent if the renderer's mesh was turned " + by +
-                                       (degrees < 0 ? " (Y-up read as Z-up, as Blender's OBJ import does)" : " (Z-up read as Y-up)"),
+                                       (degrees < 0 ? " (Y-up read as Z-up, as Blender's OBJ import does)" : " (Z-up read as Y-up)") +
+                                       ": give zcheck the mesh in the renderer's world axes (from Blender: "
+                                       "bpy.ops.wm.obj_export(forward_axis='Y', up_axis='Z'), every object exported, its "
+                                       "transforms applied; docs/datasets.md)",
                                camera.eyeFromWorld * turned});
             }
             return out;

@@ -116,6 +116,9 @@ FrameRecord recordFrom(const json& j, const std::string& where)
         r.p99RelativeEyeZ = number(e, "p99_relative_eye_z");
     }
     if (j.contains("unexplained")) r.unexplained = std::int64_t(number(j["unexplained"], "count"));
+    if (j.contains("warnings") && j["warnings"].is_array())
+        for (const json& w : j["warnings"])
+            if (w.is_string()) r.warnings.push_back(w.get<std::string>());
     if (j.contains("declared_accuracy_refused") && j["declared_accuracy_refused"].is_string())
         r.declaredRefused = j["declared_accuracy_refused"].get<std::string>();
     if (j.contains("diagnosis") && j["diagnosis"].is_array())
@@ -158,6 +161,11 @@ ResultsFile readResults(const std::string& path)
     return out;
 }
 
+FrameRecord frameRecordOf(const FrameResult& result)
+{
+    return recordFrom(json::parse(frameRecordJson(result)), "frame '" + result.frame + "'");
+}
+
 DatasetSummary summarizeResults(const std::vector<ResultsFile>& files)
 {
     DatasetSummary s;
@@ -198,6 +206,13 @@ DatasetSummary summarizeResults(const std::vector<ResultsFile>& files)
         }
     }
     s.recorded = first.size();
+    // What was assumed, once for the dataset: the same sentence for many frames (nerfstudio's
+    // default millimetres) said once, with its count.
+    std::map<std::string, std::size_t> noteCount;
+    for (const FrameRecord& r : s.all)
+        for (const std::string& w : r.warnings) ++noteCount[w];
+    s.notes.assign(noteCount.begin(), noteCount.end());
+    std::stable_sort(s.notes.begin(), s.notes.end(), [](const auto& a, const auto& b) { return a.second > b.second; });
     // The dataset's verdict, once, when most frames fail the same way.
     for (const auto& [name, count] : s.byMistake)
         if (2 * count > s.recorded) {
@@ -233,6 +248,9 @@ std::string datasetSummaryText(const DatasetSummary& s)
     }
     for (std::size_t k = 0; k < s.duplicates.size() && k < 10; ++k) out << "duplicate  " << s.duplicates[k] << "\n";
     if (s.duplicates.size() > 10) out << "duplicate  ... (" << s.duplicates.size() << " in all)\n";
+    for (std::size_t k = 0; k < s.notes.size() && k < 3; ++k)
+        out << "note       " << s.notes[k].first << " (" << s.notes[k].second << " of " << s.recorded << " frames)\n";
+    if (s.notes.size() > 3) out << "note       ... (" << s.notes.size() - 3 << " more in the records' warnings)\n";
     for (const auto& [name, count] : s.byMistake) {
         std::snprintf(line, sizeof line, "mistake    %-28s %zu frames\n", name.c_str(), count);
         out << line;
@@ -267,6 +285,8 @@ std::string datasetSummaryJson(const DatasetSummary& s)
         worst.push_back({{"frame", r.frame}, {"index", r.index}, {"error", r.error.empty() ? json(nullptr) : json(r.error)},
                          {"unexplained", r.unexplained}, {"depth_errors", r.depthErrors},
                          {"consistent_if", r.explainedBy.empty() ? json(nullptr) : json(r.explainedBy.front())}});
+    json notes = json::array();
+    for (const auto& [text, count] : s.notes) notes.push_back({{"note", text}, {"frames", count}});
     json byMistake = json::object();
     for (const auto& [name, count] : s.byMistake) byMistake[name] = count;
     return prettyJson({{"source", s.source},
@@ -280,6 +300,7 @@ std::string datasetSummaryJson(const DatasetSummary& s)
                        {"by_mistake", byMistake},
                        {"verdict", datasetVerdict(s)},
                        {"diagnosis", s.diagnosis.empty() ? json(nullptr) : json(s.diagnosis)},
+                       {"notes", notes},
                        {"worst", worst}});
 }
 

@@ -192,11 +192,13 @@ class DatasetMaker:
         return folder
 
     # ---- nerfstudio -------------------------------------------------------------------------
-    def transforms(self, name="transforms.json", broken=None, missing=(), per_unit=1000.0, camera_of=None):
+    def transforms(self, name="transforms.json", broken=None, missing=(), per_unit=1000.0, camera_of=None,
+                   float_npy=False):
         """transforms.json with 16-bit millimetre PNGs. `broken` maps a frame to how it breaks:
         "y-flip", "inverted-extrinsic", "opencv-axes", "distance", "centimetres". `camera_of(i)`, when
         given, is the frame whose camera frame i's entry lists (its map stays frame i's): a list
-        shifted by one, or shuffled."""
+        shifted by one, or shuffled. `float_npy`: the maps as float32 .npy in scene units (metres), with
+        no depth_unit_scale_factor in the file (so nerfstudio's default 1e-3 applies to them)."""
         broken = broken or {}
         depth_dir = self.root / (Path(name).stem + "_depth")
         depth_dir.mkdir(parents=True, exist_ok=True)
@@ -212,7 +214,10 @@ class DatasetMaker:
             if how == "y-flip":
                 codes = codes[::-1]
             depth_path = depth_dir / image
-            if i not in missing:
+            if float_npy:
+                depth_path = depth_path.with_suffix(".npy")
+                np.save(depth_path, np.where(np.isfinite(depth), depth, 0).astype(np.float32))
+            elif i not in missing:
                 write_png16(depth_path, codes)
             frames.append({"file_path": f"images/{image}", "depth_file_path": str(depth_path.relative_to(self.root)),
                            "transform_matrix": matrix.tolist()})

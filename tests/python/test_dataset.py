@@ -126,6 +126,23 @@ def test_shuffled_cameras_are_each_matched_with_the_frame_whose_camera_made_the_
         assert offset == [float(listed_at - i)], (i, listed_at, first)
 
 
+def test_float_metres_under_nerfstudio_s_default_scale_say_what_to_type(made):
+    m, _ = made
+    path = m.transforms("float_metres.json", float_npy=True)
+    code, records, out, _ = verify(made, path, "--diagnose", rc=1)
+    assert len(failing(records)) == FRAMES
+    # the default is said in the summary, once, with its count
+    assert f"note       depth files hold millimetres, nerfstudio's default (depth_unit_scale_factor 1e-3): scale 1000; " \
+           f"--scale replaces it ({FRAMES} of {FRAMES} frames)" in out, out
+    for r in records:
+        first = r["diagnosis"][0]
+        assert first["hypothesis"] == "implied-scale-on-float" and "pass --scale 1" in first["explanation"], first
+    assert f"{FRAMES} of {FRAMES} frames consistent read as stored" in out, out
+    # and typing it makes every frame consistent
+    code, records, out, _ = verify(made, path, "--scale", "1", rc=0)
+    assert all(r["consistent"] for r in records)
+
+
 def records_by_index(records):
     return {r["index"]: r for r in records}
 

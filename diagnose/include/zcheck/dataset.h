@@ -131,6 +131,11 @@ public:
     void run(const std::vector<std::size_t>& frames, const std::function<void(FrameResult&&)>& done) const;
 
 private:
+    // A float map read with the scale its camera file implies (nerfstudio's millimetres) that is
+    // consistent read as stored: the hypothesis "implied-scale-on-float", saying what to type.
+    std::optional<Hypothesis> impliedScaleOnFloat(const DatasetFrame& frame, const FramePlan& plan,
+                                                  const MapVerifier& verifier, const DepthMapFile& file,
+                                                  const Camera& camera, const DepthMap& map) const;
     // The other frame whose camera makes frame `index`'s map consistent (above), as a hypothesis.
     std::optional<Hypothesis> otherFrameCamera(std::size_t index, const FramePlan& plan, const MapVerifier& verifier,
                                                const DepthMapFile& file, const Camera& camera, const DepthMap& map) const;

@@ -46,10 +46,14 @@ struct FrameRecord {
     std::vector<std::string> explanations;   // their explanations
     std::string closest;                     // the best hypothesis when none explains it
     std::string declaredRefused;             // why the reading's declarations were refused ("" if not)
+    std::vector<std::string> warnings;       // what was assumed for it (a scale the camera file implies, near and far)
     double seconds = 0;
     std::string file;                        // the results file and line it was read from
     std::size_t line = 0;
 };
+
+// A result as `dataset report` reads its record back (frameRecordJson, then the reader's rule).
+FrameRecord frameRecordOf(const FrameResult& result);
 
 struct ResultsFile {
     std::string path;
@@ -73,6 +77,7 @@ struct DatasetSummary {
     std::vector<std::string> duplicates;               // "frame 'x' (index 3): a.jsonl line 4, b.jsonl line 9"
     std::map<std::string, std::size_t> byMistake;      // best explaining hypothesis → inconsistent frames
     std::string diagnosis;                             // one sentence when most frames fail the same way; ""
+    std::vector<std::pair<std::string, std::size_t>> notes;  // what was assumed, and for how many frames, most first
     std::vector<FrameRecord> worst;                    // failing frames, worst first (at most 12)
     std::vector<FrameRecord> all;                      // every counted record, by index
     double seconds = 0;                                // the frames' wall time, summed
@@ -84,7 +89,8 @@ std::string datasetSummaryText(const DatasetSummary& summary);
 // "CONSISTENT" (every frame of a non-empty dataset), "INCONSISTENT", or "INCOMPLETE" (frames missing).
 std::string datasetVerdict(const DatasetSummary& summary);
 // source, frames, recorded, consistent, inconsistent, errors, missing, duplicates, by_mistake,
-// verdict (datasetVerdict), diagnosis (the sentence, or null), worst: what the results say, not how long they took (so that a sharded run and a
+// verdict (datasetVerdict), diagnosis (the sentence, or null), notes ({note, frames}: what was
+// assumed, most frames first), worst: what the results say, not how long they took (so that a sharded run and a
 // single process give the same document).
 std::string datasetSummaryJson(const DatasetSummary& summary);
 
