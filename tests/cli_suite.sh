@@ -24,7 +24,7 @@ tmp = sys.argv[1]
 r = json.load(open(f"{tmp}/suite.json"))
 assert r["passed"] is True and r["false_positives"] == 0 and r["missed_faults"] == 0, r["detection"]
 assert len(r["configurations"]) >= 10
-assert len(r["detection"]) == 20 and "principal-point-mirrored" in r["detection"] and "x-flip" in r["detection"] and "opencv-opengl-axes" in r["detection"] and "y-flip" in r["detection"]
+assert len(r["detection"]) == 21 and "lens-shift-dropped" in r["detection"] and "principal-point-mirrored" in r["detection"] and "x-flip" in r["detection"] and "opencv-opengl-axes" in r["detection"] and "y-flip" in r["detection"]
 for name, row in r["detection"].items():
     assert row["detected"] == row["applicable"], (name, row)
 # Every fault is applicable somewhere even in the quick subset.
@@ -34,7 +34,7 @@ assert "<h1>zcheck suite: PASSED</h1>" in html and "http" not in html.replace("c
 PY
 # --filter narrows the matrix; a filter matching nothing is a usage error.
 "$zcheck" suite --quick --models "$models" --filter "pinhole" > "$tmp/pinhole.txt"
-grep -q "configurations x 20 faults" "$tmp/pinhole.txt"
+grep -q "configurations x 21 faults" "$tmp/pinhole.txt"
 set +e
 "$zcheck" suite --quick --models "$models" --filter "no such configuration" > /dev/null 2>&1
 status=$?

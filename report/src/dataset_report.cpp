@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <regex>
 #include <set>
 #include <sstream>
 
@@ -208,10 +209,21 @@ DatasetSummary summarizeResults(const std::vector<ResultsFile>& files)
     s.recorded = first.size();
     // What was assumed, once for the dataset: the same sentence for many frames (nerfstudio's
     // default millimetres) said once, with its count.
-    std::map<std::string, std::size_t> noteCount;
+    // Sentences that differ only in their numbers (each frame's near and far) are one note, said
+    // with "…" where the numbers differ.
+    struct Note {
+        std::string text;
+        std::size_t frames = 0;
+    };
+    std::map<std::string, Note> byShape;
+    const std::regex number(R"([-+]?[0-9]+(\.[0-9]+)?([eE][-+]?[0-9]+)?)");
     for (const FrameRecord& r : s.all)
-        for (const std::string& w : r.warnings) ++noteCount[w];
-    s.notes.assign(noteCount.begin(), noteCount.end());
+        for (const std::string& w : r.warnings) {
+            Note& note = byShape[std::regex_replace(w, number, "…")];
+            if (note.frames++ == 0) note.text = w;
+            else if (note.text != w) note.text = std::regex_replace(w, number, "…");
+        }
+    for (const auto& [shape, note] : byShape) s.notes.emplace_back(note.text, note.frames);
     std::stable_sort(s.notes.begin(), s.notes.end(), [](const auto& a, const auto& b) { return a.second > b.second; });
     // The dataset's verdict, once, when most frames fail the same way.
     for (const auto& [name, count] : s.byMistake)

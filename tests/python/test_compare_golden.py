@@ -24,6 +24,7 @@ import pytest
 from helpers import REPO, ZCHECK_EXE
 
 GOLDEN = Path(__file__).parent / "data" / "compare_golden_4c34671.txt"
+FAULTS_ADDED_SINCE = ["lens-shift-dropped"]
 SCENES = ["builtin:default", "builtin:near-crossing", "models/stanford-bunny.obj", "models/fandisk.obj"]
 CAMERAS = ["dimetric", "frustum", "infinite-far", "isometric", "lens", "matrix-direct3d", "oblique-cabinet",
            "oblique-cavalier", "orthographic", "perspective", "pinhole", "trimetric"]
@@ -85,7 +86,9 @@ def digests(exe, models):
         # Keys added since the digests were recorded, which a check's report holds empty (what a
         # verified map declares, its holes and its values out of range: issue 36), are left out:
         # the rest must not change.
-        drop = [*drop, "declared", "holes", "out_of_range"]
+        # So are the faults added to the catalogue since (lens-shift-dropped: issue 43), from the
+        # suite's detection table and each configuration's faults.
+        drop = [*drop, "declared", "holes", "out_of_range", *FAULTS_ADDED_SINCE]
         text = canonical(document, drop).decode().replace(json.dumps(models)[1:-1] + "/", "models/")
         return digest(text.encode())
 
