@@ -318,15 +318,23 @@ int runDatasetVerify(const DatasetVerifyOptions& o)
 }
 
 // A failing frame verified again from its record, for the HTML report's pictures.
-FramePictures picturesOf(const FrameRecord& r, const std::shared_ptr<SceneVerifiers>& verifiers)
+FramePictures picturesOf(FrameRecord r, const std::shared_ptr<SceneVerifiers>& verifiers)
 {
+    // The record's paths as `dataset verify` was given them: from where it ran, or else from the
+    // results file's folder (a report made elsewhere).
+    const fs::path resultsFolder = fs::path(r.file).parent_path();
+    auto resolved = [&](std::string& path) {
+        if (path.empty() || path.rfind("builtin:", 0) == 0 || fs::path(path).is_absolute() || fs::exists(path)) return;
+        if (const fs::path there = resultsFolder / path; !resultsFolder.empty() && fs::exists(there)) path = there.string();
+    };
+    resolved(r.source), resolved(r.depth), resolved(r.scene);
     try {
         DatasetVerifyOptions source;
         source.source = r.source;
         source.depthPattern = "{name}";  // a COLMAP model names no depth maps: the record's file is used
         const Dataset dataset = openSource(source);
         if (r.index >= dataset.frames.size() || dataset.frames[r.index].name != r.frame)
-            return {{}, {}, {}, "the dataset '" + r.source + "' no longer has frame '" + r.frame + "' at index " + std::to_string(r.index)};
+            return FramePictures::none("the dataset '" + r.source + "' no longer has frame '" + r.frame + "' at index " + std::to_string(r.index));
         DatasetFrame frame = dataset.frames[r.index];
         frame.index = 0;
         frame.depth = r.depth;
@@ -349,10 +357,10 @@ FramePictures picturesOf(const FrameRecord& r, const std::shared_ptr<SceneVerifi
                                    verifiers);
         VerifiedMap kept;
         const FrameResult again = runner.verify(0, &kept);
-        if (!again.error.empty()) return {{}, {}, {}, again.error};
+        if (!again.error.empty()) return FramePictures::none(again.error);
         return framePictures(kept);
     } catch (const Error& e) {
-        return {{}, {}, {}, e.what()};
+        return FramePictures::none(e.what());
     }
 }
 
@@ -373,7 +381,13 @@ int runDatasetReport(const std::vector<std::string>& files, const std::string& o
     if (!outDir.empty()) {
         outputs.writeText(summaryFile, summaryJson);
         const auto verifiers = std::make_shared<SceneVerifiers>();
-        outputs.writeText(htmlFile, datasetReportHtml(summary, [&](const FrameRecord& r) { return picturesOf(r, verifiers); }));
+        std::vector<std::string> missing;  // said on the terminal too, not only in the page
+        outputs.writeText(htmlFile, datasetReportHtml(summary, [&](const FrameRecord& r) {
+                              FramePictures p = picturesOf(r, verifiers);
+                              if (!p.unavailable.empty()) missing.push_back("frame '" + r.frame + "': " + p.unavailable);
+                              return p;
+                          }));
+        for (const std::string& m : missing) std::cerr << "zcheck: note: no pictures of " << m << "\n";
     }
     outputs.commit();
     std::cout << (json ? summaryJson : datasetSummaryText(summary));

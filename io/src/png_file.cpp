@@ -50,6 +50,18 @@ Rgb viridis(double t)
 
 }  // namespace
 
+std::vector<std::uint8_t> previewRgb(const QuantityImage& image, double lo, double hi)
+{
+    const std::size_t pixels = std::size_t(image.width) * image.height;
+    std::vector<std::uint8_t> rgb(pixels * 3, 0);
+    for (std::size_t i = 0; i < pixels; ++i) {
+        if (image.isMiss(i)) continue;
+        const Rgb c = viridis(hi > lo ? (image.value[i] - lo) / (hi - lo) : 0.5);
+        std::copy(c.begin(), c.end(), rgb.begin() + std::ptrdiff_t(3 * i));
+    }
+    return rgb;
+}
+
 std::vector<std::uint8_t> previewRgb(const QuantityImage& image)
 {
     const std::size_t pixels = std::size_t(image.width) * image.height;

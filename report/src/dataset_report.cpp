@@ -1,6 +1,7 @@
 #include "zcheck/dataset_report.h"
 
 #include "zcheck/dataset.h"
+#include "zcheck/inverse_projection.h"
 
 #include "report_json.h"
 #include "zcheck/detail/camera_json.h"
@@ -321,19 +322,41 @@ FramePictures framePictures(const VerifiedMap& verified)
     FramePictures out;
     const Comparison& c = verified.run.comparison;
     const int W = c.report.width, H = c.report.height;
-    QuantityImage depth;
-    depth.quantity = ExportQuantity::Window, depth.width = W, depth.height = H, depth.channels = {"window"};
-    depth.value.assign(verified.run.map.windowDepth.value.begin(), verified.run.map.windowDepth.value.end());
-    depth.missValue = NAN;
-    for (double& v : depth.value)
-        if (!std::isfinite(v)) v = NAN;
-    out.depth = pngDataUri(W, H, previewRgb(depth));
+    const Camera camera(verified.run.report.camera);
+    // The truth's and the map's eye-z, misses as misses (not the clear value, which would read as
+    // far), on the truth's range: a rotated mesh or a wrong camera shows as a different picture.
+    auto eyeZOf = [&](const RenderResult& render) {
+        QuantityImage image;
+        image.quantity = ExportQuantity::EyeZ, image.width = W, image.height = H, image.channels = {"Z"};
+        image.missValue = NAN;
+        image.value.assign(std::size_t(W) * H, NAN);
+        for (int row = 0; row < H; ++row)
+            for (int col = 0; col < W; ++col) {
+                const std::size_t i = std::size_t(row) * W + col;
+                if (render.hit(i))
+                    image.value[i] = eyeZFromWindowDepth(camera, windowFromPixelCentre(camera, col, row),
+                                                         render.windowDepth.value[i]);
+            }
+        return image;
+    };
+    const QuantityImage truth = eyeZOf(verified.run.truth), map = eyeZOf(verified.run.map);
+    double lo = INFINITY, hi = -INFINITY;
+    for (double z : truth.value)
+        if (std::isfinite(z)) lo = std::min(lo, z), hi = std::max(hi, z);
+    if (!(hi >= lo))
+        for (double z : map.value)
+            if (std::isfinite(z)) lo = std::min(lo, z), hi = std::max(hi, z);
+    out.truth = pngDataUri(W, H, previewRgb(truth, lo, hi));
+    out.depth = pngDataUri(W, H, previewRgb(map, lo, hi));
     out.heatmap = pngDataUri(W, H, errorHeatmapRgb(c));
     out.classes = pngDataUri(W, H, pixelClassRgb(c));
     return out;
 }
 
 namespace {
+
+constexpr const char* kConsistentColour = "#1e8449";
+constexpr const char* kInconsistentColour = "#c0392b";
 
 std::string escaped(const std::string& text)
 {
@@ -342,11 +365,13 @@ std::string escaped(const std::string& text)
     return out;
 }
 
-// Frames by their p99 relative eye-z error, in decades from 1e-9 to 1 (and beyond), as SVG bars.
+// Frames by their p99 relative eye-z error, in decades from 1e-9 to 1 (and beyond), as SVG bars
+// stacked by verdict: consistent frames green below, inconsistent ones red above (an inconsistent
+// frame with nothing compared sits in the first bin, red). A legend says which is which.
 std::string histogramSvg(const std::vector<FrameRecord>& records)
 {
     constexpr int kBins = 11;  // ≤1e-9, (1e-9, 1e-8], ..., (0.1, 1], >1
-    int counts[kBins] = {};
+    int good[kBins] = {}, bad[kBins] = {};
     int unverified = 0;
     for (const FrameRecord& r : records) {
         if (!r.error.empty()) {
@@ -355,25 +380,57 @@ std::string histogramSvg(const std::vector<FrameRecord>& records)
         }
         const double e = r.p99RelativeEyeZ;
         const int bin = e <= 1e-9 ? 0 : e > 1 ? kBins - 1 : std::min(kBins - 2, int(std::ceil(std::log10(e))) + 9);
-        ++counts[bin];
+        ++(r.consistent ? good : bad)[bin];
     }
-    const int most = std::max(1, *std::max_element(counts, counts + kBins));
+    int most = 1;
+    for (int b = 0; b < kBins; ++b) most = std::max(most, good[b] + bad[b]);
     std::ostringstream svg;
     const int barWidth = 56, height = 160;
-    svg << "<svg xmlns='http://www.w3.org/2000/svg' width='" << kBins * barWidth + 20 << "' height='" << height + 50 << "'>";
+    svg << "<svg xmlns='http://www.w3.org/2000/svg' id='histogram' width='" << kBins * barWidth + 20 << "' height='" << height + 70
+        << "'>";
     for (int b = 0; b < kBins; ++b) {
-        const int h = counts[b] * height / most;
-        svg << "<rect x='" << 10 + b * barWidth << "' y='" << 10 + height - h << "' width='" << barWidth - 6 << "' height='" << h
-            << "' fill='" << (b >= 6 ? "#c0392b" : "#2e86c1") << "'><title>" << counts[b] << " frames</title></rect>";
-        svg << "<text x='" << 10 + b * barWidth + (barWidth - 6) / 2 << "' y='" << 8 + height - h << "' font-size='11' text-anchor='middle'>"
-            << counts[b] << "</text>";
+        const int hGood = good[b] * height / most, hBad = bad[b] * height / most;
+        const int x = 10 + b * barWidth;
+        svg << "<rect class='consistent' x='" << x << "' y='" << 10 + height - hGood << "' width='" << barWidth - 6
+            << "' height='" << hGood << "' fill='" << kConsistentColour << "'><title>" << good[b]
+            << " consistent frames</title></rect>";
+        svg << "<rect class='inconsistent' x='" << x << "' y='" << 10 + height - hGood - hBad << "' width='" << barWidth - 6
+            << "' height='" << hBad << "' fill='" << kInconsistentColour << "'><title>" << bad[b]
+            << " inconsistent frames</title></rect>";
+        if (good[b] + bad[b] > 0)
+            svg << "<text x='" << x + (barWidth - 6) / 2 << "' y='" << 8 + height - hGood - hBad
+                << "' font-size='11' text-anchor='middle'>" << good[b] + bad[b] << "</text>";
         const std::string label = b == 0 ? "≤1e-9" : b == kBins - 1 ? ">1" : "1e" + std::to_string(b - 9);
-        svg << "<text x='" << 10 + b * barWidth + (barWidth - 6) / 2 << "' y='" << height + 26
-            << "' font-size='11' text-anchor='middle'>" << label << "</text>";
+        svg << "<text x='" << x + (barWidth - 6) / 2 << "' y='" << height + 26 << "' font-size='11' text-anchor='middle'>"
+            << label << "</text>";
     }
     svg << "<text x='10' y='" << height + 45 << "' font-size='11'>p99 relative eye-z error per frame (decades)"
-        << (unverified ? "; " + std::to_string(unverified) + " frames not verified" : std::string()) << "</text></svg>";
+        << (unverified ? "; " + std::to_string(unverified) + " frames not verified" : std::string()) << "</text>";
+    svg << "<rect x='10' y='" << height + 54 << "' width='12' height='12' fill='" << kConsistentColour
+        << "'/><text x='26' y='" << height + 64 << "' font-size='11'>consistent</text><rect x='110' y='" << height + 54
+        << "' width='12' height='12' fill='" << kInconsistentColour << "'/><text x='126' y='" << height + 64
+        << "' font-size='11'>inconsistent</text></svg>";
     return svg.str();
+}
+
+// The coverage classes' colours (report_images.h), as a legend beside the picture.
+std::string classLegend()
+{
+    std::ostringstream html;
+    html << "<div class='legend'>";
+    for (auto [name, rgb] : pixelClassLegend()) {
+        if (const std::size_t at = name.find("raster"); at != std::string::npos) name.replace(at, 6, "map");  // verify's words
+        html << "<span><i style='background:rgb(" << int(rgb[0]) << "," << int(rgb[1]) << "," << int(rgb[2]) << ")'></i>"
+             << escaped(name) << "</span>";
+    }
+    html << "</div>";
+    return html.str();
+}
+
+// A hypothesis's explanation after "consistent if", without saying it twice.
+std::string consistentIf(const std::string& explanation)
+{
+    return explanation.rfind("consistent", 0) == 0 ? explanation : "consistent if " + explanation;
 }
 
 }  // namespace
@@ -385,7 +442,9 @@ std::string datasetReportHtml(const DatasetSummary& s, const FramePictureMaker& 
          << "</title><style>body{font-family:sans-serif;margin:2em;max-width:1200px}table{border-collapse:collapse}"
             "td,th{padding:3px 10px;border-bottom:1px solid #ddd;text-align:left}.bad{color:#c0392b}.good{color:#1e8449}"
             "img{image-rendering:pixelated;max-width:360px;margin-right:8px;border:1px solid #ccc}"
-            "figure{display:inline-block;margin:0 8px 8px 0}figcaption{font-size:12px;color:#555}</style></head><body>\n";
+            "figure{display:inline-block;margin:0 8px 8px 0;vertical-align:top}figcaption{font-size:12px;color:#555;max-width:360px}"
+            ".legend{font-size:11px;max-width:360px}.legend span{display:inline-block;margin:2px 8px 2px 0}"
+            ".legend i{display:inline-block;width:10px;height:10px;margin-right:3px;border:1px solid #999}</style></head><body>\n";
     const bool all = s.missing.empty() && s.consistent == s.frames;
     html << "<h1>zcheck dataset report</h1>\n<p>" << escaped(s.source) << ": " << s.frames << " frames</p>\n";
     html << "<h2 class='" << (all ? "good'>CONSISTENT: every frame" : s.missing.empty() ? "bad'>INCONSISTENT" : "bad'>INCOMPLETE")
@@ -420,18 +479,21 @@ std::string datasetReportHtml(const DatasetSummary& s, const FramePictureMaker& 
         }
         html << "<p>" << r.unexplained << " unexplained pixels, " << r.depthErrors << " depth errors; p99 relative eye-z error "
              << r.p99RelativeEyeZ;
-        if (!r.explainedBy.empty()) html << "; <b>consistent if " << escaped(r.explanations.front()) << "</b>";
+        if (!r.explainedBy.empty()) html << "; <b class='named'>" << escaped(consistentIf(r.explanations.front())) << "</b>";
         else if (!r.closest.empty()) html << "; no hypothesis explains it (closest: " << escaped(r.closest) << ")";
         html << "</p>\n";
-        const FramePictures p = pictures ? pictures(r) : FramePictures{{}, {}, {}, "no pictures asked for"};
+        const FramePictures p = pictures ? pictures(r) : FramePictures::none("no pictures asked for");
         if (!p.unavailable.empty()) {
             html << "<p><i>pictures unavailable: " << escaped(p.unavailable) << "</i></p>\n";
             continue;
         }
-        html << "<figure><img src='" << p.depth << "'><figcaption>the map (viridis: near dark, far yellow)</figcaption></figure>"
-             << "<figure><img src='" << p.heatmap << "'><figcaption>error / tolerance (yellow = tolerance, red beyond, magenta "
-             << "unexplained coverage)</figcaption></figure><figure><img src='" << p.classes
-             << "'><figcaption>coverage classes</figcaption></figure>\n";
+        html << "<figure class='truth'><img src='" << p.truth << "'><figcaption>the truth: eye-z through the camera (near dark, "
+             << "far yellow; black: nothing hit)</figcaption></figure>"
+             << "<figure class='map'><img src='" << p.depth << "'><figcaption>the map: eye-z as read, on the truth's colours"
+             << "</figcaption></figure>"
+             << "<figure class='heatmap'><img src='" << p.heatmap << "'><figcaption>error / tolerance (yellow = tolerance, red "
+             << "beyond, magenta unexplained coverage)</figcaption></figure><figure class='classes'><img src='" << p.classes
+             << "'><figcaption>coverage classes</figcaption>" << classLegend() << "</figure>\n";
     }
     html << "</body></html>\n";
     return html.str();

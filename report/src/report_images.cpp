@@ -68,6 +68,16 @@ std::vector<std::uint8_t> errorHeatmapRgb(const Comparison& comparison)
     });
 }
 
+std::vector<std::pair<std::string, std::array<std::uint8_t, 3>>> pixelClassLegend()
+{
+    std::vector<std::pair<std::string, std::array<std::uint8_t, 3>>> out;
+    for (const PixelClass c : {PixelClass::BothMiss, PixelClass::Agree, PixelClass::EdgeSurface, PixelClass::DepthError,
+                               PixelClass::RayOnlyEdge, PixelClass::RasterOnlyEdge, PixelClass::RayOnlyAtClear,
+                               PixelClass::AtClipPlane, PixelClass::RayOnly, PixelClass::RasterOnly, PixelClass::Hole})
+        out.emplace_back(toString(c), classColour(c));
+    return out;
+}
+
 std::vector<std::uint8_t> pixelClassRgb(const Comparison& comparison)
 {
     return paint(comparison, [&](std::size_t i) { return classColour(comparison.pixelClass[i]); });

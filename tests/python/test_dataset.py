@@ -245,7 +245,8 @@ def test_html_report_has_the_worst_frames_pictures(made):
     html = m.root / "html_report" / "report.html"
     code, out, err = run_cli("dataset", "report", results, "--out", m.root / "html_report")
     page = html.read_text()
-    assert page.count("data:image/png;base64,") == 3 * 5  # depth, heatmap, classes of the 5 inconsistent frames
+    # the truth, the map, the heatmap and the classes of the 5 inconsistent frames
+    assert page.count("data:image/png;base64,") == 4 * 5
     assert "frame_021.png" in page and "not verified" in page
     assert "<svg" in page
 

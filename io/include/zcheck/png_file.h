@@ -17,5 +17,8 @@ std::string pngDataUri(int width, int height, const std::vector<std::uint8_t>& r
 // An 8-bit picture of one quantity for a person: depths through the viridis colour map
 // (near dark blue, far yellow), normals as RGB = (n + 1)/2, ids hashed to colours; misses black.
 std::vector<std::uint8_t> previewRgb(const QuantityImage& image);
+// The same for a one-channel depth image on a given range [lo, hi] (near dark, far yellow), so
+// that two pictures of one view share their colours; misses black.
+std::vector<std::uint8_t> previewRgb(const QuantityImage& image, double lo, double hi);
 
 }  // namespace zcheck

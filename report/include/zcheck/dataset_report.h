@@ -97,8 +97,15 @@ std::string datasetSummaryJson(const DatasetSummary& summary);
 // A failing frame's pictures for the HTML report, as data: URIs: the map's depth (viridis), the
 // error heatmap and the coverage classes (report_images.h); or why they could not be made.
 struct FramePictures {
-    std::string depth, heatmap, classes;
+    std::string truth, depth, heatmap, classes;  // truth and depth: eye-z on one colour range
     std::string unavailable;
+    // None, and why.
+    static FramePictures none(std::string why)
+    {
+        FramePictures out;
+        out.unavailable = std::move(why);
+        return out;
+    }
 };
 FramePictures framePictures(const VerifiedMap& verified);
 // The pictures of a record's frame, made by verifying it again (the command line does it from

@@ -7,12 +7,17 @@
 //   coverage classes — one colour per PixelClass (legend in docs/tolerance.md).
 #include "zcheck/compare.h"
 
+#include <array>
 #include <cstdint>
+#include <string>
+#include <utility>
 #include <vector>
 
 namespace zcheck {
 
 std::vector<std::uint8_t> errorHeatmapRgb(const Comparison& comparison);
 std::vector<std::uint8_t> pixelClassRgb(const Comparison& comparison);
+// Every class's name (toString(PixelClass)) and its colour in pixelClassRgb, for legends.
+std::vector<std::pair<std::string, std::array<std::uint8_t, 3>>> pixelClassLegend();
 
 }  // namespace zcheck
