@@ -149,10 +149,13 @@ CameraSpec cameraSpecFor(const Scene& scene, const SceneAndCamera& options, std:
     return withConvention(completeCamera(camera, &scene, completionOf(o, size)), o.convention);
 }
 
-CameraSpec cameraSpecFrom(const CameraOptions& options, std::optional<std::pair<int, int>> size)
+CameraSpec cameraSpecFrom(const CameraOptions& options, std::optional<std::pair<int, int>> size,
+                          std::optional<std::pair<double, double>> eyeZRange)
 {
     const ImportedCamera camera = importCamera(options.reference, formatOption(options));
-    return withConvention(completeCamera(camera, nullptr, completionOf(options, size)), options.convention);
+    CameraCompletion given = completionOf(options, size);
+    given.mapEyeZ = eyeZRange;
+    return withConvention(completeCamera(camera, nullptr, given), options.convention);
 }
 
 std::vector<double> parseNumberList(const std::string& text, const std::string& option)

@@ -79,8 +79,10 @@ extern const std::string kCameraFileHelp;
 // The file part of --camera (an input a run must not overwrite).
 std::string cameraInputPath(const CameraOptions& options);
 // A camera without a scene (matrices, precision, unproject): near and far must be in the file
-// or given; then --convention.
-CameraSpec cameraSpecFrom(const CameraOptions& options, std::optional<std::pair<int, int>> size = {});
+// or given — or, with `eyeZRange` (the eye-z an eye-z or distance value lies in, which needs no
+// near and far), taken around it; then --convention.
+CameraSpec cameraSpecFrom(const CameraOptions& options, std::optional<std::pair<int, int>> size = {},
+                          std::optional<std::pair<double, double>> eyeZRange = {});
 
 // --width and --height, as check and bench take them: they override the camera's image size.
 struct ImageSize {

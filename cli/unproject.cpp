@@ -60,7 +60,14 @@ int runUnprojectCommand(const UnprojectOptions& o)
         spec = made.spec;
         sized = std::move(made.map);
     } else {
-        spec = cameraSpecFrom(cameraOptions);
+        // One eye-z or distance value needs no near and far: a camera file without them takes
+        // planes around it (eye-z ≤ distance, so a distance's eye-z lies below it).
+        std::optional<std::pair<double, double>> eyeZRange;
+        if (o.depth && *o.depth > 0 && std::isfinite(*o.depth)) {
+            if (quantity == DepthQuantity::EyeZ) eyeZRange = std::pair{*o.depth, *o.depth};
+            if (quantity == DepthQuantity::Distance) eyeZRange = std::pair{*o.depth * 1e-3, *o.depth};
+        }
+        spec = cameraSpecFrom(cameraOptions, {}, eyeZRange);
     }
     const Camera camera(spec);
 

@@ -77,6 +77,34 @@ count = int([l for l in head.splitlines() if l.startswith("element vertex")][0].
 assert count == len(rows.splitlines()) and 0 < count < expected
 PY
 
+# regression: an eye-z or distance value needs no near and far, yet an OpenCV calibration without
+# them was refused. Pixel (0, 0) of fx = fy = 500, cx = 319.5, cy = 239.5: the ray (−0.639, −0.479, 1)
+# (the top-left pixel's centre is 0 in OpenCV's coordinates), so eye-z 2.5 and distance 2.5 / |ray|.
+cat > "$tmp/calibration.yml" << 'YML'
+%YAML:1.0
+---
+image_width: 640
+image_height: 480
+camera_matrix: !!opencv-matrix
+   rows: 3
+   cols: 3
+   dt: d
+   data: [ 500., 0., 319.5, 0., 500., 239.5, 0., 0., 1. ]
+YML
+"$zcheck" unproject --camera "$tmp/calibration.yml" --pixel 0,0 --depth 2.5 --quantity eye-z > "$tmp/eyez_point.json"
+"$zcheck" unproject --camera "$tmp/calibration.yml" --pixel 0,0 --depth 2.5 --quantity distance > "$tmp/distance_point.json"
+python3 - "$tmp/eyez_point.json" "$tmp/distance_point.json" << 'PY'
+import json, math, sys
+eyez, distance = (json.load(open(p))["point"] for p in sys.argv[1:3])
+ray = (-319.5 / 500, -239.5 / 500, 1.0)
+norm = math.sqrt(sum(c * c for c in ray))
+assert all(abs(a - 2.5 * c) < 1e-9 for a, c in zip(eyez["eye"], ray)), eyez
+assert abs(eyez["distance"] - 2.5 * norm) < 1e-9, eyez
+assert abs(distance["eye_z"] - 2.5 / norm) < 1e-9 and abs(distance["distance"] - 2.5) < 1e-9, distance
+PY
+# Window depth does depend on them: still refused.
+expect_error 2 "has no near and far in its file" unproject --camera "$tmp/calibration.yml" --pixel 0,0 --depth 0.5 --quantity window
+
 # Bad input: exit 2 with a message, and an existing output survives.
 echo precious > "$tmp/keep.ply"
 expect_error 2 "cannot read depth map" unproject --camera "$tmp/camera.json" --depth-map "$tmp/missing.exr" -o "$tmp/keep.ply"

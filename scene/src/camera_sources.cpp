@@ -207,7 +207,9 @@ CameraSpec completeCamera(const ImportedCamera& camera, const Scene* scene, cons
                 widened.near = std::max(std::min(widened.near, lo), hi * 1e-7);
                 widened.far = std::max(widened.far, hi);
                 planes = widened;
-                from = sawScene ? from + " and the map's depths" : "the map's depths (the camera sees none of the scene)";
+                from = sawScene ? from + " and the map's depths"
+                       : scene  ? "the map's depths (the camera sees none of the scene)"
+                                : "the depths given (no scene; eye-z and distance do not depend on them)";
             }
             spec.projection.near = given.near.value_or(planes->near);
             spec.projection.far = given.far.value_or(planes->far);
