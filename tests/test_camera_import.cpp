@@ -323,6 +323,76 @@ TEST_CASE("OpenCV FileStorage YAML and XML put the top-left pixel centre at 0 an
     REQUIRE_THAT(bare.cameras[0].spec.notes.at(0), Catch::Contains("has no pose"));
 }
 
+TEST_CASE("OpenCV's stereo files: intrinsics.yml#left and #right, the right posed by R and T of extrinsics.yml beside it",
+          "[import][opencv]")
+{
+    const fs::path dir = scratch("opencv_stereo");
+    auto mat = [](const std::string& name, int rows, int cols, const std::string& data) {
+        return name + ": !!opencv-matrix\n   rows: " + std::to_string(rows) + "\n   cols: " + std::to_string(cols) +
+               "\n   dt: d\n   data: [ " + data + " ]\n";
+    };
+    // As stereo_calib.cpp writes them: no image size; D1 and D2 of 8 (here zero).
+    writeText(dir / "intrinsics.yml", "%YAML:1.0\n" + mat("M1", 3, 3, "500, 0, 319.5, 0, 500, 239.5, 0, 0, 1") +
+                                          mat("D1", 1, 8, "0, 0, 0, 0, 0, 0, 0, 0") +
+                                          mat("M2", 3, 3, "510, 0, 330, 0, 505, 241, 0, 0, 1") +
+                                          mat("D2", 1, 8, "0, 0, 0, 0, 0, 0, 0, 0"));
+    // R: 5° about y; T: the right camera 0.12 to the right (x_right = R·x_left + T).
+    const double a = glm::radians(5.0), c = std::cos(a), s = std::sin(a);
+    writeText(dir / "extrinsics.yml", "%YAML:1.0\n" +
+                                          mat("R", 3, 3, std::to_string(c) + ", 0, " + std::to_string(s) + ", 0, 1, 0, " +
+                                                             std::to_string(-s) + ", 0, " + std::to_string(c)) +
+                                          mat("T", 3, 1, "-0.12, 0, 0") + mat("R1", 3, 3, "1, 0, 0, 0, 1, 0, 0, 0, 1") +
+                                          mat("P1", 3, 4, "500, 0, 320, 0, 0, 500, 240, 0, 0, 0, 1, 0") +
+                                          mat("Q", 4, 4, "1, 0, 0, -320, 0, 1, 0, -240, 0, 0, 0, 500, 0, 0, 8.3, 0"));
+    const CameraSet set = readCameraSet((dir / "intrinsics.yml").string(), CameraFormat::OpenCv);
+    const glm::dvec3 p(0.2, -0.1, 2.0);  // in the left camera's frame, the world
+    const ImportedCamera& left = set.cameras.at(set.find("left"));
+    REQUIRE(set.find("M1") == set.find("left"));
+    REQUIRE_FALSE(left.hasImageSize);  // the depth map's size is taken (completeCamera)
+    requireNear(imagePointOf(left.spec, p), glm::dvec2(500 * 0.1 + 319.5 + 0.5, 500 * -0.05 + 239.5 + 0.5));
+    const ImportedCamera& right = set.cameras.at(set.find("right"));
+    REQUIRE(set.find("M2") == set.find("right"));
+    REQUIRE(right.refusal.empty());
+    const glm::dvec3 q(c * p.x + s * p.z - 0.12, p.y, -s * p.x + c * p.z);  // R·p + T, by hand
+    requireNear(imagePointOf(right.spec, p), glm::dvec2(510 * q.x / q.z + 330 + 0.5, 505 * q.y / q.z + 241 + 0.5));
+    REQUIRE_THAT(right.spec.notes.at(0), Catch::Contains("extrinsics.yml") && Catch::Contains("R and T"));
+    // A file without a #FRAME names neither: the reference must say which.
+    REQUIRE_THROWS(set.find(""));
+    // The extrinsics alone are no camera: refused, naming the intrinsics file's cameras.
+    REQUIRE_THROWS_WITH(readCameraSet((dir / "extrinsics.yml").string(), CameraFormat::OpenCv),
+                        Catch::Contains("no camera matrix") && Catch::Contains("#left or FILE#right"));
+    // Without extrinsics.yml beside it, the right camera has no pose: refused when asked for.
+    const fs::path alone = scratch("opencv_stereo_alone");
+    fs::copy_file(dir / "intrinsics.yml", alone / "intrinsics.yml");
+    const CameraSet unposed = readCameraSet((alone / "intrinsics.yml").string(), CameraFormat::OpenCv);
+    REQUIRE_THROWS_WITH(unposed.find("right"), Catch::Contains("has no pose"));
+    REQUIRE_NOTHROW(unposed.find("left"));
+}
+
+TEST_CASE("OpenCV's calibration.cpp file: each view's extrinsic_parameters a camera (#view_N), the file's own the default",
+          "[import][opencv]")
+{
+    const fs::path dir = scratch("opencv_views");
+    writeText(dir / "out_camera_data.yml",
+              "%YAML:1.0\n---\nnr_of_frames: 2\nimage_width: 640\nimage_height: 480\n"
+              "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n   data: [ 500., 0., 319.5, 0., 500., 239.5, 0., 0., 1. ]\n"
+              "distortion_coefficients: !!opencv-matrix\n   rows: 5\n   cols: 1\n   dt: d\n   data: [ 0., 0., 0., 0., 0. ]\n"
+              "extrinsic_parameters: !!opencv-matrix\n   rows: 2\n   cols: 6\n   dt: d\n"
+              "   data: [ 0., 0., 0., 0., 0., 2., 0., 0.3, 0., 0.1, 0.2, 3. ]\n");
+    const CameraSet set = readCameraSet((dir / "out_camera_data.yml").string(), CameraFormat::OpenCv);
+    REQUIRE(set.cameras.size() == 3);
+    REQUIRE(set.find("") == 0);  // the file's own camera, no pose
+    const glm::dvec3 p(0.1, 0.05, 1.0);
+    // view_1: rvec (0, 0.3, 0) — 0.3 rad about y — and tvec (0.1, 0.2, 3): x = R·p + t by hand.
+    const double c = std::cos(0.3), s = std::sin(0.3);
+    const glm::dvec3 x(c * p.x + s * p.z + 0.1, p.y + 0.2, -s * p.x + c * p.z + 3);
+    requireNear(imagePointOf(set.cameras.at(set.find("view_1")).spec, p),
+                glm::dvec2(500 * x.x / x.z + 320, 500 * x.y / x.z + 240));
+    const glm::dvec3 x0(p.x, p.y, p.z + 2);  // view_0: no rotation, tvec (0, 0, 2)
+    requireNear(imagePointOf(set.cameras.at(set.find("view_0")).spec, p),
+                glm::dvec2(500 * x0.x / x0.z + 320, 500 * x0.y / x0.z + 240));
+}
+
 TEST_CASE("ROS CameraInfo: the calibration file and the echoed message, raw (K) and rectified (P)", "[import][ros]")
 {
     const fs::path dir = scratch("ros");

@@ -10,6 +10,13 @@
 //   pose        optional, world-to-camera as solvePnP returns it: R (3x3, or a rotation
 //               vector) and T (or t, tvec), or rvec and tvec (Rodrigues); without one the
 //               camera's own frame is the world
+//   views       calibration.cpp's extrinsic_parameters (a row rvec, tvec per view): cameras
+//               view_0, view_1, ... beside the file's own (the default)
+//   stereo      stereo_calib.cpp's intrinsics.yml: M1, D1 and M2, D2 — cameras left (alias M1)
+//               and right (M2), the left the world and the right posed by stereoCalibrate's R
+//               and T (x_right = R·x_left + T) from the same file or extrinsics.yml beside it;
+//               extrinsics.yml alone (R, T, R1, R2, P1, P2, Q) is refused, naming the intrinsics
+//   no size     the camera takes the depth map's size (K is in pixels: nothing else changes)
 //   axes        OpenCV: x right, y down, z forward
 //   pixels      the centre of the top-left pixel is (0, 0): a centred camera has cx = (W−1)/2
 //
@@ -36,6 +43,8 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <filesystem>
+#include <optional>
 #include <sstream>
 
 namespace zcheck::importers {
@@ -287,51 +296,146 @@ private:
         return m;
     }
 
-    CameraSet readOpenCv() const
+    // The image size the file gives (image_width and image_height, width and height, or
+    // image_size [w, h]); none: stereo_calib.cpp's intrinsics.yml, for one.
+    std::optional<std::pair<int, int>> imageSize() const
     {
-        std::string kKey, dKey, wKey, hKey;
-        const Node* k = anyOf({"camera_matrix", "K", "cameraMatrix", "intrinsic_matrix", "intrinsics"}, &kKey);
-        if (!k) fail("it has no camera matrix (camera_matrix or K)");
-        const PinholeIntrinsics intrinsics = intrinsicsOf(shaped(*k, kKey, 3, 3), kKey);
-        int width = 0, height = 0;
+        std::string wKey, hKey;
         if (const Node* w = anyOf({"image_width", "width"}, &wKey)) {
             const Node* h = anyOf({"image_height", "height"}, &hKey);
             if (!h) fail("it gives '" + wKey + "' but no image height (image_height)");
-            width = pixels(*w, wKey), height = pixels(*h, hKey);
-        } else if (const Node* size = anyOf({"image_size", "imageSize"}, &wKey)) {
+            return std::pair{pixels(*w, wKey), pixels(*h, hKey)};
+        }
+        if (const Node* size = anyOf({"image_size", "imageSize"}, &wKey)) {
             const Matrix s = shaped(*size, wKey, 1, 2);
             if (!Camera::isImageSide(s.values[0]) || !Camera::isImageSide(s.values[1]))
                 fail("'" + wKey + "' must be two whole numbers of pixels in 1.." + std::to_string(Camera::kMaxImageSide));
-            width = int(s.values[0]), height = int(s.values[1]);
-        } else {
-            fail("it has no image size (image_width and image_height)");
+            return std::pair{int(s.values[0]), int(s.values[1])};
         }
+        return std::nullopt;
+    }
 
-        // The pose, world-to-camera; none: the camera's own frame is the world.
-        glm::dmat4 camFromWorld(1.0);
-        std::string rKey, tKey;
+    // World-to-camera from a rotation (3x3 or a rotation vector) and a translation of 3.
+    glm::dmat4 poseOf(const Matrix& r, const std::string& rKey, const Matrix& t, const std::string& tKey) const
+    {
+        if (t.values.size() != 3) fail("'" + tKey + "' must hold 3 numbers, it holds " + std::to_string(t.values.size()));
+        return poseFromRotationTranslation(rotationOf(r, rKey), {t.values[0], t.values[1], t.values[2]});
+    }
+
+    // The file's R and T (or rvec and tvec), world-to-camera; none without them.
+    std::optional<glm::dmat4> pose(std::string& rKey, std::string& tKey) const
+    {
         const Node* r = anyOf({"R", "rvec", "rotation"}, &rKey);
         const Node* t = anyOf({"T", "t", "tvec", "translation"}, &tKey);
         if (bool(r) != bool(t)) fail("a pose needs both a rotation (R or rvec) and a translation (T or tvec)");
-        if (r) {
-            const glm::dmat3 rotation = rotationOf(matrix(*r, rKey), rKey);
-            const Matrix tv = shaped(*t, tKey, 3, 1);
-            camFromWorld = poseFromRotationTranslation(rotation, {tv.values[0], tv.values[1], tv.values[2]});
+        if (!r) return std::nullopt;
+        return poseOf(matrix(*r, rKey), rKey, matrix(*t, tKey), tKey);
+    }
+
+    // One camera of the file: K, its distortion (refused unless zero), the pose, and the size or,
+    // without one, the depth map's (the projection does not depend on it: K is in pixels).
+    ImportedCamera openCvCamera(const std::string& name, const Node& k, const std::string& kKey, const Node* d,
+                                const std::string& dKey, const glm::dmat4& camFromWorld, const std::string& poseName) const
+    {
+        const PinholeIntrinsics intrinsics = intrinsicsOf(shaped(k, kKey, 3, 3), kKey);
+        const std::optional<std::pair<int, int>> size = imageSize();
+        // Without a size, a placeholder the principal point centres (a map's size replaces it).
+        const int width = size ? size->first : std::clamp(int(std::lround(2 * intrinsics.cx + 1)), 1, Camera::kMaxImageSide);
+        const int height = size ? size->second : std::clamp(int(std::lround(2 * intrinsics.cy + 1)), 1, Camera::kMaxImageSide);
+        ImportedCamera imported = camera(name, width, height, intrinsics, camFromWorld, poseName);
+        if (!size) {
+            imported.hasImageSize = false;
+            imported.projectionForSize = [projection = imported.spec.projection](int, int) { return projection; };
         }
-        CameraSet set;
-        set.path = path_, set.format = CameraFormat::OpenCv;
-        const std::size_t slash = path_.find_last_of('/');
-        ImportedCamera imported = camera(slash == std::string::npos ? path_ : path_.substr(slash + 1), width, height, intrinsics,
-                                         camFromWorld, r ? rKey + ", " + tKey : "pose");
-        if (!r)
-            imported.spec.notes.push_back(source() +
-                                          " has no pose (R and T, or rvec and tvec): the camera's own frame is the world "
-                                          "(x right, y down, z forward)");
-        if (const Node* d = anyOf({"distortion_coefficients", "D", "dist_coeffs", "distCoeffs", "distortion"}, &dKey))
+        if (d)
             imported.refusal = distortionRefusal(source(), "OpenCV",
                                                  named(matrix(*d, dKey), {"k1", "k2", "p1", "p2", "k3", "k4", "k5", "k6", "s1",
                                                                           "s2", "s3", "s4", "tx", "ty"}));
+        return imported;
+    }
+
+    std::string fileName() const
+    {
+        const std::size_t slash = path_.find_last_of('/');
+        return slash == std::string::npos ? path_ : path_.substr(slash + 1);
+    }
+
+    CameraSet readOpenCv() const
+    {
+        CameraSet set;
+        set.path = path_, set.format = CameraFormat::OpenCv;
+        if (root_.findIgnoringCase("M1") && root_.findIgnoringCase("M2")) return readStereo(set);
+        std::string kKey, dKey;
+        const Node* k = anyOf({"camera_matrix", "K", "cameraMatrix", "intrinsic_matrix", "intrinsics"}, &kKey);
+        if (!k && (root_.findIgnoringCase("P1") || root_.findIgnoringCase("R1") || root_.findIgnoringCase("Q")))
+            fail("it holds a stereo pair's extrinsics (R, T, R1, R2, P1, P2, Q) but no camera matrix: give its intrinsics "
+                 "file (stereo_calib's intrinsics.yml, M1 and M2) as FILE#left or FILE#right, which takes R and T from "
+                 "this file beside it");
+        if (!k) fail("it has no camera matrix (camera_matrix or K; M1 and M2 for a stereo pair)");
+        const Node* d = anyOf({"distortion_coefficients", "D", "dist_coeffs", "distCoeffs", "distortion"}, &dKey);
+        // The pose, world-to-camera; none: the camera's own frame is the world.
+        std::string rKey, tKey;
+        const std::optional<glm::dmat4> camFromWorld = pose(rKey, tKey);
+        ImportedCamera imported =
+            openCvCamera(fileName(), *k, kKey, d, dKey, camFromWorld.value_or(glm::dmat4(1.0)), camFromWorld ? rKey + ", " + tKey : "pose");
+        if (!camFromWorld)
+            imported.spec.notes.push_back(source() +
+                                          " has no pose (R and T, or rvec and tvec): the camera's own frame is the world "
+                                          "(x right, y down, z forward)");
         set.cameras.push_back(imported);
+        // calibration.cpp's per-view poses: extrinsic_parameters, a row (rvec, tvec) per view,
+        // each a camera of its own (#view_0, #view_1, ...), the file's own camera the default.
+        if (const Node* views = root_.findIgnoringCase("extrinsic_parameters")) {
+            const Matrix m = matrix(*views, "extrinsic_parameters");
+            if (m.cols != 6) fail("'extrinsic_parameters' must have 6 columns (rvec and tvec of each view), it has " + std::to_string(m.cols));
+            for (std::size_t v = 0; v < m.rows; ++v) {
+                const std::string name = "view_" + std::to_string(v);
+                Matrix r, t;
+                r.rows = 1, r.cols = 3, t.rows = 3, t.cols = 1;
+                r.values.assign(m.values.begin() + std::ptrdiff_t(6 * v), m.values.begin() + std::ptrdiff_t(6 * v + 3));
+                t.values.assign(m.values.begin() + std::ptrdiff_t(6 * v + 3), m.values.begin() + std::ptrdiff_t(6 * v + 6));
+                const std::string row = "extrinsic_parameters row " + std::to_string(v);
+                ImportedCamera view = openCvCamera(name, *k, kKey, d, dKey, poseOf(r, row + " rvec", t, row + " tvec"), row);
+                set.cameras.push_back(view);
+            }
+            set.defaultCamera = 0;
+        }
+        return set;
+    }
+
+    // stereo_calib.cpp's intrinsics file: M1, D1 (the left camera, the world) and M2, D2 (the
+    // right, posed by stereoCalibrate's R and T: x_right = R·x_left + T), R and T read from this
+    // file or else from extrinsics.yml beside it.
+    CameraSet readStereo(CameraSet set) const
+    {
+        const Node* d1 = root_.findIgnoringCase("D1");
+        const Node* d2 = root_.findIgnoringCase("D2");
+        ImportedCamera left = openCvCamera("left", *root_.findIgnoringCase("M1"), "M1", d1, "D1", glm::dmat4(1.0), "pose");
+        left.aliases = {"M1", "0"};
+        left.spec.notes.push_back(source() + ": the left camera (M1) is the world (x right, y down, z forward)");
+        set.cameras.push_back(left);
+        std::string rKey, tKey;
+        std::optional<glm::dmat4> rightFromLeft = pose(rKey, tKey);
+        std::string poseSource = source();
+        if (!rightFromLeft) {
+            const std::size_t slash = path_.find_last_of('/');
+            const std::string beside = (slash == std::string::npos ? std::string() : path_.substr(0, slash + 1)) + "extrinsics.yml";
+            if (std::filesystem::is_regular_file(beside)) {
+                const CalibrationReader extrinsics(beside, format_);
+                rightFromLeft = extrinsics.pose(rKey, tKey);
+                poseSource = extrinsics.source();
+            }
+        }
+        ImportedCamera right = openCvCamera("right", *root_.findIgnoringCase("M2"), "M2", d2, "D2",
+                                            rightFromLeft.value_or(glm::dmat4(1.0)), rKey + ", " + tKey);
+        right.aliases = {"M2", "1"};
+        if (rightFromLeft) {
+            right.spec.notes.push_back("the right camera (M2) posed by R and T of " + poseSource + " (x_right = R·x_left + T)");
+        } else if (right.refusal.empty()) {
+            right.refusal = source() + ": the right camera (M2) has no pose: neither this file nor extrinsics.yml beside it "
+                                       "holds stereoCalibrate's R and T";
+        }
+        set.cameras.push_back(right);
         return set;
     }
 
