@@ -57,6 +57,16 @@ glm::dmat4 cvFromEyeAxes(const Convention& convention)
     return f;
 }
 
+// The scene's camera as pinhole intrinsics (pixels; the top-left pixel's centre is 0).
+CameraSpec pinholeSpec(const Scene& scene, const std::string& convention, int width, int height, double f, double cx, double cy)
+{
+    CameraSpec spec = smallSpec(scene, convention, width, height);
+    spec.projection.type = ProjectionType::Pinhole;
+    spec.projection.fx = spec.projection.fy = f;
+    spec.projection.cx = cx, spec.projection.cy = cy;
+    return spec;
+}
+
 // A camera whose world-to-camera pose, in OpenCV axes, is [R | t].
 CameraSpec withPose(CameraSpec spec, const glm::dmat3& r, const glm::dvec3& t)
 {
@@ -155,10 +165,7 @@ TEST_CASE("cx and cy exchanged are named", "[diagnose][vision]")
     const Checker checker(builtinScene("builtin:default"));
     const MapVerifier verifier(checker);
     for (const char* convention : {"opencv", "opengl"}) {
-        CameraSpec declared = smallSpec(checker.scene(), convention, 200, 150);
-        declared.projection.type = ProjectionType::Pinhole;
-        declared.projection.fx = declared.projection.fy = 180;
-        declared.projection.cx = 100, declared.projection.cy = 75;  // centred (pinhole: the top-left pixel's centre is 0)
+        CameraSpec declared = pinholeSpec(checker.scene(), convention, 200, 150, 180, 100, 75);
         CameraSpec renderer = declared;
         renderer.projection.cx = 75, renderer.projection.cy = 100;
         requireNamed(verifier, renderer, declared, ExportQuantity::EyeZ, {"cx-cy-swapped", ""});
@@ -262,10 +269,7 @@ TEST_CASE("a lens shift dropped is named as dropped, in x, in y, and in both", "
     const Checker checker(builtinScene("builtin:default"));
     const MapVerifier verifier(checker);
     for (const char* convention : {"opengl", "opencv"}) {
-        CameraSpec centred = smallSpec(checker.scene(), convention, 320, 240);
-        centred.projection.type = ProjectionType::Pinhole;
-        centred.projection.fx = centred.projection.fy = 300;
-        centred.projection.cx = 159.5, centred.projection.cy = 119.5;  // the top-left pixel's centre is 0
+        CameraSpec centred = pinholeSpec(checker.scene(), convention, 320, 240, 300, 159.5, 119.5);  // centred
         CameraSpec shifted = centred;
         shifted.projection.cx += 32;
         requireNamed(verifier, centred, shifted, ExportQuantity::EyeZ, {"lens-shift-dropped", "x"});

@@ -225,6 +225,19 @@ struct FilePose {
     }
 };
 
+// The pose as a file holds it, and its rotation transposed in OpenCV's camera axes and in
+// OpenGL's (R_gl = F·R with F = diag(1, −1, −1), so R_glᵀ read back into OpenCV axes is F·Rᵀ·F).
+struct TransposedPose {
+    FilePose pose;
+    glm::dmat3 cv, gl;
+    static TransposedPose of(const Camera& camera)
+    {
+        const FilePose pose = FilePose::of(camera);
+        const glm::dmat3 rt = glm::transpose(pose.r);
+        return {pose, rt, kCvFromGl * rt * kCvFromGl};
+    }
+};
+
 std::vector<Mistake> buildCatalogue()
 {
     std::vector<Mistake> all;
@@ -284,16 +297,14 @@ std::vector<Mistake> buildCatalogue()
         "transposed-rotation", "the pose's rotation transposed (R used as Rᵀ: a row- vs column-major 3×3, or a "
                                "camera-to-world rotation used as world-to-camera)",
         [](const Camera& camera) {
-            const FilePose pose = FilePose::of(camera);
-            const glm::dmat3 rt = glm::transpose(pose.r), glRt = kCvFromGl * rt * kCvFromGl;
+            const auto [pose, rt, glRt] = TransposedPose::of(camera);
             return std::vector<ViewVariant>{
                 {"translation kept", "consistent if the pose's rotation is transposed (R used as Rᵀ) and t kept: a "
                                      "row- vs column-major rotation", pose.withT(rt, pose.t)},
                 {"eye kept", "consistent if the pose's rotation is transposed (R used as Rᵀ) with the eye where it "
                              "is: a camera-to-world rotation used as world-to-camera", pose.withEye(rt, pose.eye)},
                 // The same in OpenGL camera axes (x right, y up, z back: Blender's matrix_world,
-                // nerfstudio, a zcheck world_from_eye): R_gl = F·R with F = diag(1, −1, −1), so R_glᵀ
-                // read back into OpenCV axes is F·Rᵀ·F.
+                // nerfstudio, a zcheck world_from_eye).
                 {"OpenGL axes, eye kept", "consistent if the camera-to-world rotation in OpenGL axes (Blender's matrix_world, "
                                           "nerfstudio's transform_matrix, a world_from_eye) is transposed with the eye where it is",
                  pose.withEye(glRt, pose.eye)},
@@ -305,8 +316,7 @@ std::vector<Mistake> buildCatalogue()
         "transposed-4x4", "a 4×4 pose matrix read in the other layout (row- vs column-major): its rotation transposed, "
                           "and its translation, now in the bottom row, lost",
         [](const Camera& camera) {
-            const FilePose pose = FilePose::of(camera);
-            const glm::dmat3 rt = glm::transpose(pose.r), glRt = kCvFromGl * rt * kCvFromGl;
+            const auto [pose, rt, glRt] = TransposedPose::of(camera);
             return std::vector<ViewVariant>{
                 {"OpenCV axes", "consistent if the 4×4 pose (OpenCV axes, either direction) was read transposed: rotation "
                                 "Rᵀ, the translation in the bottom row lost (the eye at the world origin)",
