@@ -293,6 +293,18 @@ TEST_CASE("property: no mistake of the catalogue is accepted under any declarati
          }},
     };
     int mistakes = 0, visible = 0;
+    // A wrong map: rejected as it is, and under every declaration and every suggestion.
+    auto neverAccepted = [&](const DepthMap& wrong) {
+        ++visible;
+        for (const Declaration& d : declarations) {
+            INFO("declared: " << d.name);
+            REQUIRE_FALSE(accepted(verifier, camera, d.apply(wrong)));
+        }
+        for (const Hypothesis& h : verifier.diagnose(camera, wrong)) {
+            INFO("suggested: " << h.name << ": " << h.explanation);
+            REQUIRE_FALSE((h.consistent && isDeclaration(h.name)));
+        }
+    };
     for (const Mistake* mistake : injectableMistakes()) {
         RouteFaults faults;
         if (!mistake->inject(camera, faults)) continue;
@@ -303,17 +315,30 @@ TEST_CASE("property: no mistake of the catalogue is accepted under any declarati
             INFO(mistake->name << ", " << toString(quantity));
             // A mistake that leaves this quantity as it is (reversed-Z in an eye-z map) makes no wrong map.
             if (accepted(verifier, camera, wrong)) continue;
-            ++visible;
-            for (const Declaration& d : declarations) {
-                INFO("declared: " << d.name);
-                REQUIRE_FALSE(accepted(verifier, camera, d.apply(wrong)));
-            }
-            for (const Hypothesis& h : verifier.diagnose(camera, wrong)) {
-                INFO("suggested: " << h.name << ": " << h.explanation);
-                REQUIRE_FALSE((h.consistent && isDeclaration(h.name)));
-            }
+            neverAccepted(wrong);
         }
     }
+    // The catalogue's mistakes made with the files (a pose's rotation, its units, the mesh's axes):
+    // the map a renderer that made one draws, through the camera it really used (the first
+    // variant of each that sees the scene), in eye-z.
+    const DepthMap anyMap = room.truth(ExportQuantity::EyeZ);
+    int fileMistakes = 0;
+    for (const Mistake& mistake : mistakeCatalogue()) {
+        if (mistake.inject || !mistake.reread) continue;
+        for (const Rereading& reading : mistake.reread(camera, anyMap)) {
+            if (!reading.camera || !reading.truthFaults.none() || reading.map) continue;
+            const Camera used(*reading.camera);
+            const RenderResult render = room.checker.renderRay(used);
+            if (!testing::anyHit(render)) continue;
+            const DepthMap wrong = mapOf(room.checker.scene(), used, render, ExportQuantity::EyeZ);
+            INFO(mistake.name << " [" << reading.variant << "]");
+            if (accepted(verifier, camera, wrong)) continue;
+            ++fileMistakes;
+            neverAccepted(wrong);
+            break;
+        }
+    }
+    REQUIRE(fileMistakes >= 5);
     // Mistakes made with the files rather than the chain: another quantity, other units.
     const RenderResult truth = room.checker.renderRay(camera);
     for (const auto& [name, make] : std::vector<std::pair<std::string, std::function<DepthMap()>>>{
@@ -331,15 +356,7 @@ TEST_CASE("property: no mistake of the catalogue is accepted under any declarati
         const DepthMap wrong = make();
         INFO(name);
         REQUIRE_FALSE(accepted(verifier, camera, wrong));
-        ++visible;
-        for (const Declaration& d : declarations) {
-            INFO("declared: " << d.name);
-            REQUIRE_FALSE(accepted(verifier, camera, d.apply(wrong)));
-        }
-        for (const Hypothesis& h : verifier.diagnose(camera, wrong)) {
-            INFO("suggested: " << h.name << ": " << h.explanation);
-            REQUIRE_FALSE((h.consistent && isDeclaration(h.name)));
-        }
+        neverAccepted(wrong);
     }
     REQUIRE(mistakes >= 15);  // 18 of the catalogue apply to this camera
     REQUIRE(visible >= 30);
