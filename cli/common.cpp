@@ -204,8 +204,8 @@ void addAccuracyOptions(CLI::App* command, MapAccuracy& accuracy)
                         "the map's values were rounded to multiples of Q (map units, after --scale): each pixel's\n"
                         "tolerance includes that step (0.001 for millimetres held as float metres). Half floats carry\n"
                         "their own step without it. The values must lie on that grid, and every declared accuracy\n"
-                        "is judged as a whole too: the map's median error must stay within a quarter of it (rounding\n"
-                        "and noise are unbiased), and it must be under a tenth of the depths")
+                        "is judged as a whole too: it must be under a tenth of the depths, and the map's mean error\n"
+                        "unbiased (within an exact map's tolerance and six sampling errors: docs/verify.md)")
         ->check(kPositiveFinite)
         ->group(group);
     command->add_option("--rel-tolerance", accuracy.relative,

@@ -302,10 +302,11 @@ int runDatasetVerify(const DatasetVerifyOptions& o)
     ResultsFile thisRun;
     thisRun.path = output;
     runner.run(frames, [&](FrameResult&& result) {
-        sink.write(frameRecordJson(result));
+        const std::string record = frameRecordJson(result);
+        sink.write(record);
         allConsistent = allConsistent && result.consistent();
         progress.frameDone(!result.consistent());
-        FrameRecord r = frameRecordOf(result);  // as `dataset report` reads the line just written
+        FrameRecord r = frameRecordOf(record, "frame '" + result.frame + "'");  // as `dataset report` reads it
         r.file = output;
         thisRun.records.push_back(r);
     });

@@ -121,16 +121,16 @@ FrameResult DatasetRunner::verify(std::size_t index, VerifiedMap* keep) const
         result.map.channel = made.map.channel;
         const DepthMapFile file = made.map;  // for the other frames' cameras, if the map needs them
         const DepthMap map = DepthMap::of(std::move(made.map), plan.quantity, plan.reading);
-        VerifiedMap verified = verifyMap(verifier, camera, map, false, result.map.name());
-        if (options_.diagnose && !verified.run.comparison.report.consistent()) {
-            verified.diagnosed = true;
+        // A frame's own readings first (its camera file's implied scale, another frame's camera),
+        // then the full diagnosis only where they explain nothing.
+        const MapDiagnoser diagnoser = [&](const Camera&, const DepthMap&) -> std::vector<Hypothesis> {
             if (std::optional<Hypothesis> unscaled = impliedScaleOnFloat(frame, plan, verifier, file, camera, map))
-                verified.diagnosis = {std::move(*unscaled)};
-            else if (std::optional<Hypothesis> other = otherFrameCamera(index, plan, verifier, file, camera, map))
-                verified.diagnosis = {std::move(*other)};
-            else
-                verified.diagnosis = verifier.diagnose(camera, map);
-        }
+                return {std::move(*unscaled)};
+            if (std::optional<Hypothesis> other = otherFrameCamera(index, plan, verifier, file, camera, map))
+                return {std::move(*other)};
+            return verifier.diagnose(camera, map);
+        };
+        VerifiedMap verified = verifyMap(verifier, camera, map, options_.diagnose, result.map.name(), diagnoser);
         result.verified = true;
         result.report = verified.run.report;
         result.diagnosed = verified.diagnosed;
@@ -167,8 +167,6 @@ const OtherFrame& otherFrame(long offset)
 
 }  // namespace
 
-std::string otherFrameHypothesisName(long offset) { return otherFrame(offset).name; }
-
 std::optional<std::string> datasetPhraseOf(const std::string& hypothesisName)
 {
     for (const OtherFrame& f : kOtherFrames)
@@ -183,8 +181,8 @@ std::optional<Hypothesis> DatasetRunner::impliedScaleOnFloat(const DatasetFrame&
     // Only where the implied scale was used (no --scale, no manifest scale) on a float file.
     if (frame.scale || options_.scale || !frame.impliedScale || file.valueQuantum > 0 || !(plan.reading.scale > 0))
         return std::nullopt;
-    DepthMap asStored = map;
-    for (double& v : asStored.value) v = (v - plan.reading.offset) * plan.reading.scale + plan.reading.offset;
+    DepthMap asStored = map;  // read with scale 1: the stored value plus the offset
+    for (double& v : asStored.value) v = map.storedOf(v) + map.offset;
     asStored.scale = 0;
     for (float& step : asStored.valueStep) step = float(step * plan.reading.scale);
     const VerifyResult run = verifier.verify(camera, asStored);

@@ -67,10 +67,12 @@ std::vector<std::uint8_t> previewRgb(const QuantityImage& image)
     const std::size_t pixels = std::size_t(image.width) * image.height;
     std::vector<std::uint8_t> rgb(pixels * 3, 0);
     const std::size_t C = image.channels.size();
-    double lo = INFINITY, hi = -INFINITY;
-    if (C == 1 && image.quantity != ExportQuantity::PrimitiveId)
+    if (C == 1 && image.quantity != ExportQuantity::PrimitiveId) {  // a depth: on its own range
+        double lo = INFINITY, hi = -INFINITY;
         for (std::size_t i = 0; i < pixels; ++i)
             if (!image.isMiss(i)) lo = std::min(lo, image.value[i]), hi = std::max(hi, image.value[i]);
+        return previewRgb(image, lo, hi);
+    }
     double boxLo[3] = {INFINITY, INFINITY, INFINITY}, boxHi[3] = {-INFINITY, -INFINITY, -INFINITY};
     if (C == 3)
         for (std::size_t i = 0; i < pixels; ++i)
@@ -92,7 +94,7 @@ std::vector<std::uint8_t> previewRgb(const QuantityImage& image)
                 c[k] = std::uint8_t(std::lround(255 * std::clamp(t, 0.0, 1.0)));
             }
         } else {
-            c = viridis(hi > lo ? (image.value[i] - lo) / (hi - lo) : 0.5);
+            c = viridis(0.5);  // no range to place it on
         }
         std::copy(c.begin(), c.end(), rgb.begin() + std::ptrdiff_t(3 * i));
     }

@@ -163,9 +163,9 @@ ResultsFile readResults(const std::string& path)
     return out;
 }
 
-FrameRecord frameRecordOf(const FrameResult& result)
+FrameRecord frameRecordOf(const std::string& recordJson, const std::string& where)
 {
-    return recordFrom(json::parse(frameRecordJson(result)), "frame '" + result.frame + "'");
+    return recordFrom(json::parse(recordJson), where);
 }
 
 DatasetSummary summarizeResults(const std::vector<ResultsFile>& files)
@@ -418,11 +418,9 @@ std::string classLegend()
 {
     std::ostringstream html;
     html << "<div class='legend'>";
-    for (auto [name, rgb] : pixelClassLegend()) {
-        if (const std::size_t at = name.find("raster"); at != std::string::npos) name.replace(at, 6, "map");  // verify's words
+    for (const auto& [pixelClass, rgb] : pixelClassLegend())
         html << "<span><i style='background:rgb(" << int(rgb[0]) << "," << int(rgb[1]) << "," << int(rgb[2]) << ")'></i>"
-             << escaped(name) << "</span>";
-    }
+             << escaped(reportjson::className(pixelClass, "map")) << "</span>";
     html << "</div>";
     return html.str();
 }

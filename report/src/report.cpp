@@ -14,15 +14,16 @@
 
 namespace zcheck {
 
-namespace {
-
-// A pixel class's name as a report says it: "raster-only" is "map-only" in verify's.
-std::string className(PixelClass c, const std::string& second)
+std::string reportjson::className(PixelClass c, const std::string& second)
 {
     std::string name = toString(c);
     if (const std::size_t at = name.find("raster"); at != std::string::npos) name.replace(at, 6, second);
     return name;
 }
+
+namespace {
+
+using reportjson::className;
 
 nlohmann::json toJson(const PixelFinding& f, const std::string& second)
 {

@@ -68,13 +68,13 @@ std::vector<std::uint8_t> errorHeatmapRgb(const Comparison& comparison)
     });
 }
 
-std::vector<std::pair<std::string, std::array<std::uint8_t, 3>>> pixelClassLegend()
+std::vector<std::pair<PixelClass, std::array<std::uint8_t, 3>>> pixelClassLegend()
 {
-    std::vector<std::pair<std::string, std::array<std::uint8_t, 3>>> out;
+    std::vector<std::pair<PixelClass, std::array<std::uint8_t, 3>>> out;
     for (const PixelClass c : {PixelClass::BothMiss, PixelClass::Agree, PixelClass::EdgeSurface, PixelClass::DepthError,
                                PixelClass::RayOnlyEdge, PixelClass::RasterOnlyEdge, PixelClass::RayOnlyAtClear,
                                PixelClass::AtClipPlane, PixelClass::RayOnly, PixelClass::RasterOnly, PixelClass::Hole})
-        out.emplace_back(toString(c), classColour(c));
+        out.emplace_back(c, classColour(c));
     return out;
 }
 

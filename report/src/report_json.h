@@ -19,5 +19,7 @@ nlohmann::json outOfRangeJson(const CheckReport& r);                  // "out_of
 nlohmann::json declaredRefusedJson(const CheckReport& r);             // "declared_accuracy_refused" (verify): why, or null
 nlohmann::json depthMapJson(const DepthMapSource& source);                 // "depth_map"
 nlohmann::json hypothesisJson(const Hypothesis& h);                        // one entry of "diagnosis"
+// A pixel class's name as a report says it: "raster-only" is "map-only" in verify's (`second`).
+std::string className(PixelClass c, const std::string& second);
 
 }  // namespace zcheck::reportjson

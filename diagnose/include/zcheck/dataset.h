@@ -75,9 +75,8 @@ CameraForMap frameCameraAndMap(const DatasetFrame& frame, const FramePlan& plan,
 // i−2 and i+2, then of every other frame of the same scene (a probe of single rays first, the
 // three that come closest judged in full), and names the first that makes the map consistent;
 // the full diagnosis runs only when none does. Cameras equal to the frame's own are skipped.
-// The hypothesis's name for an offset j − i: "previous-frame-camera" (−1), "next-frame-camera"
+// The hypotheses' names by the offset j − i: "previous-frame-camera" (−1), "next-frame-camera"
 // (+1), "camera-2-frames-back" (−2), "camera-2-frames-ahead" (+2), "another-frame-camera".
-std::string otherFrameHypothesisName(long offset);
 // What a dataset's summary says of its frames for such a hypothesis ("consistent with the
 // previous frame's camera"); nullopt for any other hypothesis.
 std::optional<std::string> datasetPhraseOf(const std::string& hypothesisName);

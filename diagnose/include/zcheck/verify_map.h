@@ -15,6 +15,7 @@
 #include "zcheck/map_verifier.h"
 #include "zcheck/verify.h"
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -42,7 +43,10 @@ struct VerifiedMap {
 // MapVerifier::diagnose. With `diagnose`, the refusal of a map holding nothing of its quantity
 // says which other quantity reads its values consistently ("…; --diagnose: its values are
 // consistent read as eye-z (pass --quantity eye-z)"), or that none does.
+// `diagnoser`, when given, replaces MapVerifier::diagnose for an inconsistent map (datasets try
+// their own readings first: another frame's camera).
+using MapDiagnoser = std::function<std::vector<Hypothesis>(const Camera&, const DepthMap&)>;
 VerifiedMap verifyMap(const MapVerifier& verifier, const Camera& camera, const DepthMap& map, bool diagnose,
-                      const std::string& name = "the depth map");
+                      const std::string& name = "the depth map", const MapDiagnoser& diagnoser = {});
 
 }  // namespace zcheck

@@ -52,8 +52,8 @@ struct FrameRecord {
     std::size_t line = 0;
 };
 
-// A result as `dataset report` reads its record back (frameRecordJson, then the reader's rule).
-FrameRecord frameRecordOf(const FrameResult& result);
+// A record line (frameRecordJson) as `dataset report` reads it back; `where` names it in errors.
+FrameRecord frameRecordOf(const std::string& recordJson, const std::string& where);
 
 struct ResultsFile {
     std::string path;

@@ -17,7 +17,7 @@ namespace zcheck {
 
 std::vector<std::uint8_t> errorHeatmapRgb(const Comparison& comparison);
 std::vector<std::uint8_t> pixelClassRgb(const Comparison& comparison);
-// Every class's name (toString(PixelClass)) and its colour in pixelClassRgb, for legends.
-std::vector<std::pair<std::string, std::array<std::uint8_t, 3>>> pixelClassLegend();
+// Every class and its colour in pixelClassRgb, for legends.
+std::vector<std::pair<PixelClass, std::array<std::uint8_t, 3>>> pixelClassLegend();
 
 }  // namespace zcheck
