@@ -40,9 +40,7 @@ int main(int argc, char** argv)
     try {
         DatasetSourceOptions sourceOptions;
         sourceOptions.depthPattern = depth;
-        const Dataset dataset = openDataset(source, sourceOptions, [](const std::string& path, std::optional<CameraFormat> f) {
-            return openCameraSet(path, f);
-        });
+        const Dataset dataset = openDataset(source, sourceOptions);
         DatasetRunOptions options;
         options.scene = scene, options.quantity = quantity, options.scale = scale;
         const Checker checker(loadScene(scene));

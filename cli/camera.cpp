@@ -1,9 +1,9 @@
 // zcheck camera: one camera of any camera file, in zcheck's JSON with its matrices in every
-// convention, or written in another format (camera_export.h).
+// convention, or written in another format (camera_formats.h).
 #include "common.h"
 
 #include "zcheck/atomic_file.h"
-#include "zcheck/camera_export.h"
+#include "zcheck/camera_formats.h"
 #include "zcheck/camera_sources.h"
 #include "zcheck/detail/camera_json.h"
 #include "zcheck/error.h"
@@ -28,28 +28,36 @@ nlohmann::json intrinsicsJson(const Camera& camera, double pixelCenter)
     return {{"fx", k.fx}, {"fy", k.fy}, {"cx", k.cx}, {"cy", k.cy}};
 }
 
+// The formats written as a folder of files ("colmap").
+std::string folderFormats()
+{
+    std::string out;
+    for (const CameraFormat* format : cameraFormats())
+        if (format->write && format->writesFolder) out += (out.empty() ? "" : " | ") + format->name;
+    return out;
+}
+
 int runCameraCommand(const CameraCommandOptions& o)
 {
-    const CameraFormat to = cameraFormatFromName(o.to);
+    const CameraFormat& to = cameraFormatNamed(o.to);
     const auto [file, frame] = splitCameraReference(o.camera.reference);
-    const std::optional<CameraFormat> format =
-        o.camera.format.empty() ? std::nullopt : std::optional<CameraFormat>(cameraFormatFromName(o.camera.format));
+    const CameraFormat* format = o.camera.format.empty() ? nullptr : &cameraFormatNamed(o.camera.format);
     OutputFiles outputs;
     outputs.addInput(file);
     if (!o.output.empty() && !o.outDir.empty()) throw Error("-o FILE and --out DIR are alternatives");
-    if (to == CameraFormat::Colmap && !o.output.empty())
-        throw Error("a COLMAP model is a folder (cameras.txt, images.txt): write it with --out DIR, not -o");
-    if (to != CameraFormat::Colmap && !o.outDir.empty())
-        throw Error("--out DIR writes a COLMAP model (--to colmap); write a " + o.to + " camera with -o FILE");
-    if (to == CameraFormat::Ros || to == CameraFormat::Gltf)
-        throw Error("--to takes zcheck, colmap, nerfstudio or opencv, not " + o.to);
+    if (!to.write)
+        throw Error("--to takes " + cameraFormatChoices(CameraFormatsWith::Writer, ", ") + ", not " + o.to);
+    if (to.writesFolder && !o.output.empty())
+        throw Error("a " + to.title + " is a folder: write it with --out DIR, not -o");
+    if (!to.writesFolder && !o.outDir.empty())
+        throw Error("--out DIR writes a format whose files make a folder (--to " + folderFormats() + "); write a " + o.to +
+                    " camera with -o FILE");
     if (!o.output.empty()) outputs.add(o.output, "-o");
     if (!o.outDir.empty()) {
         outputs.addFolder(o.outDir, "--out");
-        for (const char* name : {"cameras.txt", "images.txt"}) outputs.add(o.outDir + "/" + name, "--out");
     }
 
-    const CameraSet set = openCameraSet(file, format);
+    const CameraSet set = readCameraSet(file, format);
     const std::size_t index = set.find(frame);
     const ImportedCamera& imported = set.cameras[index];
     const std::optional<std::pair<int, int>> size =
@@ -76,11 +84,14 @@ int runCameraCommand(const CameraCommandOptions& o)
     }
     const Camera camera(spec);
 
-    if (to != CameraFormat::Zcheck || !o.output.empty()) {
+    if (to.name != "zcheck" || !o.output.empty()) {
         const std::vector<CameraFileText> files = cameraInFormat(camera, to, imported.name);
         if (!o.output.empty()) outputs.writeText(o.output, files.front().text);
         if (!o.outDir.empty())
-            for (const CameraFileText& f : files) outputs.writeText(o.outDir + "/" + f.fileName, f.text);
+            for (const CameraFileText& f : files) {
+                outputs.add(o.outDir + "/" + f.fileName, "--out");
+                outputs.writeText(o.outDir + "/" + f.fileName, f.text);
+            }
         outputs.commit();
         if (o.output.empty() && o.outDir.empty())
             for (const CameraFileText& f : files) std::cout << f.text;
@@ -88,7 +99,7 @@ int runCameraCommand(const CameraCommandOptions& o)
     }
 
     nlohmann::json out;
-    out["source"] = {{"file", file}, {"format", toString(set.format)}, {"frame", imported.name}, {"index", index},
+    out["source"] = {{"file", file}, {"format", set.format}, {"frame", imported.name}, {"index", index},
                      {"frames", set.cameras.size()}};
     out["camera"] = toJson(spec);
     if (!clipKnown) out["camera"]["projection"]["near"] = nullptr, out["camera"]["projection"]["far"] = nullptr;
@@ -124,10 +135,9 @@ Command addCameraCommand(CLI::App& app)
 {
     auto o = std::make_shared<CameraCommandOptions>();
     CLI::App* command = app.add_subcommand(
-        "camera", "Read one camera of any camera file zcheck imports (a zcheck camera, a COLMAP model, a\n"
-                  "transforms.json, OpenCV or ROS calibration YAML/XML, a glTF's camera nodes) and print it as\n"
-                  "zcheck's camera JSON with its intrinsics and its matrices in every convention, or (--to) in\n"
-                  "another format. Examples:\n"
+        "camera", "Read one camera of any camera file zcheck imports (" + cameraFormatChoices(CameraFormatsWith::Reader, ", ") +
+                      ")\nand print it as zcheck's camera JSON with its intrinsics and its matrices in every convention,\n"
+                      "or (--to) in another format. Examples:\n"
                   "  zcheck camera sparse/0#img_014.png\n"
                   "  zcheck camera transforms.json#frame_003 --to colmap --out model/\n"
                   "  zcheck camera calib.yml --to nerfstudio -o transforms.json");
@@ -135,9 +145,11 @@ Command addCameraCommand(CLI::App& app)
         ->required()
         ->check(kNonEmptyPath);
     command->add_option("--camera-format", o->camera.format,
-                        "the file's format when its content should not decide: zcheck | colmap | nerfstudio | opencv | "
-                        "ros | gltf");
-    command->add_option("--to", o->to, "zcheck (JSON with matrices) | colmap | nerfstudio | opencv")->capture_default_str();
+                        "the file's format when its content should not decide: " +
+                            cameraFormatChoices(CameraFormatsWith::Reader));
+    command->add_option("--to", o->to, "the format to write (zcheck: JSON with matrices): " +
+                                           cameraFormatChoices(CameraFormatsWith::Writer))
+        ->capture_default_str();
     command->add_option("--scene", o->scene, "a scene to take near and far from when the file has none");
     command->add_option("--near", o->camera.near, "near plane distance (default: the file's, else --scene's)")
         ->check(kPositiveFinite);
@@ -145,10 +157,10 @@ Command addCameraCommand(CLI::App& app)
         ->check(kPositiveFinite);
     command->add_option("--convention", o->camera.convention, "show the camera in this convention");
     addImageSizeOptions(command, o->size);
-    command->add_option("-o,--output", o->output, "write the camera file (zcheck, nerfstudio, opencv) instead of printing")
+    command->add_option("-o,--output", o->output, "write the camera file instead of printing (formats whose file is one file)")
         ->type_name("FILE")
         ->check(kNonEmptyPath);
-    command->add_option("--out", o->outDir, "write the COLMAP model (cameras.txt, images.txt) into this folder")
+    command->add_option("--out", o->outDir, "write a format whose files make a folder (a COLMAP model: cameras.txt, images.txt)")
         ->type_name("DIR")
         ->check(kNonEmptyPath);
     return {command, [o] { return runCameraCommand(*o); }};

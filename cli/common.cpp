@@ -60,8 +60,8 @@ void addCameraOptions(CLI::App* command, CameraOptions& options, const std::stri
 {
     command->add_option("--camera", options.reference, cameraHelp)->check(kNonEmptyPath);
     command->add_option("--camera-format", options.format,
-                        "the camera file's format when its content should not decide:\n"
-                        "zcheck | colmap | nerfstudio (instant-ngp) | opencv | ros | gltf");
+                        "the camera file's format when its content should not decide:\n" +
+                            cameraFormatChoices(CameraFormatsWith::Reader));
     command->add_option("--near", options.near, "near plane distance (eye-z > 0); default: the camera file's, else\n"
                                                 "the scene's nearest point as the camera sees it, less 1 %")
         ->check(kPositiveFinite);
@@ -79,9 +79,7 @@ void addSceneAndCameraOptions(CLI::App* command, SceneAndCamera& options)
         ->capture_default_str()
         ->check(kNonEmptyPath);
     addCameraOptions(command, options.camera,
-                     "FILE or FILE#FRAME: a zcheck camera (JSON), a COLMAP model folder (sparse/0#img_014.png),\n"
-                     "a transforms.json (nerfstudio, instant-ngp; #frame_003 or #3), an OpenCV FileStorage or\n"
-                     "ROS CameraInfo YAML, a glTF's camera nodes; default: the scene's own camera");
+                     cameraFileHelp("(#FRAME: an index, an image name, a path or its stem); default: the scene's own camera"));
 }
 
 void addImageSizeOptions(CLI::App* command, ImageSize& size)
@@ -92,10 +90,10 @@ void addImageSizeOptions(CLI::App* command, ImageSize& size)
 
 namespace {
 
-std::optional<CameraFormat> formatOption(const CameraOptions& options)
+const CameraFormat* formatOption(const CameraOptions& options)
 {
-    if (options.format.empty()) return std::nullopt;
-    return cameraFormatFromName(options.format);
+    if (options.format.empty()) return nullptr;
+    return &cameraFormatNamed(options.format);
 }
 
 CameraSpec withConvention(CameraSpec spec, const std::string& convention)
@@ -114,9 +112,12 @@ CameraCompletion completionOf(const CameraOptions& o, std::optional<std::pair<in
 
 }  // namespace
 
-const std::string kCameraFileHelp =
-    "FILE or FILE#FRAME: a zcheck camera (JSON), a COLMAP model folder, a transforms.json, an OpenCV\n"
-    "FileStorage or ROS CameraInfo YAML, a glTF's camera nodes (near and far: the file's, or --near/--far)";
+std::string cameraFileHelp(const std::string& tail)
+{
+    std::string out = "FILE or FILE#FRAME, its format told by content:";
+    for (const CameraFormat* format : cameraFormats()) out += "\n  " + format->title + " (" + format->example + ")";
+    return out + "\n" + tail;
+}
 
 std::string cameraInputPath(const CameraOptions& options) { return splitCameraReference(options.reference).first; }
 

@@ -36,6 +36,8 @@ Command addSuiteCommand(CLI::App& app);
 Command addBenchCommand(CLI::App& app);
 Command addCameraCommand(CLI::App& app);
 Command addDatasetCommand(CLI::App& app);
+Command addFormatsCommand(CLI::App& app);
+Command addFormatsCommand(CLI::App& app);
 
 // Option validators, the same in every subcommand.
 extern const CLI::Validator kNonEmptyPath;
@@ -75,7 +77,7 @@ CameraSpec cameraSpecFor(const Scene& scene, const SceneAndCamera& options, std:
 CameraForMap cameraAndMapFor(const Scene* scene, const SceneAndCamera& options, DepthQuantity quantity,
                              const std::function<DepthMapFile(int width, int height)>& read);
 // The --camera help of commands without a scene.
-extern const std::string kCameraFileHelp;
+std::string cameraFileHelp(const std::string& tail = "near and far: the file's, or --near/--far");
 // The file part of --camera (an input a run must not overwrite).
 std::string cameraInputPath(const CameraOptions& options);
 // A camera without a scene (matrices, precision, unproject): near and far must be in the file

@@ -41,9 +41,18 @@ struct DatasetVerifyOptions {
     int threads = 0;
 };
 
+// "a COLMAP model, a transforms.json": the camera formats that are dataset sources.
+std::string datasetSourceHelp()
+{
+    std::string out;
+    for (const CameraFormat* format : cameraFormats())
+        if (format->datasetSource) out += (out.empty() ? "a " : ", a ") + format->title;
+    return out;
+}
+
 void addDatasetVerifyOptions(CLI::App* command, DatasetVerifyOptions& o)
 {
-    command->add_option("source", o.source, "a transforms.json, a COLMAP model folder, or a manifest (.jsonl)")
+    command->add_option("source", o.source, datasetSourceHelp() + ", or a manifest (.jsonl)")
         ->required()
         ->check(kNonEmptyPath);
     command->add_option("--scene", o.scene, "the mesh every frame is checked against (a manifest line may name its own)")
@@ -59,7 +68,8 @@ void addDatasetVerifyOptions(CLI::App* command, DatasetVerifyOptions& o)
     command->add_option("--miss", o.miss, "the stored value meaning 'no surface': 0, 65535, 1e10, nan, inf, '>=1e9'");
     command->add_option("--channel", o.channel, "the channel or HDF5 dataset to read (depth, distance, Z, ...)");
     addAccuracyOptions(command, o.accuracy);
-    command->add_option("--camera-format", o.cameraFormat, "the source's format when its content should not decide");
+    command->add_option("--camera-format", o.cameraFormat, "the source's format when its content should not decide: " +
+                                                            cameraFormatChoices(CameraFormatsWith::Dataset));
     command->add_option("--near", o.near, "near plane of cameras whose file has none (default: from the scene)")
         ->check(kPositiveFinite);
     command->add_option("--far", o.far, "far plane of cameras whose file has none (default: from the scene)")
@@ -73,10 +83,8 @@ Dataset openSource(const DatasetVerifyOptions& o)
 {
     DatasetSourceOptions options;
     options.depthPattern = o.depthPattern;
-    if (!o.cameraFormat.empty()) options.cameraFormat = cameraFormatFromName(o.cameraFormat);
-    return openDataset(o.source, options, [](const std::string& path, std::optional<CameraFormat> format) {
-        return openCameraSet(path, format);
-    });
+    if (!o.cameraFormat.empty()) options.cameraFormat = &cameraFormatNamed(o.cameraFormat);
+    return openDataset(o.source, options);
 }
 
 DatasetRunOptions runOptions(const DatasetVerifyOptions& o)
@@ -499,8 +507,8 @@ int runDatasetSubmit(const SubmitOptions& o)
 Command addDatasetCommand(CLI::App& app)
 {
     CLI::App* dataset = app.add_subcommand(
-        "dataset", "A dataset of depth maps as one job: verify every frame of a transforms.json, a COLMAP model or\n"
-                   "a manifest (sharded, resumable), report on results, import a source as a manifest, or submit\n"
+        "dataset", "A dataset of depth maps as one job: verify every frame of " + datasetSourceHelp() + " or a\n"
+                   "manifest (sharded, resumable), report on results, import a source as a manifest, or submit\n"
                    "the job to a Slurm cluster.");
     dataset->require_subcommand(1);
 
@@ -536,10 +544,11 @@ Command addDatasetCommand(CLI::App& app)
     auto import = std::make_shared<DatasetVerifyOptions>();
     auto manifest = std::make_shared<std::string>();
     CLI::App* importCommand = dataset->add_subcommand(
-        "import", "Write the manifest (JSON Lines, one frame a line) a transforms.json or COLMAP model implies.");
-    importCommand->add_option("source", import->source, "a transforms.json or a COLMAP model folder")->required()->check(kNonEmptyPath);
+        "import", "Write the manifest (JSON Lines, one frame a line) a dataset source implies.");
+    importCommand->add_option("source", import->source, datasetSourceHelp())->required()->check(kNonEmptyPath);
     importCommand->add_option("--depth", import->depthPattern, "COLMAP: the depth map pattern ({name}, {stem})");
-    importCommand->add_option("--camera-format", import->cameraFormat, "the source's format when its content should not decide");
+    importCommand->add_option("--camera-format", import->cameraFormat, "the source's format when its content should not decide: " +
+                                                                       cameraFormatChoices(CameraFormatsWith::Dataset));
     importCommand->add_option("-o,--output", *manifest, "the manifest to write")
         ->type_name("FILE")->required()->check(kNonEmptyPath);
 

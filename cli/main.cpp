@@ -22,7 +22,7 @@ int main(int argc, char** argv)
     const Command commands[] = {addCheckCommand(app),  addMatricesCommand(app), addPrecisionCommand(app),
                                 addUnprojectCommand(app), addExportCommand(app), addVerifyCommand(app),
                                 addSuiteCommand(app),  addBenchCommand(app),    addCameraCommand(app),
-                                addDatasetCommand(app)};
+                                addDatasetCommand(app),  addFormatsCommand(app)};
 
     // CLI11 says only "a subcommand is required" for a misspelt one: name it.
     if (argc > 1 && argv[1][0] != '-') {

@@ -18,7 +18,7 @@ Command addMatricesCommand(CLI::App& app)
                     "eye_from_clip, clip_from_world, window_from_ndc, ndc_from_window (4 rows of 4, column\n"
                     "vectors p' = M·p), and a 'native' block in the convention's own form (row vectors for\n"
                     "direct3d).");
-    addCameraOptions(command, o->camera, kCameraFileHelp);
+    addCameraOptions(command, o->camera, cameraFileHelp());
     command->get_option("--camera")->required();
     return {command, [o] {
                 std::cout << matricesJsonText(Camera(cameraSpecFrom(o->camera))) << "\n";

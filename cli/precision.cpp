@@ -61,7 +61,7 @@ Command addPrecisionCommand(CLI::App& app)
         "precision", "How finely each depth layout (unorm16, unorm24, float32 x standard, reversed, infinite far)\n"
                      "resolves eye depth for a camera's near/far: the eye-z step between neighbouring stored\n"
                      "values at each distance, and which layout is best.");
-    addCameraOptions(command, o->camera, kCameraFileHelp);
+    addCameraOptions(command, o->camera, cameraFileHelp());
     command->get_option("--camera")->required();
     command->add_option("--at", o->at, "eye-z distances, comma-separated (default: 9 log-spaced from near to far)")
         ->check(kNonEmptyList);

@@ -4,7 +4,7 @@
 #include "image_plugin.h"
 
 #include "zcheck/atomic_file.h"
-#include "zcheck/detail/camera_json.h"
+#include "zcheck/detail/json.h"
 #include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
 #include "zcheck/point_cloud.h"
@@ -147,7 +147,7 @@ Command addUnprojectCommand(CLI::App& app)
     CLI::App* command = app.add_subcommand(
         "unproject", "The inverse projection: the ray through a pixel centre, the point at a depth value, or a\n"
                      "whole depth map (EXR, PFM, TIFF, 16-bit PNG with --scale) as a PLY point cloud, misses skipped.");
-    addCameraOptions(command, o->camera, kCameraFileHelp);
+    addCameraOptions(command, o->camera, cameraFileHelp());
     command->add_option("--pixel", o->pixel, "COL,ROW (row 0 at the top): print the ray through its centre");
     command->add_option("--depth", o->depth, "with --pixel: print the point at this depth value");
     command->add_option("--quantity", o->quantity,

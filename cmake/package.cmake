@@ -1,5 +1,5 @@
 # The installed CMake package: find_package(zcheck) → zcheck::zcheck (everything) and the
-# finer targets zcheck::core, io, imageio, scene, raycast, raster, check, diagnose, report.
+# finer targets zcheck::core, io, depthmaps, imageio, cameras, scene, raycast, raster, check, diagnose, report.
 include(CMakePackageConfigHelpers)
 add_library(zcheck_all INTERFACE)
 set_target_properties(zcheck_all PROPERTIES EXPORT_NAME zcheck)

@@ -1,8 +1,11 @@
-// libFuzzer harness for the camera importers and dataset sources (camera_import.h,
-// dataset_source.h): COLMAP text and binary models, transforms.json, OpenCV FileStorage YAML and
-// XML, ROS CameraInfo, manifests. The first byte chooses the format; for the two-file COLMAP
-// models the rest is split at the first "\n--8<--\n" into cameras and images. Every camera read
-// is also selected by FILE#FRAME and built, as zcheck would.
+// libFuzzer harness for the camera formats and dataset sources (camera_formats.h,
+// dataset_source.h): every row of the table, and manifests. An input is the format's name on
+// its first line, then the file's bytes: "nerfstudio\n{...}", "manifest\n{...}". A COLMAP model
+// is two files: "colmap-text" or "colmap-bin", the rest split at the first "\n--8<--\n" into
+// cameras and images. Every camera read is also selected by FILE#FRAME and built, as zcheck
+// would, and a dataset source is opened as a dataset. A new format needs no change here: a
+// seed named after it (fuzz/corpus/camera_import/NAME) is enough.
+#include "zcheck/camera_formats.h"
 #include "zcheck/camera_import.h"
 #include "zcheck/dataset_source.h"
 #include "zcheck/error.h"
@@ -38,57 +41,52 @@ void exercise(const zcheck::CameraSet& set)
     }
 }
 
+void readAs(const zcheck::CameraFormat& format, const std::string& path)
+{
+    exercise(zcheck::readCameraSet(path, &format));
+    if (format.datasetSource) {
+        zcheck::DatasetSourceOptions options;
+        options.cameraFormat = &format;
+        if (!format.namesDepthMaps) options.depthPattern = "depth/{stem}.bin";
+        (void)zcheck::openDataset(path, options);
+    }
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
 {
-    if (size < 1) return 0;
     static const std::string dir = "/tmp/zcheck-fuzz-import-" + std::to_string(::getpid());
     static const bool made = ::mkdir(dir.c_str(), 0700) == 0 || true;
     (void)made;
-    const int kind = data[0] % 7;
-    const std::string body(reinterpret_cast<const char*>(data) + 1, size - 1);
-    const std::size_t cut = body.find("\n--8<--\n");
-    const std::string first = cut == std::string::npos ? body : body.substr(0, cut);
-    const std::string second = cut == std::string::npos ? "" : body.substr(cut + 8);
-    for (const char* name : {"cameras.txt", "images.txt", "cameras.bin", "images.bin"}) std::remove((dir + "/" + name).c_str());
+    const std::string input(reinterpret_cast<const char*>(data), size);
+    const std::size_t newline = input.find('\n');
+    if (newline == std::string::npos) return 0;
+    const std::string name = input.substr(0, newline), body = input.substr(newline + 1);
+    for (const char* file : {"cameras.txt", "images.txt", "cameras.bin", "images.bin"}) std::remove((dir + "/" + file).c_str());
     try {
-        switch (kind) {
-        case 0:
-        case 1: {
-            const bool binary = kind == 1;
-            write(dir + (binary ? "/cameras.bin" : "/cameras.txt"), first);
-            write(dir + (binary ? "/images.bin" : "/images.txt"), second);
-            exercise(zcheck::readCameraSet(dir, zcheck::CameraFormat::Colmap));
-            zcheck::DatasetSourceOptions options;
-            options.depthPattern = "depth/{stem}.bin";
-            (void)zcheck::openDataset(dir, options);
-            break;
-        }
-        case 2:
-            write(dir + "/transforms.json", body);
-            exercise(zcheck::readCameraSet(dir + "/transforms.json", zcheck::CameraFormat::Nerfstudio));
-            (void)zcheck::openDataset(dir + "/transforms.json", {});
-            break;
-        case 3:
-        case 4:
-            write(dir + "/calibration", body);
-            exercise(zcheck::readCameraSet(dir + "/calibration", zcheck::CameraFormat::OpenCv));
-            break;
-        case 5:
-            write(dir + "/camera_info.yaml", body);
-            exercise(zcheck::readCameraSet(dir + "/camera_info.yaml", zcheck::CameraFormat::Ros));
-            break;
-        default:
+        if (name == "colmap-text" || name == "colmap-bin") {
+            const std::size_t cut = body.find("\n--8<--\n");
+            const std::string suffix = name == "colmap-bin" ? ".bin" : ".txt";
+            write(dir + "/cameras" + suffix, body.substr(0, cut));
+            write(dir + "/images" + suffix, cut == std::string::npos ? "" : body.substr(cut + 8));
+            readAs(zcheck::cameraFormatNamed("colmap"), dir);
+        } else if (name == "manifest") {
             write(dir + "/manifest.jsonl", body);
             (void)zcheck::openDataset(dir + "/manifest.jsonl", {});
-            break;
+        } else {
+            const zcheck::CameraFormat* format = nullptr;
+            for (const zcheck::CameraFormat* row : zcheck::cameraFormats())
+                if (row->name == name) format = row;
+            if (!format) return 0;
+            write(dir + "/input", body);
+            readAs(*format, dir + "/input");
         }
     } catch (const zcheck::Error&) {
     }
     // Telling the format by content must never throw anything but Error either.
     try {
-        (void)zcheck::detectCameraFormat(dir + "/transforms.json");
+        (void)zcheck::detectCameraFormat(dir + "/input");
     } catch (const zcheck::Error&) {
     }
     return 0;

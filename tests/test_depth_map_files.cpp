@@ -9,6 +9,8 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <atomic>
+#include <thread>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -365,4 +367,48 @@ TEST_CASE("HDF5 maps: a dataset chosen by --channel or by its name; malformed fi
     }
     REQUIRE_THROWS_WITH(read(bytesFile("cut.h5", whole.substr(0, whole.size() / 2)), channelNamed("depth")),
                         Catch::StartsWith("cannot read depth map"));
+}
+
+TEST_CASE("regression: HDF5 maps were read in a bare fork of a multithreaded process", "[depthmap][hdf5]")
+{
+    // The reader is a program of its own, started with posix_spawn: many threads read at once.
+    QuantityImage depth;
+    depth.quantity = ExportQuantity::EyeZ, depth.width = W, depth.height = H, depth.channels = {"depth"};
+    depth.value = {1, 2, 3, 4, 5, 6};
+    const std::string path = scratchPath("threads.h5");
+    REQUIRE(writeQuantityFile(path, {depth}, 0) == "hdf5");
+    std::atomic<int> right{0};
+    std::vector<std::thread> threads;
+    for (int t = 0; t < 8; ++t)
+        threads.emplace_back([&] {
+            for (int i = 0; i < 4; ++i) right += read(path).value[5] == 6.0;
+        });
+    for (std::thread& thread : threads) thread.join();
+    REQUIRE(right == 32);
+
+    // Whatever the reader does, zcheck refuses the file and goes on: it crashes, answers in
+    // another protocol, or is missing.
+    const auto withReader = [&](const std::string& script) {
+        const std::string program = scratchPath("reader.sh");
+        std::ofstream(program) << "#!/bin/sh\n" << script << "\n";
+        fs::permissions(program, fs::perms::owner_all);
+        ::setenv("ZCHECK_HDF5_READER", program.c_str(), 1);
+        std::string what;
+        try {
+            (void)read(path);
+        } catch (const Error& e) {
+            what = e.what();
+        }
+        ::unsetenv("ZCHECK_HDF5_READER");
+        return what;
+    };
+    REQUIRE_THAT(withReader("kill -SEGV $$"), Catch::Contains("cannot read depth map '" + path + "'") &&
+                                                   Catch::Contains("crashed reading it (signal 11)"));
+    REQUIRE_THAT(withReader("printf 'something else entirely, long enough for a header'"),
+                 Catch::Contains("answered in another protocol"));
+    REQUIRE_THAT(withReader("exit 0"), Catch::Contains("stopped before it answered"));
+    ::setenv("ZCHECK_HDF5_READER", "/nonexistent/zcheck-hdf5-reader", 1);
+    REQUIRE_THROWS_WITH(read(path), Catch::Contains("cannot start /nonexistent/zcheck-hdf5-reader"));
+    ::unsetenv("ZCHECK_HDF5_READER");
+    REQUIRE(read(path).value[0] == 1.0);
 }

@@ -3,8 +3,8 @@
 // camera_calibration_parsers files, and CameraInfo messages as `rostopic echo` (ROS 1) and
 // `ros2 topic echo` print them. Then every refusal: each must be a zcheck::Error naming the
 // source, the line and the rule.
-#include "xml_lite.h"
-#include "yaml_lite.h"
+#include "zcheck/detail/xml_lite.h"
+#include "zcheck/detail/yaml_lite.h"
 
 #include "zcheck/error.h"
 

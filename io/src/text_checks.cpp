@@ -1,4 +1,4 @@
-#include "text_checks.h"
+#include "zcheck/detail/text_checks.h"
 
 #include "zcheck/error.h"
 

@@ -1,6 +1,6 @@
-#include "xml_lite.h"
+#include "zcheck/detail/xml_lite.h"
 
-#include "text_checks.h"
+#include "zcheck/detail/text_checks.h"
 #include "zcheck/error.h"
 
 #include <cstdint>

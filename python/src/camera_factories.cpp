@@ -48,7 +48,7 @@ Camera cameraFromFile(const std::string& reference, std::optional<std::string> f
                       std::optional<double> near, std::optional<double> far, const py::object& width, const py::object& height)
 {
     const ImportedCamera imported =
-        importCamera(reference, format ? std::optional<CameraFormat>(cameraFormatFromName(*format)) : std::nullopt);
+        importCamera(reference, format ? &cameraFormatNamed(*format) : nullptr);
     return makeCamera(completeCamera(imported, scene, {near, far, sizeArgument(width, "Camera.from_file: width"),
                                                       sizeArgument(height, "Camera.from_file: height"), std::nullopt}),
                       "Camera.from_file");
@@ -186,22 +186,35 @@ Camera makeCamera(const CameraSpec& spec, const std::string& where)
     return prefixedErrors(where, [&] { return Camera(spec); });
 }
 
+namespace {
+
+// Camera.from_file's docstring, its formats from the table (camera_formats.h).
+const std::string& fromFileDoc()
+{
+    static const std::string doc = [] {
+        std::string formats;
+        for (const CameraFormat* format : cameraFormats())
+            formats += "\n        " + format->title + " (" + format->example + "): " + format->files;
+        return "A camera from any camera file zcheck reads, as `--camera` reads it: \"FILE\" or \"FILE#FRAME\".\n\n"
+               "FILE:   any camera file, its format told by content; FRAME an index, an image name, a path or its stem:" +
+               formats + "\nformat: forces the format: " + cameraFormatChoices(CameraFormatsWith::Reader, ", ") +
+               ".\nscene:  a Scene whose extent as the camera sees it gives near and far when the file has none\n"
+               "        (else give near and far).\n"
+               "width, height: the image size when the file has none (instant-ngp, glTF), or to replace it.\n"
+               "The errors are the command line's. camera.notes says what was assumed.";
+    }();
+    return doc;
+}
+
+}  // namespace
+
 void bindCameraFactories(py::class_<Camera>& camera)
 {
     camera
         .def_static("from_file", &cameraFromFile, py::arg("path"), py::kw_only(), py::arg("format") = py::none(),
                     py::arg("scene") = py::none(), py::arg("near") = py::none(), py::arg("far") = py::none(),
                     py::arg("width") = py::none(), py::arg("height") = py::none(),
-                    R"doc(A camera from any camera file zcheck reads, as `--camera` reads it: "FILE" or "FILE#FRAME".
-
-FILE:   a zcheck camera (JSON), a COLMAP model folder (sparse/0#img_014.png), a transforms.json
-        (nerfstudio, instant-ngp: #frame_003, #images/frame_003.png or #3), an OpenCV FileStorage
-        or ROS CameraInfo YAML/XML (#raw, #rectified), a glTF's camera nodes; told by content.
-format: forces the format: "zcheck", "colmap", "nerfstudio", "opencv", "ros", "gltf".
-scene:  a Scene whose extent as the camera sees it gives near and far when the file has none
-        (else give near and far).
-width, height: the image size when the file has none (instant-ngp, glTF), or to replace it.
-The errors are the command line's. camera.notes says what was assumed.)doc")
+                    fromFileDoc().c_str())
         .def_static(
             "from_json",
             [](const std::string& text, const std::string& source) { return Camera(cameraSpecFromJsonText(text, source)); },

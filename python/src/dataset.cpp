@@ -93,11 +93,9 @@ void bindDatasets(py::module_& m)
                      runOptions(scene, quantity, scale, offset, miss, channel, near, far, convention, diagnose, shard, declared);
                  DatasetSourceOptions sourceOptions;
                  sourceOptions.depthPattern = depth.value_or("");
-                 if (cameraFormat) sourceOptions.cameraFormat = cameraFormatFromName(*cameraFormat);
+                 if (cameraFormat) sourceOptions.cameraFormat = &cameraFormatNamed(*cameraFormat);
                  py::gil_scoped_release release;
-                 Dataset dataset = openDataset(source, sourceOptions, [](const std::string& path, std::optional<CameraFormat> format) {
-                     return openCameraSet(path, format);
-                 });
+                 Dataset dataset = openDataset(source, sourceOptions);
                  d->runner = std::make_unique<DatasetRunner>(std::move(dataset), std::move(options), readMap, d->verifiers);
                  return d;
              }),

@@ -4,7 +4,7 @@
 #include "zcheck/inverse_projection.h"
 
 #include "report_json.h"
-#include "zcheck/detail/camera_json.h"
+#include "zcheck/detail/depth_map_json.h"
 #include "zcheck/error.h"
 #include "zcheck/input_file.h"
 #include "zcheck/png_file.h"

@@ -4,6 +4,7 @@
 
 #include "report_json.h"
 #include "zcheck/detail/camera_json.h"
+#include "zcheck/detail/depth_map_json.h"
 #include "zcheck/png_file.h"
 #include "zcheck/report_images.h"
 #include "zcheck/version.h"

@@ -11,19 +11,42 @@
 
 namespace zcheck {
 
-CameraSet openCameraSet(const std::string& path, std::optional<CameraFormat> format)
-{
-    const CameraFormat f = format ? *format : detectCameraFormat(path);
-    return f == CameraFormat::Gltf ? readGltfCameras(path) : readCameraSet(path, f);
-}
-
 CameraSet readGltfCameras(const std::string& path)
 {
-    const LargeVector<char> file = readInputBytes(path, kMeshInput);
+    const LargeVector<char> file = readInputBytes(path, gltfCameraFormat().input);
     CameraSet set;
-    set.path = path, set.format = CameraFormat::Gltf;
+    set.path = path, set.format = gltfCameraFormat().name;
     set.cameras = readGltfCameraNodes(path, std::string_view(file.data(), file.size()));
     return set;
+}
+
+namespace {
+
+bool detectsGltf(const CameraFileHead& file)
+{
+    return file.head.substr(0, 4) == "glTF" || (file.looksLikeJson() && file.has("\"asset\""));
+}
+
+// glTF joins the table of camera formats when this file is linked (camera_formats.h).
+const bool kGltfRegistered = registerCameraFormat(gltfCameraFormat());
+
+}  // namespace
+
+const CameraFormat& gltfCameraFormat()
+{
+    static const CameraFormat row = [] {
+        CameraFormat f;
+        f.name = "gltf";
+        f.title = "glTF";
+        f.files = "a .gltf or .glb's camera nodes, read with its scene (#node name or index)";
+        f.example = "scene.glb#Camera";
+        f.priority = 30;
+        f.detects = detectsGltf;
+        f.read = readGltfCameras;
+        f.input = kMeshInput;
+        return f;
+    }();
+    return row;
 }
 
 namespace {
@@ -160,10 +183,11 @@ SceneNearFar sceneNearFar(const Scene& scene, const CameraSpec& spec)
     return planes;
 }
 
-ImportedCamera importCamera(const std::string& reference, std::optional<CameraFormat> format)
+ImportedCamera importCamera(const std::string& reference, const CameraFormat* format)
 {
+    (void)kGltfRegistered;
     const auto [file, frame] = splitCameraReference(reference);
-    const CameraSet set = openCameraSet(file, format);
+    const CameraSet set = readCameraSet(file, format);
     return set.cameras[set.find(frame)];
 }
 

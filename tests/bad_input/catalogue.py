@@ -20,7 +20,8 @@ path, an option) generated at test time into its own fresh folder, and demands:
 Standard library only (python 3.11), except that the HDF5 depth-map cases write their files
 with h5py (python3-h5py), imported inside their files= callables. Cases run on 2 worker
 threads. The cases named in EXTRA (variations of the same code paths) run only with --all,
-to keep the default run within ~90 s on 2 cores. -v prints every case's stderr; --keep keeps
+to keep the default run within ~90 s on 2 cores. The camera-format cases are made from zcheck's
+own table of formats (`zcheck formats --json`), so --list without ZCHECK leaves them out. -v prints every case's stderr; --keep keeps
 the case folders. Prints per-category counts and ends with the line "N passed, M failed";
 exit 0 iff M == 0.
 """
@@ -1429,6 +1430,9 @@ def materialise(c: Case, folder: str):
         c.setup(folder)
 
 
+BIG_FILE = 64 << 20  # bytes: beyond, a file is fingerprinted by its size, time and ends
+
+
 def snapshot(folder: str) -> dict:
     """relative path -> (kind, sha256 for regular files)"""
     out = {}
@@ -1441,6 +1445,11 @@ def snapshot(folder: str) -> dict:
                 out[rel] = ("link", os.readlink(path))
             elif os.path.isdir(path):
                 out[rel] = ("dir", None)
+            elif os.path.isfile(path) and st.st_size > BIG_FILE:
+                # the sparse files of the size-limit cases: their size, time and both ends
+                with open(path, "rb") as f:
+                    ends = f.read(1 << 20) + (f.seek(-(1 << 20), os.SEEK_END) and f.read())
+                out[rel] = ("file", st.st_size, st.st_mtime_ns, hashlib.sha256(ends).hexdigest())
             elif os.path.isfile(path):
                 with open(path, "rb") as f:
                     out[rel] = ("file", hashlib.sha256(f.read()).hexdigest())
@@ -1527,6 +1536,34 @@ def check_case(c: Case, zcheck: str, models: str, examples: str, root: str) -> t
     return problems, argv, code, stderr, seconds, rss, cpu
 
 
+def camera_format_cases(zcheck):
+    """Cases for every row of zcheck's table of camera formats (`zcheck formats --json`), so a new
+    format is covered without an edit here: forced with --camera-format, an empty file, bytes
+    that are no format at all, and (for a one-file format) a file one byte over the format's
+    size limit, sparse, refused before it is read; a folder format, an empty folder."""
+    listed = subprocess.run([zcheck, "formats", "--json"], capture_output=True, text=True, check=True).stdout
+    cases = []
+    for row in json.loads(listed)["camera_formats"]:
+        name = row["name"]
+
+        def add(what, files, ref, expect, limit=20.0):
+            cases.append(Case("camera-format", f"{name}-{what}", ["camera", ref, "--camera-format", name], expect,
+                              files=files, limit=limit))
+
+        if row["writes_folder"]:
+            add("empty-folder", {"model": DIR}, "model", r"'model'.*(not a|holds no|no camera)")
+            continue
+
+        def over_limit(path, size=row["max_bytes"] + 1):
+            with open(path, "wb") as f:
+                f.truncate(size)
+
+        add("empty-file", {"c": b""}, "c", r"'c'")
+        add("binary-garbage", {"c": bytes(range(256)) * 4}, "c", r"'c'")
+        add("over-its-limit", {"c": over_limit}, "c", r"'c'.*over the .* limit", limit=HOSTILE)
+    return cases
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("zcheck", nargs="?")
@@ -1537,6 +1574,8 @@ def main():
     parser.add_argument("--all", action="store_true", help="also run the extra variations (slower)")
     parser.add_argument("-v", dest="verbose", action="store_true", help="print every case's stderr")
     args = parser.parse_args()
+    if args.zcheck:
+        CASES.extend(camera_format_cases(os.path.abspath(args.zcheck)))
 
     names = [f"{c.category}/{c.name}" for c in CASES]
     duplicates = {n for n in names if names.count(n) > 1}

@@ -1,10 +1,11 @@
 #pragma once
 // Cameras for a scene, from any camera file (library zcheck::scene): the formats of
-// camera_import.h and glTF camera nodes, opened by content, a frame chosen by FILE#FRAME,
-// and completed with what the file does not say.
+// camera_formats.h and glTF camera nodes (whose row this library registers: a program linking
+// zcheck::scene reads glTF cameras with readCameraSet as any other format), a frame chosen by
+// FILE#FRAME, and completed with what the file does not say.
 //
 //   const zcheck::Scene scene = zcheck::loadScene("mesh.ply");
-//   const zcheck::CameraSet set = zcheck::openCameraSet("sparse/0", std::nullopt);      // a COLMAP model
+//   const zcheck::CameraSet set = zcheck::readCameraSet("sparse/0");      // a COLMAP model
 //   const zcheck::CameraSpec spec = zcheck::completeCamera(set.cameras[set.find("img_014.png")], scene, {});
 //
 // Near and far: only zcheck's camera files and glTF give them. An imported camera needs them
@@ -23,9 +24,8 @@
 
 namespace zcheck {
 
-// Every camera of a file (camera_import.h), glTF camera nodes included; `format` forces the
-// format, else it is told by content (detectCameraFormat).
-CameraSet openCameraSet(const std::string& path, std::optional<CameraFormat> format);
+// glTF's row of the camera formats (camera_formats.h).
+const CameraFormat& gltfCameraFormat();
 
 // The glTF file's camera nodes in the default scene, in the order the node hierarchy is
 // walked (depth first): perspective (yfov, aspectRatio or the image's, znear, zfar or an
@@ -52,8 +52,8 @@ struct CameraCompletion {
     std::optional<std::pair<double, double>> mapEyeZ;
 };
 
-// The camera FILE#FRAME names (splitCameraReference, openCameraSet, CameraSet::find).
-ImportedCamera importCamera(const std::string& reference, std::optional<CameraFormat> format);
+// The camera FILE#FRAME names (splitCameraReference, readCameraSet, CameraSet::find).
+ImportedCamera importCamera(const std::string& reference, const CameraFormat* format = nullptr);
 
 // An imported camera made usable: the image size (`given`'s — a depth map's, --width and
 // --height — else the file's, else a default of 640 wide, noted), near and far (`given`'s,

@@ -1,0 +1,51 @@
+// zcheck formats: the table of camera formats (camera_formats.h) as people and programs read
+// it — the docs' table is this command's output, and the bad-input catalogue builds a case per
+// row from its --json.
+#include "common.h"
+
+#include "zcheck/camera_formats.h"
+
+#include <nlohmann/json.hpp>
+
+#include <iostream>
+
+namespace zcheck::cli {
+
+namespace {
+
+nlohmann::json formatsJson()
+{
+    nlohmann::json rows = nlohmann::json::array();
+    for (const CameraFormat* format : cameraFormats())
+        rows.push_back({{"name", format->name},
+                        {"aliases", format->aliases},
+                        {"title", format->title},
+                        {"files", format->files},
+                        {"example", format->example},
+                        {"priority", format->priority},
+                        {"max_bytes", format->input.maxBytes},
+                        {"writes", format->write != nullptr},
+                        {"writes_folder", format->writesFolder},
+                        {"dataset_source", format->datasetSource},
+                        {"names_depth_maps", format->namesDepthMaps}});
+    return {{"camera_formats", rows}};
+}
+
+}  // namespace
+
+Command addFormatsCommand(CLI::App& app)
+{
+    auto json = std::make_shared<bool>(false);
+    CLI::App* command = app.add_subcommand(
+        "formats", "List the camera formats zcheck reads and writes: the name --camera-format and --to take, what its\n"
+                   "files look like, a --camera reference with its frame, whether `zcheck camera --to` writes it and\n"
+                   "whether it is a dataset source. A file's format is told by its content.");
+    command->add_flag("--json", *json, "the table as JSON (one object per format, with its size limit and detection order)");
+    return {command, [json] {
+                if (*json) std::cout << formatsJson().dump(2) << "\n";
+                else std::cout << cameraFormatTable();
+                return kExitConsistent;
+            }};
+}
+
+}  // namespace zcheck::cli

@@ -1,0 +1,23 @@
+#pragma once
+// What the YAML and XML subset readers (yaml_lite.h, xml_lite.h) share: their text checked and
+// normalised before they parse, and UTF-8 in and out. Private to zcheck (target zcheck_io_detail).
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+namespace zcheck::text {
+
+// Length of the well-formed UTF-8 sequence at text[i] (no overlong forms, no surrogates,
+// nothing above U+10FFFF), 0 if there is none.
+std::size_t utf8Length(std::string_view text, std::size_t i);
+// Appends code point `cp` (≤ U+10FFFF) as UTF-8.
+void appendUtf8(std::string& out, std::uint32_t cp);
+// Throws Error("<source>: line <line>: <what>").
+[[noreturn]] void failAt(const std::string& source, int line, const std::string& what);
+// The text without its BOM, CRLF and lone CR read as LF (files written on Windows), after
+// checking that it is at most `maxBytes`, UTF-8 (UTF-16 is named), and free of control
+// characters but tabs and line breaks. Parsers then deal with '\n' alone and may use '\0' as
+// the end.
+std::string normalizedText(std::string_view text, const std::string& source, std::size_t maxBytes);
+
+}  // namespace zcheck::text
