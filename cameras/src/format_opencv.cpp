@@ -591,7 +591,7 @@ const CameraFormat& opencvFormat()
         f.priority = 40;
         f.detects = detectsOpenCv;
         f.read = readOpenCv;
-        f.input = kCameraInput;
+        f.input = kCameraSetInput;  // a calibration's per-view extrinsics grow with its views
         f.write = writeOpenCv;
         return f;
     }();

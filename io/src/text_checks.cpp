@@ -50,9 +50,8 @@ std::size_t utf8Length(std::string_view text, std::size_t i)
     throw Error(source + ": line " + std::to_string(line) + ": " + what);
 }
 
-std::string normalizedText(std::string_view text, const std::string& source, std::size_t maxBytes)
+std::string normalizedText(std::string_view text, const std::string& source)
 {
-    if (text.size() > maxBytes) throw Error(source + ": larger than the " + std::to_string(maxBytes >> 20) + " MiB this reader accepts");
     if (text.size() >= 2 && ((text[0] == '\xFE' && text[1] == '\xFF') || (text[0] == '\xFF' && text[1] == '\xFE')))
         failAt(source, 1, "UTF-16 text; save the file as UTF-8");
     std::size_t i = text.size() >= 3 && text.substr(0, 3) == "\xEF\xBB\xBF" ? 3 : 0;

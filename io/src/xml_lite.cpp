@@ -47,7 +47,7 @@ bool isXmlChar(std::uint32_t cp)
 
 class Parser {
 public:
-    Parser(std::string_view text, const std::string& source) : text_(zcheck::text::normalizedText(text, source, kMaxTextBytes)), source_(source) {}
+    Parser(std::string_view text, const std::string& source) : text_(zcheck::text::normalizedText(text, source)), source_(source) {}
 
     Element parseDocument();
 

@@ -38,7 +38,7 @@ struct Place {
 
 class Parser {
 public:
-    Parser(std::string_view text, const std::string& source) : text_(zcheck::text::normalizedText(text, source, kMaxTextBytes)), source_(source) {}
+    Parser(std::string_view text, const std::string& source) : text_(zcheck::text::normalizedText(text, source)), source_(source) {}
 
     Node parseDocument();
 

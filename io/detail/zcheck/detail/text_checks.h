@@ -15,9 +15,9 @@ void appendUtf8(std::string& out, std::uint32_t cp);
 // Throws Error("<source>: line <line>: <what>").
 [[noreturn]] void failAt(const std::string& source, int line, const std::string& what);
 // The text without its BOM, CRLF and lone CR read as LF (files written on Windows), after
-// checking that it is at most `maxBytes`, UTF-8 (UTF-16 is named), and free of control
-// characters but tabs and line breaks. Parsers then deal with '\n' alone and may use '\0' as
-// the end.
-std::string normalizedText(std::string_view text, const std::string& source, std::size_t maxBytes);
+// checking that it is UTF-8 (UTF-16 is named) and free of control characters but tabs and line
+// breaks. Parsers then deal with '\n' alone and may use '\0' as the end. No size limit here:
+// the file was read within its format's (camera_formats.h, input_file.h).
+std::string normalizedText(std::string_view text, const std::string& source);
 
 }  // namespace zcheck::text

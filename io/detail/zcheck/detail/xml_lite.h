@@ -20,7 +20,8 @@
 // expanded), processing instructions other than the declaration, mismatched or unclosed
 // tags, a repeated attribute, text or elements after the root element, nesting deeper than
 // 64 elements, "--" inside a comment, "]]>" outside CDATA, text that is not UTF-8, control
-// characters, and texts over 1 MiB. The parser does not recurse.
+// characters. The parser does not recurse; the text is as long as its file may be (the
+// format's limit, camera_formats.h).
 #include <cstddef>
 #include <string>
 #include <string_view>
@@ -42,8 +43,6 @@ struct Element {
 
 // The deepest nesting of elements accepted (the root element is 1).
 inline constexpr int kMaxDepth = 64;
-// Longer texts are refused before they are read (callers read at most 1 MiB anyway).
-inline constexpr std::size_t kMaxTextBytes = std::size_t(1) << 20;
 
 // Parses `text` and returns its root element. Throws zcheck::Error("<source>: line N: ...").
 Element parse(std::string_view text, const std::string& source);

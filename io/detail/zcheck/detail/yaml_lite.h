@@ -16,7 +16,7 @@
 // multi-line scalars, explicit keys (`? `), tabs used for indentation, a key repeated in one
 // map, unterminated quotes or flow collections, inconsistent indentation, nesting deeper
 // than 64 collections, a top level that is not a map or sequence, other directives (%TAG),
-// text that is not UTF-8, control characters, and texts over 1 MiB. Scalars are kept as
+// text that is not UTF-8, control characters (no size limit: the file's format sets it). Scalars are kept as
 // text: "1.", "6.57e+002", ".Inf", "null" and "True" are the caller's to interpret.
 #include <cstddef>
 #include <string>
@@ -41,8 +41,6 @@ struct Node {
 
 // The deepest nesting of collections accepted (the top-level map or sequence is 1).
 inline constexpr int kMaxDepth = 64;
-// Longer texts are refused before they are read (callers read at most 1 MiB anyway).
-inline constexpr std::size_t kMaxTextBytes = std::size_t(1) << 20;
 
 // Parses the first document of `text`, whose top level must be a map or a sequence.
 // Throws zcheck::Error("<source>: line N: <what is wrong>").
