@@ -22,6 +22,7 @@ const CameraFormat& colmapFormat();      // format_colmap.cpp
 const CameraFormat& nerfstudioFormat();  // format_nerfstudio.cpp
 const CameraFormat& opencvFormat();      // format_opencv.cpp
 const CameraFormat& rosFormat();         // format_opencv.cpp
+const CameraFormat& metashapeFormat();   // format_metashape.cpp
 }  // namespace formats
 
 namespace {
@@ -29,7 +30,7 @@ namespace {
 std::vector<const CameraFormat*> builtInFormats()
 {
     using namespace formats;
-    return {&zcheckFormat(), &colmapFormat(), &nerfstudioFormat(), &opencvFormat(), &rosFormat()};
+    return {&zcheckFormat(), &colmapFormat(), &nerfstudioFormat(), &opencvFormat(), &rosFormat(), &metashapeFormat()};
 }
 
 void sortByPriority(std::vector<const CameraFormat*>& rows)

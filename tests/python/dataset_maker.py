@@ -229,6 +229,66 @@ class DatasetMaker:
         path.write_text(json.dumps(document, indent=1))
         return path
 
+    # ---- Agisoft Metashape ------------------------------------------------------------------
+    def metashape(self, name="cameras.xml", drop_scale=False):
+        """cameras.xml as Metashape exports it (its manual's camera model and its export scripts):
+        a frame sensor with f and cx, cy as offsets from the image centre (top-left pixel centre
+        at 0.5), each camera's camera-to-chunk <transform> row-major in OpenCV axes, and the chunk's
+        <transform> (world = s·R·p + t) after the cameras; every third camera in a <group>, one
+        more disabled camera (its pose sheared: it must be skipped). Depth maps: depth/{stem}.npy,
+        float32 eye-z. `drop_scale`: the chunk's <scale> left out, as a converter that ignores it
+        would write the file."""
+        t = self.trajectory
+        angle = math.radians(25.0)
+        axis = np.array([1.0, 2.0, 2.0]) / 3.0
+        k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+        rotation = np.eye(3) + math.sin(angle) * k + (1 - math.cos(angle)) * k @ k  # Rodrigues
+        translation, scale = np.array([4.0, -1.5, 0.25]), 1.75
+        depth = self.root / "depth"
+        depth.mkdir(exist_ok=True)
+
+        def camera_xml(i, label, pose, extra=""):
+            world_from_camera = np.linalg.inv(pose)
+            rc = rotation.T @ world_from_camera[:3, :3]
+            tc = rotation.T @ (world_from_camera[:3, 3] - translation) / scale
+            m = np.eye(4)
+            m[:3, :3], m[:3, 3] = rc, tc
+            numbers = " ".join(repr(float(v)) for v in m.reshape(-1))
+            return (f'      <camera id="{i}" sensor_id="0" component_id="0" label="{label}"{extra}>\n'
+                    f"        <transform>{numbers}</transform>\n"
+                    "        <rotation_covariance>1e-06 0 0 0 1e-06 0 0 0 1e-06</rotation_covariance>\n"
+                    "        <orientation>1</orientation>\n      </camera>\n")
+
+        grouped, loose = [], []
+        for i, (pose, image) in enumerate(zip(t.poses, t.names)):
+            label = image.replace(".png", ".JPG")
+            np.save(depth / (label.rsplit(".", 1)[0] + ".npy"), self.eye_z(i).astype(np.float32))
+            (grouped if i % 3 == 0 else loose).append(camera_xml(i, label, pose))
+        sheared = t.poses[0].copy()
+        sheared[0, 1] += 0.5  # not a rotation: read, it would fail the whole file
+        loose.append(camera_xml(len(t.poses), "disabled.JPG", sheared, ' enabled="false"'))
+        similarity = ("    <transform>\n"
+                      f"      <rotation locked=\"false\">{' '.join(repr(float(v)) for v in rotation.reshape(-1))}</rotation>\n"
+                      f"      <translation locked=\"false\">{' '.join(repr(float(v)) for v in translation)}</translation>\n"
+                      + ("" if drop_scale else f"      <scale locked=\"false\">{scale!r}</scale>\n") +
+                      "    </transform>\n")
+        text = ('<?xml version="1.0" encoding="UTF-8"?>\n<document version="1.5.0">\n  <chunk label="Chunk 1" enabled="true">\n'
+                '    <sensors next_id="1">\n      <sensor id="0" label="camera" type="frame">\n'
+                f'        <resolution width="{t.width}" height="{t.height}"/>\n'
+                '        <property name="pixel_width" value="0.0039"/>\n        <bands><band label="Red"/></bands>\n'
+                '        <data_type>uint8</data_type>\n        <calibration type="frame" class="adjusted">\n'
+                f'          <resolution width="{t.width}" height="{t.height}"/>\n'
+                f"          <f>{t.fx!r}</f>\n          <cx>{t.cx - t.width / 2!r}</cx>\n          <cy>{t.cy - t.height / 2!r}</cy>\n"
+                "        </calibration>\n      </sensor>\n    </sensors>\n"
+                '    <cameras next_id="99" next_group_id="1">\n      <group id="0" label="Group 1" type="folder">\n'
+                + "".join("  " + c.replace("\n      ", "\n        ") for c in grouped) + "      </group>\n" + "".join(loose) +
+                "    </cameras>\n" + similarity +
+                '    <reference>LOCAL_CS["Local Coordinates (m)",LOCAL_DATUM["Local Datum",0],UNIT["metre",1]]</reference>\n'
+                "  </chunk>\n</document>\n")
+        path = self.root / name
+        path.write_text(text)
+        return path
+
     # ---- a manifest over every other format ----------------------------------------------
     def opencv_file(self, i):
         """OpenCV FileStorage YAML of frame i: camera_matrix (centre of the top-left pixel at 0),

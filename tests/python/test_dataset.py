@@ -429,3 +429,22 @@ def test_exported_npy_hdf5_and_colmap_maps_read_back_as_rendered(made, tmp_path)
         code, out, err = run_cli("verify", "--scene", BUNNY, "--camera", camera_file, "--depth-map", tmp_path / name,
                                  "--quantity", "eye-z")
         assert code == 0, out + err
+
+
+def test_a_metashape_export_is_a_dataset_and_a_lost_chunk_scale_is_caught(made):
+    m, _ = made
+    good = m.metashape("cameras.xml")
+    code, records, out, err = verify(made, good, "--depth", str(m.root / "depth" / "{stem}.npy"), rc=0)
+    assert len(records) == FRAMES  # the disabled camera is skipped
+    assert all(r["consistent"] and r["error"] is None for r in records), out + err
+    # The chunk's scale left out: every frame's camera sits at the wrong place.
+    lost = m.metashape("cameras_without_scale.xml", drop_scale=True)
+    code, records, out, err = verify(made, lost, "--depth", str(m.root / "depth" / "{stem}.npy"), rc=1)
+    assert len(records) == FRAMES and not any(r["consistent"] for r in records)
+    # One camera of the file, converted: COLMAP's model of it reads back to the same projection.
+    code, out, err = run_cli("camera", f"{good}#frame_005.JPG", "--near", "0.1", "--far", "50")
+    assert code == 0, err
+    shown = json.loads(out)
+    assert shown["source"]["format"] == "metashape"
+    assert shown["source"]["frame"] == "frame_005.JPG"
+
