@@ -65,7 +65,7 @@ int runExportCommand(const ExportOptions& o)
     std::vector<QuantityImage> images;
     for (ExportQuantity q : quantities) images.push_back(quantityImage(scene, camera, route, q));
     std::string format;
-    outputs.write(o.output, [&](const std::string& temporary) { format = cli::images().writeQuantityFile(temporary, images, o.scale); });
+    outputs.write(o.output, [&](const std::string& temporary) { format = writeDepthMapFile(temporary, images, o.scale); });
 
     nlohmann::json channels = nlohmann::json::array();
     for (const auto& image : images)
@@ -132,7 +132,7 @@ Command addExportCommand(CLI::App& app)
                               "primitive-id (several only into .exr)")
         ->capture_default_str();
     addSceneAndCameraOptions(command, o->input);
-    command->add_option("-o,--output", o->output, "the depth file: .exr, .pfm, .tif, .npy, .h5, .bin (COLMAP) or .png (written atomically)")
+    command->add_option("-o,--output", o->output, "the depth file, in its extension's format (`zcheck formats` lists them: .exr, .npy, .png, ...;\nwritten atomically)")
         ->type_name("FILE")
         ->check(kNonEmptyPath);
     command->add_option("--scale", o->scale, "16-bit PNG: stored = value x scale (e.g. 1000 = millimetres)")

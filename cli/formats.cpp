@@ -4,6 +4,7 @@
 #include "common.h"
 
 #include "zcheck/camera_formats.h"
+#include "zcheck/depth_map_formats.h"
 
 #include <nlohmann/json.hpp>
 
@@ -28,7 +29,15 @@ nlohmann::json formatsJson()
                         {"writes_folder", format->writesFolder},
                         {"dataset_source", format->datasetSource},
                         {"names_depth_maps", format->namesDepthMaps}});
-    return {{"camera_formats", rows}};
+    nlohmann::json maps = nlohmann::json::array();
+    for (const DepthMapFormat* format : depthMapFormats())
+        maps.push_back({{"name", format->name},
+                        {"title", format->title},
+                        {"extensions", format->extensions},
+                        {"writes", format->write != nullptr},
+                        {"writes_several_quantities", format->writesSeveral},
+                        {"holds", format->holds}});
+    return {{"camera_formats", rows}, {"depth_map_formats", maps}};
 }
 
 }  // namespace
@@ -37,13 +46,18 @@ Command addFormatsCommand(CLI::App& app)
 {
     auto json = std::make_shared<bool>(false);
     CLI::App* command = app.add_subcommand(
-        "formats", "List the camera formats zcheck reads and writes: the name --camera-format and --to take, what its\n"
-                   "files look like, a --camera reference with its frame, whether `zcheck camera --to` writes it and\n"
-                   "whether it is a dataset source. A file's format is told by its content.");
+        "formats", "List the file formats zcheck reads and writes. Camera files: the name --camera-format and --to\n"
+                   "take, what its files look like, a --camera reference with its frame, whether `zcheck camera --to`\n"
+                   "writes it and whether it is a dataset source. Depth maps: read by their first bytes, written by\n"
+                   "their extension (export -o). A file's format is always told by its content.");
     command->add_flag("--json", *json, "the table as JSON (one object per format, with its size limit and detection order)");
     return {command, [json] {
-                if (*json) std::cout << formatsJson().dump(2) << "\n";
-                else std::cout << cameraFormatTable();
+                if (*json) {
+                    (void)depthMapFormatTable();  // loads the formats of the image plugin
+                    std::cout << formatsJson().dump(2) << "\n";
+                } else {
+                    std::cout << cameraFormatTable() << "\n" << depthMapFormatTable();
+                }
                 return kExitConsistent;
             }};
 }

@@ -17,10 +17,12 @@ const ImageFunctions& images()
     return *functions;
 }
 
-DepthMapFile readDepthMapFile(const std::string& path, const DepthMapReading& reading, int width, int height)
+void loadImageFormatsWhenNeeded()
 {
-    if (std::optional<DepthMapFile> native = readDepthMapNatively(path, reading, width, height)) return std::move(*native);
-    return images().readDepthMap(path, reading, width, height);
+    setDepthMapFormatLoader([] {
+        const ImageFunctions& plugin = images();
+        for (std::size_t i = 0; i < plugin.formatCount; ++i) registerDepthMapFormat(*plugin.formats[i]);
+    });
 }
 
 }  // namespace zcheck::cli

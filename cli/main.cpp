@@ -3,6 +3,7 @@
 // and calls the libraries. Exit status: 0 consistent, 1 inconsistent, 2 usage or input error, 3 internal
 // failure (out of memory, a library error); errors are one line on stderr.
 #include "common.h"
+#include "image_plugin.h"
 
 #include "zcheck/error.h"
 #include "zcheck/version.h"
@@ -13,6 +14,7 @@ int main(int argc, char** argv)
 {
     using namespace zcheck::cli;
     using zcheck::Error;
+    loadImageFormatsWhenNeeded();
     CLI::App app{"zcheck proves a graphics transform chain correct by computing every pixel's depth twice —\n"
                  "by ray casting through the camera's definition (Embree) and by rasterizing forward through\n"
                  "view, projection, clipping, divide and viewport — and demanding agreement.",

@@ -153,7 +153,7 @@ Command addUnprojectCommand(CLI::App& app)
     command->add_option("--quantity", o->quantity,
                         "what --depth / the map holds: window | ndc | eye-z | distance (default: as zcheck's export\n"
                         "sidecar given with --sidecar says, else window)");
-    command->add_option("--depth-map", o->depthMap, "a depth map to turn into a point cloud")->check(kNonEmptyPath);
+    command->add_option("--depth-map", o->depthMap, "a depth map to turn into a point cloud (any format `zcheck formats` lists)")->check(kNonEmptyPath);
     addDepthMapOptions(command, o->reading);
     command->add_option("-o,--output", o->output, "the PLY file to write (atomically)")
         ->type_name("FILE")->check(kNonEmptyPath);

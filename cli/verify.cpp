@@ -68,7 +68,7 @@ Command addVerifyCommand(CLI::App& app)
                   "ground truth for the same scene and camera, with the same tolerance model, report and exit codes\n"
                   "as check; --diagnose names the classic mistake that explains an inconsistent map.");
     addSceneAndCameraOptions(command, o->input);
-    command->add_option("--depth-map", o->depthMap, "EXR (multi-layer too), PFM, TIFF, or 16-bit PNG with --scale")
+    command->add_option("--depth-map", o->depthMap, "the depth map: any format `zcheck formats` lists, told by its first bytes (integers need --scale)")
         ->required()
         ->check(kNonEmptyPath);
     command->add_option("--quantity", o->quantity,

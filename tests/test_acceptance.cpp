@@ -1,6 +1,6 @@
 // No declaration accepts a wrong map: every way a map can be accepted — exact, a rounding grid,
 // relative and absolute tolerances, a noise model, holes — goes through one rule that also
-// judges the map's errors as a whole (judgeDeclaredAccuracy, verify.h), and the diagnosis offers
+// judges the map's errors as a whole (judgeDeclaredAccuracy, diagnose/src/verify_estimators.h), and the diagnosis offers
 // a declaration only as that rule judges it. An eye-z or distance map's tolerance is its own,
 // whatever the camera's depth buffer; a sensor's noise is answered with a noise model.
 #include "zcheck/declared_reading.h"

@@ -638,7 +638,7 @@ std::optional<ComparisonReport> requireFormsAgree(const Scene& scene, const Came
 
 TEST_CASE("the comparison's AVX-512 form is bit-identical to its baseline form on edge values too", "[compare][kernel]")
 {
-    // The AVX-512 form's lane pass is written out by hand (compare.cpp), so renders alone,
+    // The AVX-512 form's lane pass is written out by hand (check/src/compare_rows.cpp), so renders alone,
     // which hold few of the values where two ways of computing a lane part, do not pin it.
     // Here the routes' arrays are made up: rows of 5, 67 and 203 pixels (every tile's row ends in a
     // part of eight lanes), hits on one side, on neither and on two triangles, and in the common

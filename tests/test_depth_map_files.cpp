@@ -1,6 +1,7 @@
 // Depth maps as real renderers write them: multi-layer EXRs (the depth pass beside the colour),
 // "no surface" marked by 0, 65535, 1e10, NaN or +inf, integer maps with a scale and an offset,
 // and 8-bit pictures that are not depth maps at all.
+#include "zcheck/depth_map_formats.h"
 #include "zcheck/depth_map_reading.h"
 #include "zcheck/error.h"
 #include "zcheck/image_io.h"
@@ -10,6 +11,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <thread>
 #include <cmath>
 #include <cstring>
@@ -411,4 +413,39 @@ TEST_CASE("regression: HDF5 maps were read in a bare fork of a multithreaded pro
     REQUIRE_THROWS_WITH(read(path), Catch::Contains("cannot start /nonexistent/zcheck-hdf5-reader"));
     ::unsetenv("ZCHECK_HDF5_READER");
     REQUIRE(read(path).value[0] == 1.0);
+}
+
+namespace {
+
+// A format of this test alone: "FAKE" then nothing; read as a 3x2 map of ones.
+DepthMapFile readFake(const std::string&, const DepthMapReading&, int, int)
+{
+    DepthMapFile map;
+    map.width = W, map.height = H;
+    map.channel = "Y";
+    map.value.assign(std::size_t(W) * H, 1.0);
+    return map;
+}
+
+const DepthMapFormat kFake{"fake", "a test's own format", {".fake"}, "nothing",
+                           [](std::string_view head) { return head.substr(0, 4) == "FAKE"; }, readFake};
+
+}  // namespace
+
+TEST_CASE("regression: concurrent first reads failed while the loader of more formats was running", "[depthmap]")
+{
+    // The command line loads OpenImageIO's formats on the first file none of its own claims; the
+    // readers on other threads must wait for them, not refuse their files meanwhile.
+    const std::string path = bytesFile("map.fake", "FAKE");
+    setDepthMapFormatLoader([] {
+        std::this_thread::sleep_for(std::chrono::milliseconds(300));
+        registerDepthMapFormat(kFake);
+    });
+    std::atomic<int> read{0};
+    std::vector<std::thread> threads;
+    for (int t = 0; t < 8; ++t)
+        threads.emplace_back([&] { read += readDepthMapFile(path, {}, W, H).value.size() == std::size_t(W) * H; });
+    for (std::thread& thread : threads) thread.join();
+    REQUIRE(read == 8);
+    setDepthMapFormatLoader(nullptr);
 }

@@ -87,9 +87,7 @@ DepthMapFile readDataset(const std::string& path, const DepthMapReading& reading
     integer = kind == H5T_INTEGER;
     if (integer && bytes < 2)
         refuse("its dataset '" + map.channel + "' stores 8-bit integers, which cannot hold depth (a picture, not a depth map?)");
-    if (integer && !(reading.scale > 0))
-        throw Error("depth map '" + path + "' stores integers (HDF5 dataset '" + map.channel +
-                    "'): give --scale (stored value = depth × scale, e.g. 1000 for millimetres)");
+    if (integer) reading.requireScaleForIntegers(path, "HDF5 dataset '" + map.channel + "'");
     map.value.resize(std::size_t(map.width) * std::size_t(map.height));
     if (H5Dread(dataset.id, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, map.value.data()) < 0)
         refuse("the HDF5 library cannot read its dataset '" + map.channel + "' (truncated or corrupt)");

@@ -179,9 +179,7 @@ DepthMapFile readNpy(const std::string& path, const DepthMapReading& reading, in
     if ((kind == 'u' || kind == 'i') && size == 1) refuse("dtype " + d + " stores 8-bit integers, which cannot hold depth (a picture, not a depth map?)");
     if (!floating && !integer)
         refuse("dtype " + d + " is not one zcheck reads as depth (float16, float32, float64, (u)int16, (u)int32)");
-    if (integer && !(reading.scale > 0))
-        throw Error("depth map '" + path + "' stores integers (.npy " + d +
-                    "): give --scale (stored value = depth × scale, e.g. 1000 for millimetres)");
+    if (integer) reading.requireScaleForIntegers(path, ".npy " + d);
 
     // shape: (H, W), (H, W, C).
     const std::vector<long long>& s = header.shape;
@@ -316,6 +314,23 @@ void writeColmapDepth(const std::string& path, const QuantityImage& image)
         bytes.append(reinterpret_cast<const char*>(&f), 4);
     }
     writeFileBytes(path, bytes);
+}
+
+const DepthMapFormat& npyFormat()
+{
+    static const DepthMapFormat row{
+        "npy", "NumPy .npy", {".npy"}, "one quantity as float32 (H, W) or (H, W, C); primitive ids as uint32", isNpy, readNpy,
+        [](const std::string& path, const std::vector<QuantityImage>& images, double) { writeNpy(path, images.front()); }};
+    return row;
+}
+
+const DepthMapFormat& colmapDepthFormat()
+{
+    static const DepthMapFormat row{
+        "colmap", "COLMAP depth map", {".bin"}, "one depth quantity as COLMAP's dense maps hold eye-z (W&H&1&, float32, 0 a miss)",
+        isColmapDepth, readColmapDepth,
+        [](const std::string& path, const std::vector<QuantityImage>& images, double) { writeColmapDepth(path, images.front()); }};
+    return row;
 }
 
 }  // namespace zcheck::depthformats

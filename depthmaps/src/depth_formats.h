@@ -1,6 +1,7 @@
 #pragma once
-// The depth-map formats datasets use beside EXR, TIFF, PNG and PFM (image_io.h dispatches to
-// them by their first bytes). Private to zcheck::depthmaps (and its OpenImageIO backend).
+// The depth-map formats datasets use beside EXR, TIFF, PNG and PFM (depth_map_formats.h
+// dispatches to them by their first bytes), and the rows of the table each file defines.
+// Private to zcheck::depthmaps.
 //
 //   .npy    NumPy's format (numpy.org/neps/nep-0001): "\x93NUMPY", version 1, 2 or 3, a Python
 //           dict header {'descr', 'fortran_order', 'shape'}, then the raw array. Read: shape
@@ -16,6 +17,7 @@
 //           (its path, e.g. "depth", "dataset", "group/depth") or as image_io.h chooses a
 //           channel; float or integer of 16 bits or more. Read in a child process: a malformed
 //           file that crashes or hangs the HDF5 library is refused, never fatal.
+#include "zcheck/depth_map_formats.h"
 #include "zcheck/depth_map_reading.h"
 #include "zcheck/quantity.h"
 
@@ -41,5 +43,12 @@ DepthMapFile readHdf5(const std::string& path, const DepthMapReading& reading, i
 void writeNpy(const std::string& path, const QuantityImage& image);
 void writeColmapDepth(const std::string& path, const QuantityImage& image);
 void writeHdf5(const std::string& path, const std::vector<QuantityImage>& images);
+
+// The rows of the table (depth_map_formats.cpp lists them).
+const DepthMapFormat& npyFormat();          // depth_formats.cpp
+const DepthMapFormat& colmapDepthFormat();  // depth_formats.cpp
+const DepthMapFormat& hdf5Format();         // depth_hdf5.cpp
+const DepthMapFormat& pfmFormat();          // depth_map_files.cpp
+const DepthMapFormat& png16Format();        // depth_map_files.cpp
 
 }  // namespace zcheck::depthformats

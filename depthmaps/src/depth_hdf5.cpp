@@ -171,4 +171,13 @@ void writeHdf5(const std::string& path, const std::vector<QuantityImage>& images
     if (H5Fflush(file.id, H5F_SCOPE_GLOBAL) < 0) fail("the HDF5 library cannot flush it");
 }
 
+const DepthMapFormat& hdf5Format()
+{
+    static const DepthMapFormat row{
+        "hdf5", "HDF5", {".h5", ".hdf5"}, "any quantities, one float32 dataset each named by its channel (ids uint32)", isHdf5,
+        readHdf5, [](const std::string& path, const std::vector<QuantityImage>& images, double) { writeHdf5(path, images); },
+        true};
+    return row;
+}
+
 }  // namespace zcheck::depthformats

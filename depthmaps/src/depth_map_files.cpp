@@ -1,6 +1,6 @@
-// The depth-map files zcheck reads by itself — PFM, 16-bit PNG (libpng), NumPy .npy, COLMAP
-// maps, HDF5 — in zcheck::depthmaps, so that reading them never loads the image library (image_io.h
-// reads EXR and TIFF through it, and every format).
+// PFM and 16-bit PNG depth maps (libpng), read and written by zcheck itself, and the rules every
+// depth-map reader shares (the size check, refusals).
+#include "zcheck/depth_map_formats.h"
 #include "zcheck/depth_map_reading.h"
 
 #include "depth_formats.h"
@@ -8,6 +8,7 @@
 #include "zcheck/camera.h"
 #include "zcheck/error.h"
 #include "zcheck/input_file.h"
+#include "zcheck/atomic_file.h"
 
 #include <algorithm>
 #include <cctype>
@@ -91,59 +92,116 @@ DepthMapFile readPfm(const std::string& path, const std::string& bytes, const De
 
 }  // namespace
 
-std::optional<DepthMapFile> readDepthMapNatively(const std::string& path, const DepthMapReading& reading, int expectedWidth,
-                                                 int expectedHeight)
+namespace {
+
+DepthMapFile readPfmFile(const std::string& path, const DepthMapReading& reading, int expectedWidth, int expectedHeight)
 {
-    const double scale = reading.scale;
-    if (scale != 0) DepthMapReading::requireScale(scale, "--scale");
-    DepthMapReading::requireOffset(reading.offset, "--offset");
-    checkInputFile(path, kDepthMapInput);
-    // The format is decided by the file's first bytes, and only that format's reader sees it.
-    char head[32] = {};
-    std::streamsize headBytes = 0;
-    {
-        std::ifstream probe(path, std::ios::binary);
-        probe.read(head, sizeof head);
-        headBytes = probe.gcount();
-    }
-    const std::string_view first(head, std::size_t(headBytes));
-    if (depthformats::isNpy(first)) return depthformats::readNpy(path, reading, expectedWidth, expectedHeight);
-    if (depthformats::isHdf5(first)) return depthformats::readHdf5(path, reading, expectedWidth, expectedHeight);
-    if (depthformats::isColmapDepth(first)) return depthformats::readColmapDepth(path, reading, expectedWidth, expectedHeight);
-    const auto* magic = reinterpret_cast<const unsigned char*>(head);
-    if (magic[0] == 'P' && (magic[1] == 'f' || magic[1] == 'F') && std::isspace(magic[2])) {
-        DepthMapFile map = readPfm(path, readInputFile(path, kDepthMapInput), reading, expectedWidth, expectedHeight);
-        depthsFromStored(map, StoredValues::Float, reading);
-        return map;
-    }
-    if (magic[0] == 0x89 && magic[1] == 'P' && magic[2] == 'N' && magic[3] == 'G') {
-        // zcheck's own libpng reader (OpenImageIO's leaks on libpng's error path).
-        if (!(scale > 0))
-            throw Error("depth map '" + path +
-                        "' stores integers (16-bit PNG): give --scale (stored value = depth × scale, e.g. 1000 for "
-                        "millimetres, 5000 for many RGB-D sets, 256 for KITTI)");
-        Png16 png;
-        try {
-            png = decodePng16(readInputFile(path, kDepthMapInput), [&](long long width, long long height) {
-                requireDepthMapSize(path, width, height, expectedWidth, expectedHeight);
-            });
-        } catch (const Error& e) {
-            const std::string what = e.what();
-            if (what.rfind("depth map '", 0) == 0) throw;  // the size message names the file already
-            refuseDepthMap(path, what);
-        }
-        DepthMapFile map;
-        map.width = png.width, map.height = png.height;
-        map.channel = chooseDepthChannel(path, {"Y"}, reading.channel, reading.quantityChannel);
-        map.value.assign(png.codes.begin(), png.codes.end());
-        depthsFromStored(map, StoredValues::Integer, reading);
-        return map;
-    }
-    const bool exr = magic[0] == 0x76 && magic[1] == 0x2f && magic[2] == 0x31 && magic[3] == 0x01;
-    const bool tiff = (magic[0] == 'I' && magic[1] == 'I' && magic[2] == 42 && magic[3] == 0) ||
-                      (magic[0] == 'M' && magic[1] == 'M' && magic[2] == 0 && magic[3] == 42);
-    if (exr || tiff) return std::nullopt;
-    refuseDepthMap(path, "not an EXR, TIFF, PNG, PFM, NumPy .npy, HDF5 or COLMAP depth map file (judged by its first bytes)");
+    DepthMapFile map = readPfm(path, readInputFile(path, kDepthMapInput), reading, expectedWidth, expectedHeight);
+    depthsFromStored(map, StoredValues::Float, reading);
+    return map;
 }
+
+// zcheck's own libpng reader (OpenImageIO's leaks on libpng's error path).
+DepthMapFile readPng16File(const std::string& path, const DepthMapReading& reading, int expectedWidth, int expectedHeight)
+{
+    reading.requireScaleForIntegers(path, "16-bit PNG");
+    Png16 png;
+    try {
+        png = decodePng16(readInputFile(path, kDepthMapInput), [&](long long width, long long height) {
+            requireDepthMapSize(path, width, height, expectedWidth, expectedHeight);
+        });
+    } catch (const Error& e) {
+        const std::string what = e.what();
+        if (what.rfind("depth map '", 0) == 0) throw;  // the size message names the file already
+        refuseDepthMap(path, what);
+    }
+    DepthMapFile map;
+    map.width = png.width, map.height = png.height;
+    map.channel = chooseDepthChannel(path, {"Y"}, reading.channel, reading.quantityChannel);
+    map.value.assign(png.codes.begin(), png.codes.end());
+    depthsFromStored(map, StoredValues::Integer, reading);
+    return map;
+}
+
+// round(value × scale) as 16-bit codes, 0 a miss: every value must fit in 1..65535.
+void writePng16(const std::string& path, const std::vector<QuantityImage>& images, double scale)
+{
+    const QuantityImage& image = images.front();
+    const ExportQuantity q = image.quantity;
+    if (q != ExportQuantity::Window && q != ExportQuantity::Ndc && q != ExportQuantity::EyeZ && q != ExportQuantity::Distance)
+        throw Error("cannot write '" + path + "': 16-bit PNG holds one depth quantity (window, ndc, eye-z or distance), not " +
+                    toString(q));
+    if (!(scale > 0) || !std::isfinite(scale))
+        throw Error("cannot write '" + path + "': 16-bit PNG needs --scale (stored = value × scale, e.g. 1000 for millimetres)");
+    double largest = 0, smallest = INFINITY;
+    for (std::size_t i = 0; i < image.value.size(); ++i) {
+        if (image.isMiss(i)) continue;
+        largest = std::max(largest, image.value[i]);
+        smallest = std::min(smallest, image.value[i]);
+    }
+    if (smallest < 0)
+        throw Error("cannot write '" + path + "': " + toString(q) + " has negative values (" + formatNumber(smallest) +
+                    "), which 16-bit PNG cannot store");
+    if (std::round(largest * scale) > 65535)
+        throw Error("cannot write '" + path + "': the largest " + toString(q) + " " + formatNumber(largest) +
+                    " times --scale " + formatNumber(scale) + " exceeds 65535; the largest scale that fits is " +
+                    formatNumber(std::floor(65535.0 / largest * 1e6) / 1e6));
+    if (std::isfinite(smallest) && std::round(smallest * scale) < 1)
+        throw Error("cannot write '" + path + "': the smallest " + toString(q) + " " + formatNumber(smallest) +
+                    " rounds to 0 at --scale " + formatNumber(scale) + ", which means a miss; raise --scale");
+    std::vector<std::uint16_t> codes(image.value.size(), 0);
+    for (std::size_t i = 0; i < codes.size(); ++i)
+        if (!image.isMiss(i)) codes[i] = static_cast<std::uint16_t>(std::lround(image.value[i] * scale));
+    writeFileBytes(path, encodePng(image.width, image.height, 1, 16, codes.data()));
+}
+
+// PFM, written here because OpenImageIO 2.4 (Debian 12) reads PFM but has no writer for it.
+// Per the format: "Pf" (1 channel) or "PF" (3), "width height", a negative scale for
+// little-endian data, then float32 rows from the BOTTOM row of the picture to the top.
+void writePfm(const std::string& path, const std::vector<QuantityImage>& images, double)
+{
+    const QuantityImage& image = images.front();
+    const std::size_t C = image.channels.size();
+    if (image.quantity == ExportQuantity::PrimitiveId || (C != 1 && C != 3))
+        throw Error("cannot write '" + path + "': PFM holds 1 or 3 float channels, not " + toString(image.quantity) +
+                    " (use .exr or .tif)");
+    std::string bytes = std::string(C == 1 ? "Pf" : "PF") + "\n" + std::to_string(image.width) + " " +
+                        std::to_string(image.height) + "\n-1.0\n";
+    std::vector<float> row(std::size_t(image.width) * C);
+    for (int y = image.height - 1; y >= 0; --y) {
+        for (std::size_t k = 0; k < row.size(); ++k) row[k] = float(image.value[std::size_t(y) * image.width * C + k]);
+        bytes.append(reinterpret_cast<const char*>(row.data()), row.size() * sizeof(float));
+    }
+    writeFileBytes(path, bytes);
+}
+
+bool isPfm(std::string_view head)
+{
+    return head.size() >= 3 && head[0] == 'P' && (head[1] == 'f' || head[1] == 'F') &&
+           std::isspace(static_cast<unsigned char>(head[2]));
+}
+
+bool isPng(std::string_view head) { return head.substr(0, 4) == "\x89PNG"; }
+
+}  // namespace
+
+namespace depthformats {
+
+const DepthMapFormat& pfmFormat()
+{
+    static const DepthMapFormat row{"pfm", "PFM", {".pfm"}, "one quantity of 1 or 3 float32 channels, rows bottom to top",
+                                    isPfm, readPfmFile, writePfm};
+    return row;
+}
+
+const DepthMapFormat& png16Format()
+{
+    static const DepthMapFormat row{"png", "16-bit PNG", {".png"},
+                                    "one depth quantity (window, ndc, eye-z, distance) as round(value × --scale), 0 a miss",
+                                    isPng, readPng16File, writePng16};
+    return row;
+}
+
+}  // namespace depthformats
 
 }  // namespace zcheck

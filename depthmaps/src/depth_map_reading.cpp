@@ -170,6 +170,14 @@ void DepthMapReading::requireScale(double scale, const std::string& name)
     if (!(scale > 0 && std::isfinite(scale))) throw Error(name + " must be a positive finite number, got " + formatNumber(scale));
 }
 
+void DepthMapReading::requireScaleForIntegers(const std::string& path, const std::string& storage) const
+{
+    if (!(scale > 0))
+        throw Error("depth map '" + path + "' stores integers (" + storage +
+                    "): give --scale (stored value = depth × scale, e.g. 1000 for millimetres, 5000 for many RGB-D sets, 256 "
+                    "for KITTI)");
+}
+
 void DepthMapReading::requireOffset(double offset, const std::string& name)
 {
     if (!std::isfinite(offset)) throw Error(name + " must be a finite number, got " + formatNumber(offset));

@@ -1,5 +1,6 @@
 #include "zcheck/dataset.h"
 
+#include "verify_estimators.h"
 #include "zcheck/camera_sources.h"
 #include "zcheck/detail/clock.h"
 #include "zcheck/error.h"

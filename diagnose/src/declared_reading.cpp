@@ -1,6 +1,7 @@
 #include "zcheck/declared_reading.h"
 
 #include "numerics.h"
+#include "verify_estimators.h"
 #include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
 
@@ -135,9 +136,7 @@ std::optional<MapAccuracy> toleranceFinding(const Camera& camera, const DepthMap
         for (int col = 0; col < W; ++col) {
             const std::size_t i = std::size_t(row) * W + col;
             if (!truth.hit(i) || !holdsSurface(camera, map, col, row)) continue;
-            const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
-            const double expected = depthValueFromEyeZ(
-                camera, pWindow, eyeZFromWindowDepth(camera, pWindow, truth.windowDepth.value[i]), map.quantity);
+            const double expected = truthValueAt(camera, truth, col, row, map.quantity);
             const double error = std::abs(map.value[i] - expected);
             absolute.push_back(error), relative.push_back(error / expected);
         }
@@ -167,9 +166,7 @@ std::optional<NoiseFinding> noiseFinding(const Camera& camera, const DepthMap& m
         for (int col = 0; col < W; ++col) {
             const std::size_t i = std::size_t(row) * W + col;
             if (!truth.hit(i) || kindOfDepthValue(camera, map.quantity, map.value[i]) != DepthValueKind::Depth) continue;
-            const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
-            const double expected = depthValueFromEyeZ(
-                camera, pWindow, eyeZFromWindowDepth(camera, pWindow, truth.windowDepth.value[i]), map.quantity);
+            const double expected = truthValueAt(camera, truth, col, row, map.quantity);
             error[i] = map.value[i] - expected;
             z.push_back(map.value[i]), e.push_back(error[i]);
         }

@@ -1,5 +1,6 @@
 #include "zcheck/map_verifier.h"
 
+#include "verify_estimators.h"
 #include "zcheck/declared_reading.h"
 #include "zcheck/error.h"
 #include "zcheck/fit.h"
@@ -28,8 +29,6 @@ Hypothesis hypothesis(std::string name, std::string variant, std::string explana
     return h;
 }
 
-// Whether a hypothesis explains the map: consistent, or consistent but for edge pixels.
-bool explains(const Hypothesis& h) { return h.consistent || h.consistentExceptEdges(); }
 
 // One reading of the catalogue (a mistake, one of its variants) as the diagnosis holds it. A
 // reading that changes the camera or the sampling keeps its truth, for the pairs.
@@ -121,7 +120,7 @@ private:
     // in the steps' order.
     void rank();
 
-    bool anyExplains() const { return std::any_of(out_.begin(), out_.end(), explains); }
+    bool anyExplains() const { return std::any_of(out_.begin(), out_.end(), [](const Hypothesis& h) { return h.explains(); }); }
     // One hypothesis judged against `truthUsed` (the truth through `hypothesisCamera`), the map
     // as re-read.
     Hypothesis judge(Hypothesis h, const Camera& hypothesisCamera, const DepthMap& hypothesisMap,
@@ -434,7 +433,7 @@ void Diagnosis::suggestTolerance()
     // Only where no convention explains the map (a uniform offset, which the depth-scale fit
     // measures, may be the map's stated accuracy): the tolerance that would accept the map as
     // read with the findings of judgeDeclaredReadings.
-    if (std::any_of(out_.begin(), out_.end(), [](const Hypothesis& h) { return explains(h) && h.name != "depth-scale"; }))
+    if (std::any_of(out_.begin(), out_.end(), [](const Hypothesis& h) { return h.explains() && h.name != "depth-scale"; }))
         return;
     const DepthMap read = declaredReading(map_, findings_, found_);
     if (const std::optional<NoiseFinding> noise = noiseFinding(camera_, read, truth_)) {

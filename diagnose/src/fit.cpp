@@ -1,6 +1,7 @@
 #include "zcheck/fit.h"
 
 #include "numerics.h"
+#include "verify_estimators.h"
 #include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
 #include "zcheck/verify.h"

@@ -1,5 +1,7 @@
 #include "zcheck/map_verifier.h"
 
+#include "verify_estimators.h"
+
 namespace zcheck {
 
 const VertexNeighbours& MapVerifier::neighbours() const

@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <initializer_list>
 
 namespace zcheck {
 
@@ -200,9 +201,6 @@ std::string factorText(double k) { return k >= 1 ? "× " + formatNumber(k) : "/ 
 
 // A camera's pose as files store it: world-to-camera [R | t] in OpenCV axes, the eye at −Rᵀt;
 // and views back in the camera's own axes from such a rotation with a translation or an eye.
-// OpenCV camera axes from OpenGL's (x kept, y and z turned round), its own inverse.
-const glm::dmat3 kCvFromGl(1, 0, 0, 0, -1, 0, 0, 0, -1);
-
 struct FilePose {
     glm::dmat4 cvFromEyeAxes;
     glm::dmat3 r;
@@ -225,6 +223,9 @@ struct FilePose {
     }
 };
 
+// OpenCV camera axes from OpenGL's (x kept, y and z turned round), its own inverse.
+const glm::dmat3 kCvFromGl(1, 0, 0, 0, -1, 0, 0, 0, -1);
+
 // The pose as a file holds it, and its rotation transposed in OpenCV's camera axes and in
 // OpenGL's (R_gl = F·R with F = diag(1, −1, −1), so R_glᵀ read back into OpenCV axes is F·Rᵀ·F).
 struct TransposedPose {
@@ -238,11 +239,48 @@ struct TransposedPose {
     }
 };
 
-std::vector<Mistake> buildCatalogue()
+// The projection with the principal point's offset terms of the x and y rows in `rows` (0: x,
+// 1: y) multiplied by `factor`: −1 mirrors the principal point about the image centre, 0 drops
+// it (the image drawn centred). The offset lives in the z column (perspective) or the w column
+// (parallel) of those rows. False where that changes nothing (a principal point at the centre).
+bool principalScaled(const Camera& camera, double factor, std::initializer_list<int> rows, glm::dmat4& clipFromEye)
+{
+    clipFromEye = camera.clipFromEye;
+    for (int c : {2, 3})
+        for (int r : rows)  // a dropped offset is +0, not the −0 of −x·0 (a matrix written out shows it)
+            clipFromEye[c][r] = factor == 0 ? 0.0 : factor * clipFromEye[c][r];
+    return differ(clipFromEye, camera.clipFromEye);
+}
+
+// One axis of the principal point, as the explanations name it.
+struct PrincipalAxis {
+    int row;                               // the projection's row: 0 for x, 1 for y
+    const char *axis, *c, *size, *shift;   // "x", "cx", "W" and Blender's "shift_x"
+};
+constexpr PrincipalAxis kPrincipalAxes[] = {{0, "x", "cx", "W", "shift_x"}, {1, "y", "cy", "H", "shift_y"}};
+
+// The principal point's offset multiplied by `factor` (principalScaled) in one axis only, each
+// through a raw-matrix camera: variants "x only" and "y only", explained by `explain`. None unless
+// the offset changes something in both axes (in one only, the re-reading of both is that axis's).
+Rereadings principalInOneAxis(const Camera& camera, double factor,
+                              const std::function<std::string(const PrincipalAxis&)>& explain)
+{
+    Rereadings out;
+    glm::dmat4 xOnly, yOnly;
+    if (!principalScaled(camera, factor, {0}, xOnly) || !principalScaled(camera, factor, {1}, yOnly)) return out;
+    for (const PrincipalAxis& a : kPrincipalAxes) {
+        CameraSpec spec = camera.spec();
+        spec.projection.type = ProjectionType::Matrix;
+        spec.projection.clipFromEye = a.row == 0 ? xOnly : yOnly;
+        out.push_back({std::string(a.axis) + " only", explain(a), spec, {}, {}});
+    }
+    return out;
+}
+
+// Orientation and sampling: the ray route samples the image mirrored or half a pixel off.
+std::vector<Mistake> samplingMistakes()
 {
     std::vector<Mistake> all;
-
-    // Orientation and sampling.
     RayFaults halfPixel;
     halfPixel.shiftPixels = {-0.5, -0.5};
     all.push_back(mirrored("y-flip", "the window's y axis flipped (bottom-left vs top-left origin mixed up)",
@@ -271,7 +309,13 @@ std::vector<Mistake> buildCatalogue()
         return out;
     };
     all.push_back(half);
+    return all;
+}
 
+// The view built wrongly in the renderer's chain: inverted, or in the other camera axes.
+std::vector<Mistake> viewMistakes()
+{
+    std::vector<Mistake> all;
     // The view: the camera-pose mistakes public issue trackers show most.
     all.push_back(wrongView("inverted-extrinsic",
                             "the view inverted: world-from-camera used as camera-from-world (or the reverse)",
@@ -290,7 +334,15 @@ std::vector<Mistake> buildCatalogue()
                                 m = turn * camera.eyeFromWorld;
                                 return true;
                             }));
+    return all;
+}
 
+// Poses read wrongly from the files a renderer was given, each tried alone: the rotation
+// transposed, a 4×4 in the other layout, the quaternion's order, the translation's units, and the
+// mesh's up axis (a turned view too).
+std::vector<Mistake> filePoseMistakes()
+{
+    std::vector<Mistake> all;
     // Poses as files store them (COLMAP, OpenCV, TUM-style trajectories): in OpenCV axes,
     // world-to-camera [R | t] or camera-to-world [Rᵀ | C].
     all.push_back(otherViews(
@@ -381,7 +433,14 @@ std::vector<Mistake> buildCatalogue()
             }
             return out;
         }));
+    return all;
+}
 
+// The other files a renderer was given, each tried alone: the mesh in other units than the pose,
+// and the intrinsics' principal point with its coordinates exchanged.
+std::vector<Mistake> meshUnitAndIntrinsicMistakes()
+{
+    std::vector<Mistake> all;
     // The mesh in other units: the renderer drew k·p through the view [R | t]. Its eye points are
     // k × those of p through [R | t/k], seen along the same rays by a perspective camera, and
     // clipped by near and far where p's are by near/k and far/k: the truth through that camera,
@@ -437,8 +496,68 @@ std::vector<Mistake> buildCatalogue()
         return out;
     };
     all.push_back(swappedPrincipal);
+    return all;
+}
 
-    // The projection matrix.
+// An off-centre principal point mirrored about the image centre or dropped, in x and y or in
+// one axis only (projectionMistakes' middle entries).
+std::vector<Mistake> principalPointMistakes()
+{
+    std::vector<Mistake> all;
+    Mistake mirroredPrincipal = wrongProjection(
+        "principal-point-mirrored",
+        "an off-centre principal point mirrored about the image centre (cx for W - 1 - cx, a frustum's left for "
+        "-right), as a y-up vs y-down or sign slip does",
+        "consistent if the principal point is mirrored about the image centre",
+        [](const Camera& camera, glm::dmat4& m) { return principalScaled(camera, -1, {0, 1}, m); });
+    // ... or in one axis only: a sign slip in cx or cy alone (Blender's shift_x or shift_y read
+    // with the wrong sign), a diagnosis of its own.
+    mirroredPrincipal.reread = [both = mirroredPrincipal.reread](const Camera& camera, const DepthMap& map) {
+        Rereadings out = both(camera, map);
+        for (Rereading& r : principalInOneAxis(camera, -1, [](const PrincipalAxis& a) {
+                 return "consistent if the principal point is mirrored about the image centre in " + std::string(a.axis) +
+                        " only (" + a.c + " for " + a.size + " - 1 - " + a.c + ": a sign slip in " + a.c +
+                        ", or Blender's " + a.shift + " read with the wrong sign)";
+             }))
+            out.push_back(std::move(r));
+        return out;
+    };
+    all.push_back(mirroredPrincipal);
+    // ... or dropped: the renderer drew a centred image where the camera has an off-centre
+    // principal point (Blender's lens shift, an asymmetric frustum, cx and cy ignored): the
+    // offset terms of the x and y rows set to zero.
+    Mistake droppedShift = wrongProjection(
+        "lens-shift-dropped",
+        "an off-centre principal point dropped (Blender's shift_x and shift_y, an asymmetric frustum, cx and cy "
+        "ignored): the image drawn centred",
+        "consistent if the principal point's offset from the image centre was dropped in x and y (a lens shift "
+        "ignored: the image drawn centred)",
+        [](const Camera& camera, glm::dmat4& m) { return principalScaled(camera, 0, {0, 1}, m); });
+    droppedShift.reread = [both = droppedShift.reread](const Camera& camera, const DepthMap& map) {
+        Rereadings out = both(camera, map);
+        glm::dmat4 xOnly, yOnly;
+        const bool x = principalScaled(camera, 0, {0}, xOnly), y = principalScaled(camera, 0, {1}, yOnly);
+        for (auto& r : out) {
+            r.variant = x && y ? "x and y" : x ? "x" : "y";
+            if (!(x && y)) r.explanation = "consistent if the principal point's offset in " + r.variant + " was dropped (a lens "
+                                           "shift ignored: the image drawn centred)";
+        }
+        for (Rereading& r : principalInOneAxis(camera, 0, [](const PrincipalAxis& a) {
+                 return "consistent if the principal point's offset in " + std::string(a.axis) + " was dropped (Blender's " +
+                        a.shift + " ignored: the image drawn centred in " + std::string(a.axis) + ")";
+             }))
+            out.push_back(std::move(r));
+        return out;
+    };
+    all.push_back(droppedShift);
+    return all;
+}
+
+// The projection matrix: its depth range, its depth mapping, its handedness, its principal point
+// (principalPointMistakes), its layout, its aspect and field of view, its near and far planes.
+std::vector<Mistake> projectionMistakes()
+{
+    std::vector<Mistake> all;
     all.push_back(wrongProjection(
         "ndc-range", "a [-1,1] depth matrix used with a [0,1] convention, or the reverse",
         "consistent if the projection maps depth to the other NDC range ([-1,1] vs [0,1]) than the viewport expects",
@@ -474,82 +593,7 @@ std::vector<Mistake> buildCatalogue()
                                       m = camera.clipFromEye * mirror;
                                       return true;
                                   }));
-    // The image offset lives in the z column (perspective) or the w column (parallel) of the x
-    // and y rows: negated in `rows`, the principal point is mirrored about the image centre there.
-    auto principalMirrored = [](const Camera& camera, glm::dmat4& m, std::initializer_list<int> rows) {
-        m = camera.clipFromEye;
-        for (int c : {2, 3})
-            for (int r : rows) m[c][r] = -m[c][r];
-        return differ(m, camera.clipFromEye);
-    };
-    Mistake mirroredPrincipal = wrongProjection(
-        "principal-point-mirrored",
-        "an off-centre principal point mirrored about the image centre (cx for W - 1 - cx, a frustum's left for "
-        "-right), as a y-up vs y-down or sign slip does",
-        "consistent if the principal point is mirrored about the image centre",
-        [principalMirrored](const Camera& camera, glm::dmat4& m) { return principalMirrored(camera, m, {0, 1}); });
-    // ... or in one axis only: a sign slip in cx or cy alone (Blender's shift_x or shift_y read
-    // with the wrong sign), a diagnosis of its own.
-    mirroredPrincipal.reread = [both = mirroredPrincipal.reread, principalMirrored](const Camera& camera, const DepthMap& map) {
-        Rereadings out = both(camera, map);
-        for (const auto& [row, axis] : {std::pair{0, "x"}, std::pair{1, "y"}}) {
-            glm::dmat4 m;
-            glm::dmat4 other;
-            if (!principalMirrored(camera, m, {row}) || !principalMirrored(camera, other, {1 - row})) continue;
-            CameraSpec spec = camera.spec();
-            spec.projection.type = ProjectionType::Matrix;
-            spec.projection.clipFromEye = m;
-            const std::string c = row == 0 ? "cx" : "cy", shift = row == 0 ? "shift_x" : "shift_y";
-            out.push_back({std::string(axis) + " only",
-                           "consistent if the principal point is mirrored about the image centre in " + std::string(axis) +
-                               " only (" + c + " for " + (row == 0 ? "W" : "H") + " - 1 - " + c + ": a sign slip in " + c +
-                               ", or Blender's " + shift + " read with the wrong sign)",
-                           spec, {}, {}});
-        }
-        return out;
-    };
-    all.push_back(mirroredPrincipal);
-    // ... or dropped: the renderer drew a centred image where the camera has an off-centre
-    // principal point (Blender's lens shift, an asymmetric frustum, cx and cy ignored): the
-    // offset terms of the x and y rows set to zero.
-    auto principalCentred = [](const Camera& camera, glm::dmat4& m, std::initializer_list<int> rows) {
-        m = camera.clipFromEye;
-        for (int c : {2, 3})
-            for (int r : rows) m[c][r] = 0;
-        return differ(m, camera.clipFromEye);
-    };
-    Mistake droppedShift = wrongProjection(
-        "lens-shift-dropped",
-        "an off-centre principal point dropped (Blender's shift_x and shift_y, an asymmetric frustum, cx and cy "
-        "ignored): the image drawn centred",
-        "consistent if the principal point's offset from the image centre was dropped in x and y (a lens shift "
-        "ignored: the image drawn centred)",
-        [principalCentred](const Camera& camera, glm::dmat4& m) { return principalCentred(camera, m, {0, 1}); });
-    droppedShift.reread = [both = droppedShift.reread, principalCentred](const Camera& camera, const DepthMap& map) {
-        Rereadings out = both(camera, map);
-        glm::dmat4 xOnly, yOnly;
-        const bool x = principalCentred(camera, xOnly, {0}), y = principalCentred(camera, yOnly, {1});
-        for (auto& r : out) {
-            r.variant = x && y ? "x and y" : x ? "x" : "y";
-            if (!(x && y)) r.explanation = "consistent if the principal point's offset in " + r.variant + " was dropped (a lens "
-                                           "shift ignored: the image drawn centred)";
-        }
-        for (const auto& [row, axis] : {std::pair{0, "x"}, std::pair{1, "y"}}) {
-            glm::dmat4 m;
-            if (!(x && y) || !principalCentred(camera, m, {row})) continue;
-            CameraSpec spec = camera.spec();
-            spec.projection.type = ProjectionType::Matrix;
-            spec.projection.clipFromEye = m;
-            const std::string shift = row == 0 ? "shift_x" : "shift_y";
-            out.push_back({std::string(axis) + " only",
-                           "consistent if the principal point's offset in " + std::string(axis) +
-                               " was dropped (Blender's " + shift + " ignored: the image drawn centred in " +
-                               std::string(axis) + ")",
-                           spec, {}, {}});
-        }
-        return out;
-    };
-    all.push_back(droppedShift);
+    for (Mistake& m : principalPointMistakes()) all.push_back(std::move(m));
     all.push_back(wrongProjection("transposed", "the projection matrix transposed (row- vs column-major confusion)",
                                   "consistent if the projection matrix is transposed (row- vs column-major)",
                                   [](const Camera& camera, glm::dmat4& m) {
@@ -593,8 +637,14 @@ std::vector<Mistake> buildCatalogue()
     all.push_back(swapped);
     // A field of view off by a small factor is measured, not guessed: fit.h's field-of-view
     // family, in MapVerifier::diagnose.
+    return all;
+}
 
-    // What the numbers are.
+// What the numbers are: linear depth, an offset, a coarser storage, and every swap of the four
+// quantities.
+std::vector<Mistake> quantityMistakes()
+{
+    std::vector<Mistake> all;
     Mistake linear{"linear-depth", "linear eye depth (z − n)/(f − n) stored as the window depth", Route::Raster, {}, {}};
     linear.inject = [](const Camera& camera, RouteFaults& faults) {
         return !camera.farIsInfinite() && (faults.raster.storeLinearEyeZ = true);
@@ -685,8 +735,13 @@ std::vector<Mistake> buildCatalogue()
             quantityMistake(name, std::string(actualText) + " delivered where " + declaredText + " was declared", declared,
                             actual, std::string("consistent if read as ") + actualText + " instead of " + declaredText);
         }
+    return all;
+}
 
-    // The rasterizer's own mistakes: nothing to re-read in a finished map.
+// The rasterizer's own mistakes: nothing to re-read in a finished map (inject only).
+std::vector<Mistake> rasterOnlyMistakes()
+{
+    std::vector<Mistake> all;
     auto rasterOnly = [&](std::string name, std::string description, std::function<bool(const Camera&, RasterFaults&)> set) {
         Mistake m{std::move(name), std::move(description), Route::Raster, {}, {}};
         m.inject = [set](const Camera& camera, RouteFaults& faults) { return set(camera, faults.raster); };
@@ -702,6 +757,17 @@ std::vector<Mistake> buildCatalogue()
                [](const Camera& camera, RasterFaults& f) {
                    return camera.depth().format != DepthFormat::Float32 && (f.truncateUnorm = true);
                });
+    return all;
+}
+
+// The catalogue: the families in their order, each in its own order.
+std::vector<Mistake> buildCatalogue()
+{
+    std::vector<Mistake> all;
+    for (std::vector<Mistake> (*family)() : {samplingMistakes, viewMistakes, filePoseMistakes,
+                                             meshUnitAndIntrinsicMistakes, projectionMistakes, quantityMistakes,
+                                             rasterOnlyMistakes})
+        for (Mistake& mistake : family()) all.push_back(std::move(mistake));
     return all;
 }
 

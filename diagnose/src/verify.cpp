@@ -1,6 +1,7 @@
 #include "zcheck/verify.h"
 
 #include "numerics.h"
+#include "verify_estimators.h"
 #include "zcheck/detail/clock.h"
 #include "zcheck/drawn_polygon.h"
 #include "zcheck/error.h"
@@ -422,35 +423,71 @@ VerifyResult verifyAgainst(const Scene& scene, const Camera& camera, const Depth
     return run;
 }
 
-void judgeDeclaredAccuracy(const PixelJudge& judge, const DepthMap& map, const RenderResult& truth,
-                           const RenderResult& mapRender, const std::vector<double>& quantum, Comparison& comparison)
+double truthValueAt(const Camera& camera, const RenderResult& truth, int col, int row, DepthQuantity quantity)
 {
-    ComparisonReport& report = comparison.report;
-    report.declaredAccuracyRefused.clear();
+    const std::size_t i = std::size_t(row) * camera.width() + col;
+    const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
+    return depthValueFromEyeZ(camera, pWindow, eyeZFromWindowDepth(camera, pWindow, truth.windowDepth.value[i]), quantity);
+}
+
+namespace {
+
+// One pixel judgeDeclaredAccuracy weighs, in the map's units.
+struct DeclaredPixel {
+    double error;          // map − truth (the truth rounded to the declared grid, if any)
+    double intrinsic;      // C·q + S·m + E, the tolerance of a map declaring nothing
+    double declared;       // ValueAccuracy::declaredAt
+    double relativeEyeZ;   // the declared accuracy as a fraction of the pixel's eye-z
+    bool onGrid;           // within 1/1000 of Q (or four binary32 spacings) of a multiple of Q
+    int col, row;
+    double value;          // the map's
+};
+
+// The median of one field of `pixels`.
+double medianOfField(const std::vector<DeclaredPixel>& pixels, double DeclaredPixel::*field)
+{
+    std::vector<double> values;
+    values.reserve(pixels.size());
+    for (const DeclaredPixel& c : pixels) values.push_back(c.*field);
+    return medianOf(std::move(values));
+}
+
+// "12.5%": a fraction as a percentage to a tenth.
+std::string percentText(double fraction) { return formatNumber(std::round(fraction * 1000) / 10) + "%"; }
+
+// Four significant digits.
+std::string fourDigits(double v)
+{
+    char text[32];
+    std::snprintf(text, sizeof text, "%.4g", v);
+    return std::string(text);
+}
+
+// judgeDeclaredAccuracy's "holes": why allowed holes cannot stand (more than half the pixels
+// where the surface is hit), or "".
+std::string holesRefusal(const DepthMap& map, const ComparisonReport& report)
+{
     // Holes are a sensor's few: a map that holds nothing where most of the surface is proves nothing.
     const std::int64_t surface = report.bothHit + report.rayOnly;
-    if (map.accuracy.allowHoles && report.holes > 0 && report.holes * 2 > surface) {
-        report.declaredAccuracyRefused = "holes at " + std::to_string(report.holes) + " of the " + std::to_string(surface) +
-                                         " pixels where the surface is hit: --allow-holes accepts a sensor's few holes, "
-                                         "not a map that holds nothing where most of the surface is";
-        return;
-    }
-    if (!map.accuracy.anyAccuracy()) return;
+    if (map.accuracy.allowHoles && report.holes > 0 && report.holes * 2 > surface)
+        return "holes at " + std::to_string(report.holes) + " of the " + std::to_string(surface) +
+               " pixels where the surface is hit: --allow-holes accepts a sensor's few holes, "
+               "not a map that holds nothing where most of the surface is";
+    return "";
+}
+
+// The pixels judgeDeclaredAccuracy weighs, in scan order: compared on depth (Agree, DepthError),
+// hit by the truth, the map showing the truth's own surface there (`mapRender`) and holding a
+// depth of its quantity.
+std::vector<DeclaredPixel> declaredPixels(const PixelJudge& judge, const DepthMap& map, const RenderResult& truth,
+                                          const RenderResult& mapRender, const std::vector<double>& quantum,
+                                          const Comparison& comparison)
+{
     const Camera& camera = judge.camera();
     const int W = camera.width(), H = camera.height();
     const DepthQuantity quantity = map.quantity;
     const double Q = map.accuracy.quantum;
-    // One compared pixel, in the map's units.
-    struct Compared {
-        double error;          // map − truth
-        double intrinsic;      // C·q + S·m + E, the tolerance of a map declaring nothing
-        double declared;       // ValueAccuracy::declaredAt
-        double relativeEyeZ;   // the declared accuracy as a fraction of the pixel's eye-z
-        bool onGrid;
-        int col, row;
-        double value;
-    };
-    std::vector<std::vector<Compared>> rows(static_cast<std::size_t>(H));
+    std::vector<std::vector<DeclaredPixel>> rows(static_cast<std::size_t>(H));
     tbb::parallel_for(0, H, [&](int row) {
         for (int col = 0; col < W; ++col) {
             const std::size_t i = std::size_t(row) * W + col;
@@ -461,7 +498,7 @@ void judgeDeclaredAccuracy(const PixelJudge& judge, const DepthMap& map, const R
                 continue;
             const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
             const double truthWindow = truth.windowDepth.value[i];
-            const double trueEyeZ = eyeZFromWindowDepth(camera, pWindow, truthWindow);
+            const double trueEyeZ = truthValueAt(camera, truth, col, row, DepthQuantity::EyeZ);
             // The map's value of a window depth at this pixel, and the eye-z of a map value.
             auto valueOfWindow = [&](double d) {
                 return depthValueFromEyeZ(camera, pWindow, eyeZFromWindowDepth(camera, pWindow, d), quantity);
@@ -475,7 +512,7 @@ void judgeDeclaredAccuracy(const PixelJudge& judge, const DepthMap& map, const R
                 }
                 return NAN;
             };
-            const double trueValue = depthValueFromEyeZ(camera, pWindow, trueEyeZ, quantity);
+            const double trueValue = truthValueAt(camera, truth, col, row, quantity);
             const double tolerance = judge.surfaceTolerance(truth.primitiveId[i], quantum[i]);
             double intrinsic = 0;
             for (const double side : {truthWindow - tolerance, truthWindow + tolerance})
@@ -499,69 +536,82 @@ void judgeDeclaredAccuracy(const PixelJudge& judge, const DepthMap& map, const R
             rows[std::size_t(row)].push_back({v - expected, intrinsic, declared, relativeEyeZ, onGrid, col, row, v});
         }
     });
-    std::vector<Compared> all;
+    std::vector<DeclaredPixel> all;
     for (auto& r : rows) all.insert(all.end(), r.begin(), r.end());
+    return all;
+}
+
+// judgeDeclaredAccuracy's "coarse": why the declared accuracy, at the median of `all`, is too
+// coarse to judge (a tenth of the eye-z or more), or "".
+std::string coarseRefusal(const std::vector<DeclaredPixel>& all)
+{
+    const double relative = medianOfField(all, &DeclaredPixel::relativeEyeZ);
+    if (relative <= 0.1) return "";
+    return "the declared accuracy is as coarse as the depths: ±" +
+           fourDigits(medianOfField(all, &DeclaredPixel::declared)) + " at the median pixel, " +
+           (std::isfinite(relative) ? percentText(relative) : std::string("beyond the far plane")) +
+           " of its eye-z (a declaration zcheck can judge is under a tenth of the depth); a "
+           "map of the wrong scale or quantity would pass it";
+}
+
+// judgeDeclaredAccuracy's "grid": why the declared quantum Q (> 0) is not the grid of the values
+// of `all` (more than 1 % off it), or "" (also for Q = 0).
+std::string gridRefusal(double Q, const std::vector<DeclaredPixel>& all)
+{
+    if (!(Q > 0)) return "";
+    const auto off = std::count_if(all.begin(), all.end(), [](const DeclaredPixel& c) { return !c.onGrid; });
+    if (off * 100 <= std::int64_t(all.size())) return "";
+    const DeclaredPixel& first = *std::find_if(all.begin(), all.end(), [](const DeclaredPixel& c) { return !c.onGrid; });
+    return "the declared quantum " + formatNumber(Q) + " is not the map's grid: " + percentText(double(off) / double(all.size())) +
+           " of the values compared lie off its multiples (pixel (" + std::to_string(first.col) + ", " +
+           std::to_string(first.row) + ") holds " + formatNumber(first.value) +
+           "); --quantum states the step the values were rounded to";
+}
+
+// judgeDeclaredAccuracy's "bias": why the mean error of `all` (256 pixels or more) is beyond what
+// an unbiased map shows, or "" (also for fewer pixels, or a single interleaved sample).
+std::string biasRefusal(double Q, const std::vector<DeclaredPixel>& all)
+{
+    if (all.size() < 256) return "";
+    // The mean's own sampling error, from the means of 16 interleaved samples (pixel
+    // (col, row) in sample 4·(row mod 4) + col mod 4, each spread over the whole image).
+    std::array<double, 16> sum{}, count{};
+    double bias = 0;
+    for (const DeclaredPixel& c : all) {
+        const std::size_t k = std::size_t(4 * (c.row % 4) + c.col % 4);
+        sum[k] += c.error, count[k] += 1, bias += c.error / double(all.size());
+    }
+    std::vector<double> means;
+    for (std::size_t k = 0; k < sum.size(); ++k)
+        if (count[k] > 0) means.push_back(sum[k] / count[k]);
+    if (means.size() < 2) return "";  // one sample (an image one pixel wide and tall): no spread to judge by
+    double centre = 0, squares = 0;
+    for (double m : means) centre += m / double(means.size());
+    for (double m : means) squares += (m - centre) * (m - centre);
+    const double sampling = std::sqrt(squares / double(means.size() - 1) / double(means.size()));
+    const double exact = medianOfField(all, &DeclaredPixel::intrinsic);
+    const double allowed = exact + 6 * sampling;
+    if (std::abs(bias) <= allowed) return "";
+    return "the map's errors are systematic: their mean is " + fourDigits(bias) + " (map units" +
+           (Q > 0 ? ", against the truth rounded to the grid" : "") + "), beyond the ±" + fourDigits(allowed) +
+           " an unbiased map may show (an exact map's median tolerance " + fourDigits(exact) +
+           ", and six times the mean's sampling error " + fourDigits(sampling) +
+           "); a declared accuracy absorbs rounding and noise, never a wrong scale, quantity, offset or pose";
+}
+
+}  // namespace
+
+void judgeDeclaredAccuracy(const PixelJudge& judge, const DepthMap& map, const RenderResult& truth,
+                           const RenderResult& mapRender, const std::vector<double>& quantum, Comparison& comparison)
+{
+    std::string& refused = comparison.report.declaredAccuracyRefused;
+    refused = holesRefusal(map, comparison.report);
+    if (!refused.empty() || !map.accuracy.anyAccuracy()) return;
+    const std::vector<DeclaredPixel> all = declaredPixels(judge, map, truth, mapRender, quantum, comparison);
     if (all.empty()) return;
-    auto medianOfField = [&](double Compared::*field) {
-        std::vector<double> values;
-        values.reserve(all.size());
-        for (const Compared& c : all) values.push_back(c.*field);
-        return medianOf(std::move(values));
-    };
-    auto percent = [](double fraction) { return formatNumber(std::round(fraction * 1000) / 10) + "%"; };
-    auto number = [](double v) {  // four significant digits
-        char text[32];
-        std::snprintf(text, sizeof text, "%.4g", v);
-        return std::string(text);
-    };
-    const double relative = medianOfField(&Compared::relativeEyeZ);
-    if (!(relative <= 0.1)) {
-        report.declaredAccuracyRefused = "the declared accuracy is as coarse as the depths: ±" +
-                                         number(medianOfField(&Compared::declared)) + " at the median pixel, " +
-                                         (std::isfinite(relative) ? percent(relative) : std::string("beyond the far plane")) +
-                                         " of its eye-z (a declaration zcheck can judge is under a tenth of the depth); a "
-                                         "map of the wrong scale or quantity would pass it";
-        return;
-    }
-    if (Q > 0) {
-        const auto off = std::count_if(all.begin(), all.end(), [](const Compared& c) { return !c.onGrid; });
-        if (off * 100 > std::int64_t(all.size())) {
-            const Compared& first = *std::find_if(all.begin(), all.end(), [](const Compared& c) { return !c.onGrid; });
-            report.declaredAccuracyRefused =
-                "the declared quantum " + formatNumber(Q) + " is not the map's grid: " + percent(double(off) / double(all.size())) +
-                " of the values compared lie off its multiples (pixel (" + std::to_string(first.col) + ", " +
-                std::to_string(first.row) + ") holds " + formatNumber(first.value) +
-                "); --quantum states the step the values were rounded to";
-            return;
-        }
-    }
-    if (all.size() >= 256) {
-        // The mean's own sampling error, from the means of 16 interleaved samples (pixel
-        // (col, row) in sample 4·(row mod 4) + col mod 4, each spread over the whole image).
-        std::array<double, 16> sum{}, count{};
-        double bias = 0;
-        for (const Compared& c : all) {
-            const std::size_t k = std::size_t(4 * (c.row % 4) + c.col % 4);
-            sum[k] += c.error, count[k] += 1, bias += c.error / double(all.size());
-        }
-        std::vector<double> means;
-        for (std::size_t k = 0; k < sum.size(); ++k)
-            if (count[k] > 0) means.push_back(sum[k] / count[k]);
-        if (means.size() < 2) return;  // one sample (an image one pixel wide and tall): no spread to judge by
-        double centre = 0, squares = 0;
-        for (double m : means) centre += m / double(means.size());
-        for (double m : means) squares += (m - centre) * (m - centre);
-        const double sampling = std::sqrt(squares / double(means.size() - 1) / double(means.size()));
-        const double exact = medianOfField(&Compared::intrinsic);
-        const double allowed = exact + 6 * sampling;
-        if (!(std::abs(bias) <= allowed))
-            report.declaredAccuracyRefused =
-                "the map's errors are systematic: their mean is " + number(bias) + " (map units" +
-                (Q > 0 ? ", against the truth rounded to the grid" : "") + "), beyond the ±" + number(allowed) +
-                " an unbiased map may show (an exact map's median tolerance " + number(exact) +
-                ", and six times the mean's sampling error " + number(sampling) +
-                "); a declared accuracy absorbs rounding and noise, never a wrong scale, quantity, offset or pose";
-    }
+    refused = coarseRefusal(all);
+    if (refused.empty()) refused = gridRefusal(map.accuracy.quantum, all);
+    if (refused.empty()) refused = biasRefusal(map.accuracy.quantum, all);
 }
 
 void measureMapErrors(const Camera& camera, const DepthMap& map, VerifyResult& run)
@@ -579,9 +629,9 @@ void measureMapErrors(const Camera& camera, const DepthMap& map, VerifyResult& r
             const std::size_t i = std::size_t(row) * W + col;
             const PixelClass c = run.comparison.pixelClass[i];
             if (c != PixelClass::Agree && c != PixelClass::DepthError) continue;
+            // In the units mapErrors reports: the map's own for eye-z and distance, eye-z for the others.
+            truthOf[i] = truthValueAt(camera, run.truth, col, row, linear ? map.quantity : DepthQuantity::EyeZ);
             const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
-            const double trueEyeZ = eyeZFromWindowDepth(camera, pWindow, run.truth.windowDepth.value[i]);
-            truthOf[i] = linear ? depthValueFromEyeZ(camera, pWindow, trueEyeZ, map.quantity) : trueEyeZ;
             mineOf[i] = linear ? map.value[i] : eyeZFromWindowDepth(camera, pWindow, run.map.windowDepth.value[i]);
         }
     });

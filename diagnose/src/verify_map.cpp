@@ -1,5 +1,6 @@
 #include "zcheck/verify_map.h"
 
+#include "verify_estimators.h"
 #include "zcheck/error.h"
 
 #include <string>

@@ -6,6 +6,22 @@
 
 namespace zcheck::text {
 
+char lowerAscii(char c) { return (c >= 'A' && c <= 'Z') ? char(c - 'A' + 'a') : c; }
+
+bool equalIgnoringCase(std::string_view a, std::string_view b)
+{
+    if (a.size() != b.size()) return false;
+    for (std::size_t i = 0; i < a.size(); ++i)
+        if (lowerAscii(a[i]) != lowerAscii(b[i])) return false;
+    return true;
+}
+
+std::string quoted(std::string_view text)
+{
+    constexpr std::size_t kMax = 40;
+    return "'" + printableExcerpt(text, kMax) + (text.size() > kMax ? "...'" : "'");
+}
+
 void appendUtf8(std::string& out, std::uint32_t cp)
 {
     if (cp < 0x80) {

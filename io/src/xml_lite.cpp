@@ -19,21 +19,9 @@ bool isLetter(char c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z');
 // byte is let through as part of a (UTF-8, already validated) name character.
 bool isNameStart(char c) { return isLetter(c) || c == '_' || c == ':' || static_cast<unsigned char>(c) >= 0x80; }
 bool isNameChar(char c) { return isNameStart(c) || isDigit(c) || c == '-' || c == '.'; }
-char lowerAscii(char c) { return (c >= 'A' && c <= 'Z') ? char(c - 'A' + 'a') : c; }
-
-bool equalIgnoringCase(std::string_view a, std::string_view b)
-{
-    if (a.size() != b.size()) return false;
-    for (std::size_t i = 0; i < a.size(); ++i)
-        if (lowerAscii(a[i]) != lowerAscii(b[i])) return false;
-    return true;
-}
-
-std::string quoted(std::string_view text)
-{
-    constexpr std::size_t kMax = 40;
-    return "'" + printableExcerpt(text, kMax) + (text.size() > kMax ? "...'" : "'");
-}
+using text::equalIgnoringCase;
+using text::lowerAscii;
+using text::quoted;
 
 // "<name>" for a message, readable whatever the name holds.
 std::string tag(std::string_view name, const char* open = "<") { return open + printableExcerpt(name, 40) + ">"; }

@@ -20,13 +20,9 @@ bool isAlnum(char c) { return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'z') |
 // Tags are names like "opencv-matrix" or "str"; URI escapes and punctuation beyond these are
 // not needed by any writer we read.
 bool isTagChar(char c) { return isAlnum(c) || c == '-' || c == '_' || c == '.' || c == ':' || c == '/' || c == '~'; }
-char lowerAscii(char c) { return (c >= 'A' && c <= 'Z') ? char(c - 'A' + 'a') : c; }
-
-std::string quoted(std::string_view text)
-{
-    constexpr std::size_t kMax = 40;
-    return "'" + printableExcerpt(text, kMax) + (text.size() > kMax ? "...'" : "'");
-}
+using text::equalIgnoringCase;
+using text::lowerAscii;
+using text::quoted;
 
 // Where a node sits in block context, which decides what may start there.
 struct Place {
@@ -686,14 +682,6 @@ void Parser::readEscape(std::string& out, int line)
     if ((codePoint >= 0xD800 && codePoint <= 0xDFFF) || codePoint > 0x10FFFF)
         fail(line_, "an escape for a code point that is not a character (a surrogate or above U+10FFFF)");
     zcheck::text::appendUtf8(out, codePoint);
-}
-
-bool equalIgnoringCase(const std::string& a, const std::string& b)
-{
-    if (a.size() != b.size()) return false;
-    for (std::size_t i = 0; i < a.size(); ++i)
-        if (lowerAscii(a[i]) != lowerAscii(b[i])) return false;
-    return true;
 }
 
 }  // namespace

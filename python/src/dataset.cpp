@@ -5,6 +5,7 @@
 #include "zcheck/camera_sources.h"
 #include "zcheck/dataset.h"
 #include "zcheck/dataset_report.h"
+#include "zcheck/image_io.h"
 
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>

@@ -20,13 +20,7 @@
 
 namespace zcheck {
 
-namespace {
-
 using nlohmann::json;
-
-bool explains(const Hypothesis& h) { return h.consistent || h.consistentExceptEdges(); }
-
-}  // namespace
 
 std::string frameRecordJson(const FrameResult& r)
 {
@@ -49,7 +43,7 @@ std::string frameRecordJson(const FrameResult& r)
     if (r.diagnosed) {
         json list = json::array();
         for (const Hypothesis& h : r.diagnosis)
-            if (explains(h)) list.push_back(reportjson::hypothesisJson(h));
+            if (h.explains()) list.push_back(reportjson::hypothesisJson(h));
         record["diagnosis"] = list;
         const ComparisonReport& c = r.report.comparison;
         if (list.empty() && !r.diagnosis.empty() && comesClose(r.diagnosis.front(), c.bothHit + c.rayOnly + c.rasterOnly)) {

@@ -367,10 +367,10 @@ std::string formatDiagnosis(const std::vector<Hypothesis>& hypotheses, std::int6
     };
     const Hypothesis& best = hypotheses.front();
     if (best.name == "empty-map") return "diagnosis  " + best.explanation + "\n";
-    if (best.consistent || best.consistentExceptEdges()) {
+    if (best.explains()) {
         std::string out = "diagnosis  " + named(best) + "\n";
         for (std::size_t k = 1; k < hypotheses.size() && k < 4; ++k)
-            if (hypotheses[k].consistent || hypotheses[k].consistentExceptEdges())
+            if (hypotheses[k].explains())
                 out += "  also     " + hypotheses[k].name + ": " + named(hypotheses[k]) + "\n";
         return out;
     }

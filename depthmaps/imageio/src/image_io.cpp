@@ -1,8 +1,6 @@
 #include "zcheck/image_io.h"
 
-#include "depth_formats.h"
-
-#include "png_codec.h"
+#include "zcheck/depth_map_formats.h"
 #include "zcheck/atomic_file.h"
 #include "zcheck/error.h"
 #include "zcheck/input_file.h"
@@ -123,41 +121,26 @@ void preflightExr(const std::string& path, int expectedWidth, int expectedHeight
     if (!sawDataWindow) malformed("no dataWindow attribute");
 }
 
-}  // namespace
 
-DepthMapFile readDepthMap(const std::string& path, const DepthMapReading& reading, int expectedWidth, int expectedHeight)
+bool isExr(std::string_view head) { return head.substr(0, 4) == std::string_view("\x76\x2f\x31\x01", 4); }
+
+bool isTiff(std::string_view head)
 {
-    if (std::optional<DepthMapFile> native = readDepthMapNatively(path, reading, expectedWidth, expectedHeight))
-        return std::move(*native);
-    const double scale = reading.scale;
-    // EXR or TIFF (readDepthMapNatively refused anything else): only that format's reader sees
-    // the file — OpenImageIO would otherwise offer unknown bytes to every plugin it has (video,
-    // camera raw, DICOM, ...).
-    unsigned char magic[4] = {0, 0, 0, 0};
-    {
-        std::ifstream probe(path, std::ios::binary);
-        probe.read(reinterpret_cast<char*>(magic), 4);
-    }
-    const char* plugin = magic[0] == 0x76 && magic[1] == 0x2f && magic[2] == 0x31 && magic[3] == 0x01 ? "openexr"
-                         : (magic[0] == 'I' && magic[1] == 'I' && magic[2] == 42 && magic[3] == 0) ||
-                                   (magic[0] == 'M' && magic[1] == 'M' && magic[2] == 0 && magic[3] == 42)
-                             ? "tiff"
-                                                                                                      : nullptr;
-    if (!plugin) refuseDepthMap(path, "not an EXR or TIFF file (judged by its first bytes)");
-    auto requireScale = [&](const std::string& what) {
-        if (!(scale > 0))
-            throw Error("depth map '" + path + "' stores integers (" + what +
-                        "): give --scale (stored value = depth × scale, e.g. 1000 for millimetres, 5000 for many RGB-D "
-                        "sets, 256 for KITTI)");
-    };
-    if (plugin == std::string("openexr")) preflightExr(path, expectedWidth, expectedHeight);
+    return head.substr(0, 4) == std::string_view("II\x2a\x00", 4) || head.substr(0, 4) == std::string_view("MM\x00\x2a", 4);
+}
+
+// An EXR or TIFF through OpenImageIO's plugin of that format alone (`plugin`: "openexr" or
+// "tiff"), never through its other plugins.
+DepthMapFile readThroughPlugin(const char* plugin, const std::string& path, const DepthMapReading& reading,
+                               int expectedWidth, int expectedHeight)
+{
     auto in = OIIO::ImageInput::create(plugin);
     OIIO::ImageSpec opened;
     if (!in || !in->open(path, opened)) {
         std::string reason = in ? in->geterror() : OIIO::geterror();
         for (char& c : reason)
             if (c == '\n') c = ' ';
-        refuseDepthMap(path, "malformed " + std::string(plugin == std::string("openexr") ? "EXR" : plugin == std::string("tiff") ? "TIFF" : "PNG") +
+        refuseDepthMap(path, "malformed " + std::string(plugin == std::string("openexr") ? "EXR" : "TIFF") +
                             (reason.empty() ? "" : ": " + reason));
     }
     const OIIO::ImageSpec& spec = in->spec();
@@ -178,7 +161,7 @@ DepthMapFile readDepthMap(const std::string& path, const DepthMapReading& readin
     if (integer && format.size() < 2)
         refuseDepthMap(path, "channel '" + map.channel + "' stores " + std::to_string(8 * format.size()) +
                             "-bit integers, which cannot hold depth (a picture, not a depth map?)");
-    if (integer) requireScale(format.c_str());
+    if (integer) reading.requireScaleForIntegers(path, format.c_str());
     std::vector<double> pixels(std::size_t(spec.width) * std::size_t(spec.height));
     if (!in->read_image(0, 0, channel, channel + 1, OIIO::TypeDesc::DOUBLE, pixels.data())) {
         std::string reason = in->geterror();
@@ -199,94 +182,9 @@ DepthMapFile readDepthMap(const std::string& path, const DepthMapReading& readin
     return map;
 }
 
-namespace {
-
-void writePng16(const std::string& path, const QuantityImage& image, double scale)
+// EXR or TIFF: each quantity's channels interleaved as 4 bytes, float32 or uint32 for ids.
+void writeThroughOiio(const std::string& path, const std::vector<QuantityImage>& images, bool exr)
 {
-    const ExportQuantity q = image.quantity;
-    if (q != ExportQuantity::Window && q != ExportQuantity::Ndc && q != ExportQuantity::EyeZ && q != ExportQuantity::Distance)
-        throw Error("cannot write '" + path + "': 16-bit PNG holds one depth quantity (window, ndc, eye-z or distance), not " +
-                    toString(q));
-    if (!(scale > 0) || !std::isfinite(scale))
-        throw Error("cannot write '" + path + "': 16-bit PNG needs --scale (stored = value × scale, e.g. 1000 for millimetres)");
-    double largest = 0, smallest = INFINITY;
-    for (std::size_t i = 0; i < image.value.size(); ++i) {
-        if (image.isMiss(i)) continue;
-        largest = std::max(largest, image.value[i]);
-        smallest = std::min(smallest, image.value[i]);
-    }
-    if (smallest < 0)
-        throw Error("cannot write '" + path + "': " + toString(q) + " has negative values (" + formatNumber(smallest) +
-                    "), which 16-bit PNG cannot store");
-    if (std::round(largest * scale) > 65535)
-        throw Error("cannot write '" + path + "': the largest " + toString(q) + " " + formatNumber(largest) +
-                    " times --scale " + formatNumber(scale) + " exceeds 65535; the largest scale that fits is " +
-                    formatNumber(std::floor(65535.0 / largest * 1e6) / 1e6));
-    if (std::isfinite(smallest) && std::round(smallest * scale) < 1)
-        throw Error("cannot write '" + path + "': the smallest " + toString(q) + " " + formatNumber(smallest) +
-                    " rounds to 0 at --scale " + formatNumber(scale) + ", which means a miss; raise --scale");
-    std::vector<std::uint16_t> codes(image.value.size(), 0);
-    for (std::size_t i = 0; i < codes.size(); ++i)
-        if (!image.isMiss(i)) codes[i] = static_cast<std::uint16_t>(std::lround(image.value[i] * scale));
-    writeFileBytes(path, encodePng(image.width, image.height, 1, 16, codes.data()));
-}
-
-// PFM, written here because OpenImageIO 2.4 (Debian 12) reads PFM but has no writer for it.
-// Per the format: "Pf" (1 channel) or "PF" (3), "width height", a negative scale for
-// little-endian data, then float32 rows from the BOTTOM row of the picture to the top.
-void writePfm(const std::string& path, const QuantityImage& image)
-{
-    const std::size_t C = image.channels.size();
-    if (image.quantity == ExportQuantity::PrimitiveId || (C != 1 && C != 3))
-        throw Error("cannot write '" + path + "': PFM holds 1 or 3 float channels, not " + toString(image.quantity) +
-                    " (use .exr or .tif)");
-    std::string bytes = std::string(C == 1 ? "Pf" : "PF") + "\n" + std::to_string(image.width) + " " +
-                        std::to_string(image.height) + "\n-1.0\n";
-    std::vector<float> row(std::size_t(image.width) * C);
-    for (int y = image.height - 1; y >= 0; --y) {
-        for (std::size_t k = 0; k < row.size(); ++k) row[k] = float(image.value[std::size_t(y) * image.width * C + k]);
-        bytes.append(reinterpret_cast<const char*>(row.data()), row.size() * sizeof(float));
-    }
-    writeFileBytes(path, bytes);
-}
-
-}  // namespace
-
-std::string writeQuantityFile(const std::string& path, const std::vector<QuantityImage>& images, double scale)
-{
-    const std::string ext = lowerExtension(path);
-    const std::string format = ext == ".exr" ? "exr" : ext == ".pfm" ? "pfm" : (ext == ".tif" || ext == ".tiff") ? "tiff"
-                               : ext == ".png"                    ? "png"
-                               : ext == ".npy"                    ? "npy"
-                               : (ext == ".h5" || ext == ".hdf5") ? "hdf5"
-                               : ext == ".bin"                    ? "colmap"
-                                                                  : "";
-    if (format.empty())
-        throw Error("cannot write '" + path + "': unknown format '" + ext +
-                    "' (expected .exr, .pfm, .tif, .png, .npy, .h5 or .bin for a COLMAP depth map)");
-    if (images.empty()) throw Error("nothing to write to '" + path + "'");
-    if (format != "exr" && format != "hdf5" && images.size() > 1)
-        throw Error("cannot write '" + path + "': several quantities go into one file only as .exr or .h5");
-    if (format == "npy") {
-        depthformats::writeNpy(path, images[0]);
-        return format;
-    }
-    if (format == "colmap") {
-        depthformats::writeColmapDepth(path, images[0]);
-        return format;
-    }
-    if (format == "hdf5") {
-        depthformats::writeHdf5(path, images);
-        return format;
-    }
-    if (format == "png") {
-        writePng16(path, images[0], scale);
-        return format;
-    }
-    if (format == "pfm") {
-        writePfm(path, images[0]);
-        return format;
-    }
     const QuantityImage& first = images[0];
     const bool hasId = std::any_of(images.begin(), images.end(), [](const QuantityImage& q) { return q.quantity == ExportQuantity::PrimitiveId; });
     // Interleave every channel as 4 bytes: float32, or uint32 for ids.
@@ -319,9 +217,50 @@ std::string writeQuantityFile(const std::string& path, const std::vector<Quantit
     OIIO::ImageSpec spec(first.width, first.height, int(channels), hasId && !mixed ? OIIO::TypeDesc::UINT32 : OIIO::TypeDesc::FLOAT);
     spec.channelnames = names;
     if (mixed) spec.channelformats = formats;
-    if (format == "exr") spec.attribute("compression", "zip");
+    if (exr) spec.attribute("compression", "zip");
     writeImage(path, spec, words.data());
-    return format;
+}
+
+DepthMapFile readExr(const std::string& path, const DepthMapReading& reading, int expectedWidth, int expectedHeight)
+{
+    preflightExr(path, expectedWidth, expectedHeight);
+    return readThroughPlugin("openexr", path, reading, expectedWidth, expectedHeight);
+}
+
+DepthMapFile readTiff(const std::string& path, const DepthMapReading& reading, int expectedWidth, int expectedHeight)
+{
+    return readThroughPlugin("tiff", path, reading, expectedWidth, expectedHeight);
+}
+
+const DepthMapFormat kExr{"exr", "EXR", {".exr"}, "any quantities, one channel each, float32 (ids uint32), ZIP", isExr, readExr,
+                          [](const std::string& path, const std::vector<QuantityImage>& images, double) {
+                              writeThroughOiio(path, images, true);
+                          },
+                          true};
+const DepthMapFormat kTiff{"tiff", "TIFF", {".tif", ".tiff"}, "one quantity, float32 (ids uint32)", isTiff, readTiff,
+                           [](const std::string& path, const std::vector<QuantityImage>& images, double) {
+                               writeThroughOiio(path, images, false);
+                           }};
+
+}  // namespace
+
+std::vector<const DepthMapFormat*> imageIoDepthMapFormats() { return {&kExr, &kTiff}; }
+
+void registerImageIoDepthMapFormats()
+{
+    for (const DepthMapFormat* format : imageIoDepthMapFormats()) registerDepthMapFormat(*format);
+}
+
+DepthMapFile readDepthMap(const std::string& path, const DepthMapReading& reading, int expectedWidth, int expectedHeight)
+{
+    registerImageIoDepthMapFormats();
+    return readDepthMapFile(path, reading, expectedWidth, expectedHeight);
+}
+
+std::string writeQuantityFile(const std::string& path, const std::vector<QuantityImage>& images, double scale)
+{
+    registerImageIoDepthMapFormats();
+    return writeDepthMapFile(path, images, scale);
 }
 
 }  // namespace zcheck

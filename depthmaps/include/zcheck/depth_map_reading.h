@@ -106,6 +106,9 @@ struct DepthMapReading {
     // `name` as the caller calls the value ("--scale", "scale").
     static void requireScale(double scale, const std::string& name);
     static void requireOffset(double offset, const std::string& name);
+    // A file that stores integers needs a scale: throws Error "depth map '<path>' stores integers
+    // (<storage>): give --scale (...)" when none was given. Every integer format's reader asks this.
+    void requireScaleForIntegers(const std::string& path, const std::string& storage) const;
 };
 
 // The channel of a file with channels `names` that holds depth: `wanted` when given (Error
@@ -140,15 +143,6 @@ enum class StoredValues {
 // (binary16Step), nothing for Float. The one rule every reader of stored values and the
 // Python module's arrays use.
 void depthsFromStored(DepthMapFile& map, StoredValues stored, const DepthMapReading& reading);
-
-// Reads a map in a format zcheck reads by itself — PFM, 16-bit PNG (libpng), NumPy .npy,
-// COLMAP dense maps, HDF5 (depth_formats.h) — told by its first bytes, as `reading` says; or
-// returns nothing for EXR and TIFF, which only image_io.h's readDepthMap (the image library)
-// reads. The rules of readDepthMap (image_io.h) apply: a regular file of at most 2 GiB, its
-// declared size compared with expectedWidth × expectedHeight (0 × 0: any size a camera may
-// have) before any pixel is allocated, 8-bit integers refused. Throws Error naming the file.
-std::optional<DepthMapFile> readDepthMapNatively(const std::string& path, const DepthMapReading& reading, int expectedWidth,
-                                                 int expectedHeight);
 
 // The size a file declares against the camera's (0 × 0: any size a camera may have: 1..16384
 // per side, 2^25 pixels in all); throws Error naming the file and both sizes.

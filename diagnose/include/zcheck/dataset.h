@@ -15,7 +15,7 @@
 #include "zcheck/camera_sources.h"
 #include "zcheck/checker.h"
 #include "zcheck/dataset_source.h"
-#include "zcheck/image_io.h"
+#include "zcheck/depth_map_reading.h"
 #include "zcheck/map_verifier.h"
 #include "zcheck/verify_map.h"
 

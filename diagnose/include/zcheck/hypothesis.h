@@ -39,6 +39,9 @@ struct Hypothesis {
         return !consistent && !estimated && unexplained > 0 && unexplainedAtEdges == unexplained && compared > 0 &&
                unexplained <= compared / 10;
     }
+    // The hypothesis explains the map: consistent, or consistent but for edge pixels. The one
+    // rule the diagnosis, the reports and the datasets name a mistake by.
+    bool explains() const { return consistent || consistentExceptEdges(); }
 };
 
 }  // namespace zcheck

@@ -1,7 +1,10 @@
 #pragma once
 // Verifying a depth map rendered elsewhere (a GPU, an engine, Blender, a simulator) against
-// the ray route's ground truth (library zcheck::diagnose): the pieces MapVerifier::verify and
-// MapVerifier::diagnose (map_verifier.h) are made of, and what a verification returns.
+// the ray route's ground truth (library zcheck::diagnose): what a verification returns, the
+// tolerance a map is judged with, and the pixel-by-pixel reading a verification is made of, for
+// judging a sample of pixels without the whole comparison. MapVerifier (map_verifier.h) is the
+// entry point; the rest of verification's steps are private to the library
+// (src/verify_estimators.h).
 //
 // The map does not say which surface it saw: each hit takes the ground truth's surface when
 // the comparison's rule (PixelJudge) accepts the map's depth on it; otherwise, among the
@@ -9,8 +12,9 @@
 // pixel centre whose tolerance interval joined with the truth's holds the depth and under
 // which the comparison explains the pixel — and, where no ray meets one, among the triangles
 // zcheck's rasterizer draws at and around the pixel (a sliver's or a tip's snapped footprint);
-// otherwise the truth's surface (a depth error) or kUnknownPrimitive. The accepted depths at a pixel are therefore one interval around the
-// true depth: a map nearer the truth never fails where a farther one passes.
+// otherwise the truth's surface (a depth error) or kUnknownPrimitive. The accepted depths at a
+// pixel are therefore one interval around the true depth: a map nearer the truth never fails
+// where a farther one passes.
 #include "zcheck/checker.h"
 #include "zcheck/depth_map.h"
 
@@ -92,28 +96,10 @@ struct MapPixel {
     std::uint32_t primitive = kNoPrimitive;    // the surface chosen (above); kNoPrimitive for a miss
 };
 
-// The eye-z step of a standard binary32 depth buffer (near → 0, far → 1, not reversed) of the
-// camera's near and far planes at `eyeZ`: the precision of an eye-z or distance map linearized
-// from a renderer's depth buffer, which such a map is allowed besides its own storage step —
-// the same whatever the camera's depth format, range and reversal, which no linear map depends on.
-double linearizedBufferStep(const Camera& camera, double eyeZ);
-
-// The pixel's window depth, storage step and allowance as the comparison reads them (its
-// surface left kNoPrimitive); `truthDepth` is the truth's window depth there, the reference for
-// a miss. The value's step and declared accuracy are carried into window units through the
-// quantity's mapping at the pixel: the larger window change of value ± step, and of value ±
-// ValueAccuracy::declaredAt(value). A window map's step is the camera's depth format's unless
-// the file states one (then at least binary32's spacing at the window depth); an eye-z or
-// distance map's is at least linearizedBufferStep.
-MapPixel mapPixelDepth(const Camera& camera, const DepthMap& map, int col, int row, double truthDepth);
-// The same for one value of `quantity` judged by `accuracy` (a step of 0: binary32, or for a
-// window map the camera's depth format).
-MapPixel mapPixelDepth(const Camera& camera, DepthQuantity quantity, double value, const ValueAccuracy& accuracy, int col,
-                       int row, double truthDepth);
-
-// Reads a map pixel by pixel against an already rendered truth: the per-pixel rule of
-// renderResultFromMap, and the comparison's class for one pixel, so that a diagnosis can
-// judge a sample of pixels without reading the whole map. Holds references; thread-safe.
+// Reads a map pixel by pixel against an already rendered truth: the per-pixel rule a
+// verification reads the whole map with, and the comparison's class for one pixel, so that a
+// diagnosis can judge a sample of pixels without reading the whole map. Holds references;
+// thread-safe.
 // `judge`: made for the scene and camera with mapTolerance(map) (std::logic_error otherwise);
 // SlopeSource::TableOfSeen for reading every pixel, EachCall for a sample.
 class MapReader {
@@ -140,24 +126,6 @@ private:
     mutable RenderResult drawn_;
 };
 
-// The map as the raster side of a comparison (window depth per pixel, a hit where the value is
-// not a miss, the surface chosen as above). `quantum` and `allowance` receive each pixel's
-// storage step and declared accuracy in window units (allowance left empty where the map
-// declares none), for the comparison's DeclaredMap. `judge` as MapReader's; the comparison of
-// the result may then use it too (compareRoutes), finding the slopes it computed.
-RenderResult renderResultFromMap(const PixelJudge& judge, const DepthMap& map, const RenderResult& truth,
-                                 const VertexNeighbours& neighbours, std::vector<double>& quantum,
-                                 std::vector<double>& allowance);
-
-// Throws Error unless `map` is camera.width() × camera.height() with a value per pixel.
-void requireMapFits(const Camera& camera, const DepthMap& map);
-// The map's values its quantity cannot hold (kindOfDepthValue), counted into `report`
-// (outOfRange, the first one and its stored value); verifyAgainst does it for every reading.
-void countOutOfRange(const Camera& camera, const DepthMap& map, ComparisonReport& report);
-// Refuses (Error beginning with `name`) a map whose values are all misses or out of range with
-// at least one out of range: it holds nothing of its quantity (a wrong --quantity, mostly).
-void requireDepthsInRange(const Camera& camera, const DepthMap& map, const std::string& name);
-
 // Whether `map` certainly cannot be consistent with `truth`, judged on a sample: the pixels
 // that do not simply agree with the truth's own surface are looked for on every fourth row
 // and column, and an evenly spaced sample of at most 1024 of them is read and classified
@@ -168,66 +136,5 @@ void requireDepthsInRange(const Camera& camera, const DepthMap& map, const std::
 // only the full comparison can tell.
 std::optional<std::int64_t> screenUnexplained(const Scene& scene, const Camera& camera, const DepthMap& map,
                                               const RenderResult& truth, const VertexNeighbours& neighbours);
-
-// How near a hypothesis comes, before a truth is rendered for it: at a 16×16 grid of pixel
-// centres, one ray each (RayRenderer::primitiveAt), whether `map`, read through `camera`,
-// agrees with the surface the ray meets by the comparison's rule (PixelJudge). `agreeing`:
-// the share of the grid's pixels where the map or the truth sees a surface at which they agree
-// (0 where none does); `seen`: that share of the whole grid. A consistent reading fails only at
-// edges and where the map shows a neighbouring surface, which a coarse grid seldom meets: an
-// `agreeing` under 3/4 rules it out.
-struct Probe {
-    double agreeing = 0, seen = 0;
-    bool rulesOut() const { return agreeing < 0.75; }
-    // The unexplained pixels of `pixels` the probe's share stands for.
-    std::int64_t unexplainedOf(double pixels) const { return std::llround((1 - agreeing) * seen * pixels); }
-};
-Probe probeAgreement(const Scene& scene, const RayRenderer& rays, const Camera& camera, const DepthMap& map);
-
-// Whether the truth around pixel (col, row) is one smooth surface: its 3×3 neighbourhood
-// (clamped at the image's border) all hit or all miss, and, where hit, window depth nearly
-// affine in x and y (a plane's is): second differences across the pixel in x, y and both
-// diagonals within a tenth of the rise plus 1e-12. False at silhouettes and occlusion edges
-// (there the second difference is as large as the rise) and at sharp creases; true on a
-// finely tessellated curved surface, whose gentle creases bend depth far less.
-bool onePlaneAround(const RenderResult& truth, int width, int height, int col, int row);
-
-// Of a comparison's unexplained pixels, those at edges of the truth (a 3×3 neighbourhood that
-// is not one plane, or a coverage change), and of those the ones whose map depth lies between
-// the truth's depths around them (the clear value standing for a miss): a blend of the
-// surfaces either side, as anti-aliased or resolved multisample depth holds.
-struct EdgeTally {
-    std::int64_t atEdges = 0, blends = 0;
-};
-EdgeTally tallyEdges(const Camera& camera, const RenderResult& truth, const RenderResult& map, const Comparison& comparison);
-
-// A map's declarations (MapAccuracy) judged as a whole, over the pixels a
-// comparison compared on depth (Agree, DepthError), in the map's own units (`mapRender`: the
-// map as renderResultFromMap read it, the surface each pixel saw): what no pixel's
-// tolerance can see. Sets report.declaredAccuracyRefused, which makes the map inconsistent:
-//   holes   where holes are allowed, they are at most half the pixels where the truth sees a surface;
-//   coarse  the declared accuracy at the median pixel is under a tenth of its depth (in eye-z):
-//           a grid or tolerance as coarse as the depths accepts any map of the right order;
-//   grid    a declared quantum Q is the grid the values were rounded to: ≥ 99 % of them (less
-//           the offset) lie within 1/1000 of Q (or four binary32 spacings) of a multiple of Q;
-//   bias    rounding and noise are unbiased: over the pixels where the map shows the truth's own
-//           surface (256 or more), |mean(map − truth)| — the truth rounded to the declared grid,
-//           if any, so that a rounding's own error is no bias — is within the median of C·q + S·m
-//           + E (the tolerance of a map declaring nothing) plus six times the mean's sampling
-//           error (the spread of the means of 16 interleaved samples, over 4). A declared
-//           tolerance or noise absorbs no bias: a map 4·10⁻⁴ short everywhere is a scale mistake
-//           whatever --rel-tolerance says, and one a centimetre far is an offset under any grid.
-// A map declaring no accuracy is left as it is: its per-pixel tolerance bounds its median.
-void judgeDeclaredAccuracy(const PixelJudge& judge, const DepthMap& map, const RenderResult& truth,
-                           const RenderResult& mapRender, const std::vector<double>& quantum, Comparison& comparison);
-
-// The map's errors in its own units (report.mapErrors, mapError per pixel), from a comparison
-// of it: MapVerifier::verify's last step (a diagnosis's readings skip it).
-void measureMapErrors(const Camera& camera, const DepthMap& map, VerifyResult& run);
-
-// The comparison of `map` against an already rendered ground truth `truth` (one BVH, one
-// truth render, many readings of the map).
-VerifyResult verifyAgainst(const Scene& scene, const Camera& camera, const DepthMap& map, RenderResult truth,
-                           const VertexNeighbours& neighbours);
 
 }  // namespace zcheck

@@ -14,7 +14,7 @@
 // clipped to the camera's view (its four side planes and the eye plane), less and more 1 %
 // (sceneNearFar). A window or NDC map depends on near and far: give the renderer's.
 #include "zcheck/camera_import.h"
-#include "zcheck/image_io.h"
+#include "zcheck/depth_map_reading.h"
 #include "zcheck/quantity.h"
 #include "zcheck/scene.h"
 

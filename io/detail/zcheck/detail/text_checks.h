@@ -12,6 +12,11 @@ namespace zcheck::text {
 std::size_t utf8Length(std::string_view text, std::size_t i);
 // Appends code point `cp` (≤ U+10FFFF) as UTF-8.
 void appendUtf8(std::string& out, std::uint32_t cp);
+// ASCII case folding, for keys and names that files write in either case.
+char lowerAscii(char c);
+bool equalIgnoringCase(std::string_view a, std::string_view b);
+// `text` quoted for a message: '...', at most 40 characters shown (printableExcerpt), "..." when cut.
+std::string quoted(std::string_view text);
 // Throws Error("<source>: line <line>: <what>").
 [[noreturn]] void failAt(const std::string& source, int line, const std::string& what);
 // The text without its BOM, CRLF and lone CR read as LF (files written on Windows), after

@@ -1,0 +1,269 @@
+// The per-pixel rule (compare.h): PixelJudge, the tolerance model's constants, the pixel
+// classes, and the slope m of a triangle's plane, one at a time (DepthSlopeFrame) or a block of
+// 64 at a time for the judge's table (slope_table.h), in a baseline and an AVX-512 form. The
+// comparison's row pass (compare_rows.cpp) and its tile driver (compare.cpp) apply this rule.
+#include "zcheck/compare.h"
+
+#include "zcheck/drawn_polygon.h"
+#include "zcheck/inverse_projection.h"
+#include "zcheck/detail/kernel_choice.h"
+#include "slope_table.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+namespace zcheck {
+
+std::string toString(PixelClass pixelClass)
+{
+    switch (pixelClass) {
+    case PixelClass::BothMiss: return "both-miss";
+    case PixelClass::Agree: return "agree";
+    case PixelClass::EdgeSurface: return "edge-surface";
+    case PixelClass::DepthError: return "depth-error";
+    case PixelClass::RayOnlyEdge: return "ray-only-edge";
+    case PixelClass::RasterOnlyEdge: return "raster-only-edge";
+    case PixelClass::RayOnlyAtClear: return "ray-only-at-clear";
+    case PixelClass::AtClipPlane: return "at-clip-plane";
+    case PixelClass::RayOnly: return "ray-only";
+    case PixelClass::RasterOnly: return "raster-only";
+    case PixelClass::Hole: return "hole";
+    }
+    return "?";
+}
+
+double ToleranceModel::constantQuanta(const DepthSettings& depth)
+{
+    switch (depth.format) {
+    case DepthFormat::Unorm16: return 1.0;
+    case DepthFormat::Unorm24: return 4.0;
+    case DepthFormat::Float32: return depth.reversed ? 8.0 : 4.0;
+    }
+    return 4.0;
+}
+
+DepthSlopeFrame::DepthSlopeFrame(const Camera& camera, SlopeCredit credit)
+    // The plane n·p + d = 0 in world space maps to clip space through the transpose of
+    // worldFromClip; there a·x + b·y + c·z + d·w = 0, so in NDC z = −(a·x + b·y + d)/c.
+    : clipPlaneFromWorldPlane(glm::transpose(camera.worldFromClip)),
+      zWindowPerZNdc(std::abs(camera.windowFromNdc[2][2])),
+      ndcPerPixelX(std::abs(camera.ndcFromWindow[0][0])),
+      ndcPerPixelY(std::abs(camera.ndcFromWindow[1][1])),
+      credit(credit)
+{
+}
+
+namespace {
+
+// DepthSlopeFrame::slope's arithmetic, inlined where it is called: one triangle at a time, and
+// over lane arrays in PixelJudge::slopes (several triangles per instruction there, so no
+// branch: a plane seen edge-on selects +inf after the division by its zero).
+ZCHECK_ALWAYS_INLINE inline double slopeOfTriangle(const DepthSlopeFrame& frame, const glm::dvec3& a,
+                                                             const glm::dvec3& b, const glm::dvec3& c)
+{
+    const glm::dvec3 normal = glm::cross(b - a, c - a);
+    const glm::dvec4 plane(normal, -glm::dot(normal, a));
+    // The clip-space plane's x, y and z (its w is not needed): rows 0-2 of the product.
+    const glm::dmat4& m = frame.clipPlaneFromWorldPlane;
+    const double x = m[0][0] * plane.x + m[1][0] * plane.y + m[2][0] * plane.z + m[3][0] * plane.w;
+    const double y = m[0][1] * plane.x + m[1][1] * plane.y + m[2][1] * plane.z + m[3][1] * plane.w;
+    const double z = m[0][2] * plane.x + m[1][2] * plane.y + m[2][2] * plane.z + m[3][2] * plane.w;
+    const double dx = std::abs(x) * frame.ndcPerPixelX, dy = std::abs(y) * frame.ndcPerPixelY;
+    // A sample up to S off in x and in y moves depth by up to S·(|∂d/∂x| + |∂d/∂y|); vertices
+    // snapped by up to S/2 per axis by no more than S·max (compare.h).
+    const double slope =
+        frame.zWindowPerZNdc * (frame.credit == SlopeCredit::SampleOffset ? dx + dy : std::max(dx, dy)) / std::abs(z);
+    return z == 0 ? INFINITY : slope;
+}
+
+}  // namespace
+
+double DepthSlopeFrame::slope(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) const
+{
+    return slopeOfTriangle(*this, a, b, c);
+}
+
+double windowDepthSlope(const Camera& camera, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c)
+{
+    return DepthSlopeFrame(camera).slope(a, b, c);
+}
+
+namespace {
+
+// Slopes of up to kSlopeLanes consecutive triangles together: their corners dealt into lane
+// arrays, then slopeOfTriangle lane by lane. Inlined into a baseline and an AVX-512 form
+// (kernel_choice.h), both bit-identical to DepthSlopeFrame::slope of each (the same IEEE
+// operations in the same order).
+constexpr std::size_t kSlopeLanes = 64;
+
+// The corners of `n` ≤ Lanes triangles dealt into lane arrays in double, for kernels that then
+// work on several triangles per instruction: corner[v][axis][k] is corner v of triangle
+// `triangle[k]`. The indices must be in range (validateScene). Always inlined, so that each
+// form of a kernel compiles its own copy.
+template <std::size_t Lanes>
+ZCHECK_ALWAYS_INLINE inline void cornersInLanes(const Scene& scene, const std::uint32_t* triangle, std::size_t n,
+                                                double (&corner)[3][3][Lanes])
+{
+    for (std::size_t k = 0; k < n; ++k) {
+        const glm::uvec3& t = scene.triangles[triangle[k]];
+        for (int v = 0; v < 3; ++v)
+            for (int axis = 0; axis < 3; ++axis) corner[v][axis][k] = double(scene.positions[t[v]][axis]);
+    }
+}
+
+ZCHECK_ALWAYS_INLINE inline void slopesTogether(const DepthSlopeFrame& frame, const Scene& scene, std::uint32_t first,
+                                                std::size_t n, double* slope)
+{
+    std::uint32_t triangle[kSlopeLanes];
+    for (std::size_t k = 0; k < n; ++k) triangle[k] = first + std::uint32_t(k);
+    // Every corner asked for before the first is read (the loads then overlap, where reading
+    // them in order waited on each few in turn), and the next block's index triples too: the
+    // comparison often asks for blocks in order (the comparison ~5 % faster in process).
+    for (std::size_t k = 0; k < n; ++k)
+        for (int corner = 0; corner < 3; ++corner) __builtin_prefetch(&scene.positions[scene.triangles[first + k][corner]]);
+    const std::size_t nextBlock = first + n, nextBlockEnd = std::min(scene.triangles.size(), nextBlock + kSlopeLanes);
+    for (std::size_t k = nextBlock; k < nextBlockEnd; k += 64 / sizeof(glm::uvec3)) __builtin_prefetch(&scene.triangles[k]);
+    alignas(64) double corner[3][3][kSlopeLanes];  // corner, axis, lane
+    cornersInLanes(scene, triangle, n, corner);
+    for (std::size_t k = 0; k < n; ++k)
+        slope[k] = slopeOfTriangle(frame, glm::dvec3(corner[0][0][k], corner[0][1][k], corner[0][2][k]),
+                                   glm::dvec3(corner[1][0][k], corner[1][1][k], corner[1][2][k]),
+                                   glm::dvec3(corner[2][0][k], corner[2][1][k], corner[2][2][k]));
+}
+
+void slopesTogetherBaseline(const DepthSlopeFrame& frame, const Scene& scene, std::uint32_t first, std::size_t n,
+                            double* slope)
+{
+    slopesTogether(frame, scene, first, n, slope);
+}
+
+#ifdef ZCHECK_X86_AVX512
+ZCHECK_TARGET_AVX512 void slopesTogetherAvx512(const DepthSlopeFrame& frame, const Scene& scene, std::uint32_t first,
+                                               std::size_t n, double* slope)
+{
+    slopesTogether(frame, scene, first, n, slope);
+}
+#endif
+
+}  // namespace
+
+PixelJudge::PixelJudge(const Scene& scene, const Camera& camera, const ToleranceModel& tolerance, SlopeSource slopes)
+    : scene_(scene),
+      camera_(camera),
+      tolerance_(tolerance),
+      terms_{tolerance.constantFor(camera.depth()), tolerance.snapPixels(),
+             16 * std::ldexp(1.0, -52) * std::max(std::abs(camera.depth().rangeMin), std::abs(camera.depth().rangeMax))},
+      avx512_(useAvx512Form("ZCHECK_COMPARE_KERNEL", "baseline")),
+      slopeFrame_(camera, tolerance.slopeCredit)
+{
+    if (slopes == SlopeSource::TableOfSeen) table_ = std::make_unique<SlopeTable>(scene_, slopeFrame_, avx512_);
+}
+
+PixelJudge::~PixelJudge() = default;
+
+double PixelJudge::slope(std::uint32_t primitive) const
+{
+    if (!known(primitive)) return 0.0;
+    if (table_ && table_->ready(primitive)) return table_->at(primitive);
+    return computeSlope(primitive);
+}
+
+SlopeTable::SlopeTable(const Scene& scene, const DepthSlopeFrame& frame, bool avx512)
+    : scene_(scene), frame_(frame), avx512_(avx512)
+{
+    const std::size_t n = scene.triangles.size();
+    none_ = std::uint32_t(n);
+    slopeOfTriangle_.resize(n + 1);  // uninitialised: an entry is read only once its block is ready
+    slopeOfTriangle_[n] = 0.0;
+    blockCount_ = std::uint32_t((n + kBlock - 1) / kBlock);
+    blockState_ = std::make_unique<std::atomic<std::uint8_t>[]>(blockCount_);
+}
+
+bool SlopeTable::makeBlockReady(std::uint32_t block) const
+{
+    std::atomic<std::uint8_t>& state = blockState(block);
+    std::uint8_t notComputed = 0;
+    if (!state.compare_exchange_strong(notComputed, 1, std::memory_order_acquire))
+        return notComputed == kReady;  // false: another thread is computing it
+    static_assert(kBlock == kSlopeLanes, "a block's slopes are computed together");
+    auto* together = &slopesTogetherBaseline;
+#ifdef ZCHECK_X86_AVX512
+    if (avx512_) together = &slopesTogetherAvx512;
+#endif
+    const std::size_t first = std::size_t(block) * kBlock;
+    together(frame_, scene_, std::uint32_t(first), std::min<std::size_t>(kBlock, scene_.triangles.size() - first),
+             slopeOfTriangle_.data() + first);
+    state.store(kReady, std::memory_order_release);
+    return true;
+}
+
+glm::dvec3 PixelJudge::vertex(std::uint32_t primitive, int corner) const
+{
+    return glm::dvec3(scene_.positions[scene_.triangles[primitive][corner]]);
+}
+
+double PixelJudge::computeSlope(std::uint32_t primitive) const
+{
+    return slopeFrame_.slope(vertex(primitive, 0), vertex(primitive, 1), vertex(primitive, 2));
+}
+
+double PixelJudge::surfaceTolerance(std::uint32_t primitive, double q, double allowance) const
+{
+    return toleranceForSlope(slope(primitive), q, allowance);
+}
+
+// Does the primitive's plane cross the pixel's ray at the near or far plane, to within
+// binary32 rounding (2^-20 relative) of the distances where the routes clip?
+bool PixelJudge::atClipPlane(std::uint32_t primitive, const glm::dvec2& pWindow) const
+{
+    if (!known(primitive)) return false;
+    const EyePlaneRay ray = worldEyePlaneRayThroughWindow(camera_, pWindow);
+    const glm::dvec3 a = vertex(primitive, 0);
+    const glm::dvec3 normal = glm::cross(vertex(primitive, 1) - a, vertex(primitive, 2) - a);
+    const double t = glm::dot(normal, a - ray.origin) / glm::dot(normal, ray.direction);
+    const double epsilon = std::ldexp(1.0, -20);
+    // An infinite far plane has no surface to lie on (inf <= inf must not explain anything).
+    return std::isfinite(t) && (std::abs(t - ray.tNear) <= epsilon * std::abs(ray.tNear) ||
+                                (std::isfinite(ray.tFar) && std::abs(t - ray.tFar) <= epsilon * ray.tFar));
+}
+
+bool PixelJudge::nearEdge(std::uint32_t primitive, const glm::dvec2& pWindow) const
+{
+    if (!known(primitive)) return false;
+    return distanceToDrawnEdge(camera_, vertex(primitive, 0), vertex(primitive, 1), vertex(primitive, 2), pWindow) <= terms_.S;
+}
+
+PixelClass PixelJudge::bothHit(double rayDepth, std::uint32_t rayPrimitive, double rasterDepth,
+                               std::uint32_t rasterPrimitive, double q, const glm::dvec2& pWindow, double& bound,
+                               double allowance) const
+{
+    const double error = std::abs(rasterDepth - rayDepth);
+    // Different surfaces: the raster's may legitimately win where the two lie within both
+    // tolerances of each other, so the bound is their sum.
+    const bool samePrimitive = rayPrimitive == rasterPrimitive;
+    bound = surfaceTolerance(rayPrimitive, q, allowance) + (samePrimitive ? 0.0 : surfaceTolerance(rasterPrimitive, q));
+    if (error <= bound) return PixelClass::Agree;
+    if (!samePrimitive && (nearEdge(rayPrimitive, pWindow) || nearEdge(rasterPrimitive, pWindow) ||
+                           atClipPlane(rayPrimitive, pWindow) || atClipPlane(rasterPrimitive, pWindow)))
+        return PixelClass::EdgeSurface;
+    return PixelClass::DepthError;
+}
+
+PixelClass PixelJudge::oneHit(bool rayHit, double depth, std::uint32_t primitive, double q,
+                              const glm::dvec2& pWindow, bool holesAllowed) const
+{
+    // Explained at an edge of its triangle, (ray route only) at the clear value, or on the
+    // near/far plane.
+    if (nearEdge(primitive, pWindow)) return rayHit ? PixelClass::RayOnlyEdge : PixelClass::RasterOnlyEdge;
+    if (rayHit && std::abs(depth - camera_.clearDepth()) <= surfaceTolerance(primitive, q)) return PixelClass::RayOnlyAtClear;
+    if (atClipPlane(primitive, pWindow)) return PixelClass::AtClipPlane;
+    return !rayHit ? PixelClass::RasterOnly : holesAllowed ? PixelClass::Hole : PixelClass::RayOnly;
+}
+
+bool isUnexplained(PixelClass c)
+{
+    return c == PixelClass::DepthError || c == PixelClass::RayOnly || c == PixelClass::RasterOnly;
+}
+
+}  // namespace zcheck
