@@ -1,10 +1,11 @@
 // libFuzzer harness for the camera formats and dataset sources (camera_formats.h,
 // dataset_source.h): every row of the table, and manifests. An input is the format's name on
-// its first line, then the file's bytes: "nerfstudio\n{...}", "manifest\n{...}". A COLMAP model
-// is two files: "colmap-text" or "colmap-bin", the rest split at the first "\n--8<--\n" into
-// cameras and images. Every camera read is also selected by FILE#FRAME and built, as zcheck
-// would, and a dataset source is opened as a dataset. A new format needs no change here: a
-// seed named after it (fuzz/corpus/camera_import/NAME) is enough.
+// its first line, then the file's bytes: "nerfstudio\n{...}", "manifest\n{...}". A one-file
+// format's reader is fed the bytes directly (CameraFormat::parse); a COLMAP model is two files:
+// "colmap-text" or "colmap-bin", the rest split at the first "\n--8<--\n" into cameras and
+// images, written to a folder. Every camera read is also selected by FILE#FRAME and built, as
+// zcheck would, and a dataset source is opened as a dataset. A new format needs no change here:
+// a seed named after it (fuzz/corpus/camera_import/NAME) is enough.
 #include "zcheck/camera_formats.h"
 #include "zcheck/camera_import.h"
 #include "zcheck/dataset_source.h"
@@ -41,10 +42,15 @@ void exercise(const zcheck::CameraSet& set)
     }
 }
 
-void readAs(const zcheck::CameraFormat& format, const std::string& path)
+void readAs(const zcheck::CameraFormat& format, const std::string& path, const std::string& bytes)
 {
-    exercise(zcheck::readCameraSet(path, &format));
+    if (format.parse) {
+        exercise(format.parse(bytes, path));
+    } else {
+        exercise(zcheck::readCameraSet(path, &format));
+    }
     if (format.datasetSource) {
+        if (format.parse) write(path, bytes);
         zcheck::DatasetSourceOptions options;
         options.cameraFormat = &format;
         if (!format.namesDepthMaps) options.depthPattern = "depth/{stem}.bin";
@@ -70,7 +76,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             const std::string suffix = name == "colmap-bin" ? ".bin" : ".txt";
             write(dir + "/cameras" + suffix, body.substr(0, cut));
             write(dir + "/images" + suffix, cut == std::string::npos ? "" : body.substr(cut + 8));
-            readAs(zcheck::cameraFormatNamed("colmap"), dir);
+            readAs(zcheck::cameraFormatNamed("colmap"), dir, "");
         } else if (name == "manifest") {
             write(dir + "/manifest.jsonl", body);
             (void)zcheck::openDataset(dir + "/manifest.jsonl", {});
@@ -79,8 +85,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             for (const zcheck::CameraFormat* row : zcheck::cameraFormats())
                 if (row->name == name) format = row;
             if (!format) return 0;
-            write(dir + "/input", body);
-            readAs(*format, dir + "/input");
+            readAs(*format, dir + "/input", body);
         }
     } catch (const zcheck::Error&) {
     }

@@ -286,13 +286,19 @@ CameraSpec cameraSpecFromJson(const json& document, const std::string& source)
     return spec;
 }
 
-CameraSpec readCameraFile(const std::string& path)
+namespace {
+
+// A camera file's text, or an export sidecar's, as the camera; `path` names it in messages.
+CameraSpec cameraSpecFromFileText(std::string_view text, const std::string& path)
 {
-    const std::string text = readInputFile(path, kCameraInput);
-    const json document = parseJsonStrictly(text, "camera file '" + path + "'");
+    const json document = parseJsonStrictly(std::string(text), "camera file '" + path + "'");
     if (isExportSidecar(document)) return cameraSpecFromJson(document["camera"], "sidecar '" + path + "' camera");
     return cameraSpecFromJson(document, "camera file '" + path + "'");
 }
+
+}  // namespace
+
+CameraSpec readCameraFile(const std::string& path) { return cameraSpecFromFileText(readInputFile(path, kCameraInput), path); }
 
 namespace {
 json matrixJson(const glm::dmat4& m)
@@ -408,11 +414,11 @@ namespace formats {
 
 namespace {
 
-CameraSet readZcheckCamera(const std::string& path)
+CameraSet readZcheckCamera(std::string_view bytes, const std::string& path)
 {
     CameraSet set;
     ImportedCamera camera;
-    camera.spec = readCameraFile(path);
+    camera.spec = cameraSpecFromFileText(bytes, path);
     camera.hasClipPlanes = true;
     const std::size_t slash = path.find_last_of('/');
     camera.name = slash == std::string::npos ? path : path.substr(slash + 1);
@@ -440,7 +446,7 @@ const CameraFormat& zcheckFormat()
         f.example = "camera.json";
         f.priority = 90;
         f.detects = detectsZcheckCamera;
-        f.read = readZcheckCamera;
+        f.parse = readZcheckCamera;
         f.input = kCameraInput;
         f.write = writeZcheckCamera;
         return f;

@@ -145,7 +145,7 @@ const CameraFormat& detectCameraFormat(const std::string& path)
 CameraSet readCameraSet(const std::string& path, const CameraFormat* format)
 {
     const CameraFormat& row = format ? *format : detectCameraFormat(path);
-    CameraSet set = row.read(path);
+    CameraSet set = row.parse ? row.parse(readInputFile(path, row.input), path) : row.read(path);
     set.path = path, set.format = row.name;
     return set;
 }

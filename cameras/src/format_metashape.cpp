@@ -53,8 +53,7 @@ struct Similarity {
 
 class MetashapeReader {
 public:
-    explicit MetashapeReader(const std::string& path)
-        : path_(path), root_(xml::parse(readInputFile(path, metashapeFormat().input), source()))
+    MetashapeReader(std::string_view bytes, const std::string& path) : path_(path), root_(xml::parse(bytes, source()))
     {
         if (root_.name != "document") fail(root_, "the root element must be <document>, as Metashape writes it");
         chunk_ = root_.child("chunk");
@@ -313,7 +312,7 @@ private:
     std::map<std::string, Similarity> components_;
 };
 
-CameraSet readMetashape(const std::string& path) { return MetashapeReader(path).read(); }
+CameraSet readMetashape(std::string_view bytes, const std::string& path) { return MetashapeReader(bytes, path).read(); }
 
 bool detectsMetashape(const CameraFileHead& file)
 {
@@ -334,7 +333,7 @@ const CameraFormat& metashapeFormat()
         f.example = "cameras.xml#IMG_0001.JPG";
         f.priority = 35;
         f.detects = detectsMetashape;
-        f.read = readMetashape;
+        f.parse = readMetashape;
         f.datasetSource = true;
         return f;
     }();

@@ -41,9 +41,9 @@ using nlohmann::json;
 
 class TransformsReader {
 public:
-    explicit TransformsReader(const std::string& path) : path_(path)
+    TransformsReader(std::string_view bytes, const std::string& path) : path_(path)
     {
-        root_ = parseJsonStrictly(readInputFile(path, nerfstudioFormat().input), source());
+        root_ = parseJsonStrictly(std::string(bytes), source());
         if (!root_.is_object()) fail("the document must be a JSON object");
         const json* frames = find(root_, "frames");
         if (!frames || !frames->is_array()) fail("'frames' must be an array of frames");
@@ -280,7 +280,7 @@ std::vector<CameraFileText> writeTransformsJson(const Camera& camera, const std:
     return {{"transforms.json", prettyJson(document) + "\n"}};
 }
 
-CameraSet readTransformsJson(const std::string& path) { return TransformsReader(path).read(); }
+CameraSet readTransformsJson(std::string_view bytes, const std::string& path) { return TransformsReader(bytes, path).read(); }
 
 bool detectsTransformsJson(const CameraFileHead& file) { return file.looksLikeJson() && file.has("\"frames\""); }
 
@@ -297,7 +297,7 @@ const CameraFormat& nerfstudioFormat()
         f.example = "transforms.json#frame_003";
         f.priority = 20;
         f.detects = detectsTransformsJson;
-        f.read = readTransformsJson;
+        f.parse = readTransformsJson;
         f.write = writeTransformsJson;
         f.datasetSource = true;
         f.namesDepthMaps = true;

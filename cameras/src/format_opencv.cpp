@@ -124,9 +124,9 @@ struct Matrix {
 
 class CalibrationReader {
 public:
-    CalibrationReader(const std::string& path, bool ros) : path_(path), ros_(ros)
+    CalibrationReader(std::string_view bytes, const std::string& path, bool ros) : path_(path), ros_(ros)
     {
-        const std::string text = readInputFile(path, ros ? rosFormat().input : opencvFormat().input);
+        const std::string text(bytes);
         std::size_t start = text.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;
         while (start < text.size() && std::isspace(static_cast<unsigned char>(text[start]))) ++start;
         if (text.compare(start, 1, "<") == 0) {
@@ -421,10 +421,9 @@ private:
         std::optional<glm::dmat4> rightFromLeft = pose(rKey, tKey);
         std::string poseSource = source();
         if (!rightFromLeft) {
-            const std::size_t slash = path_.find_last_of('/');
-            const std::string beside = (slash == std::string::npos ? std::string() : path_.substr(0, slash + 1)) + "extrinsics.yml";
+            const std::string beside = (std::filesystem::path(path_).parent_path() / "extrinsics.yml").string();
             if (std::filesystem::is_regular_file(beside)) {
-                const CalibrationReader extrinsics(beside, ros_);
+                const CalibrationReader extrinsics(readInputFile(beside, opencvFormat().input), beside, ros_);
                 rightFromLeft = extrinsics.pose(rKey, tKey);
                 poseSource = extrinsics.source();
             }
@@ -560,8 +559,8 @@ std::vector<CameraFileText> writeOpenCv(const Camera& camera, const std::string&
                                opencvMatrix("T", 3, 1, {m[3][0], m[3][1], m[3][2]})}};
 }
 
-CameraSet readOpenCv(const std::string& path) { return CalibrationReader(path, false).read(); }
-CameraSet readRos(const std::string& path) { return CalibrationReader(path, true).read(); }
+CameraSet readOpenCv(std::string_view bytes, const std::string& path) { return CalibrationReader(bytes, path, false).read(); }
+CameraSet readRos(std::string_view bytes, const std::string& path) { return CalibrationReader(bytes, path, true).read(); }
 
 bool detectsOpenCv(const CameraFileHead& file)
 {
@@ -590,7 +589,7 @@ const CameraFormat& opencvFormat()
         f.example = "calib.yml";
         f.priority = 40;
         f.detects = detectsOpenCv;
-        f.read = readOpenCv;
+        f.parse = readOpenCv;
         f.input = kCameraSetInput;  // a calibration's per-view extrinsics grow with its views
         f.write = writeOpenCv;
         return f;
@@ -608,7 +607,7 @@ const CameraFormat& rosFormat()
         f.example = "camera_info.yaml#rectified";
         f.priority = 50;
         f.detects = detectsRos;
-        f.read = readRos;
+        f.parse = readRos;
         f.input = kCameraInput;
         return f;
     }();

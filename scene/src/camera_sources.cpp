@@ -22,6 +22,17 @@ CameraSet readGltfCameras(const std::string& path)
 
 namespace {
 
+CameraSet parseGltfCameras(std::string_view bytes, const std::string& path)
+{
+    CameraSet set;
+    set.cameras = readGltfCameraNodes(path, bytes);
+    return set;
+}
+
+}  // namespace
+
+namespace {
+
 bool detectsGltf(const CameraFileHead& file)
 {
     return file.head.substr(0, 4) == "glTF" || (file.looksLikeJson() && file.has("\"asset\""));
@@ -42,7 +53,7 @@ const CameraFormat& gltfCameraFormat()
         f.example = "scene.glb#Camera";
         f.priority = 30;
         f.detects = detectsGltf;
-        f.read = readGltfCameras;
+        f.parse = parseGltfCameras;
         f.input = kMeshInput;
         return f;
     }();

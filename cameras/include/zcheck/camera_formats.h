@@ -52,9 +52,14 @@ struct CameraFormat {
     std::string example;               // a reference with #FRAME, for help and docs
     int priority = 0;                  // detection order, lower first
     bool (*detects)(const CameraFileHead& file) = nullptr;
-    // Every camera of the file (or folder) `path`; the file is at most `input.maxBytes`.
+    // A one-file format's reader: every camera of the file's bytes. `path` names the file in
+    // messages, and resolves the files it names beside it (depth maps, a stereo pair's
+    // extrinsics.yml). The fuzzers feed it bytes directly.
+    CameraSet (*parse)(std::string_view bytes, const std::string& path) = nullptr;
+    // A format of several files (a COLMAP model folder): every camera of the folder or file
+    // `path`. nullptr when `parse` reads the format.
     CameraSet (*read)(const std::string& path) = nullptr;
-    InputKind input = kCameraSetInput;
+    InputKind input = kCameraSetInput;  // the size limit of its files, checked before they are read
     // The camera in this format (nullptr: the format is read only). `name` names the frame.
     std::vector<CameraFileText> (*write)(const Camera& camera, const std::string& name) = nullptr;
     bool writesFolder = false;         // the writer's files make a folder (a COLMAP model): --out DIR
