@@ -274,8 +274,194 @@ ZCHECK_INTRINSICS_END
 #endif
 
 // RayRenderer::traceRect's work, inlined into two functions: one compiled for the build's
-// baseline and one for AVX-512 (kernel_choice.h). Its per-packet steps are lambdas that must
-// be inlined too, or they would stay baseline code. kAvx512: the AVX-512 form's own steps.
+// baseline and one for AVX-512 (kernel_choice.h). Its per-packet steps below, and the lambdas
+// of traceRectBody that call them, must be inlined too, or they would stay baseline code. The
+// arrays that finish's steps share are declared in its lambda and passed by reference, as
+// arrays: so both forms compile to the code the uncut body did (declared inside the steps, as
+// triangle and tEmbree were, or passed as pointers, GCC laid out and scheduled the loop anew).
+
+// A rectangle as the per-packet steps read it, made once: its pixels [col0, col1) × [row0, row1)
+// of the W×H image and where they go (traceRect's contract), the camera's depths and window origin.
+struct RectSetUp {
+    int col0, row0, col1, row1;
+    int W, H;
+    double near, far, clearDepth;  // in the order they are read from the camera
+    bool windowOriginTop;          // else y_image = H − y_window
+    double height;                 // H
+    double* windowDepth;
+    std::uint32_t* primitiveId;
+    std::size_t stride;
+    glm::dvec3* pEye;  // may be null
+};
+
+// Packet p at pixel (px, py): which of its lanes lie in the rectangle (p.valid), each lane's image point.
+ZCHECK_ALWAYS_INLINE inline void imagePointsOfPacket(PacketInFlight& p, int px, int py, const RectSetUp& setUp,
+                                                     const RayFaults& fault)
+{
+    p.col0 = px, p.row0 = py;
+    // The image points: windowFromPixelCentre plus the shift, then imageYFromWindowY,
+    // spelt out so that this loop too computes several lanes per instruction.
+    for (int k = 0; k < kPacketRays; ++k) {
+        const int col = px + k % kPacketSide, row = py + k / kPacketSide;
+        p.valid[k] = (col < setUp.col1 && row < setUp.row1) ? -1 : 0;
+        const int sampleRow = fault.flipRows ? setUp.H - 1 - row : row;
+        const int sampleCol = fault.flipCols ? setUp.W - 1 - col : col;
+        const double yImage = sampleRow + 0.5;
+        const double xWindow = (sampleCol + 0.5) + fault.shiftPixels.x;
+        const double yWindow = (setUp.windowOriginTop ? yImage : setUp.height - yImage) + fault.shiftPixels.y;
+        p.imageX[k] = xWindow, p.imageY[k] = setUp.windowOriginTop ? yWindow : setUp.height - yWindow;
+    }
+}
+
+// Each lane's ray through its image point, in double (p.lane), and its [tnear, tfar] for Embree.
+ZCHECK_ALWAYS_INLINE inline void raysOfPacket(PacketInFlight& p, const std::optional<AffineRays>& affine,
+                                              const CameraRays& cameraRays, const RectSetUp& setUp)
+{
+    RTCRay16& ray = p.packet.ray;
+    if (affine) {  // t is eye-z: the near and far planes lie at t = near and far
+        for (int c = 0; c < 3; ++c) {
+            const double o = affine->origin[c], oX = affine->originPerX[c], oY = affine->originPerY[c];
+            const double d = affine->direction[c], dX = affine->directionPerX[c], dY = affine->directionPerY[c];
+            // Origins and directions in loops apart: in one loop, GCC made the origins lane by lane.
+            for (int k = 0; k < kPacketRays; ++k) p.lane[c][k] = o + p.imageX[k] * oX + p.imageY[k] * oY;
+            for (int k = 0; k < kPacketRays; ++k) p.lane[3 + c][k] = d + p.imageX[k] * dX + p.imageY[k] * dY;
+        }
+        const float nearT = float(setUp.near), farT = std::isinf(setUp.far) ? INFINITY : float(setUp.far);
+        for (int k = 0; k < kPacketRays; ++k) ray.tnear[k] = nearT, ray.tfar[k] = farT;
+    } else {
+        for (int k = 0; k < kPacketRays; ++k) {
+            const EyePlaneRay r = cameraRays.worldRay(p.pImage(k));
+            for (int c = 0; c < 3; ++c) p.lane[c][k] = r.origin[c], p.lane[3 + c][k] = r.direction[c];
+            // A raw matrix whose near plane crosses the eye plane puts it behind the eye at
+            // some pixels: the camera sees nothing behind its eye plane (and Embree takes no
+            // negative tnear).
+            ray.tnear[k] = float(std::max(0.0, r.tNear)), ray.tfar[k] = std::isinf(r.tFar) ? INFINITY : float(r.tFar);
+        }
+    }
+}
+
+// The rest of every lane for Embree: an invalid one a zero-length ray, all in binary32 in Embree's frame, no hit.
+ZCHECK_ALWAYS_INLINE inline void embreeLanesOfPacket(PacketInFlight& p, const glm::dvec3& frameOrigin)
+{
+    RTCRay16& ray = p.packet.ray;
+    for (int k = 0; k < kPacketRays; ++k) {
+        if (p.valid[k]) continue;
+        for (int c = 0; c < 3; ++c) p.lane[c][k] = frameOrigin[c], p.lane[3 + c][k] = c == 2 ? 1.0 : 0.0;
+        ray.tnear[k] = 0, ray.tfar[k] = 0;
+    }
+    for (int k = 0; k < kPacketRays; ++k) {
+        ray.org_x[k] = float(p.lane[0][k] - frameOrigin.x);
+        ray.org_y[k] = float(p.lane[1][k] - frameOrigin.y);
+        ray.org_z[k] = float(p.lane[2][k] - frameOrigin.z);
+        ray.dir_x[k] = float(p.lane[3][k]);
+        ray.dir_y[k] = float(p.lane[4][k]);
+        ray.dir_z[k] = float(p.lane[5][k]);
+        ray.time[k] = 0.0f;
+        ray.mask[k] = 0xFFFFFFFFu;  // Debian's Embree has ray masks on
+        ray.id[k] = unsigned(k);
+        ray.flags[k] = 0;
+        p.packet.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+        p.packet.hit.primID[k] = RTC_INVALID_GEOMETRY_ID;
+        p.packet.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+    }
+}
+
+// Traces the packet (Embree's hits in p.packet, then p.hits) and asks for the hit planes its finish reads.
+ZCHECK_ALWAYS_INLINE inline void intersectPacket(PacketInFlight& p, RTCScene rtcScene, RTCIntersectContext& context,
+                                                 const HitPlane* planes)
+{
+    rtcIntersect16(p.valid, rtcScene, &context, &p.packet);
+    p.noteHits();
+    for (int k = 0; k < kPacketRays; ++k)  // the hit planes asked for: both ends of each entry
+        if (p.hit(k)) {
+            const char* entry = reinterpret_cast<const char*>(planes + p.packet.hit.primID[k]);
+            __builtin_prefetch(entry);
+            __builtin_prefetch(entry + sizeof(HitPlane) - 1);
+        }
+}
+
+// Each lane's triangle (a miss: 0) and that triangle's plane: plane[0..2] a vertex, plane[3..5] the normal.
+template <bool kAvx512>
+ZCHECK_ALWAYS_INLINE inline void hitPlanesOfPacket(const PacketInFlight& p, const HitPlane* planes,
+                                                   std::uint32_t (&triangle)[kPacketRays],
+                                                   double (&plane)[6][kPacketRays])
+{
+    // The planes, every lane's own, without a branch, from the table (HitPlane). (Keeping
+    // a plane while the next lanes hit the same triangle, as this did before, cost more in
+    // mispredicted branches than the arithmetic it saved.) A miss takes triangle 0's plane
+    // (a scene has one, RayRenderer checked), and its result is not used.
+    for (int k = 0; k < kPacketRays; ++k) triangle[k] = p.hit(k) ? p.packet.hit.primID[k] : 0;
+#ifdef ZCHECK_X86_AVX512
+    if constexpr (kAvx512) planesInLanesAvx512(planes, triangle, plane);
+#endif
+    if constexpr (!kAvx512)
+        for (int k = 0; k < kPacketRays; ++k) {
+            const HitPlane& h = planes[triangle[k]];
+            for (int axis = 0; axis < 3; ++axis)
+                plane[axis][k] = double(h.vertex[axis]), plane[3 + axis][k] = h.normal[axis];
+        }
+}
+
+// Each lane's hit again, in double: tEmbree Embree's t, t the ray's at its plane (else Embree's), eyeZ t's eye-z.
+ZCHECK_ALWAYS_INLINE inline void hitsInDouble(const PacketInFlight& p, const double (&plane)[6][kPacketRays],
+                                              const CameraRays& cameraRays, const RayFaults& fault,
+                                              double (&tEmbree)[kPacketRays], double (&t)[kPacketRays],
+                                              double (&eyeZ)[kPacketRays])
+{
+    // Lane by lane in plain arrays (several lanes per instruction): the ray parameter t
+    // of the hit (Embree's, where the plane gives none) and its eye-z.
+    for (int k = 0; k < kPacketRays; ++k) tEmbree[k] = p.packet.ray.tfar[k];  // apart: the loop below stays SIMD
+    for (int k = 0; k < kPacketRays; ++k) {
+        const glm::dvec3 vertex(plane[0][k], plane[1][k], plane[2][k]), n(plane[3][k], plane[4][k], plane[5][k]);
+        const double tPlane = glm::dot(n, vertex - p.origin(k)) / glm::dot(n, p.direction(k));
+        t[k] = std::abs(tPlane) <= std::numeric_limits<double>::max() ? tPlane : tEmbree[k];  // isfinite, branch-free
+    }
+    if (fault.distanceAsEyeZ) {  // the fault "distance as eye-z": the distance along the ray for eye-z
+        for (int k = 0; k < kPacketRays; ++k) eyeZ[k] = t[k] * glm::length(p.direction(k));
+    } else {
+        for (int k = 0; k < kPacketRays; ++k) eyeZ[k] = cameraRays.eyeZ(p.origin(k) + t[k] * p.direction(k));
+    }
+}
+
+// The packet's pixels inside the rectangle written: window depth, primitive and, where asked, eye point.
+ZCHECK_ALWAYS_INLINE inline void writePacketPixels(const PacketInFlight& p, const double (&t)[kPacketRays],
+                                                   const double (&eyeZ)[kPacketRays], const CameraRays& cameraRays,
+                                                   const RectSetUp& setUp)
+{
+    // The pixels, lane by lane into plain arrays, then a row of the packet at a time: four
+    // adjacent pixels, copied whole where all four lie in the rectangle. Every lane's window
+    // depth at once where the camera has a closed form (a miss's is computed too, from
+    // triangle 0's plane, and not used); a raw-matrix camera's, hits only.
+    alignas(64) double depthOf[kPacketRays];
+    alignas(64) std::uint32_t primitiveOf[kPacketRays];
+    const bool closedForm = cameraRays.windowDepths(eyeZ, kPacketRays, depthOf);
+    for (int k = 0; k < kPacketRays; ++k) primitiveOf[k] = p.hit(k) ? p.packet.hit.primID[k] : kNoPrimitive;
+    if (closedForm) {
+        for (int k = 0; k < kPacketRays; ++k) depthOf[k] = p.hit(k) ? depthOf[k] : setUp.clearDepth;
+    } else {
+        for (int k = 0; k < kPacketRays; ++k)
+            depthOf[k] = p.hit(k) ? cameraRays.windowDepth(p.pImage(k), eyeZ[k]) : setUp.clearDepth;
+    }
+    const int cols = std::min(kPacketSide, setUp.col1 - p.col0), rows = std::min(kPacketSide, setUp.row1 - p.row0);
+    for (int r = 0; r < rows; ++r) {
+        const std::size_t i = std::size_t(p.row0 + r - setUp.row0) * setUp.stride + std::size_t(p.col0 - setUp.col0);
+        const int k = r * kPacketSide;
+        if (cols == kPacketSide) {
+            std::memcpy(setUp.windowDepth + i, depthOf + k, sizeof(double) * kPacketSide);
+            std::memcpy(setUp.primitiveId + i, primitiveOf + k, sizeof(std::uint32_t) * kPacketSide);
+        } else {
+            std::copy(depthOf + k, depthOf + k + cols, setUp.windowDepth + i);
+            std::copy(primitiveOf + k, primitiveOf + k + cols, setUp.primitiveId + i);
+        }
+        if (setUp.pEye)
+            for (int j = 0; j < cols; ++j)
+                setUp.pEye[i + j] = p.hit(k + j)
+                                        ? cameraRays.eyeFromWorld(p.origin(k + j) + t[k + j] * p.direction(k + j))
+                                        : glm::dvec3(NAN);
+    }
+}
+
+// traceRect for one rectangle, packet by packet through the steps above. kAvx512: the AVX-512 form's own steps.
 template <bool kAvx512>
 ZCHECK_ALWAYS_INLINE inline void traceRectBody(RTCScene rtcScene, const glm::dvec3& frameOrigin, const HitPlane* planes,
                                         const Camera& camera, const PixelRect& rect, double* windowDepth,
@@ -286,9 +472,9 @@ ZCHECK_ALWAYS_INLINE inline void traceRectBody(RTCScene rtcScene, const glm::dve
     const int W = camera.width(), H = camera.height();
     const CameraRays cameraRays(camera);
     const std::optional<AffineRays> affine = cameraRays.affine();
-    const double near = camera.nearDistance(), far = camera.farDistance(), clearDepth = camera.clearDepth();
-    const bool windowOriginTop = camera.convention().windowOriginTop;  // else y_image = H − y_window
-    const double height = H;
+    const RectSetUp setUp{col0, row0, col1, row1, W, H, camera.nearDistance(), camera.farDistance(),
+                          camera.clearDepth(), camera.convention().windowOriginTop, double(H),
+                          windowDepth, primitiveId, stride, pEye};
 
     FlushDenormals flush;
     RTCIntersectContext context;
@@ -299,131 +485,19 @@ ZCHECK_ALWAYS_INLINE inline void traceRectBody(RTCScene rtcScene, const glm::dve
     // compiler can compute several lanes per instruction. Every field of every lane is
     // initialised, valid or not; an invalid lane (outside the rectangle) is a zero-length ray.
     auto trace = [&](PacketInFlight& p, int px, int py) ZCHECK_ALWAYS_INLINE {
-        p.col0 = px, p.row0 = py;
-        // The image points: windowFromPixelCentre plus the shift, then imageYFromWindowY,
-        // spelt out so that this loop too computes several lanes per instruction.
-        for (int k = 0; k < kPacketRays; ++k) {
-            const int col = px + k % kPacketSide, row = py + k / kPacketSide;
-            p.valid[k] = (col < col1 && row < row1) ? -1 : 0;
-            const int sampleRow = fault.flipRows ? H - 1 - row : row;
-            const int sampleCol = fault.flipCols ? W - 1 - col : col;
-            const double yImage = sampleRow + 0.5;
-            const double xWindow = (sampleCol + 0.5) + fault.shiftPixels.x;
-            const double yWindow = (windowOriginTop ? yImage : height - yImage) + fault.shiftPixels.y;
-            p.imageX[k] = xWindow, p.imageY[k] = windowOriginTop ? yWindow : height - yWindow;
-        }
-        RTCRay16& ray = p.packet.ray;
-        if (affine) {  // t is eye-z: the near and far planes lie at t = near and far
-            for (int c = 0; c < 3; ++c) {
-                const double o = affine->origin[c], oX = affine->originPerX[c], oY = affine->originPerY[c];
-                const double d = affine->direction[c], dX = affine->directionPerX[c], dY = affine->directionPerY[c];
-                // Origins and directions in loops apart: in one loop, GCC made the origins lane by lane.
-                for (int k = 0; k < kPacketRays; ++k) p.lane[c][k] = o + p.imageX[k] * oX + p.imageY[k] * oY;
-                for (int k = 0; k < kPacketRays; ++k) p.lane[3 + c][k] = d + p.imageX[k] * dX + p.imageY[k] * dY;
-            }
-            const float nearT = float(near), farT = std::isinf(far) ? INFINITY : float(far);
-            for (int k = 0; k < kPacketRays; ++k) ray.tnear[k] = nearT, ray.tfar[k] = farT;
-        } else {
-            for (int k = 0; k < kPacketRays; ++k) {
-                const EyePlaneRay r = cameraRays.worldRay(p.pImage(k));
-                for (int c = 0; c < 3; ++c) p.lane[c][k] = r.origin[c], p.lane[3 + c][k] = r.direction[c];
-                // A raw matrix whose near plane crosses the eye plane puts it behind the eye at
-                // some pixels: the camera sees nothing behind its eye plane (and Embree takes no
-                // negative tnear).
-                ray.tnear[k] = float(std::max(0.0, r.tNear)), ray.tfar[k] = std::isinf(r.tFar) ? INFINITY : float(r.tFar);
-            }
-        }
-        for (int k = 0; k < kPacketRays; ++k) {
-            if (p.valid[k]) continue;
-            for (int c = 0; c < 3; ++c) p.lane[c][k] = frameOrigin[c], p.lane[3 + c][k] = c == 2 ? 1.0 : 0.0;
-            ray.tnear[k] = 0, ray.tfar[k] = 0;
-        }
-        for (int k = 0; k < kPacketRays; ++k) {
-            ray.org_x[k] = float(p.lane[0][k] - frameOrigin.x);
-            ray.org_y[k] = float(p.lane[1][k] - frameOrigin.y);
-            ray.org_z[k] = float(p.lane[2][k] - frameOrigin.z);
-            ray.dir_x[k] = float(p.lane[3][k]);
-            ray.dir_y[k] = float(p.lane[4][k]);
-            ray.dir_z[k] = float(p.lane[5][k]);
-            ray.time[k] = 0.0f;
-            ray.mask[k] = 0xFFFFFFFFu;  // Debian's Embree has ray masks on
-            ray.id[k] = unsigned(k);
-            ray.flags[k] = 0;
-            p.packet.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-            p.packet.hit.primID[k] = RTC_INVALID_GEOMETRY_ID;
-            p.packet.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
-        }
-        rtcIntersect16(p.valid, rtcScene, &context, &p.packet);
-        p.noteHits();
-        for (int k = 0; k < kPacketRays; ++k)  // the hit planes asked for: both ends of each entry
-            if (p.hit(k)) {
-                const char* entry = reinterpret_cast<const char*>(planes + p.packet.hit.primID[k]);
-                __builtin_prefetch(entry);
-                __builtin_prefetch(entry + sizeof(HitPlane) - 1);
-            }
+        imagePointsOfPacket(p, px, py, setUp, fault);
+        raysOfPacket(p, affine, cameraRays, setUp);
+        embreeLanesOfPacket(p, frameOrigin);
+        intersectPacket(p, rtcScene, context, planes);
     };
     // Each hit again, in double: the ray against the hit triangle's plane; then the pixels written.
     auto finish = [&](const PacketInFlight& p) ZCHECK_ALWAYS_INLINE {
-        // The planes, every lane's own, without a branch, from the table (HitPlane). (Keeping
-        // a plane while the next lanes hit the same triangle, as this did before, cost more in
-        // mispredicted branches than the arithmetic it saved.) A miss takes triangle 0's plane
-        // (a scene has one, RayRenderer checked), and its result is not used.
         std::uint32_t triangle[kPacketRays];
-        for (int k = 0; k < kPacketRays; ++k) triangle[k] = p.hit(k) ? p.packet.hit.primID[k] : 0;
-        alignas(64) double plane[6][kPacketRays];  // a vertex x, y, z and the normal x, y, z
-#ifdef ZCHECK_X86_AVX512
-        if constexpr (kAvx512) planesInLanesAvx512(planes, triangle, plane);
-#endif
-        if constexpr (!kAvx512)
-            for (int k = 0; k < kPacketRays; ++k) {
-                const HitPlane& h = planes[triangle[k]];
-                for (int axis = 0; axis < 3; ++axis)
-                    plane[axis][k] = double(h.vertex[axis]), plane[3 + axis][k] = h.normal[axis];
-            }
-        // Lane by lane in plain arrays (several lanes per instruction): the ray parameter t
-        // of the hit (Embree's, where the plane gives none) and its eye-z.
+        alignas(64) double plane[6][kPacketRays];
+        hitPlanesOfPacket<kAvx512>(p, planes, triangle, plane);
         alignas(64) double tEmbree[kPacketRays], t[kPacketRays], eyeZ[kPacketRays];
-        for (int k = 0; k < kPacketRays; ++k) tEmbree[k] = p.packet.ray.tfar[k];  // apart: the loop below stays SIMD
-        for (int k = 0; k < kPacketRays; ++k) {
-            const glm::dvec3 vertex(plane[0][k], plane[1][k], plane[2][k]), n(plane[3][k], plane[4][k], plane[5][k]);
-            const double tPlane = glm::dot(n, vertex - p.origin(k)) / glm::dot(n, p.direction(k));
-            t[k] = std::abs(tPlane) <= std::numeric_limits<double>::max() ? tPlane : tEmbree[k];  // isfinite, branch-free
-        }
-        if (fault.distanceAsEyeZ) {  // the fault "distance as eye-z": the distance along the ray for eye-z
-            for (int k = 0; k < kPacketRays; ++k) eyeZ[k] = t[k] * glm::length(p.direction(k));
-        } else {
-            for (int k = 0; k < kPacketRays; ++k) eyeZ[k] = cameraRays.eyeZ(p.origin(k) + t[k] * p.direction(k));
-        }
-        // The pixels, lane by lane into plain arrays, then a row of the packet at a time: four
-        // adjacent pixels, copied whole where all four lie in the rectangle. Every lane's window
-        // depth at once where the camera has a closed form (a miss's is computed too, from
-        // triangle 0's plane, and not used); a raw-matrix camera's, hits only.
-        alignas(64) double depthOf[kPacketRays];
-        alignas(64) std::uint32_t primitiveOf[kPacketRays];
-        const bool closedForm = cameraRays.windowDepths(eyeZ, kPacketRays, depthOf);
-        for (int k = 0; k < kPacketRays; ++k) primitiveOf[k] = p.hit(k) ? p.packet.hit.primID[k] : kNoPrimitive;
-        if (closedForm) {
-            for (int k = 0; k < kPacketRays; ++k) depthOf[k] = p.hit(k) ? depthOf[k] : clearDepth;
-        } else {
-            for (int k = 0; k < kPacketRays; ++k)
-                depthOf[k] = p.hit(k) ? cameraRays.windowDepth(p.pImage(k), eyeZ[k]) : clearDepth;
-        }
-        const int cols = std::min(kPacketSide, col1 - p.col0), rows = std::min(kPacketSide, row1 - p.row0);
-        for (int r = 0; r < rows; ++r) {
-            const std::size_t i = std::size_t(p.row0 + r - row0) * stride + std::size_t(p.col0 - col0);
-            const int k = r * kPacketSide;
-            if (cols == kPacketSide) {
-                std::memcpy(windowDepth + i, depthOf + k, sizeof(double) * kPacketSide);
-                std::memcpy(primitiveId + i, primitiveOf + k, sizeof(std::uint32_t) * kPacketSide);
-            } else {
-                std::copy(depthOf + k, depthOf + k + cols, windowDepth + i);
-                std::copy(primitiveOf + k, primitiveOf + k + cols, primitiveId + i);
-            }
-            if (pEye)
-                for (int j = 0; j < cols; ++j)
-                    pEye[i + j] = p.hit(k + j) ? cameraRays.eyeFromWorld(p.origin(k + j) + t[k + j] * p.direction(k + j))
-                                               : glm::dvec3(NAN);
-        }
+        hitsInDouble(p, plane, cameraRays, fault, tEmbree, t, eyeZ);
+        writePacketPixels(p, t, eyeZ, cameraRays, setUp);
     };
 
     // Packets row by row over the rectangle, two in flight: packet i is traced and its hit

@@ -345,27 +345,9 @@ void validate(const GlDepthInput& input, int repeats)
             throw std::invalid_argument("GL reference: vertex index out of range");
 }
 
-} // namespace
-
-GlDepthTiming timeGlDepthDraw(const GlDepthInput& input, int repeats)
+// Compiles and links the depth-only program, makes it current and gives it input's clipFromWorld.
+void buildProgram(const Gl& gl, GlObjects& objects, const GlDepthInput& input)
 {
-    validate(input, repeats);
-    configureMesaEnvironment(input.threads);
-
-    EglSession session;
-    session.open();
-    Gl gl{};
-    gl.loadAll();
-    GlObjects objects(gl);
-    gl.check("creating the context");
-
-    GlDepthTiming timing;
-    if (const auto* renderer = reinterpret_cast<const char*>(gl.GetString(GL_RENDERER))) timing.renderer = renderer;
-
-    const bool zeroToOne = input.reversedZ || input.zeroToOne;
-    if (zeroToOne && !gl.supportsClipControl()) fail("glClipControl unsupported (needs GL 4.5 or GL_ARB_clip_control)");
-
-    // Program.
     objects.vertexShader = compileShader(gl, GL_VERTEX_SHADER, kVertexShader, "vertex");
     objects.fragmentShader = compileShader(gl, GL_FRAGMENT_SHADER, kFragmentShader, "fragment");
     objects.program = gl.CreateProgram();
@@ -388,8 +370,11 @@ GlDepthTiming timeGlDepthDraw(const GlDepthInput& input, int repeats)
         clipFromWorld[i] = static_cast<GLfloat>(input.clipFromWorld[i]);
     gl.UniformMatrix4fv(clipFromWorldLocation, 1, GL_FALSE, clipFromWorld.data()); // column-major, as given
     gl.check("building the shader program");
+}
 
-    // Mesh, uploaded once.
+// Uploads the mesh once, into buffers that the vertex array records; the vertex array stays bound.
+void uploadMesh(const Gl& gl, GlObjects& objects, const GlDepthInput& input)
+{
     gl.GenVertexArrays(1, &objects.vertexArray);
     gl.BindVertexArray(objects.vertexArray);
     gl.GenBuffers(1, &objects.vertexBuffer);
@@ -403,40 +388,58 @@ GlDepthTiming timeGlDepthDraw(const GlDepthInput& input, int repeats)
     gl.BufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(3 * input.triangleCount * sizeof(std::uint32_t)),
                   input.indices, GL_STATIC_DRAW);
     gl.check("uploading the mesh");
+}
 
+// A complete depth-only framebuffer of input's size (`samples` > 1: multisampled), left bound; `what` names the step.
+void createDepthTarget(const Gl& gl, const GlDepthInput& input, GLenum depthFormat, int samples, GLuint& renderbuffer,
+                       GLuint& framebuffer, const char* what)
+{
+    gl.GenRenderbuffers(1, &renderbuffer);
+    gl.BindRenderbuffer(GL_RENDERBUFFER, renderbuffer);
+    if (samples > 1)
+        gl.RenderbufferStorageMultisample(GL_RENDERBUFFER, samples, depthFormat, input.width, input.height);
+    else
+        gl.RenderbufferStorage(GL_RENDERBUFFER, depthFormat, input.width, input.height);
+    gl.GenFramebuffers(1, &framebuffer);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+    gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, renderbuffer);
+    gl.DrawBuffer(GL_NONE);
+    gl.ReadBuffer(GL_NONE);
+    gl.check(what);
+    if (const GLenum status = gl.CheckFramebufferStatus(GL_FRAMEBUFFER); status != GL_FRAMEBUFFER_COMPLETE)
+        fail(std::string(what) + ": framebuffer incomplete (status " + hex(status) + ")");
+}
+
+// The framebuffer drawn into, left bound, and with multisampling first the single-sample one it is resolved into.
+void createDepthTargets(const Gl& gl, GlObjects& objects, const GlDepthInput& input)
+{
     // Depth-only render target. Reversed-Z keeps its precision only with a float buffer.
     const GLenum depthFormat = input.reversedZ ? GL_DEPTH_COMPONENT32F : GL_DEPTH_COMPONENT24;
-    const auto depthTarget = [&](GLuint& renderbuffer, GLuint& framebuffer, int samples, const char* what) {
-        gl.GenRenderbuffers(1, &renderbuffer);
-        gl.BindRenderbuffer(GL_RENDERBUFFER, renderbuffer);
-        if (samples > 1)
-            gl.RenderbufferStorageMultisample(GL_RENDERBUFFER, samples, depthFormat, input.width, input.height);
-        else
-            gl.RenderbufferStorage(GL_RENDERBUFFER, depthFormat, input.width, input.height);
-        gl.GenFramebuffers(1, &framebuffer);
-        gl.BindFramebuffer(GL_FRAMEBUFFER, framebuffer);
-        gl.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, renderbuffer);
-        gl.DrawBuffer(GL_NONE);
-        gl.ReadBuffer(GL_NONE);
-        gl.check(what);
-        if (const GLenum status = gl.CheckFramebufferStatus(GL_FRAMEBUFFER); status != GL_FRAMEBUFFER_COMPLETE)
-            fail(std::string(what) + ": framebuffer incomplete (status " + hex(status) + ")");
-    };
     if (input.samples > 1)
-        depthTarget(objects.resolvedRenderbuffer, objects.resolvedFramebuffer, 1, "creating the resolved depth framebuffer");
-    depthTarget(objects.depthRenderbuffer, objects.framebuffer, input.samples, "creating the depth framebuffer");
-    if (input.samples > 1) {
-        GLint samples = 0;
-        gl.GetIntegerv(GL_SAMPLES, &samples);
-        for (GLint k = 0; k < samples; ++k) {
-            std::array<GLfloat, 2> position{};
-            gl.GetMultisamplefv(GL_SAMPLE_POSITION, GLuint(k), position.data());
-            timing.samplePositions.push_back({position[0], position[1]});
-        }
-        gl.check("querying the sample positions");
-    }
+        createDepthTarget(gl, input, depthFormat, 1, objects.resolvedRenderbuffer, objects.resolvedFramebuffer,
+                          "creating the resolved depth framebuffer");
+    createDepthTarget(gl, input, depthFormat, input.samples, objects.depthRenderbuffer, objects.framebuffer,
+                      "creating the depth framebuffer");
+}
 
-    // Fixed-function state.
+// The bound framebuffer's sample positions as GL reports them (GlDepthTiming::samplePositions).
+std::vector<std::array<float, 2>> samplePositionsOf(const Gl& gl)
+{
+    std::vector<std::array<float, 2>> positions;
+    GLint samples = 0;
+    gl.GetIntegerv(GL_SAMPLES, &samples);
+    for (GLint k = 0; k < samples; ++k) {
+        std::array<GLfloat, 2> position{};
+        gl.GetMultisamplefv(GL_SAMPLE_POSITION, GLuint(k), position.data());
+        positions.push_back({position[0], position[1]});
+    }
+    gl.check("querying the sample positions");
+    return positions;
+}
+
+// Fixed-function state for a depth-only draw in input's depth convention (zeroToOne: glClipControl).
+void setDepthState(const Gl& gl, const GlDepthInput& input, bool zeroToOne)
+{
     gl.Viewport(0, 0, input.width, input.height);
     gl.ColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
     gl.Disable(GL_CULL_FACE);
@@ -446,7 +449,11 @@ GlDepthTiming timeGlDepthDraw(const GlDepthInput& input, int repeats)
     gl.DepthFunc(input.reversedZ ? GL_GREATER : GL_LESS);
     gl.ClearDepth(input.reversedZ ? 0.0 : 1.0);
     gl.check("setting the depth state");
+}
 
+// One warm-up draw, then `repeats` timed ones: each one's wall time in milliseconds (GlDepthTiming::drawMs).
+std::vector<double> timeDraws(const Gl& gl, const GlDepthInput& input, int repeats)
+{
     const auto indexCount = static_cast<GLsizei>(3 * input.triangleCount);
     const auto draw = [&] {
         gl.Clear(GL_DEPTH_BUFFER_BIT);
@@ -455,25 +462,33 @@ GlDepthTiming timeGlDepthDraw(const GlDepthInput& input, int repeats)
     };
     draw(); // warm-up: llvmpipe generates its shader and rasterizer code with LLVM here
     gl.check("warm-up draw");
-    timing.drawMs.reserve(static_cast<std::size_t>(repeats));
+    std::vector<double> drawMs;
+    drawMs.reserve(static_cast<std::size_t>(repeats));
     for (int repeat = 0; repeat < repeats; ++repeat) {
         const auto start = std::chrono::steady_clock::now();
         draw();
         const auto end = std::chrono::steady_clock::now();
-        timing.drawMs.push_back(std::chrono::duration<double, std::milli>(end - start).count());
+        drawMs.push_back(std::chrono::duration<double, std::milli>(end - start).count());
     }
     gl.check("timed draws");
+    return drawMs;
+}
 
+// The multisampled depth blitted into the single-sample framebuffer, which is left bound for reading.
+void resolveMultisampledDepth(const Gl& gl, const GlObjects& objects, const GlDepthInput& input)
+{
     // A multisampled buffer is resolved as an application does it, by a blit (which sample, or
     // what blend, a depth resolve keeps is the implementation's choice).
-    if (input.samples > 1) {
-        gl.BindFramebuffer(GL_READ_FRAMEBUFFER, objects.framebuffer);
-        gl.BindFramebuffer(GL_DRAW_FRAMEBUFFER, objects.resolvedFramebuffer);
-        gl.BlitFramebuffer(0, 0, input.width, input.height, 0, 0, input.width, input.height, GL_DEPTH_BUFFER_BIT, GL_NEAREST);
-        gl.BindFramebuffer(GL_FRAMEBUFFER, objects.resolvedFramebuffer);
-        gl.check("resolving the multisampled depth");
-    }
+    gl.BindFramebuffer(GL_READ_FRAMEBUFFER, objects.framebuffer);
+    gl.BindFramebuffer(GL_DRAW_FRAMEBUFFER, objects.resolvedFramebuffer);
+    gl.BlitFramebuffer(0, 0, input.width, input.height, 0, 0, input.width, input.height, GL_DEPTH_BUFFER_BIT, GL_NEAREST);
+    gl.BindFramebuffer(GL_FRAMEBUFFER, objects.resolvedFramebuffer);
+    gl.check("resolving the multisampled depth");
+}
 
+// The bound framebuffer's depth, read back with row 0 the top of the image (GlDepthTiming::depth).
+std::vector<float> readBackDepth(const Gl& gl, const GlDepthInput& input)
+{
     // GL's rows run bottom-up; the result's row 0 is the top of the image.
     const auto width = static_cast<std::size_t>(input.width);
     const auto height = static_cast<std::size_t>(input.height);
@@ -481,9 +496,40 @@ GlDepthTiming timeGlDepthDraw(const GlDepthInput& input, int repeats)
     gl.PixelStorei(GL_PACK_ALIGNMENT, 1);
     gl.ReadPixels(0, 0, input.width, input.height, GL_DEPTH_COMPONENT, GL_FLOAT, bottomUp.data());
     gl.check("reading back the depth");
-    timing.depth.resize(width * height);
+    std::vector<float> depth(width * height);
     for (std::size_t row = 0; row < height; ++row)
-        std::memcpy(&timing.depth[row * width], &bottomUp[(height - 1 - row) * width], width * sizeof(float));
+        std::memcpy(&depth[row * width], &bottomUp[(height - 1 - row) * width], width * sizeof(float));
+    return depth;
+}
+
+} // namespace
+
+GlDepthTiming timeGlDepthDraw(const GlDepthInput& input, int repeats)
+{
+    validate(input, repeats);
+    configureMesaEnvironment(input.threads);
+
+    EglSession session;
+    session.open();
+    Gl gl{};
+    gl.loadAll();
+    GlObjects objects(gl);
+    gl.check("creating the context");
+
+    GlDepthTiming timing;
+    if (const auto* renderer = reinterpret_cast<const char*>(gl.GetString(GL_RENDERER))) timing.renderer = renderer;
+
+    const bool zeroToOne = input.reversedZ || input.zeroToOne;
+    if (zeroToOne && !gl.supportsClipControl()) fail("glClipControl unsupported (needs GL 4.5 or GL_ARB_clip_control)");
+
+    buildProgram(gl, objects, input);
+    uploadMesh(gl, objects, input);
+    createDepthTargets(gl, objects, input);
+    if (input.samples > 1) timing.samplePositions = samplePositionsOf(gl);
+    setDepthState(gl, input, zeroToOne);
+    timing.drawMs = timeDraws(gl, input, repeats);
+    if (input.samples > 1) resolveMultisampledDepth(gl, objects, input);
+    timing.depth = readBackDepth(gl, input);
     return timing;
 }
 
