@@ -21,6 +21,7 @@ nlohmann::json formatsJson()
         rows.push_back({{"name", format->name},
                         {"aliases", format->aliases},
                         {"title", format->title},
+                        {"extensions", format->extensions},
                         {"files", format->files},
                         {"example", format->example},
                         {"priority", format->priority},

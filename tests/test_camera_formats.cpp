@@ -85,6 +85,7 @@ TEST_CASE("camera formats: every name and alias names its row, and an unknown on
         REQUIRE((format->parse != nullptr) != (format->read != nullptr));  // one reader or the other
         REQUIRE(!format->title.empty());
         REQUIRE(!format->example.empty());
+        REQUIRE(!format->extensions.empty());
         names.push_back(format->name);
     }
     // glTF is the scene library's row, registered because this program links zcheck::scene.

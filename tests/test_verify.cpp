@@ -2,6 +2,7 @@
 #include "zcheck/map_verifier.h"
 #include "zcheck/mistakes.h"
 #include "zcheck/verify.h"
+#include "verify_estimators.h"  // white-box: screenUnexplained
 
 #include "zcheck/camera_file.h"
 #include "zcheck/export.h"

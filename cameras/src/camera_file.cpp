@@ -442,6 +442,7 @@ const CameraFormat& zcheckFormat()
         CameraFormat f;
         f.name = "zcheck";
         f.title = "zcheck camera";
+        f.extensions = {".json"};
         f.files = "JSON: a camera file (camera_file.h) or the sidecar `zcheck export` writes";
         f.example = "camera.json";
         f.priority = 90;

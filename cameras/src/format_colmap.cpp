@@ -468,6 +468,7 @@ const CameraFormat& colmapFormat()
         CameraFormat f;
         f.name = "colmap";
         f.title = "COLMAP model";
+        f.extensions = {".txt", ".bin"};
         f.files = "a folder with cameras.txt and images.txt, or cameras.bin and images.bin (or one of those files)";
         f.example = "sparse/0#img_014.png";
         f.priority = 10;

@@ -328,6 +328,7 @@ const CameraFormat& metashapeFormat()
         f.name = "metashape";
         f.aliases = {"photoscan"};
         f.title = "Metashape cameras.xml";
+        f.extensions = {".xml"};
         f.files = "Agisoft Metashape's XML camera export: frame sensors, each camera's camera-to-chunk transform and "
                   "the chunk's (disabled cameras skipped)";
         f.example = "cameras.xml#IMG_0001.JPG";

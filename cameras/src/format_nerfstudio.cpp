@@ -293,6 +293,7 @@ const CameraFormat& nerfstudioFormat()
         f.name = "nerfstudio";
         f.aliases = {"instant-ngp"};
         f.title = "transforms.json";
+        f.extensions = {".json"};
         f.files = "nerfstudio's or instant-ngp's JSON with \"frames\", each a transform_matrix";
         f.example = "transforms.json#frame_003";
         f.priority = 20;

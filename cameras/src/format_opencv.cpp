@@ -584,6 +584,7 @@ const CameraFormat& opencvFormat()
         CameraFormat f;
         f.name = "opencv";
         f.title = "OpenCV FileStorage";
+        f.extensions = {".yml", ".yaml", ".xml", ".json"};
         f.files = "YAML, XML or JSON with camera_matrix (calibration.cpp's output, stereo_calib's intrinsics.yml as "
                   "#left or #right, per-view extrinsics as #view_N)";
         f.example = "calib.yml";
@@ -603,6 +604,7 @@ const CameraFormat& rosFormat()
         CameraFormat f;
         f.name = "ros";
         f.title = "ROS CameraInfo";
+        f.extensions = {".yaml", ".yml"};
         f.files = "camera_calibration_parsers YAML or a `topic echo` of a CameraInfo message (#raw, #rectified)";
         f.example = "camera_info.yaml#rectified";
         f.priority = 50;

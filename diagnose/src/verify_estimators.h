@@ -15,7 +15,8 @@
 // (onePlaneAround, tallyEdges); the judgement of a map's declarations as a whole
 // (judgeDeclaredAccuracy); the map's errors in its own units (measureMapErrors); and the
 // comparison every verification and every reading of a diagnosis runs (verifyAgainst).
-// screenUnexplained, an estimator too, stays in verify.h: tests/test_verify.cpp calls it.
+// and the sampled screen that rules a hypothesis out before its full comparison
+// (screenUnexplained). White-box tests include this header through their own include path.
 #include "zcheck/verify.h"
 
 #include <cmath>
@@ -128,5 +129,16 @@ void measureMapErrors(const Camera& camera, const DepthMap& map, VerifyResult& r
 // truth render, many readings of the map).
 VerifyResult verifyAgainst(const Scene& scene, const Camera& camera, const DepthMap& map, RenderResult truth,
                            const VertexNeighbours& neighbours);
+
+// Whether `map` certainly cannot be consistent with `truth`, judged on a sample: the pixels
+// that do not simply agree with the truth's own surface are looked for on every fourth row
+// and column, and an evenly spaced sample of at most 1024 of them is read and classified
+// exactly as the full comparison would, in blocks, until 64 unexplained ones are found. An
+// unexplained pixel proves the map inconsistent (a consistent map has none anywhere); the
+// value returned then estimates how many pixels are unexplained, from the sample's share.
+// std::nullopt: every sampled pixel is explained, or there are too few suspects to bother;
+// only the full comparison can tell.
+std::optional<std::int64_t> screenUnexplained(const Scene& scene, const Camera& camera, const DepthMap& map,
+                                              const RenderResult& truth, const VertexNeighbours& neighbours);
 
 }  // namespace zcheck

@@ -49,6 +49,7 @@ const CameraFormat& gltfCameraFormat()
         CameraFormat f;
         f.name = "gltf";
         f.title = "glTF";
+        f.extensions = {".gltf", ".glb"};
         f.files = "a .gltf or .glb's camera nodes, read with its scene (#node name or index)";
         f.example = "scene.glb#Camera";
         f.priority = 30;

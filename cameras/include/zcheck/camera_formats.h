@@ -48,6 +48,7 @@ struct CameraFormat {
     std::string name;                  // "colmap": --camera-format, --to, reports, dataset kinds
     std::vector<std::string> aliases;  // other names --camera-format takes ("instant-ngp")
     std::string title;                 // in messages and help: "COLMAP model"
+    std::vector<std::string> extensions;  // what its files are usually called (".xml"); detection is by content
     std::string files;                 // what its files look like, for help and docs
     std::string example;               // a reference with #FRAME, for help and docs
     int priority = 0;                  // detection order, lower first

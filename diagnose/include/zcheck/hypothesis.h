@@ -25,7 +25,7 @@ struct Hypothesis {
     bool consistent = false;
     std::int64_t unexplained = 0;
     bool estimated = false;   // `unexplained` estimated from a sample that already ruled the
-                              // hypothesis out (verify.h, screenUnexplained)
+                              // hypothesis out (src/verify_estimators.h, screenUnexplained)
     std::vector<FittedValue> fitted;  // a fitted hypothesis's values (fit.h); empty for the catalogue's
     // Of the unexplained pixels, those at edges of the truth (a 3×3 neighbourhood that is not
     // one plane), and of those the ones whose depth lies between the truth's around them.
