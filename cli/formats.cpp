@@ -54,7 +54,7 @@ Command addFormatsCommand(CLI::App& app)
     command->add_flag("--json", *json, "the table as JSON (one object per format, with its size limit and detection order)");
     return {command, [json] {
                 if (*json) {
-                    (void)depthMapFormatTable();  // loads the formats of the image plugin
+                    loadAllDepthMapFormats();  // the image plugin's formats too
                     std::cout << formatsJson().dump(2) << "\n";
                 } else {
                     std::cout << cameraFormatTable() << "\n" << depthMapFormatTable();

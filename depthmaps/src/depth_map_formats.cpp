@@ -146,6 +146,8 @@ std::string writeDepthMapFile(const std::string& path, const std::vector<Quantit
     return format->name;
 }
 
+void loadAllDepthMapFormats() { loadMore(); }
+
 std::string depthMapFormatTable()
 {
     loadMore();

@@ -2,7 +2,6 @@
 
 #include "zcheck/error.h"
 #include "zcheck/input_file.h"
-#include "zcheck/large_buffer.h"
 #include "zcheck/mesh_formats.h"
 
 #include <algorithm>
@@ -10,15 +9,6 @@
 #include <limits>
 
 namespace zcheck {
-
-CameraSet readGltfCameras(const std::string& path)
-{
-    const LargeVector<char> file = readInputBytes(path, gltfCameraFormat().input);
-    CameraSet set;
-    set.path = path, set.format = gltfCameraFormat().name;
-    set.cameras = readGltfCameraNodes(path, std::string_view(file.data(), file.size()));
-    return set;
-}
 
 namespace {
 
@@ -28,10 +18,6 @@ CameraSet parseGltfCameras(std::string_view bytes, const std::string& path)
     set.cameras = readGltfCameraNodes(path, bytes);
     return set;
 }
-
-}  // namespace
-
-namespace {
 
 bool detectsGltf(const CameraFileHead& file)
 {

@@ -61,7 +61,11 @@ DepthMapFile readDepthMapFile(const std::string& path, const DepthMapReading& re
 // Throws Error naming the file (an unknown extension lists the known ones).
 std::string writeDepthMapFile(const std::string& path, const std::vector<QuantityImage>& images, double scale);
 
-// The table as Markdown (`zcheck formats` prints it).
+// Runs the loader (setDepthMapFormatLoader) now, if it has not run: every format is then in
+// the table (`zcheck formats` lists them all).
+void loadAllDepthMapFormats();
+
+// The table as Markdown, every format loaded (`zcheck formats` prints it).
 std::string depthMapFormatTable();
 
 }  // namespace zcheck

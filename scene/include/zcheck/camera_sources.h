@@ -24,16 +24,14 @@
 
 namespace zcheck {
 
-// glTF's row of the camera formats (camera_formats.h).
+// glTF's row of the camera formats (camera_formats.h); readCameraSet reads a file with it: the
+// camera nodes of the default scene, in the order the node hierarchy is walked (depth first):
+// perspective (yfov, aspectRatio or the image's, znear, zfar or an infinite far plane) and
+// orthographic (xmag, ymag half extents, znear, zfar) cameras, posed by the node's world
+// transform without its scale (as glTF says), looking down −Z with +Y up. glTF has no image
+// size: the cameras carry hasImageSize false. Named by the node's name, else "nodes[i]"; the
+// camera's own name is an alias.
 const CameraFormat& gltfCameraFormat();
-
-// The glTF file's camera nodes in the default scene, in the order the node hierarchy is
-// walked (depth first): perspective (yfov, aspectRatio or the image's, znear, zfar or an
-// infinite far plane) and orthographic (xmag, ymag half extents, znear, zfar) cameras, posed by
-// the node's world transform without its scale (as glTF says), looking down −Z with +Y up.
-// glTF has no image size: the cameras carry hasImageSize false. Named by the node's name, else
-// "nodes[i]"; the camera's own name is an alias.
-CameraSet readGltfCameras(const std::string& path);
 
 struct SceneNearFar {
     double near = 0, far = 0;
