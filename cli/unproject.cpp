@@ -79,8 +79,9 @@ int runUnprojectCommand(const UnprojectOptions& o)
         const glm::ivec2 pixel = parsePixel(o.pixel, camera);
         const glm::dvec2 pWindow = windowFromPixelCentre(camera, pixel.x, pixel.y);
         nlohmann::json out = {{"pixel", {pixel.x, pixel.y}}, {"window", {pWindow.x, pWindow.y}}};
+        requireRayThroughWindow(camera, pWindow);
         if (!o.depth) {
-            const EyePlaneRay rayEye = eyePlaneRayFrom(eyeRayThroughWindow(camera, pWindow));
+            const EyePlaneRay rayEye = eyePlaneRayThroughWindow(camera, pWindow);
             const EyePlaneRay rayWorld = worldEyePlaneRayThroughWindow(camera, pWindow);
             auto rayJson = [](const EyePlaneRay& r) {
                 return nlohmann::json{{"origin", vec3Json(r.origin)},

@@ -50,7 +50,7 @@ TEST_CASE("affine rays are the definition's rays, with t equal to eye-z", "[came
         for (const glm::dvec2 pImage : {glm::dvec2(0.5, 0.5), glm::dvec2(camera.width() - 0.5, 0.5),
                                         glm::dvec2(17.25, camera.height() - 3.75),
                                         glm::dvec2(camera.width() / 2.0, camera.height() / 2.0)}) {
-            const EyePlaneRay r = rays.worldRay(pImage);
+            const EyePlaneRay r = rays.worldRay(pImage).value();
             const glm::dvec3 origin = affine->originAt(pImage), direction = affine->directionAt(pImage);
             const double scale = 1.0 + glm::length(r.origin);
             REQUIRE(glm::length(origin - r.origin) <= 1e-12 * scale);

@@ -149,9 +149,48 @@ double readFar(ObjectReader& projection)
     return projection.number("far");
 }
 
-Projection readProjection(ObjectReader projection)
+// The "lens" object beside the projection: "model" and the model's parameters by name (lens.h).
+// fx, fy, cx, cy come from a pinhole projection when the model has them (OpenCV's K beside its
+// distortion coefficients); a projection without a type gives only near and far, and the lens
+// every parameter. Parameters past the model's required ones default to 0.
+LensSpec readLens(ObjectReader lens, const Projection& pinhole, bool fromPinhole)
+{
+    LensSpec spec;
+    spec.model = lens.string("model", "");
+    const LensModelInfo* info = lensModelNamed(spec.model);
+    if (!info) lens.failKey("model", spec.model.empty() ? "is missing (" + lensModelNames() + ")"
+                                                         : "must be one of " + lensModelNames() + ", got '" + spec.model + "'");
+    const double fromProjection[4] = {pinhole.fx, pinhole.fy, pinhole.cx, pinhole.cy};
+    const bool hasK = info->hasFocal && std::string(info->params[0]) == "fx";
+    if (fromPinhole && !hasK)
+        lens.failKey("model", "'" + spec.model + "' does not take a pinhole's fx, fy, cx, cy: give the projection only "
+                              "near and far, and every parameter in the lens");
+    for (std::size_t i = 0; i < info->params.size(); ++i) {
+        const std::string name = info->params[i];
+        if (fromPinhole && i < 4) {
+            if (lens.has(name)) lens.failKey(name, "is the pinhole projection's: give it there only");
+            spec.params.push_back(fromProjection[i]);
+        } else if (lens.has(name) || int(i) < info->required) {
+            spec.params.push_back(lens.number(name));
+        } else {
+            spec.params.push_back(0.0);
+        }
+    }
+    lens.finish();
+    return spec;
+}
+
+Projection readProjection(ObjectReader projection, const json* lens, const std::string& source)
 {
     Projection p;
+    if (lens && !projection.has("type")) {  // near and far only: the lens holds the rest
+        p.type = ProjectionType::NonLinear;
+        p.lens = readLens(ObjectReader(*lens, "lens", source), p, false);
+        p.near = projection.number("near");
+        p.far = readFar(projection);
+        projection.finish();
+        return p;
+    }
     const std::string type = projection.string("type", "");
     const std::string types = "perspective, frustum, orthographic, oblique, pinhole, lens or matrix";
     if (type.empty()) projection.failKey("type", "is missing (" + types + ")");
@@ -195,6 +234,13 @@ Projection readProjection(ObjectReader projection)
     p.near = projection.number("near");
     p.far = readFar(projection);
     projection.finish();
+    if (lens) {
+        if (p.type != ProjectionType::Pinhole)
+            throw Error(source + ": 'lens' goes with a pinhole projection (fx, fy, cx, cy) or one of near and far "
+                                 "only, not with a " + type + " projection");
+        p.lens = readLens(ObjectReader(*lens, "lens", source), p, true);
+        p.type = ProjectionType::NonLinear;
+    }
     return p;
 }
 
@@ -259,7 +305,8 @@ CameraSpec cameraSpecFromJson(const json& document, const std::string& source)
         spec.height = image.integer("height", 480);
         image.finish();
     }
-    spec.projection = readProjection(root.child("projection"));
+    const json* lens = root.has("lens") ? &root.at("lens") : nullptr;
+    spec.projection = readProjection(root.child("projection"), lens, source);
     spec.view = readView(root.child("view"), spec.convention);
     if (root.has("depth")) {
         ObjectReader depth = root.child("depth");
@@ -322,8 +369,22 @@ json toJson(const CameraSpec& spec)
 {
     const Projection& p = spec.projection;
     json projection;
+    json lens;
     projection["type"] = toString(p.type);
     switch (p.type) {
+    case ProjectionType::NonLinear: {
+        // K in a pinhole projection where the model has it, the rest in "lens" (readLens).
+        const LensModelInfo& info = *lensModelNamed(p.lens.model);
+        const bool hasK = info.hasFocal && std::string(info.params[0]) == "fx";
+        lens["model"] = p.lens.model;
+        if (hasK)
+            projection["type"] = "pinhole", projection["fx"] = p.lens.params[0], projection["fy"] = p.lens.params[1],
+            projection["cx"] = p.lens.params[2], projection["cy"] = p.lens.params[3];
+        else
+            projection.erase("type");
+        for (std::size_t i = hasK ? 4 : 0; i < info.params.size(); ++i) lens[info.params[i]] = p.lens.params[i];
+        break;
+    }
     case ProjectionType::Perspective:
         projection["fovy_deg"] = p.fovyDeg;
         if (p.aspect > 0) projection["aspect"] = p.aspect;
@@ -362,7 +423,7 @@ json toJson(const CameraSpec& spec)
     } else {
         view = {{"eye", array3(v.eye)}, {"target", array3(v.target)}, {"up", array3(v.up)}};
     }
-    return json{
+    json out{
         {"convention", spec.convention.name},
         {"image", {{"width", spec.width}, {"height", spec.height}}},
         {"projection", projection},
@@ -372,6 +433,8 @@ json toJson(const CameraSpec& spec)
           {"reversed", spec.depth.reversed},
           {"range", json::array({spec.depth.rangeMin, spec.depth.rangeMax})}}},
     };
+    if (p.type == ProjectionType::NonLinear) out["lens"] = lens;
+    return out;
 }
 
 json matricesJson(const Camera& camera)

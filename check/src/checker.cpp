@@ -99,6 +99,7 @@ CheckResult Checker::checkTileByTile(const Camera& camera, const CheckOptions& o
 
 CheckResult Checker::check(const Camera& camera, const CheckOptions& options) const
 {
+    if (camera.lens()) return checkLens(camera, options);
     if (!options.keepPixels) return checkTileByTile(camera, options);
     CheckResult run;
     run.ray = rays_.render(camera, options.faults.ray);

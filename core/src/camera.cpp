@@ -18,6 +18,7 @@ std::string toString(ProjectionType type)
     case ProjectionType::Pinhole: return "pinhole";
     case ProjectionType::Lens: return "lens";
     case ProjectionType::Matrix: return "matrix";
+    case ProjectionType::NonLinear: return "lens model";
     }
     return "?";
 }
@@ -208,6 +209,7 @@ void validateProjection(const CameraSpec& spec)
         requirePositive(p.focalMm, "projection.focal_mm");
         requirePositive(p.sensorWidthMm, "projection.sensor_width_mm");
         break;
+    case ProjectionType::NonLinear: break;  // the LensModel's constructor validates the lens
     case ProjectionType::Oblique:
         requireFinite(p.angleDeg, "projection.angle_deg");
         requireFinite(p.foreshortening, "projection.foreshortening");
@@ -281,7 +283,7 @@ struct Window {
     double left, right, bottom, top;
 };
 
-Window imageWindow(const CameraSpec& spec, double aspect)
+Window imageWindow(const CameraSpec& spec, double aspect, const LensModel* lens)
 {
     const Projection& p = spec.projection;
     const double n = p.near;
@@ -301,6 +303,14 @@ Window imageWindow(const CameraSpec& spec, double aspect)
         const double right = n * p.sensorWidthMm / (2 * p.focalMm);
         const double top = right * spec.height / spec.width;
         return {-right, right, -top, top};
+    }
+    case ProjectionType::NonLinear: {
+        // The linear part (camera.h): the pinhole of the model's fx, fy, cx, cy; for a panorama a
+        // 90° view.
+        const LensModel::Terms& t = lens->terms();
+        if (lens->isPanorama()) return {-n, n, -n * spec.height / spec.width, n * spec.height / spec.width};
+        const double W = spec.width, H = spec.height;
+        return {n * (-0.5 - t.cx) / t.fx, n * (W - 0.5 - t.cx) / t.fx, -n * (H - 0.5 - t.cy) / t.fy, n * (t.cy + 0.5) / t.fy};
     }
     default: return {p.left, p.right, p.bottom, p.top};
     }
@@ -325,6 +335,10 @@ Camera::Camera(const CameraSpec& spec) : spec_(spec)
 {
     validate(spec_);
     const Projection& p = spec_.projection;
+    if (p.type == ProjectionType::NonLinear) {
+        lens_ = std::make_shared<const LensModel>(p.lens, spec_.width, spec_.height);
+        spec_.projection.lens = lens_->spec();  // every parameter, the defaults written out
+    }
     const Convention& c = spec_.convention;
 
     // View: a raw matrix, or a look-at with the eye axes the convention asks for.
@@ -349,7 +363,7 @@ Camera::Camera(const CameraSpec& spec) : spec_(spec)
     if (p.type == ProjectionType::Matrix) {
         clipFromEye = p.clipFromEye;
     } else {
-        const Window w = imageWindow(spec_, aspect());
+        const Window w = imageWindow(spec_, aspect(), lens_.get());
         left_ = w.left, right_ = w.right, bottom_ = w.bottom, top_ = w.top;
         glm::dmat4 clipFromClipGl(1.0);
         clipFromClipGl[1][1] = c.ndcUpY;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <utility>
 
 namespace zcheck {
@@ -15,7 +16,51 @@ glm::dvec4 clipFromWindow(const Camera& camera, const glm::dvec3& pWindow)
     return glm::dvec4(glm::dvec3(camera.ndcFromWindow * glm::dvec4(pWindow, 1.0)), 1.0);
 }
 
+// A lens camera's unit direction through a window point, eye space; NaN outside the field.
+glm::dvec3 lensEyeDirection(const Camera& camera, const glm::dvec2& pWindow)
+{
+    const std::optional<glm::dvec3> dLens =
+        camera.lens()->directionFromImage({pWindow.x, camera.imageYFromWindowY(pWindow.y)});
+    return dLens ? camera.eyeFromLensFrame(*dLens) : glm::dvec3(NAN);
+}
+
 }  // namespace
+
+std::optional<glm::dvec3> eyeDirectionThroughWindow(const Camera& camera, const glm::dvec2& pWindow)
+{
+    if (camera.lens()) {
+        const glm::dvec3 d = lensEyeDirection(camera, pWindow);
+        return std::isnan(d.x) ? std::nullopt : std::optional<glm::dvec3>(d);
+    }
+    return eyePlaneRayFrom(eyeRayThroughWindow(camera, pWindow)).direction;
+}
+
+void requireRayThroughWindow(const Camera& camera, const glm::dvec2& pWindow)
+{
+    if (!camera.lens() || eyeDirectionThroughWindow(camera, pWindow)) return;
+    char where[96];
+    std::snprintf(where, sizeof where, "image point (%.6g, %.6g)", pWindow.x, camera.imageYFromWindowY(pWindow.y));
+    char field[32];
+    std::snprintf(field, sizeof field, "%.4g", camera.lens()->fieldAngle() * 180 / 3.14159265358979323846);
+    throw Error(std::string(where) + " is outside the lens model's field (" + camera.lens()->spec().model + ", up to " +
+                field + "° from the axis, where it is one-to-one): it has no ray");
+}
+
+EyePlaneRay eyePlaneRayThroughWindow(const Camera& camera, const glm::dvec2& pWindow)
+{
+    if (camera.lens())
+        return {glm::dvec3(0.0), lensEyeDirection(camera, pWindow), camera.nearDistance(), camera.farDistance()};
+    return eyePlaneRayFrom(eyeRayThroughWindow(camera, pWindow));
+}
+
+std::optional<glm::dvec2> imageFromEye(const Camera& camera, const glm::dvec3& pEye)
+{
+    if (const LensModel* lens = camera.lens()) return lens->imageFromDirection(camera.lensFrameFromEye(pEye));
+    const glm::dvec4 pClip = camera.clipFromEye * glm::dvec4(pEye, 1.0);
+    if (!(pClip.w > 0)) return std::nullopt;  // at or behind the eye plane of a perspective camera
+    const glm::dvec3 pWindow = windowFromEye(camera, pEye);
+    return glm::dvec2(pWindow.x, camera.imageYFromWindowY(pWindow.y));
+}
 
 EyePlaneRay eyePlaneRayFrom(const Ray& rayEye)
 {
@@ -33,7 +78,9 @@ EyePlaneRay eyePlaneRayFrom(const Ray& rayEye)
 
 EyePlaneRay worldEyePlaneRayThroughWindow(const Camera& camera, const glm::dvec2& pWindow)
 {
-    EyePlaneRay ray = eyePlaneRayFrom(eyeRayThroughWindow(camera, pWindow));
+    EyePlaneRay ray = camera.lens() ? EyePlaneRay{glm::dvec3(0.0), lensEyeDirection(camera, pWindow), camera.nearDistance(),
+                                                  camera.farDistance()}
+                                    : eyePlaneRayFrom(eyeRayThroughWindow(camera, pWindow));
     ray.origin = glm::dvec3(camera.worldFromEye * glm::dvec4(ray.origin, 1.0));
     ray.direction = glm::dvec3(camera.worldFromEye * glm::dvec4(ray.direction, 0.0));
     return ray;
@@ -41,6 +88,11 @@ EyePlaneRay worldEyePlaneRayThroughWindow(const Camera& camera, const glm::dvec2
 
 Ray eyeRayThroughWindow(const Camera& camera, const glm::dvec2& pWindow)
 {
+    if (camera.lens()) {  // from the near sphere to the far one
+        const glm::dvec3 d = lensEyeDirection(camera, pWindow);
+        if (camera.farIsInfinite()) return {camera.nearDistance() * d, d, INFINITY};
+        return {camera.nearDistance() * d, (camera.farDistance() - camera.nearDistance()) * d, 1.0};
+    }
     const glm::dvec4 nearEye = camera.eyeFromClip * clipFromWindow(camera, {pWindow, camera.windowDepthNear()});
     const glm::dvec4 farEye = camera.eyeFromClip * clipFromWindow(camera, {pWindow, camera.windowDepthFar()});
     Ray ray;
@@ -92,6 +144,8 @@ namespace {
 glm::dvec3 eyePointAtEyeZ(const Camera& camera, const glm::dvec2& pWindow, double eyeZ)
 {
     const Ray ray = eyeRayThroughWindow(camera, pWindow);
+    // A lens's ray 90° or more off the axis has no eye-z.
+    if (camera.lens() && !(camera.eyeZOf(ray.direction) > 0)) return glm::dvec3(NAN);
     const double t = (eyeZ - camera.eyeZOf(ray.origin)) / camera.eyeZOf(ray.direction);
     return ray.origin + t * ray.direction;
 }
@@ -120,6 +174,7 @@ double depthValueFromEyeZ(const Camera& camera, const glm::dvec2& pWindow, doubl
 
 double eyeZFromDistance(const Camera& camera, const glm::dvec2& pWindow, double distance)
 {
+    if (camera.lens()) return camera.eyeZOf(distance * lensEyeDirection(camera, pWindow));
     const EyePlaneRay ray = eyePlaneRayFrom(eyeRayThroughWindow(camera, pWindow));
     return camera.eyeZOf(ray.origin + distance * ray.direction);
 }
@@ -143,6 +198,7 @@ DepthValueKind kindOfDepthValue(const Camera& camera, DepthQuantity quantity, do
     if (!std::isfinite(value)) return DepthValueKind::Miss;
     const bool linear = quantity == DepthQuantity::EyeZ || quantity == DepthQuantity::Distance;
     if (linear) return value > 0 ? DepthValueKind::Depth : value == 0 ? DepthValueKind::Miss : DepthValueKind::OutOfRange;
+    if (camera.lens()) return DepthValueKind::OutOfRange;  // no depth buffer: no window or NDC depth
     const auto [lo, hi] = depthValueBounds(camera, quantity);
     const double slack = 0x1p-23 * std::max({1.0, std::abs(lo), std::abs(hi)});  // one binary32 step
     if (!(value >= lo - slack && value <= hi + slack)) return DepthValueKind::OutOfRange;
@@ -153,6 +209,7 @@ DepthValueKind kindOfDepthValue(const Camera& camera, DepthQuantity quantity, do
 std::string depthValueRange(const Camera& camera, DepthQuantity quantity)
 {
     if (quantity == DepthQuantity::EyeZ || quantity == DepthQuantity::Distance) return "> 0 (0 means no depth)";
+    if (camera.lens()) return "nothing: a lens model has no depth buffer (use eye-z or distance)";
     const auto [lo, hi] = depthValueBounds(camera, quantity);
     return "[" + formatNumber(lo) + ", " + formatNumber(hi) + "], the camera's " +
            (quantity == DepthQuantity::Window ? "depth range" : "NDC depth range");
@@ -165,8 +222,15 @@ std::optional<glm::dvec3> eyePointFromDepth(const Camera& camera, const glm::dve
     switch (quantity) {
     case DepthQuantity::Ndc: value = camera.windowDepthFromNdcZ(value); [[fallthrough]];
     case DepthQuantity::Window: return eyeFromWindow(camera, {pWindow, value});
-    case DepthQuantity::EyeZ: return eyePointAtEyeZ(camera, pWindow, value);
+    case DepthQuantity::EyeZ: {
+        const glm::dvec3 pEye = eyePointAtEyeZ(camera, pWindow, value);  // NaN: a lens's ray with no eye-z
+        return std::isnan(pEye.x) ? std::nullopt : std::optional<glm::dvec3>(pEye);
+    }
     case DepthQuantity::Distance: {
+        if (camera.lens()) {
+            const glm::dvec3 d = lensEyeDirection(camera, pWindow);
+            return std::isnan(d.x) ? std::nullopt : std::optional<glm::dvec3>(value * d);
+        }
         const EyePlaneRay ray = eyePlaneRayFrom(eyeRayThroughWindow(camera, pWindow));
         return ray.origin + value * ray.direction;
     }
@@ -176,6 +240,7 @@ std::optional<glm::dvec3> eyePointFromDepth(const Camera& camera, const glm::dve
 
 double distanceOfEyePoint(const Camera& camera, const glm::dvec3& pEye)
 {
+    if (camera.lens()) return glm::length(pEye);
     const glm::dvec3 pWindow = windowFromEye(camera, pEye);
     return glm::length(pEye - eyePlaneRayFrom(eyeRayThroughWindow(camera, {pWindow.x, pWindow.y})).origin);
 }
@@ -189,6 +254,9 @@ void requireDepthValue(const Camera& camera, DepthQuantity quantity, double valu
         if (!(value > 0)) throw Error(given + " must be > 0: the point must lie in front of the eye");
         return;
     }
+    if (camera.lens())
+        throw Error(given + ": a lens model (" + camera.lens()->spec().model +
+                    ") has no depth buffer, so no window or ndc depth: give eye-z or distance");
     const auto [lo, hi] = depthValueBounds(camera, quantity);
     if (!(value >= lo && value <= hi)) throw Error(given + " must lie in " + depthValueRange(camera, quantity));
 }
@@ -197,7 +265,11 @@ PointAtDepth pointAtDepth(const Camera& camera, const glm::dvec2& pWindow, doubl
                           const std::string& name)
 {
     requireDepthValue(camera, quantity, value, name);
+    requireRayThroughWindow(camera, pWindow);
     const std::optional<glm::dvec3> pEye = eyePointFromDepth(camera, pWindow, value, quantity);
+    if (!pEye && camera.lens())  // a ray 90° or more off the axis: no eye-z there
+        throw Error(name + " " + formatNumber(value) + " (" + toString(quantity) +
+                    "): the ray there is 90° or more off the axis, where eye-z does not exist; give distance");
     if (!pEye) throw Error(name + " " + formatNumber(value) + " is a miss for quantity " + toString(quantity));
     return {*pEye, glm::dvec3(camera.worldFromEye * glm::dvec4(*pEye, 1.0)), camera.eyeZOf(*pEye),
             distanceOfEyePoint(camera, *pEye)};

@@ -72,6 +72,72 @@ py::dict pointAt(const Camera& camera, int col, int row, double value, const std
     return out;
 }
 
+// (N, 3) from a (3,) or (N, 3) array of finite or NaN numbers; `what` names it in messages.
+DoubleArray rowsOf(const py::object& object, int columns, const std::string& what)
+{
+    DoubleArray a = asDoubles(numericArray(object, what));
+    if (a.ndim() == 1 && a.shape(0) == columns) a = a.reshape({py::ssize_t(1), py::ssize_t(columns)});
+    if (a.ndim() != 2 || a.shape(1) != columns)
+        fail(what + " must have shape (N, " + std::to_string(columns) + "), got " + shapeText(a));
+    return a;
+}
+
+// Camera.project: world (or eye) points to pixel coordinates, OpenCV's (the centre of pixel (c, r) at (c, r)).
+py::array_t<double> project(const Camera& camera, const py::object& points, const std::string& space)
+{
+    const PointSpace from = pointSpaceFromName(space, "space");
+    const DoubleArray p = rowsOf(points, 3, "Camera.project: points");
+    const py::ssize_t n = p.shape(0);
+    py::array_t<double> out({n, py::ssize_t(2)});
+    auto o = out.mutable_unchecked<2>();
+    const auto in = p.unchecked<2>();
+    for (py::ssize_t i = 0; i < n; ++i) {
+        glm::dvec3 q(in(i, 0), in(i, 1), in(i, 2));
+        if (from == PointSpace::World) q = glm::dvec3(camera.eyeFromWorld * glm::dvec4(q, 1.0));
+        const std::optional<glm::dvec2> pImage = imageFromEye(camera, q);
+        o(i, 0) = pImage ? pImage->x - 0.5 : NAN;
+        o(i, 1) = pImage ? pImage->y - 0.5 : NAN;
+    }
+    return out;
+}
+
+// Camera.unproject: pixel coordinates (OpenCV's) and depths of one quantity to points.
+py::array_t<double> unproject(const Camera& camera, const py::object& pixels, const py::object& depth,
+                              const std::string& quantityName, const std::string& space)
+{
+    const DepthQuantity quantity = depthQuantityFromName(quantityName);
+    const PointSpace to = pointSpaceFromName(space, "space");
+    const DoubleArray p = rowsOf(pixels, 2, "Camera.unproject: pixels");
+    const DoubleArray d = asDoubles(numericArray(depth, "Camera.unproject: depth"));
+    const py::ssize_t n = p.shape(0);
+    if (d.size() != n) fail("Camera.unproject: depth holds " + std::to_string(d.size()) + " values for " + std::to_string(n) + " pixels");
+    if (camera.lens() && (quantity == DepthQuantity::Window || quantity == DepthQuantity::Ndc))
+        requireDepthValue(camera, quantity, 0.5, "Camera.unproject: quantity");  // refused: no depth buffer
+    py::array_t<double> out({n, py::ssize_t(3)});
+    auto o = out.mutable_unchecked<2>();
+    const auto in = p.unchecked<2>();
+    const double* values = d.data();
+    for (py::ssize_t i = 0; i < n; ++i) {
+        const glm::dvec2 pImage(in(i, 0) + 0.5, in(i, 1) + 0.5);
+        const std::optional<glm::dvec3> pEye =
+            eyePointFromDepth(camera, {pImage.x, camera.windowYFromImageY(pImage.y)}, values[i], quantity);
+        glm::dvec3 q = pEye ? *pEye : glm::dvec3(NAN);
+        if (pEye && to == PointSpace::World) q = glm::dvec3(camera.worldFromEye * glm::dvec4(q, 1.0));
+        o(i, 0) = q.x, o(i, 1) = q.y, o(i, 2) = q.z;
+    }
+    return out;
+}
+
+py::object lensDict(const Camera& camera)
+{
+    const LensModel* lens = camera.lens();
+    if (!lens) return py::none();
+    py::dict out;
+    out["model"] = lens->spec().model;
+    for (std::size_t i = 0; i < lens->info().params.size(); ++i) out[lens->info().params[i]] = lens->spec().params[i];
+    return std::move(out);
+}
+
 std::string cameraRepr(const Camera& c)
 {
     std::ostringstream out;
@@ -113,6 +179,22 @@ direction is a unit vector, and t in [t_near, t_far] spans near to far plane.)do
         .def("point_at", &pointAt, py::arg("col"), py::arg("row"), py::arg("depth"), py::arg("quantity"),
              R"doc(The point seen at pixel (col, row) at `depth` of `quantity` (window, ndc, eye-z, distance), as
 `zcheck unproject --pixel --depth` prints it: {"eye", "world", "eye_z", "distance"}.)doc")
+        .def("project", &project, py::arg("points"), py::kw_only(), py::arg("space") = "world",
+             R"doc(Where points are seen: an (N, 2) float64 array of pixel coordinates as OpenCV counts them
+(the centre of pixel (col, row) is (col, row); x right, y down) for an (N, 3) array of points in
+`space` ("world" or "eye"), through the lens model where the camera has one (the closed form:
+what cv2.projectPoints computes). NaN where a point is not seen: at or behind a perspective
+camera's eye plane, outside a lens's field. Points beyond the image's edges keep their coordinates.)doc")
+        .def("unproject", &unproject, py::arg("pixels"), py::arg("depth"), py::arg("quantity"), py::kw_only(),
+             py::arg("space") = "world",
+             R"doc(The points seen at pixels at depths: an (N, 3) float64 array in `space` ("world" or "eye") for an
+(N, 2) array of pixel coordinates as Camera.project gives them and N depth values of `quantity`
+("eye-z", "distance"; "window", "ndc" for cameras with a depth buffer, not lens models). NaN
+where a value is a miss (0, inf, NaN, the clear value) or out of range, where a pixel has no
+ray (outside a lens's field) and where eye-z is not defined (a lens's ray 90° or more off the axis).)doc")
+        .def_property_readonly("lens", &lensDict,
+                               "The lens model as a dict (\"model\" and each parameter by name), or None for a linear "
+                               "projection.")
         .def_property_readonly("width", &Camera::width)
         .def_property_readonly("height", &Camera::height)
         .def_property_readonly(

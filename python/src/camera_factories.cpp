@@ -5,6 +5,8 @@
 // validation (Camera). Refusals are prefixed with the factory's name ("Camera.from_opencv: ").
 #include "bindings.h"
 
+#include <algorithm>
+
 #include "zcheck/camera_file.h"
 #include "zcheck/camera_sources.h"
 #include "zcheck/pose.h"
@@ -121,9 +123,33 @@ View viewFromExtrinsics(const py::object& R, const py::object& t, const py::obje
     return prefixedErrors(where, [&] { return viewFromPose(pose, direction, convention, convention, named); });
 }
 
-Camera cameraFromOpencv(py::object K, py::object R, py::object t, py::object width, py::object height,
-                        py::object camFromWorld, py::object worldFromCam, double near, double far, double pixelCenter,
-                        const std::string& convention, const std::string& depthFormat, bool reversed,
+// OpenCV's distortion coefficients as a lens (lens.h): calib3d's 4, 5, 8, 12 or 14 (k1 k2 p1 p2
+// [k3 [k4 k5 k6 [s1 s2 s3 s4 [τx τy]]]]), or cv::fisheye's 4 (k1..k4) when `fisheye`. None or all
+// zeros: the pinhole itself.
+Projection projectionWithDistortion(Projection pinhole, py::object D, bool fisheye, const std::string& where)
+{
+    if (D.is_none()) {
+        if (fisheye) fail(where + ": fisheye=True needs D, cv::fisheye's 4 coefficients (k1, k2, k3, k4)");
+        return pinhole;
+    }
+    const DoubleArray d = asDoubles(numericArray(D, where + ": D"));
+    std::vector<double> coefficients(d.data(), d.data() + d.size());
+    const std::size_t n = coefficients.size();
+    if (fisheye ? n != 4 : (n != 4 && n != 5 && n != 8 && n != 12 && n != 14))
+        fail(where + ": D holds " + std::to_string(n) + " coefficients; " +
+             (fisheye ? "cv::fisheye takes 4 (k1, k2, k3, k4)" : "OpenCV takes 4, 5, 8, 12 or 14"));
+    if (!fisheye && std::all_of(coefficients.begin(), coefficients.end(), [](double c) { return c == 0; })) return pinhole;
+    Projection p = pinhole;
+    p.type = ProjectionType::NonLinear;
+    p.lens.model = fisheye ? "opencv_fisheye" : "opencv";
+    p.lens.params = {pinhole.fx, pinhole.fy, pinhole.cx, pinhole.cy};
+    p.lens.params.insert(p.lens.params.end(), coefficients.begin(), coefficients.end());
+    return p;
+}
+
+Camera cameraFromOpencv(py::object K, py::object R, py::object t, py::object width, py::object height, py::object D,
+                        py::object camFromWorld, py::object worldFromCam, bool fisheye, double near, double far,
+                        double pixelCenter, const std::string& convention, const std::string& depthFormat, bool reversed,
                         std::pair<double, double> depthRange)
 {
     const std::string where = "Camera.from_opencv";
@@ -131,7 +157,7 @@ Camera cameraFromOpencv(py::object K, py::object R, py::object t, py::object wid
     std::tie(spec.width, spec.height) = requireImageSize(width, height, where);
     spec.convention = conventionNamed(convention, where);
     spec.depth = depthSettings(depthFormat, reversed, depthRange, where);
-    spec.projection = projectionFromK(K, pixelCenter, near, far, where);
+    spec.projection = projectionWithDistortion(projectionFromK(K, pixelCenter, near, far, where), D, fisheye, where);
     spec.view = viewFromExtrinsics(R, t, camFromWorld, worldFromCam, spec.convention, where);
     return makeCamera(spec, where);
 }
@@ -222,13 +248,18 @@ void bindCameraFactories(py::class_<Camera>& camera)
             R"doc(A camera from the camera file's JSON text; `source` begins every error message.)doc")
         .def_static("from_opencv", &cameraFromOpencv, py::arg("K"), py::arg("R") = py::none(), py::arg("t") = py::none(),
                     py::arg("width") = py::none(), py::arg("height") = py::none(), py::kw_only(),
-                    py::arg("cam_from_world") = py::none(), py::arg("world_from_cam") = py::none(),
-                    py::arg("near") = 0.1, py::arg("far") = 100.0, py::arg("pixel_center") = 0.0,
+                    py::arg("D") = py::none(), py::arg("cam_from_world") = py::none(),
+                    py::arg("world_from_cam") = py::none(), py::arg("fisheye") = false, py::arg("near") = 0.1, py::arg("far") = 100.0, py::arg("pixel_center") = 0.0,
                     py::arg("convention") = "opencv", py::arg("depth_format") = "float32", py::arg("reversed") = false,
                     py::arg("depth_range") = std::pair<double, double>(0.0, 1.0),
-                    R"doc(A pinhole camera from OpenCV-style intrinsics and extrinsics.
+                    R"doc(A camera from OpenCV-style intrinsics, distortion and extrinsics.
 
 K:            3x3 intrinsics [[fx, 0, cx], [0, fy, cy], [0, 0, 1]] in pixels (no skew).
+D=           (keyword) distortion coefficients as OpenCV orders them: calib3d's 4, 5, 8, 12 or 14
+              (k1 k2 p1 p2 [k3 [k4 k5 k6 [s1 s2 s3 s4 [tau_x tau_y]]]]), or with fisheye=True
+              cv::fisheye's 4 (k1 k2 k3 k4, Kannala-Brandt). None or all zeros: a pinhole.
+              With distortion the camera is a lens model (lens "opencv" or "opencv_fisheye"):
+              near and far are then distances along the rays, and only eye-z and distance exist.
 R, t:         cam_from_world = [R | t]: x_cam = R @ x_world + t (OpenCV's rvec/tvec, COLMAP's
               qvec/tvec). Or give instead, as a keyword, exactly one of
 cam_from_world=  4x4 or 3x4 [R | t], the same transform, or

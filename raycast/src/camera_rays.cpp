@@ -5,7 +5,7 @@
 namespace zcheck {
 
 CameraRays::CameraRays(const Camera& camera)
-    : camera_(camera), fromMatrix_(camera.spec().projection.type == ProjectionType::Matrix)
+    : camera_(camera), lens_(camera.lens()), fromMatrix_(camera.spec().projection.type == ProjectionType::Matrix)
 {
     const CameraSpec& spec = camera.spec();
     const Convention& c = spec.convention;
@@ -23,7 +23,7 @@ CameraRays::CameraRays(const Camera& camera)
         up_ = glm::cross(right_, forward_);
         eye_ = spec.view.eye;
     }
-    if (fromMatrix_) return;
+    if (fromMatrix_ || lens_) return;
     // The depth mapping of the header, folded into window = A + B/d (perspective) or A + B·d
     // (parallel): z_ndc = a + b/d or a + b·d, then window = rangeMin + (z_ndc − ndcZMin)·s.
     const Projection& p = spec.projection;
@@ -84,13 +84,22 @@ void CameraRays::eyeRay(const glm::dvec2& pImage, glm::dvec3& origin, glm::dvec3
         }
         break;
     }
-    case ProjectionType::Matrix: break;  // no definition but the matrix: see worldRay
+    case ProjectionType::Matrix:     // no definition but the matrix: see worldRay
+    case ProjectionType::NonLinear:  // the lens's own: see worldRay
+        break;
     }
 }
 
-EyePlaneRay CameraRays::worldRay(const glm::dvec2& pImage) const
+std::optional<EyePlaneRay> CameraRays::worldRay(const glm::dvec2& pImage) const
 {
     if (fromMatrix_) return worldEyePlaneRayThroughWindow(camera_, {pImage.x, camera_.windowYFromImageY(pImage.y)});
+    if (lens_) {
+        const std::optional<glm::dvec3> dLens = lens_->directionFromImage(pImage);
+        if (!dLens) return std::nullopt;
+        // The lens frame is x right, y down, z forward: world = x·right − y·up + z·forward.
+        const Projection& p = camera_.spec().projection;
+        return EyePlaneRay{eye_, glm::normalize(dLens->x * right_ - dLens->y * up_ + dLens->z * forward_), p.near, p.far};
+    }
     glm::dvec3 origin, direction;
     eyeRay(pImage, origin, direction);
     // Into world space: eye-plane point and direction along the view's axes.
@@ -106,7 +115,7 @@ EyePlaneRay CameraRays::worldRay(const glm::dvec2& pImage) const
 
 std::optional<AffineRays> CameraRays::affine() const
 {
-    if (fromMatrix_) return std::nullopt;
+    if (fromMatrix_ || lens_) return std::nullopt;
     // Each model's ray is affine in the image point: three points fix it.
     glm::dvec3 o00, d00, o10, d10, o01, d01;
     eyeRay({0.0, 0.0}, o00, d00);

@@ -330,7 +330,13 @@ ZCHECK_ALWAYS_INLINE inline void raysOfPacket(PacketInFlight& p, const std::opti
         for (int k = 0; k < kPacketRays; ++k) ray.tnear[k] = nearT, ray.tfar[k] = farT;
     } else {
         for (int k = 0; k < kPacketRays; ++k) {
-            const EyePlaneRay r = cameraRays.worldRay(p.pImage(k));
+            if (!p.valid[k]) continue;
+            const std::optional<EyePlaneRay> ray1 = cameraRays.worldRay(p.pImage(k));
+            if (!ray1) {  // outside a lens's field: no ray, a miss (embreeLanesOfPacket fills the lane)
+                p.valid[k] = 0;
+                continue;
+            }
+            const EyePlaneRay& r = *ray1;
             for (int c = 0; c < 3; ++c) p.lane[c][k] = r.origin[c], p.lane[3 + c][k] = r.direction[c];
             // A raw matrix whose near plane crosses the eye plane puts it behind the eye at
             // some pixels: the camera sees nothing behind its eye plane (and Embree takes no
@@ -436,7 +442,9 @@ ZCHECK_ALWAYS_INLINE inline void writePacketPixels(const PacketInFlight& p, cons
     alignas(64) std::uint32_t primitiveOf[kPacketRays];
     const bool closedForm = cameraRays.windowDepths(eyeZ, kPacketRays, depthOf);
     for (int k = 0; k < kPacketRays; ++k) primitiveOf[k] = p.hit(k) ? p.packet.hit.primID[k] : kNoPrimitive;
-    if (closedForm) {
+    if (cameraRays.lens()) {  // no window depth: the distance along the unit ray
+        for (int k = 0; k < kPacketRays; ++k) depthOf[k] = p.hit(k) ? t[k] : setUp.clearDepth;
+    } else if (closedForm) {
         for (int k = 0; k < kPacketRays; ++k) depthOf[k] = p.hit(k) ? depthOf[k] : setUp.clearDepth;
     } else {
         for (int k = 0; k < kPacketRays; ++k)

@@ -26,7 +26,7 @@ AffineRays yardstickRays(const Camera& camera)
     const CameraRays cameraRays(camera);
     if (const std::optional<AffineRays> rays = cameraRays.affine()) return *rays;
     auto at = [&](double x, double y, glm::dvec3& origin, glm::dvec3& direction) {
-        const EyePlaneRay r = cameraRays.worldRay({x, y});
+        const EyePlaneRay r = *cameraRays.worldRay({x, y});  // a raw matrix has a ray at every point
         origin = r.origin, direction = r.tNear * r.direction;
     };
     glm::dvec3 o00, d00, o10, d10, o01, d01;

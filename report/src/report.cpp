@@ -192,6 +192,23 @@ nlohmann::json toJson(const CheckReport& report)
           {"tile_by_tile", report.timings.tileByTile}}},
         {"consistent", c.consistent()},
     };
+    if (report.lens) {  // a lens model's check: no raster; its two directions
+        const LensCheck& lens = *report.lens;
+        document["timings_ms"].erase("raster");
+        document["timings_ms"].erase("tile_by_tile");
+        document["lens"] = {
+            {"model", lens.model},
+            {"field_angle_deg", lens.fieldAngleDeg},
+            {"in_field", lens.inField},
+            {"outside_field", lens.outsideField},
+            {"hits", lens.hits},
+            {"round_trip", {{"max_px", lens.roundTripMaxPx}, {"bound_px", LensCheck::kRoundTripBoundPx},
+                            {"col", lens.roundTripCol}, {"row", lens.roundTripRow}, {"beyond", lens.roundTripFailures}}},
+            {"forward", {{"max_px", lens.forwardMaxPx}, {"bound_px", LensCheck::kForwardBoundPx},
+                         {"col", lens.forwardCol}, {"row", lens.forwardRow}, {"beyond", lens.forwardFailures}}},
+            {"raster", "does not apply: a lens model has no projection matrix to rasterize through"},
+        };
+    }
     if (report.secondRoute == "map") {  // verify: no raster was drawn; the map's errors in its units
         document["timings_ms"].erase("raster");
         document["timings_ms"].erase("tile_by_tile");
@@ -206,8 +223,59 @@ nlohmann::json toJson(const CheckReport& report)
 
 std::string checkReportJson(const CheckReport& report) { return prettyJson(toJson(report)); }
 
+namespace {
+
+// A lens model's check (checker.h, LensCheck): its own table in place of the routes' classes.
+std::string formatLensCheck(const CheckReport& report)
+{
+    const LensCheck& lens = *report.lens;
+    const ComparisonReport& c = report.comparison;
+    const CameraSpec& cam = report.camera;
+    const std::int64_t total = std::int64_t(c.width) * c.height;
+    std::ostringstream out;
+    char line[320];
+    out << "zcheck " << kVersion << " — lens model: its two directions and the ray route (Embree)\n";
+    out << "scene      " << report.scene << "  (" << report.triangles << " triangles)\n";
+    for (const std::string& warning : report.warnings) out << "warning    " << warning << "\n";
+    std::snprintf(line, sizeof line, "camera     %s, lens model %s, %dx%d, near %g, far %g (distances along the rays)\n",
+                  cam.convention.name.c_str(), lens.model.c_str(), cam.width, cam.height, cam.projection.near,
+                  cam.projection.far);
+    out << line;
+    std::snprintf(line, sizeof line, "field      up to %.4g° from the axis\n", lens.fieldAngleDeg);
+    out << line;
+    out << "\npixels                             count\n";
+    auto row = [&](const char* label, std::int64_t n) {
+        std::snprintf(line, sizeof line, "  %-28s %9lld  %s\n", label, static_cast<long long>(n), percent(n, total).c_str());
+        out << line;
+    };
+    row("in the lens's field", lens.inField);
+    row("  ray hits the scene", lens.hits);
+    row("  ray misses", lens.inField - lens.hits);
+    row("outside the lens's field", lens.outsideField);
+    out << "\n";
+    std::snprintf(line, sizeof line, "round trip  pixel -> ray -> pixel over the field: max %.3g px (bound %g px)", lens.roundTripMaxPx,
+                  LensCheck::kRoundTripBoundPx);
+    out << line;
+    if (lens.roundTripRow >= 0) out << " at (" << lens.roundTripCol << ", " << lens.roundTripRow << ")";
+    out << "; " << lens.roundTripFailures << " beyond\n";
+    std::snprintf(line, sizeof line, "forward     traced hit -> pixel: max %.3g px (bound %g px)", lens.forwardMaxPx,
+                  LensCheck::kForwardBoundPx);
+    out << line;
+    if (lens.forwardRow >= 0) out << " at (" << lens.forwardCol << ", " << lens.forwardRow << ")";
+    out << "; " << lens.forwardFailures << " beyond\n";
+    out << "raster     does not apply: a lens model has no projection matrix to rasterize through\n";
+    std::snprintf(line, sizeof line, "\ntimings    BVH build %.1f ms, trace %.1f ms, compare %.1f ms\n", report.timings.bvhBuildMs,
+                  report.timings.traceMs, report.timings.compareMs);
+    out << line;
+    out << "verdict    " << (c.consistent() ? "CONSISTENT" : "INCONSISTENT") << "\n";
+    return out.str();
+}
+
+}  // namespace
+
 std::string formatSummary(const CheckReport& report, const std::string& comparing)
 {
+    if (report.lens) return formatLensCheck(report);
     const ComparisonReport& c = report.comparison;
     const CameraSpec& cam = report.camera;
     const std::int64_t total = std::int64_t(c.width) * c.height;

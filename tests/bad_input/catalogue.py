@@ -607,6 +607,8 @@ def cam_case(name, content, expect, cmd="check", limit=20.0, fname="c.json"):
         argv = ["precision", "--camera", fname]
     elif cmd == "unproject":
         argv = ["unproject", "--camera", fname, "--pixel", "1,1"]
+    elif cmd == "unproject-depth":
+        argv = ["unproject", "--camera", fname, "--pixel", "1,1", "--depth", "0.5", "--quantity", "window"]
     elif cmd == "export":
         argv = ["export", "--camera", fname, "-o", "out.exr"]
     elif cmd == "verify":
@@ -632,7 +634,38 @@ cam_case("duplicate-top-level-key", GOOD_CAM.replace('"convention": "opengl"',
          rf"{C}.*'convention'.*twice")
 cam_case("duplicate-key-in-projection", GOOD_CAM.replace('"near": 0.1', '"near": 0.1, "near": 0.5'),
          rf"{C}.*'(projection\.)?near'.*twice")
-cam_case("unknown-top-level-key", camera(lens=50), rf"{C}.*unknown key 'lens'")
+cam_case("unknown-top-level-key", camera(lense=50), rf"{C}.*unknown key 'lense'")
+# Lens models (lens.h): refused with the model, the parameter and the rule.
+PINHOLE64 = {"type": "pinhole", "fx": 60, "fy": 60, "cx": 31.5, "cy": 23.5, "near": 0.1, "far": 100}
+cam_case("lens-with-perspective", camera(lens={"model": "opencv", "k1": 0.1}),
+         rf"{C}.*'lens' goes with a pinhole projection")
+cam_case("lens-unknown-model", camera_with(PINHOLE64, lens={"model": "brown"}), rf"{C}.*'lens.model' must be one of")
+cam_case("lens-model-missing", camera_with(PINHOLE64, lens={"k1": 0.1}), rf"{C}.*'lens.model' is missing")
+cam_case("lens-huge-coefficient", camera_with(PINHOLE64, lens={"model": "opencv", "k1": -1e300}),
+         rf"{C}.*lens model opencv.*folds")
+cam_case("lens-folds-inside-image", camera_with(PINHOLE64, lens={"model": "opencv", "k1": -1.5}),
+         rf"{C}.*lens model opencv folds \(is no longer one-to-one\).*inside the image")
+cam_case("lens-fx-twice", camera_with(PINHOLE64, lens={"model": "opencv_fisheye", "fx": 60}),
+         rf"{C}.*'lens.fx' is the pinhole projection's")
+cam_case("lens-unknown-parameter", camera_with(PINHOLE64, lens={"model": "opencv_fisheye", "k5": 0.1}),
+         rf"{C}.*unknown key 'lens.k5'")
+cam_case("lens-parameter-not-a-number", camera_with(PINHOLE64, lens={"model": "opencv_fisheye", "k1": "0.1"}),
+         rf"{C}.*'lens.k1' must be a number")
+cam_case("lens-fov-omega-out-of-range", camera_with(PINHOLE64, lens={"model": "fov", "omega": 7}),
+         rf"{C}.*'omega' must lie in \(0, π\)")
+cam_case("lens-panorama-over-360", camera_with({"near": 0.1, "far": 100}, lens={
+    "model": "equirectangular", "lon_min_deg": -180, "lon_max_deg": 200, "lat_min_deg": -90, "lat_max_deg": 90}),
+         rf"{C}.*'lon_max_deg' must be at most 360°")
+cam_case("lens-panorama-latitude-beyond-pole", camera_with({"near": 0.1, "far": 100}, lens={
+    "model": "equirectangular", "lon_min_deg": -180, "lon_max_deg": 180, "lat_min_deg": -91, "lat_max_deg": 90}),
+         rf"{C}.*'lat_min_deg' must be at least -90")
+cam_case("lens-panorama-with-pinhole", camera_with(PINHOLE64, lens={
+    "model": "equirectangular", "lon_min_deg": -180, "lon_max_deg": 180, "lat_min_deg": -90, "lat_max_deg": 90}),
+         rf"{C}.*does not take a pinhole's fx")
+cam_case("lens-window-quantity", camera_with(PINHOLE64, lens={"model": "opencv_fisheye", "k1": 0.01}),
+         r"--depth 0\.5 \(window\): a lens model \(opencv_fisheye\) has no depth buffer", cmd="unproject-depth")
+cam_case("lens-pixel-outside-field", camera_with(PINHOLE64, lens={"model": "opencv", "k1": -0.9}),
+         r"image point \(1\.5, 1\.5\) is outside the lens model's field \(opencv", cmd="unproject")
 cam_case("unknown-nested-key", camera(**{"projection.fov": 60}), rf"{C}.*unknown key 'projection\.fov'")
 cam_case("near-is-string", camera(**{"projection.near": "0.1"}), rf"{C}.*projection\.near.*(number|string)")
 cam_case("convention-is-number", camera(convention=5), rf"{C}.*convention.*(string|number)")

@@ -28,6 +28,7 @@
 #include "zcheck/ray_renderer.h"
 #include "zcheck/scene.h"
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -69,6 +70,27 @@ struct MapErrors {
     double worstMap = 0, worstTrue = 0;
 };
 
+// A lens model's check (lens.h). A lens has no projection matrix, so there is no raster route:
+// its two directions are checked against each other and against the trace. Over the field, every
+// pixel centre's ray projected back lands on the centre (the round trip, ≤ kRoundTripBoundPx), and
+// every traced hit point projected forward by the closed form lands on its own pixel centre
+// (≤ kForwardBoundPx). Pixels outside the field have no ray: counted, never traced.
+struct LensCheck {
+    static constexpr double kRoundTripBoundPx = 1e-9;
+    static constexpr double kForwardBoundPx = 1e-6;
+    std::string model;                 // the lens model's name
+    double fieldAngleDeg = 0;          // the field's largest angle from the axis
+    std::int64_t inField = 0;          // pixel centres with a ray
+    std::int64_t outsideField = 0;     // pixel centres outside the lens's field: no ray
+    std::int64_t hits = 0;             // of the rays, those that hit the scene
+    double roundTripMaxPx = 0;         // max |image(ray(p)) − p| over the field
+    int roundTripCol = -1, roundTripRow = -1;
+    std::int64_t roundTripFailures = 0;  // pixels beyond kRoundTripBoundPx (or whose ray has no image)
+    double forwardMaxPx = 0;           // max |image(hit) − p| over the hits
+    int forwardCol = -1, forwardRow = -1;
+    std::int64_t forwardFailures = 0;  // hits beyond kForwardBoundPx
+};
+
 // What was compared, how long it took, what was found (report.h prints it).
 struct CheckReport {
     std::string scene;              // scene name as addressed
@@ -84,6 +106,7 @@ struct CheckReport {
     MapErrors mapErrors;                // verify: the map's errors in its units; check: nothing compared
     std::string outOfRangeRule;         // verify: what the map's quantity holds ("window map holds values
                                         // in [0, 1], the camera's depth range"), for values out of range
+    std::optional<LensCheck> lens;      // check of a lens model's camera: what was checked instead of a raster
 
     // Fills what the report says of its inputs: the scene (name, triangles, warnings), the
     // camera and the tolerance. Checker::check and verifying a map (verify.h) share it.
@@ -123,7 +146,9 @@ public:
     const Scene& scene() const { return scene_; }
     double bvhBuildMilliseconds() const { return rays_.buildMilliseconds(); }
 
-    // Both routes through `camera`, compared.
+    // Both routes through `camera`, compared; for a lens model's camera, its two directions and
+    // the trace (LensCheck), reported in the same form (a hit within the bounds agrees, one beyond
+    // them is a depth error, a pixel outside the field a miss).
     CheckResult check(const Camera& camera, const CheckOptions& options = {}) const;
 
     // One route's render: window depth and primitive per pixel (row 0 at the top).
@@ -141,6 +166,7 @@ public:
 
 private:
     CheckResult checkTileByTile(const Camera& camera, const CheckOptions& options) const;
+    CheckResult checkLens(const Camera& camera, const CheckOptions& options) const;
 
     Scene scene_;
     RayRenderer rays_;

@@ -17,6 +17,13 @@
 // Units: angles in degrees at the interface, lengths in scene units, near and far are
 // positive distances along the viewing direction (eye-z).
 //
+// A camera whose projection is a lens model (ProjectionType::NonLinear: distortion, fisheyes,
+// panoramas) has no projection matrix and no depth buffer: lens() maps directions to image points
+// and back, its near and far are distances along the rays, and only the eye-z and distance
+// quantities exist. Its matrices are those of its linear part (the pinhole of its fx, fy, cx, cy;
+// a 90° view for a panorama), kept so that a matrix is always defined, never used to project:
+// whatever projects asks lens() first.
+//
 // Cameras are built by a validating constructor: a NaN, a degenerate view, near ≤ 0,
 // far ≤ near, an empty frustum or an image outside 1…16384 pixels per side (or over 2^25
 // pixels in all) throws Error naming the parameter. Nothing is silently repaired. A Camera
@@ -27,10 +34,12 @@
 //   spec.view = zcheck::View::lookAt({0, 1, 3}, {0, 0, 0}, {0, 1, 0});
 //   const zcheck::Camera camera(spec);                          // camera.clipFromWorld, ...
 #include "zcheck/convention.h"
+#include "zcheck/lens.h"
 
 #include <glm/glm.hpp>
 
 #include <cmath>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -45,6 +54,7 @@ enum class ProjectionType {
     Pinhole,       // OpenCV intrinsics fx, fy, cx, cy in pixels, near, far
     Lens,          // physical lens: focal_mm on a sensor sensor_width_mm wide (horizontal fit)
     Matrix,        // a raw clipFromEye matrix
+    NonLinear,     // a lens model (lens.h): distortion, fisheye, panorama; Projection::lens holds it
 };
 
 std::string toString(ProjectionType type);
@@ -69,8 +79,13 @@ struct Projection {
     double focalMm = 50.0, sensorWidthMm = 36.0;
     // matrix: the convention's clip space from the convention's eye space, p' = M·p.
     glm::dmat4 clipFromEye{1.0};
+    // non-linear: the lens model and its parameters (lens.h), fx, fy, cx, cy among them where
+    // the model has them.
+    LensSpec lens;
     double near = 0.1;      // > 0 (not used by matrix: derived from it)
     double far = 100.0;     // > near, or +inf for the perspective types (infinite far plane)
+    // A non-linear camera has no near or far plane: near and far bound the distance along each
+    // ray (the `distance` quantity), a sphere around the centre of projection.
 
     // Rays meet at a centre of projection (perspective, frustum, pinhole, lens; a matrix
     // whose w depends on z) rather than running parallel.
@@ -136,6 +151,14 @@ public:
     explicit Camera(const CameraSpec& spec);  // validates; throws Error naming the parameter
 
     const CameraSpec& spec() const { return spec_; }
+    // The lens model of a non-linear camera; nullptr for every linear projection.
+    const LensModel* lens() const { return lens_.get(); }
+    // The camera frame of lens.h (x right, y down, z forward) from the convention's eye space.
+    glm::dvec3 lensFrameFromEye(const glm::dvec3& vEye) const
+    {
+        return {vEye.x, -spec_.convention.eyeUpY * vEye.y, spec_.convention.eyeForwardZ * vEye.z};
+    }
+    glm::dvec3 eyeFromLensFrame(const glm::dvec3& vLens) const { return lensFrameFromEye(vLens); }  // an involution
     const Convention& convention() const { return spec_.convention; }
     const DepthSettings& depth() const { return spec_.depth; }
     int width() const { return spec_.width; }
@@ -166,7 +189,8 @@ public:
     double windowDepthNear() const { return windowDepthFromNdcZ(ndcZNear()); }
     double windowDepthFar() const { return windowDepthFromNdcZ(ndcZFar()); }
     // The value a cleared depth buffer holds: the far end of the range (rangeMin when reversed).
-    double clearDepth() const { return quantizeDepth(spec_.depth.format, windowDepthFar()); }
+    // A lens camera's ray route holds distances, and a miss is +inf.
+    double clearDepth() const { return lens_ ? INFINITY : quantizeDepth(spec_.depth.format, windowDepthFar()); }
     // The depth test: LESS, or GREATER with reversed-Z.
     bool passesDepthTest(double candidate, double stored) const
     {
@@ -204,6 +228,7 @@ private:
     void requireRepresentable() const;
 
     CameraSpec spec_;
+    std::shared_ptr<const LensModel> lens_;
     double left_ = 0, right_ = 0, bottom_ = 0, top_ = 0;
     double near_ = 0, far_ = 0;
 };

@@ -65,7 +65,24 @@ EyePlaneRay eyePlaneRayFrom(const Ray& ray);
 // In world space, for the tracer.
 EyePlaneRay worldEyePlaneRayThroughWindow(const Camera& camera, const glm::dvec2& pWindow);
 
-// Window point (x, y, window depth) → eye-space point, and the forward map.
+// The unit viewing direction through a window point, eye space (for a parallel projection, the
+// rays' common direction); empty only outside a lens model's field.
+std::optional<glm::dvec3> eyeDirectionThroughWindow(const Camera& camera, const glm::dvec2& pWindow);
+// Throws Error "image point (x, y) is outside the lens model's field (...)" for a window point of
+// a lens camera that has no ray; nothing for every other point and camera.
+void requireRayThroughWindow(const Camera& camera, const glm::dvec2& pWindow);
+// The viewing ray through a window point parametrized from the eye plane (eyePlaneRayFrom of
+// eyeRayThroughWindow; a lens's from its centre, t the distance); NaN outside a lens's field.
+EyePlaneRay eyePlaneRayThroughWindow(const Camera& camera, const glm::dvec2& pWindow);
+// The image point (camera.h: x right, y down from the top-left corner, pixel centres at +½) where
+// an eye-space point is seen, through the lens for a lens model; empty where it is not seen (at or
+// behind a perspective camera's eye plane, outside a lens's field). Points beyond the image's
+// edges still have image points.
+std::optional<glm::dvec2> imageFromEye(const Camera& camera, const glm::dvec3& pEye);
+
+// Window point (x, y, window depth) → eye-space point, and the forward map. (A lens model has no
+// window depth: for its camera, everything below that takes a window point reads only its x and y,
+// and rays come from the lens — from the near to the far distance along each.)
 glm::dvec3 eyeFromWindow(const Camera& camera, const glm::dvec3& pWindow);
 glm::dvec3 windowFromEye(const Camera& camera, const glm::dvec3& pEye);
 glm::dvec3 windowFromWorld(const Camera& camera, const glm::dvec3& pWorld);

@@ -23,6 +23,9 @@
 // None of this reads Camera's matrices, nor the camera's resolved near-plane window. A
 // raw-matrix projection has no other definition: its rays and depths necessarily come from
 // the matrix (the inverse-projection module), as the raster route's do.
+//   lens model   the lens's own inverse (lens.h): a unit direction per image point, none outside
+//                the lens's field; near and far are distances along it, and the route's depth
+//                is the distance (there is no window depth)
 #include "zcheck/camera.h"
 #include "zcheck/inverse_projection.h"
 
@@ -48,13 +51,17 @@ class CameraRays {
 public:
     explicit CameraRays(const Camera& camera);
 
-    // The rays as an affine function of the image point; empty for a raw-matrix projection.
+    // The rays as an affine function of the image point; empty for a raw-matrix projection and
+    // a lens model.
     std::optional<AffineRays> affine() const;
+    // A lens model's camera (its route's depth is the distance along a unit ray).
+    const LensModel* lens() const { return lens_; }
 
     // The viewing ray through image point pImage (pixels; x right, y down from the top-left
     // corner), in world space: origin on the eye plane, unit direction, [tNear, tFar]
-    // between the near and far planes; t is the `distance` quantity.
-    EyePlaneRay worldRay(const glm::dvec2& pImage) const;
+    // between the near and far planes; t is the `distance` quantity. Empty only for a lens
+    // model's point outside its field.
+    std::optional<EyePlaneRay> worldRay(const glm::dvec2& pImage) const;
     // Eye-space point (the convention's eye axes) of a world point.
     glm::dvec3 eyeFromWorld(const glm::dvec3& pWorld) const;
     // Eye-z (along the viewing axis) of a world point.
@@ -148,6 +155,7 @@ private:
     glm::dvec3 worldFromEyeVector(const glm::dvec3& v) const { return v.x * right_ + v.y * up_ - v.z * forward_; }
 
     const Camera& camera_;
+    const LensModel* lens_;                // a lens model's camera: its own rays
     bool fromMatrix_;                     // raw-matrix projection: the inverse-projection module
     bool parallel_ = false;               // orthographic or oblique: window depth affine in eye-z
     double depthA_ = 0, depthB_ = 0;      // window depth = A + B/eyeZ, or A + B·eyeZ when parallel

@@ -1,0 +1,154 @@
+#pragma once
+// Lens models: central cameras whose projection is not linear — lens distortion, fisheyes,
+// panoramas. One model, written once; every importer, the rays, verify, export, unproject,
+// remap, the writers and Python use it.
+//
+// Spaces
+//   camera frame — OpenCV's and COLMAP's: x right, y down, z forward (Camera turns a
+//                  convention's eye space into it: x, −eyeUpY·y, eyeForwardZ·z)
+//   image        — zcheck's image coordinates (camera.h): x from the left edge, y from the top
+//                  edge, pixel (col,row) centred at (col + ½, row + ½)
+//   cx, cy       — a model's principal point is OpenCV's pixel coordinates, where the centre of
+//                  the top-left pixel is (0,0), as the pinhole projection's is. Importers of
+//                  formats that count from the corner (COLMAP, nerfstudio) subtract ½.
+//
+// Every radially symmetric model is one chain, each stage written once:
+//   direction d (unit)  → θ = angle from +z, φ = atan2(d.y, d.x)
+//   radial profile      m = ρ(θ)·(cos φ, sin φ)          ρ: tan θ, θ, 2 sin(θ/2), FOV, division,
+//                                                         unified, EUCM, double sphere
+//   plane distortion    m' = m·N(r²)/D(r²) + T(m) + S(r²), r = |m|   (N up to r¹², D up to r⁶,
+//                       T tangential, S thin prism; T and S on m·N/D for FISHEYE624), then
+//                       OpenCV's tilt (τx, τy)
+//   affine              u = fx·m'x + skew·m'y + cx,  v = fy·m'y + cy,  image = (u + ½, v + ½)
+// The equirectangular panorama maps longitude atan2(d.x, d.z) and latitude atan2(−d.y,
+// hypot(d.x, d.z)) linearly onto the image instead.
+//
+// Inverse: the profile's inverse in closed form (atan, asin, Mei's, Khomutenko's, Usenko's);
+// the plane distortion's by Newton's method on its own Jacobian — on the radius alone when it
+// is purely radial (bracketed, so it cannot leave the valid interval), in the plane otherwise.
+// Convergence test: the forward map of the result lands within kInverseTolerancePx of the pixel.
+//
+// Valid field: the directions within θ ≤ fieldAngle() — where the profile is defined and the
+// whole chain is one-to-one (the radial map r ↦ |m'| increases, the plane distortion's Jacobian
+// determinant stays positive on a polar sample of the disc) — and for the panorama its longitude
+// and latitude ranges. Outside it a pixel has no ray and a direction no pixel: their own class,
+// never a garbage ray. A lens that folds before reaching the image's edge along the principal
+// point's row or column is refused when the camera is built.
+//
+// Models are data: lensModels() lists them with their parameters in order; a model's
+// parameters are given by name (missing trailing ones are 0 where the row says so).
+//
+//   zcheck::LensSpec spec{"opencv_fisheye", {fx, fy, cx, cy, k1, k2, k3, k4}};
+//   const zcheck::LensModel lens(spec, 1920, 1080);           // validates; throws Error
+//   if (auto dCam = lens.directionFromImage({960.5, 540.5})) ...  // unit ray, camera frame
+#include <glm/glm.hpp>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace zcheck {
+
+// What a camera file or importer says: a model's name and its parameters in the model's order.
+struct LensSpec {
+    std::string model;
+    std::vector<double> params;
+
+    bool operator==(const LensSpec& other) const { return model == other.model && params == other.params; }
+    bool operator!=(const LensSpec& other) const { return !(*this == other); }
+};
+
+// One model as data: its name, where it comes from, its parameters and what they mean.
+struct LensModelInfo {
+    const char* name;       // "opencv_fisheye"
+    const char* title;      // "OpenCV fisheye (Kannala–Brandt)"
+    const char* formula;    // the forward map, one line, for docs and --help
+    std::vector<const char*> params;  // in order: "fx", "fy", "cx", "cy", "k1", ...
+    int required;           // the first `required` parameters must be given; the rest default to 0
+    bool hasFocal;          // fx, fy, cx, cy are its first four parameters (all but panoramas)
+};
+
+const std::vector<LensModelInfo>& lensModels();
+// The row named `name`; nullptr for none.
+const LensModelInfo* lensModelNamed(const std::string& name);
+// "opencv, opencv_fisheye, ...": for messages.
+std::string lensModelNames();
+
+// A validated lens model for an image of width × height pixels. Immutable; share freely.
+class LensModel {
+public:
+    // Throws Error "lens model <name>: <param> ..." for an unknown model, a wrong number of
+    // parameters, a value not finite or outside the model's range (fx, fy > 0; FOV ω in (0, π);
+    // unified ξ ≥ 0; EUCM α ∈ [0, 1], β > 0; double sphere α ∈ [0, 1], ξ in (−1, 1); panorama
+    // ranges within 360° × 180°), a field of no width, and a lens that folds inside the image.
+    LensModel(const LensSpec& spec, int width, int height);
+
+    const LensSpec& spec() const { return spec_; }
+    const LensModelInfo& info() const { return *info_; }
+    // The parameter named `name` (0 for one the model does not have).
+    double param(const std::string& name) const;
+
+    // The image point of a direction in the camera frame (any length > 0); empty outside the
+    // valid field.
+    std::optional<glm::dvec2> imageFromDirection(const glm::dvec3& dCam) const;
+    // The unit direction, camera frame, through image point pImage; empty outside the valid
+    // field (or where the inverse does not converge: then the pixel is outside it too).
+    std::optional<glm::dvec3> directionFromImage(const glm::dvec2& pImage) const;
+
+    // The largest angle from the axis (radians) the field reaches; for the panorama, π.
+    double fieldAngle() const { return fieldAngle_; }
+    // Whether a direction's angle from the axis can exceed 90°, where eye-z is not defined.
+    bool seesBehind() const { return fieldAngle_ > kHalfPi; }
+    bool isPanorama() const { return panorama_; }
+
+    // The inverse's convergence test, in pixels (module comment).
+    static constexpr double kInverseTolerancePx = 1e-10;
+    static constexpr double kHalfPi = 1.57079632679489661923;
+
+    // The evaluated terms of the chain (module comment), public for tests and the fits that
+    // perturb them; built from the spec by the model's row.
+    enum class Profile { Perspective, Equidistant, Equisolid, Fov, Division, Unified, Eucm, DoubleSphere };
+    struct Terms {
+        Profile profile = Profile::Perspective;
+        double profileA = 0, profileB = 0;  // FOV ω; division k; unified ξ; EUCM α, β; double sphere ξ, α
+        double numerator[6] = {0, 0, 0, 0, 0, 0};  // N(r²) = 1 + Σ a_i r^(2i)
+        double denominator[3] = {0, 0, 0};         // D(r²) = 1 + Σ b_i r^(2i)
+        double p1 = 0, p2 = 0;                     // OpenCV's tangential pair
+        double s[4] = {0, 0, 0, 0};                // OpenCV's thin prism s1..s4
+        double tauX = 0, tauY = 0;                 // OpenCV's tilt, radians
+        bool tangentialAfterRadial = false;        // FISHEYE624: T and S on m·N/D
+        double fx = 1, fy = 1, skew = 0, cx = 0, cy = 0;
+        // panorama: longitude and latitude ranges, radians
+        double lonMin = 0, lonMax = 0, latMin = 0, latMax = 0;
+    };
+    const Terms& terms() const { return terms_; }
+
+    // Each stage on its own (module comment), for tests: ρ(θ) and its inverse; the plane
+    // distortion m ↦ m' (before the affine) and its inverse (empty where Newton fails).
+    double profileRadius(double theta) const;
+    double profileAngle(double radius) const;
+    glm::dvec2 distortPlane(const glm::dvec2& m) const;
+    std::optional<glm::dvec2> undistortPlane(const glm::dvec2& mDistorted) const;
+
+private:
+    bool planeIsIdentity() const;
+    bool planeIsRadial() const;
+    double radialFactor(double r2) const;  // N(r²)/D(r²)
+    double distortedRadius(double r) const { return r * radialFactor(r * r); }
+    glm::dmat2 planeJacobian(const glm::dvec2& m) const;
+    void findField();
+    bool profileEndsAt(double theta) const;  // whether θ is at (or past) the profile's own end
+    void requireNoFoldInImage() const;
+
+    LensSpec spec_;
+    int width_ = 0, height_ = 0;
+    const LensModelInfo* info_ = nullptr;
+    Terms terms_;
+    bool panorama_ = false;
+    double fieldAngle_ = 0;    // θ_max
+    double fieldRadius_ = 0;   // ρ(θ_max): the undistorted plane's radius at the field's edge
+    bool fieldEndsInFold_ = false;  // the field ends where the distortion folds, not where the profile ends
+    glm::dmat3 tilt_{1.0}, untilt_{1.0};
+};
+
+}  // namespace zcheck

@@ -1,0 +1,322 @@
+// Lens models (core/include/zcheck/lens.h): each model's two directions against each other over
+// random coefficient sets, against hand-computed projections, and the refusals. OpenCV's own
+// implementation is the oracle in tests/python/test_lens_opencv.py.
+#include "zcheck/camera.h"
+#include "zcheck/camera_file.h"
+#include "zcheck/checker.h"
+#include "zcheck/error.h"
+#include "zcheck/lens.h"
+#include "zcheck/scene.h"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <functional>
+#include <random>
+
+using namespace zcheck;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr int kWidth = 1280, kHeight = 960;
+
+// A model's parameters drawn from realistic ranges.
+using Draw = std::function<std::vector<double>(std::mt19937_64&)>;
+
+double uniform(std::mt19937_64& rng, double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); }
+
+std::vector<double> focal(std::mt19937_64& rng)
+{
+    const double f = uniform(rng, 350, 900);
+    return {f, f * uniform(rng, 0.98, 1.02), kWidth / 2.0 - 0.5 + uniform(rng, -30, 30),
+            kHeight / 2.0 - 0.5 + uniform(rng, -30, 30)};
+}
+
+std::vector<double> with(std::vector<double> head, std::initializer_list<double> tail)
+{
+    head.insert(head.end(), tail);
+    return head;
+}
+
+struct ModelDraw {
+    const char* model;
+    Draw draw;
+};
+
+const std::vector<ModelDraw>& draws()
+{
+    static const std::vector<ModelDraw> table = {
+        {"opencv",
+         [](std::mt19937_64& r) {
+             return with(focal(r), {uniform(r, -0.3, 0.1), uniform(r, -0.05, 0.1), uniform(r, -1e-3, 1e-3),
+                                    uniform(r, -1e-3, 1e-3), uniform(r, -0.01, 0.01), uniform(r, -0.05, 0.05),
+                                    uniform(r, -0.02, 0.02), uniform(r, -0.01, 0.01), uniform(r, -1e-3, 1e-3),
+                                    uniform(r, -1e-4, 1e-4), uniform(r, -1e-3, 1e-3), uniform(r, -1e-4, 1e-4),
+                                    uniform(r, -0.02, 0.02), uniform(r, -0.02, 0.02)});
+         }},
+        {"opencv_fisheye",
+         [](std::mt19937_64& r) {
+             return with(focal(r), {uniform(r, -0.05, 0.05), uniform(r, -0.02, 0.02), uniform(r, -0.005, 0.005),
+                                    uniform(r, -0.001, 0.001)});
+         }},
+        {"thin_prism_fisheye",
+         [](std::mt19937_64& r) {
+             return with(focal(r), {uniform(r, -0.05, 0.05), uniform(r, -0.02, 0.02), uniform(r, -1e-3, 1e-3),
+                                    uniform(r, -1e-3, 1e-3), uniform(r, -0.005, 0.005), uniform(r, -0.001, 0.001),
+                                    uniform(r, -1e-3, 1e-3), uniform(r, -1e-3, 1e-3)});
+         }},
+        {"fisheye624",
+         [](std::mt19937_64& r) {
+             return with(focal(r), {uniform(r, -0.05, 0.05), uniform(r, -0.02, 0.02), uniform(r, -0.005, 0.005),
+                                    uniform(r, -0.001, 0.001), uniform(r, -1e-4, 1e-4), uniform(r, -1e-5, 1e-5),
+                                    uniform(r, -1e-3, 1e-3), uniform(r, -1e-3, 1e-3), uniform(r, -1e-3, 1e-3),
+                                    uniform(r, -1e-4, 1e-4), uniform(r, -1e-3, 1e-3), uniform(r, -1e-4, 1e-4)});
+         }},
+        {"fov", [](std::mt19937_64& r) { return with(focal(r), {uniform(r, 0.2, 1.6)}); }},
+        {"division", [](std::mt19937_64& r) { return with(focal(r), {uniform(r, -0.4, 0.1)}); }},
+        {"unified",
+         [](std::mt19937_64& r) {
+             return with(focal(r), {uniform(r, 0.0, 1.6), uniform(r, -0.1, 0.1), uniform(r, -0.02, 0.02),
+                                    uniform(r, -1e-3, 1e-3), uniform(r, -1e-3, 1e-3)});
+         }},
+        {"eucm", [](std::mt19937_64& r) { return with(focal(r), {uniform(r, 0.3, 0.8), uniform(r, 0.6, 1.5)}); }},
+        {"double_sphere", [](std::mt19937_64& r) { return with(focal(r), {uniform(r, -0.3, 0.3), uniform(r, 0.4, 0.7)}); }},
+        {"metashape_frame",
+         [](std::mt19937_64& r) {
+             return std::vector<double>{uniform(r, 400, 900), kWidth / 2.0 - 0.5 + uniform(r, -30, 30), kHeight / 2.0 - 0.5 + uniform(r, -30, 30),
+                     uniform(r, -5, 5), uniform(r, -1, 1), uniform(r, -0.3, 0.1), uniform(r, -0.05, 0.1),
+                     uniform(r, -0.01, 0.01), uniform(r, -0.002, 0.002), uniform(r, -1e-3, 1e-3), uniform(r, -1e-3, 1e-3)};
+         }},
+        {"metashape_fisheye",
+         [](std::mt19937_64& r) {
+             return std::vector<double>{uniform(r, 300, 600), kWidth / 2.0 - 0.5 + uniform(r, -30, 30), kHeight / 2.0 - 0.5 + uniform(r, -30, 30),
+                     uniform(r, -5, 5), uniform(r, -1, 1), uniform(r, -0.05, 0.05), uniform(r, -0.02, 0.02),
+                     uniform(r, -0.005, 0.005), uniform(r, -0.001, 0.001), uniform(r, -1e-3, 1e-3), uniform(r, -1e-3, 1e-3)};
+         }},
+        {"equisolid", [](std::mt19937_64& r) { return focal(r); }},
+        {"equirectangular",
+         [](std::mt19937_64& r) {
+             const double lon = uniform(r, 30, 360), lat = uniform(r, 20, 180);
+             const double lonMin = uniform(r, -180, 180 - lon), latMin = uniform(r, -90, 90 - lat);
+             return std::vector<double>{lonMin, lonMin + lon, latMin, latMin + lat};
+         }},
+    };
+    return table;
+}
+
+glm::dvec3 direction(double theta, double phi) { return {std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)}; }
+
+}  // namespace
+
+TEST_CASE("every lens model is in the table, and the table's tests cover every model", "[lens]")
+{
+    REQUIRE(draws().size() == lensModels().size());
+    for (const LensModelInfo& info : lensModels()) {
+        bool drawn = false;
+        for (const ModelDraw& d : draws()) drawn = drawn || std::string(d.model) == info.name;
+        INFO(info.name);
+        REQUIRE(drawn);
+    }
+}
+
+TEST_CASE("each lens model's two directions agree over its field, 100 coefficient sets each", "[lens]")
+{
+    std::mt19937_64 rng(20261129);
+    for (const ModelDraw& d : draws()) {
+        INFO("model " << d.model);
+        int accepted = 0, attempts = 0, pixelsWithRays = 0;
+        while (accepted < 100) {
+            REQUIRE(++attempts < 400);  // realistic ranges: nearly every set makes a lens
+            std::vector<double> params = d.draw(rng);
+            std::optional<LensModel> lens;
+            try {
+                lens.emplace(LensSpec{d.model, params}, kWidth, kHeight);
+            } catch (const Error&) {
+                continue;  // folds inside the image: refused (tested below)
+            }
+            ++accepted;
+            // Pixels: a 33×25 grid of points spread over the image; where there is a ray, it
+            // projects back onto the point.
+            for (int j = 0; j <= 24; ++j)
+                for (int i = 0; i <= 32; ++i) {
+                    const glm::dvec2 p(kWidth * (i + 0.5) / 33.0, kHeight * (j + 0.5) / 25.0);
+                    const std::optional<glm::dvec3> ray = lens->directionFromImage(p);
+                    if (!ray) continue;
+                    ++pixelsWithRays;
+                    REQUIRE(std::abs(glm::length(*ray) - 1) <= 1e-14);
+                    const std::optional<glm::dvec2> back = lens->imageFromDirection(*ray);
+                    REQUIRE(back.has_value());
+                    INFO("pixel " << p.x << ", " << p.y << " back at " << back->x << ", " << back->y);
+                    REQUIRE(glm::length(*back - p) <= 1e-9);
+                }
+            // Directions within the field (short of a fold's end, where the inverse is ill-posed):
+            // to a pixel and back to themselves.
+            const double field = lens->isPanorama() ? kPi : 0.98 * lens->fieldAngle();
+            for (int k = 0; k < 200; ++k) {
+                const glm::dvec3 dCam = direction(uniform(rng, 0, field), uniform(rng, -kPi, kPi));
+                const std::optional<glm::dvec2> pImage = lens->imageFromDirection(dCam);
+                if (!pImage) {
+                    REQUIRE(lens->isPanorama());  // a panorama's field is its ranges
+                    continue;
+                }
+                const std::optional<glm::dvec3> back = lens->directionFromImage(*pImage);
+                INFO("direction " << dCam.x << ", " << dCam.y << ", " << dCam.z << " at " << pImage->x << ", " << pImage->y
+                                  << "; field " << lens->fieldAngle() << "; parameters " << [&] {
+                                         std::string text;
+                                         for (double v : params) text += std::to_string(v) + " ";
+                                         return text;
+                                     }());
+                REQUIRE(back.has_value());
+                REQUIRE(glm::length(*back - dCam) <= 1e-9);
+            }
+        }
+        REQUIRE(pixelsWithRays > 100 * 33 * 25 / 4);
+    }
+}
+
+TEST_CASE("lens models project as their authors' formulas say, by hand", "[lens]")
+{
+    const double fx = 500, fy = 480, cx = 639.5, cy = 479.5;
+    const auto at = [](const char* model, std::vector<double> params, glm::dvec3 d) {
+        return LensModel({model, std::move(params)}, kWidth, kHeight).imageFromDirection(d).value();
+    };
+    const glm::dvec3 d = direction(0.5, 0.0);  // 0.5 rad towards +x
+    // Kannala–Brandt without coefficients: equidistant, m = θ. Image x = fx·θ + cx + ½.
+    REQUIRE(at("opencv_fisheye", {fx, fy, cx, cy}, d).x == Approx(fx * 0.5 + cx + 0.5).epsilon(1e-14));
+    // θd = θ(1 + k1θ²): θ = 0.5, k1 = 0.1 → 0.5125.
+    REQUIRE(at("opencv_fisheye", {fx, fy, cx, cy, 0.1}, d).x == Approx(fx * 0.5125 + cx + 0.5).epsilon(1e-14));
+    // OpenCV: tan 0.5 = 0.5463024898; m' = m(1 + k1 m²), k1 = −0.1.
+    const double m = std::tan(0.5);
+    REQUIRE(at("opencv", {fx, fy, cx, cy, -0.1}, d).x == Approx(fx * m * (1 - 0.1 * m * m) + cx + 0.5).epsilon(1e-14));
+    // Tangential alone at a point on +y: m = (0, t): x' = 2·p1·0 + p2·t², y' = t + p1·3t².
+    const double t = std::tan(0.5);
+    const glm::dvec2 tangential = at("opencv", {fx, fy, cx, cy, 0, 0, 0.01, 0.02}, direction(0.5, kPi / 2));
+    REQUIRE(tangential.x == Approx(fx * 0.02 * t * t + cx + 0.5).epsilon(1e-14));
+    REQUIRE(tangential.y == Approx(fy * (t + 0.01 * 3 * t * t) + cy + 0.5).epsilon(1e-14));
+    // Metashape's P1 goes with r² + 2x² (OpenCV's p2): the same point along +x moves by P1·3r².
+    REQUIRE(at("metashape_frame", {fx, cx, cy, 0, 0, 0, 0, 0, 0, 0.01, 0}, d).x ==
+            Approx(fx * (m + 0.01 * 3 * m * m) + cx + 0.5).epsilon(1e-14));
+    // Equisolid: 2 sin(θ/2); at 60°, 1.
+    REQUIRE(at("equisolid", {fx, fy, cx, cy}, direction(kPi / 3, 0)).x == Approx(fx + cx + 0.5).epsilon(1e-14));
+    // Unified with ξ = 1 is the stereographic projection: tan(θ/2).
+    REQUIRE(at("unified", {fx, fy, cx, cy, 1.0}, d).x == Approx(fx * std::tan(0.25) + cx + 0.5).epsilon(1e-14));
+    // EUCM with α = 0 and double sphere with ξ = α = 0 are the pinhole.
+    REQUIRE(at("eucm", {fx, fy, cx, cy, 0.0, 1.0}, d).x == Approx(fx * m + cx + 0.5).epsilon(1e-14));
+    REQUIRE(at("double_sphere", {fx, fy, cx, cy, 0.0, 0.0}, d).x == Approx(fx * m + cx + 0.5).epsilon(1e-14));
+    // FOV: atan(2·tan θ·tan(ω/2))/ω.
+    const double omega = 0.9;
+    REQUIRE(at("fov", {fx, fy, cx, cy, omega}, d).x ==
+            Approx(fx * std::atan(2 * m * std::tan(omega / 2)) / omega + cx + 0.5).epsilon(1e-14));
+    // Division: the ray through m is (m, 1 + k|m|²); at m = 0.4 with k = −0.2 the ray's slope is 0.4/0.968.
+    const glm::dvec3 divisionRay(0.4, 0, 1 - 0.2 * 0.16);
+    REQUIRE(at("division", {fx, fy, cx, cy, -0.2}, divisionRay).x == Approx(fx * 0.4 + cx + 0.5).epsilon(1e-14));
+    // Equirectangular over the sphere: +x is longitude 90°, three quarters across; up is the top row.
+    const glm::dvec2 east = at("equirectangular", {-180, 180, -90, 90}, {1, 0, 0});
+    REQUIRE(east.x == Approx(0.75 * kWidth).epsilon(1e-14));
+    REQUIRE(east.y == Approx(0.5 * kHeight).epsilon(1e-14));
+    REQUIRE(at("equirectangular", {-180, 180, -90, 90}, {0, -1, 1e-300}).y == Approx(0.0).margin(1e-9));
+}
+
+TEST_CASE("a lens is refused with one line naming the model, the parameter and the rule", "[lens]")
+{
+    const auto refusal = [](const char* model, std::vector<double> params) {
+        try {
+            LensModel({model, std::move(params)}, 640, 480);
+        } catch (const Error& e) {
+            return std::string(e.what());
+        }
+        return std::string("accepted");
+    };
+    REQUIRE(refusal("brown", {1, 1, 1, 1}).find("unknown lens model 'brown'") != std::string::npos);
+    REQUIRE(refusal("opencv_fisheye", {300, 300, 319.5}) == "lens model opencv_fisheye takes 4 to 8 parameters, got 3");
+    REQUIRE(refusal("opencv_fisheye", {300, 300, 319.5, 239.5, 0, 0, 0, 0, 0}) ==
+            "lens model opencv_fisheye takes 4 to 8 parameters, got 9");
+    REQUIRE(refusal("opencv", {300, 300, 319.5, 239.5, NAN}) == "lens model opencv: 'k1' must be a finite number, got nan");
+    REQUIRE(refusal("opencv", {-300, 300, 319.5, 239.5}) == "lens model opencv: 'fx' must be > 0, got -300");
+    REQUIRE(refusal("fov", {300, 300, 319.5, 239.5, 4}).find("'omega' must lie in (0, π)") != std::string::npos);
+    REQUIRE(refusal("eucm", {300, 300, 319.5, 239.5, 1.5, 1}).find("'alpha' must lie in [0, 1]") != std::string::npos);
+    REQUIRE(refusal("equirectangular", {-180, 270, -90, 90}).find("'lon_max_deg' must be at most 360°") != std::string::npos);
+    REQUIRE(refusal("equirectangular", {-180, 180, -100, 90}).find("'lat_min_deg' must be at least -90") != std::string::npos);
+    // k1 = −1 folds at r = 1/√3 ≈ 0.577 (r·(1 − r²) stops increasing): 173 px from the centre at
+    // fx = 300, inside a 480-pixel-high image.
+    const std::string fold = refusal("opencv", {300, 300, 319.5, 239.5, -1});
+    REQUIRE(fold.find("lens model opencv folds (is no longer one-to-one) 30") != std::string::npos);
+    REQUIRE(fold.find("inside the image") != std::string::npos);
+    // A huge coefficient folds at once.
+    REQUIRE(refusal("opencv", {300, 300, 319.5, 239.5, -1e300}).find("lens model opencv") != std::string::npos);
+}
+
+TEST_CASE("pixels beyond a fold outside the image's inscribed disc have no ray: their own class", "[lens]")
+{
+    // k1 = −0.2 at fx = 300: the fold at r = 1/√(3·0.2) = 1.29, where the image radius is
+    // 300·1.29·(1 − 0.2·1.29²) = 258 px: beyond the nearest edge (240 px), inside the corners (400 px).
+    const LensModel lens({"opencv", {300, 300, 319.5, 239.5, -0.2}}, 640, 480);
+    REQUIRE(lens.fieldAngle() == Approx(std::atan(1 / std::sqrt(3 * 0.2))).epsilon(1e-6));
+    REQUIRE(lens.directionFromImage({320, 240}).has_value());
+    REQUIRE(!lens.directionFromImage({0.5, 0.5}).has_value());  // a corner: beyond the fold
+    REQUIRE(!lens.imageFromDirection(direction(lens.fieldAngle() + 1e-6, 0.3)).has_value());
+}
+
+TEST_CASE("a camera file's lens object reads and writes back as itself", "[lens]")
+{
+    const std::string text = R"({"convention": "opencv", "image": {"width": 640, "height": 480},
+        "projection": {"type": "pinhole", "fx": 200, "fy": 210, "cx": 319.5, "cy": 239.5, "near": 0.1, "far": 100},
+        "lens": {"model": "opencv_fisheye", "k1": 0.02, "k2": -0.005},
+        "view": {"eye": [0, 1, 3], "target": [0, 0, 0], "up": [0, -1, 0]}})";
+    const CameraSpec spec = cameraSpecFromJsonText(text, "test");
+    REQUIRE(spec.projection.type == ProjectionType::NonLinear);
+    REQUIRE(spec.projection.lens == LensSpec{"opencv_fisheye", {200, 210, 319.5, 239.5, 0.02, -0.005, 0, 0}});
+    REQUIRE(cameraSpecFromJsonText(cameraJsonText(spec), "again").projection.lens == spec.projection.lens);
+    // A panorama: near and far only in the projection, every parameter in the lens.
+    const std::string panorama = R"({"image": {"width": 512, "height": 256}, "projection": {"near": 0.1, "far": 50},
+        "lens": {"model": "equirectangular", "lon_min_deg": -180, "lon_max_deg": 180, "lat_min_deg": -90, "lat_max_deg": 90},
+        "view": {"eye": [0, 0, 0], "target": [0, 0, -1]}})";
+    const CameraSpec pano = cameraSpecFromJsonText(panorama, "pano");
+    REQUIRE(pano.projection.lens.model == "equirectangular");
+    REQUIRE(cameraSpecFromJsonText(cameraJsonText(pano), "again").projection.lens == pano.projection.lens);
+    const auto refusal = [](const std::string& json) {
+        try {
+            cameraSpecFromJsonText(json, "cam.json");
+        } catch (const Error& e) {
+            return std::string(e.what());
+        }
+        return std::string("accepted");
+    };
+    const std::string head = R"({"projection": {"type": "pinhole", "fx": 200, "fy": 200, "cx": 319.5, "cy": 239.5, "near": 0.1, "far": 100}, "view": {"eye": [0, 1, 3], "target": [0, 0, 0]}, )";
+    REQUIRE(refusal(head + R"("lens": {"model": "opencv_fisheye", "k9": 1}})") == "cam.json: unknown key 'lens.k9'");
+    REQUIRE(refusal(head + R"("lens": {"model": "opencv_fisheye", "fx": 1}})") ==
+            "cam.json: 'lens.fx' is the pinhole projection's: give it there only");
+    REQUIRE(refusal(head + R"("lens": {"model": "fov"}})") == "cam.json: 'lens.omega' is missing");
+    REQUIRE(refusal(head + R"("lens": {"model": "equirectangular"}})").find("does not take a pinhole's fx") != std::string::npos);
+}
+
+TEST_CASE("check of a lens camera: the two directions and the trace agree; a shifted ray does not", "[lens]")
+{
+    const Checker checker(builtinScene("default"));
+    for (const LensSpec& lens : {LensSpec{"opencv_fisheye", {200, 200, 319.5, 239.5, 0.02, -0.005, 0.001}},
+                                 LensSpec{"opencv", {500, 500, 319.5, 239.5, -0.2, 0.05, 1e-3, -1e-3}},
+                                 LensSpec{"double_sphere", {150, 150, 319.5, 239.5, -0.2, 0.6}},
+                                 LensSpec{"equirectangular", {-180, 180, -90, 90}}}) {
+        INFO(lens.model);
+        CameraSpec spec;
+        spec.convention = Convention::preset("vulkan");
+        spec.width = 640, spec.height = lens.model == "equirectangular" ? 320 : 480;
+        spec.projection.type = ProjectionType::NonLinear;
+        spec.projection.lens = lens;
+        spec.projection.near = 0.05, spec.projection.far = 100;
+        spec.view = View::lookAt({0.3, 0.8, 2.5}, {0, 0, 0}, {0, 1, 0});
+        const Camera camera(spec);
+        const CheckResult clean = checker.check(camera);
+        REQUIRE(clean.report.lens.has_value());
+        REQUIRE(clean.report.lens->hits > 10000);
+        REQUIRE(clean.report.lens->roundTripMaxPx <= 1e-9);
+        REQUIRE(clean.report.lens->forwardMaxPx <= 1e-6);
+        REQUIRE(clean.report.comparison.consistent());
+        CheckOptions shifted;
+        shifted.faults.ray.shiftPixels = {0.01, 0.0};
+        const CheckResult wrong = checker.check(camera, shifted);
+        REQUIRE(!wrong.report.comparison.consistent());
+        REQUIRE(wrong.report.lens->forwardMaxPx == Approx(0.01).epsilon(1e-3));
+    }
+}
