@@ -55,6 +55,11 @@ const std::vector<ModelDraw>& draws()
                                     uniform(r, -1e-4, 1e-4), uniform(r, -1e-3, 1e-3), uniform(r, -1e-4, 1e-4),
                                     uniform(r, -0.02, 0.02), uniform(r, -0.02, 0.02)});
          }},
+        {"brown_conrady",
+         [](std::mt19937_64& r) {
+             return with(focal(r), {uniform(r, -0.3, 0.1), uniform(r, -0.05, 0.1), uniform(r, -0.01, 0.01),
+                                    uniform(r, -0.002, 0.002), uniform(r, -1e-3, 1e-3), uniform(r, -1e-3, 1e-3)});
+         }},
         {"opencv_fisheye",
          [](std::mt19937_64& r) {
              return with(focal(r), {uniform(r, -0.05, 0.05), uniform(r, -0.02, 0.02), uniform(r, -0.005, 0.005),

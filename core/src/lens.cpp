@@ -47,6 +47,15 @@ const std::vector<ModelRow>& rows()
              for (int i = 0; i < 4; ++i) t.s[i] = p[12 + i];
              t.tauX = p[16], t.tauY = p[17];
          }},
+        {{"brown_conrady", "Brown–Conrady: radial polynomial to r⁸, tangential (nerfstudio and instant-ngp OPENCV)",
+          "m = (x/z, y/z); m' = m·(1+k1r²+k2r⁴+k3r⁶+k4r⁸) + tangential(p1, p2)",
+          {"fx", "fy", "cx", "cy", "k1", "k2", "k3", "k4", "p1", "p2"}, 4, true},
+         [](const double* p, Terms& t) {
+             focal4(p, t);
+             t.profile = Profile::Perspective;
+             for (int i = 0; i < 4; ++i) t.numerator[i] = p[4 + i];
+             t.p1 = p[8], t.p2 = p[9];
+         }},
         {{"opencv_fisheye", "OpenCV fisheye (Kannala–Brandt)",
           "θ = angle from the axis; m = θ·(1+k1θ²+k2θ⁴+k3θ⁶+k4θ⁸)·(cos φ, sin φ)",
           {"fx", "fy", "cx", "cy", "k1", "k2", "k3", "k4"}, 4, true},

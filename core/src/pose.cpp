@@ -176,6 +176,18 @@ Projection PinholeIntrinsics::projection(double near, double far, const std::str
     return p;
 }
 
+Projection PinholeIntrinsics::lensProjection(const std::string& model, const std::vector<double>& coefficients,
+                                             double near, double far, const std::string& what) const
+{
+    const Projection pinhole = projection(near, far, what);
+    Projection p = pinhole;
+    p.type = ProjectionType::NonLinear;
+    p.lens.model = model;
+    p.lens.params = {pinhole.fx, pinhole.fy, pinhole.cx, pinhole.cy};
+    p.lens.params.insert(p.lens.params.end(), coefficients.begin(), coefficients.end());
+    return p;
+}
+
 PinholeIntrinsics PinholeIntrinsics::fromK(const double (&k)[3][3], double pixelCenter, const std::string& what)
 {
     for (int r = 0; r < 3; ++r)
@@ -194,6 +206,13 @@ PinholeIntrinsics PinholeIntrinsics::fromK(const double (&k)[3][3], double pixel
 PinholeIntrinsics pinholeIntrinsicsOf(const Camera& camera, double pixelCenter)
 {
     const ProjectionType type = camera.spec().projection.type;
+    if (const LensModel* lens = camera.lens()) {  // a lens model's fx, fy, cx, cy, where it has them
+        const LensModelInfo& info = lens->info();
+        if (!info.hasFocal || std::string(info.params[0]) != "fx")
+            throw Error("lens model " + lens->spec().model + " has no pinhole intrinsics fx, fy, cx, cy");
+        const std::vector<double>& q = lens->spec().params;
+        return {q[0], q[1], q[2] + pixelCenter, q[3] + pixelCenter, pixelCenter};
+    }
     if (type != ProjectionType::Perspective && type != ProjectionType::Frustum && type != ProjectionType::Pinhole &&
         type != ProjectionType::Lens)
         throw Error("a " + toString(type) +

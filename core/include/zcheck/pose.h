@@ -109,6 +109,12 @@ struct PinholeIntrinsics {
     // Refuses a pixelCenter other than 0 or 0.5 and focal lengths or a principal point that are
     // not finite (or focal lengths ≤ 0), naming `what`.
     Projection projection(double near, double far, const std::string& what) const;
+    // zcheck's lens-model projection (camera.h, ProjectionType::NonLinear; lens.h): `model` with
+    // these fx, fy, cx, cy (moved to OpenCV's coordinates) and then `coefficients` in the model's
+    // order (its parameters after cy). Refuses as projection() does; the lens itself is validated
+    // when a Camera is built from it.
+    Projection lensProjection(const std::string& model, const std::vector<double>& coefficients, double near,
+                              double far, const std::string& what) const;
 
     // From K = [[fx, 0, cx], [0, fy, cy], [0, 0, 1]] (k[row][col]); refuses skew and any other
     // form, naming `what` ("K", "camera_matrix") and the element.
@@ -116,7 +122,8 @@ struct PinholeIntrinsics {
 };
 
 // The pinhole intrinsics of a camera whose rays meet at a point and whose image plane is
-// perpendicular to the viewing axis (perspective, frustum, pinhole, lens), with the principal
+// perpendicular to the viewing axis (perspective, frustum, pinhole, lens; the fx, fy, cx, cy of a
+// lens model that has them — its distortion is not in them), with the principal
 // point in coordinates whose top-left pixel centre is `pixelCenter`. Throws Error naming the
 // projection type for any other (orthographic, oblique, a raw matrix).
 PinholeIntrinsics pinholeIntrinsicsOf(const Camera& camera, double pixelCenter);
