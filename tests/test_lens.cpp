@@ -6,7 +6,10 @@
 #include "zcheck/checker.h"
 #include "zcheck/error.h"
 #include "zcheck/lens.h"
+#include "zcheck/map_verifier.h"
+#include "zcheck/pose.h"
 #include "zcheck/scene.h"
+#include "zcheck/verify_map.h"
 
 #include <catch2/catch.hpp>
 
@@ -324,4 +327,72 @@ TEST_CASE("check of a lens camera: the two directions and the trace agree; a shi
         REQUIRE(!wrong.report.comparison.consistent());
         REQUIRE(wrong.report.lens->forwardMaxPx == Approx(0.01).epsilon(1e-3));
     }
+}
+
+TEST_CASE("verify of a lens camera's map: the truth passes, a distortion mistake or a scale does not", "[lens]")
+{
+    const Checker checker(builtinScene("default"));
+    const MapVerifier verifier(checker);
+    CameraSpec spec;
+    spec.convention = Convention::preset("opencv");
+    spec.width = 320, spec.height = 240;
+    spec.projection.type = ProjectionType::NonLinear;
+    spec.projection.lens = {"opencv", {210, 210, 159.5, 119.5, -0.25, 0.08, 1e-3, -5e-4}};
+    spec.projection.near = 0.05, spec.projection.far = 100;
+    spec.view = View::lookAt({0.3, 0.8, 2.5}, {0, 0, 0}, {0, 1, 0});
+    const Camera camera(spec);
+    for (const DepthQuantity quantity : {DepthQuantity::Distance, DepthQuantity::EyeZ}) {
+        INFO(toString(quantity));
+        const QuantityImage truth = checker.render(camera, exportQuantityOf(quantity), Route::Ray);
+        std::vector<double> values(truth.value.size());
+        for (std::size_t i = 0; i < values.size(); ++i) values[i] = std::isinf(truth.value[i]) ? 0.0 : double(float(truth.value[i]));
+        const DepthMap exact = DepthMap::exact(320, 240, quantity, values);
+        const VerifyResult clean = verifier.verify(camera, exact);
+        REQUIRE(clean.report.comparison.consistent());
+        REQUIRE(clean.report.comparison.agree > 40000);
+        REQUIRE(clean.report.mapErrors.maxRel < 1e-6);
+        // One part in 10⁴ too far: every pixel beyond its tolerance.
+        DepthMap scaled = exact;
+        for (double& v : scaled.value) v *= 1.0001;
+        REQUIRE(!verifier.verify(camera, scaled).report.comparison.consistent());
+        // Distortion ignored: the same map verified with the pinhole that has the lens's K.
+        CameraSpec pinhole = spec;
+        pinhole.projection = PinholeIntrinsics{210, 210, 159.5, 119.5, 0}.projection(0.05, 100, "K");
+        const VerifyResult ignored = verifier.verify(Camera(pinhole), exact);
+        REQUIRE(!ignored.report.comparison.consistent());
+        REQUIRE(ignored.report.comparison.unexplained() > 10000);
+        // k1 off by 1 %.
+        CameraSpec off = spec;
+        off.projection.lens.params[4] *= 1.01;
+        REQUIRE(!verifier.verify(Camera(off), exact).report.comparison.consistent());
+    }
+    // A window map cannot come from a lens: refused.
+    REQUIRE_THROWS_WITH(verifyMap(verifier, camera, DepthMap::exact(320, 240, DepthQuantity::Window, std::vector<double>(320 * 240, 0.5)), false, "map.exr"),
+                        Catch::Contains("a window map cannot come from a lens model (opencv)"));
+}
+
+TEST_CASE("verify of a lens camera's map: a depth outside the lens's field is the map's invention", "[lens]")
+{
+    const Checker checker(builtinScene("default"));
+    const MapVerifier verifier(checker);
+    CameraSpec spec;
+    spec.convention = Convention::preset("opencv");
+    spec.width = 320, spec.height = 240;
+    spec.projection.type = ProjectionType::NonLinear;
+    // The fold at r = 1/√(3·0.2): 130 px from the centre at fx = 150, beyond the nearest edge
+    // (120 px) but not the corners.
+    spec.projection.lens = {"opencv", {150, 150, 159.5, 119.5, -0.2}};
+    spec.projection.near = 0.05, spec.projection.far = 100;
+    spec.view = View::lookAt({0.3, 0.8, 2.5}, {0, 0, 0}, {0, 1, 0});
+    const Camera camera(spec);
+    REQUIRE(!camera.lens()->directionFromImage({0.5, 0.5}).has_value());
+    const QuantityImage truth = checker.render(camera, ExportQuantity::Distance, Route::Ray);
+    std::vector<double> values(truth.value.size());
+    for (std::size_t i = 0; i < values.size(); ++i) values[i] = std::isinf(truth.value[i]) ? 0.0 : truth.value[i];
+    DepthMap map = DepthMap::exact(320, 240, DepthQuantity::Distance, values);
+    REQUIRE(verifier.verify(camera, map).report.comparison.consistent());
+    map.value[0] = 3.0;  // pixel (0, 0): outside the field
+    const VerifyResult invented = verifier.verify(camera, map);
+    REQUIRE(!invented.report.comparison.consistent());
+    REQUIRE(invented.comparison.pixelClass[0] == PixelClass::RasterOnly);
 }

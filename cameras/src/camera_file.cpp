@@ -439,6 +439,17 @@ json toJson(const CameraSpec& spec)
 
 json matricesJson(const Camera& camera)
 {
+    if (const LensModel* lens = camera.lens())  // no projection matrix: the view, and what projects instead
+        return json{
+            {"vectors", "column (p' = M·p), rows as printed"},
+            {"eye_from_world", matrixJson(camera.eyeFromWorld)},
+            {"world_from_eye", matrixJson(camera.worldFromEye)},
+            {"projection", "lens model " + lens->spec().model +
+                               ": no projection matrix; the camera's 'lens' maps directions to pixels (near and far are "
+                               "distances along the rays)"},
+            {"near", camera.nearDistance()},
+            {"far", camera.farIsInfinite() ? json("inf") : json(camera.farDistance())},
+        };
     json out = {
         {"vectors", "column (p' = M·p), rows as printed"},
         {"eye_from_world", matrixJson(camera.eyeFromWorld)},

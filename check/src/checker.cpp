@@ -134,6 +134,9 @@ RenderResult Checker::renderRay(const Camera& camera, const RayFaults& faults, E
 
 RenderResult Checker::renderRaster(const Camera& camera, const RasterFaults& faults) const
 {
+    if (const LensModel* lens = camera.lens())
+        throw Error("the raster route does not apply to a lens model (" + lens->spec().model +
+                    "): it has no projection matrix to rasterize through; use the ray route");
     return raster_.render(camera, faults);
 }
 

@@ -1,5 +1,6 @@
 #include "zcheck/export.h"
 
+#include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
 
 #include <cmath>
@@ -23,6 +24,9 @@ QuantityImage quantityImage(const Scene& scene, const Camera& camera, const Rend
     case ExportQuantity::PrimitiveId: image.channels = {"id"}, image.unit = "triangle index (uint32)", image.missValue = double(kNoPrimitive); break;
     }
     const std::size_t C = image.channels.size();
+    if (const LensModel* lens = camera.lens(); lens && (quantity == ExportQuantity::Window || quantity == ExportQuantity::Ndc))
+        throw Error("quantity " + toString(quantity) + ": a lens model (" + lens->spec().model +
+                    ") has no depth buffer, so no window or ndc depth; export eye-z or distance");
     if (quantity == ExportQuantity::PrimitiveId) {
         image.id.assign(route.primitiveId.begin(), route.primitiveId.end());
         return image;
@@ -40,7 +44,13 @@ QuantityImage quantityImage(const Scene& scene, const Camera& camera, const Rend
             switch (quantity) {
             case ExportQuantity::Window: out[0] = windowDepth; break;
             case ExportQuantity::Ndc: out[0] = camera.ndcZFromWindowDepth(windowDepth); break;
-            case ExportQuantity::EyeZ: out[0] = camera.eyeZOf(pEye); break;
+            case ExportQuantity::EyeZ:
+                out[0] = camera.eyeZOf(pEye);
+                if (camera.lens() && !(out[0] > 0))  // a lens's ray 90° or more off the axis
+                    throw Error("quantity eye-z: the lens model " + camera.lens()->spec().model + " sees pixel (" +
+                                std::to_string(col) + ", " + std::to_string(row) +
+                                ") hit 90° or more off the axis, where eye-z does not exist; export distance");
+                break;
             case ExportQuantity::Distance: out[0] = distanceOfEyePoint(camera, pEye); break;
             case ExportQuantity::PositionEye: out[0] = pEye.x, out[1] = pEye.y, out[2] = pEye.z; break;
             case ExportQuantity::PositionWorld: {

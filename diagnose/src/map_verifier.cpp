@@ -15,6 +15,7 @@ const VertexNeighbours& MapVerifier::neighbours() const
 
 VerifyResult MapVerifier::verify(const Camera& camera, const DepthMap& map) const
 {
+    if (camera.lens()) return verifyLensMap(checker_, camera, map);
     VerifyResult run = verifyAgainst(checker_.scene(), camera, map, checker_.renderRay(camera), neighbours());
     run.report.timings.bvhBuildMs = checker_.bvhBuildMilliseconds();
     measureMapErrors(camera, map, run);

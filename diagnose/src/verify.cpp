@@ -388,6 +388,9 @@ void countOutOfRange(const Camera& camera, const DepthMap& map, ComparisonReport
 
 void requireDepthsInRange(const Camera& camera, const DepthMap& map, const std::string& name)
 {
+    if (const LensModel* lens = camera.lens(); lens && (map.quantity == DepthQuantity::Window || map.quantity == DepthQuantity::Ndc))
+        throw Error(name + ": a " + toString(map.quantity) + " map cannot come from a lens model (" + lens->spec().model +
+                    "), which has no depth buffer: give --quantity eye-z or distance");
     for (const double v : map.value)
         if (kindOfDepthValue(camera, map.quantity, v) == DepthValueKind::Depth) return;
     ComparisonReport count;  // only misses and values out of range: which, and where the first is

@@ -60,6 +60,10 @@ RenderResult renderResultFromMap(const PixelJudge& judge, const DepthMap& map, c
                                  const VertexNeighbours& neighbours, std::vector<double>& quantum,
                                  std::vector<double>& allowance);
 
+// A map made through a lens model (camera.lens()) against the ray route, compared as distances
+// along the pixels' rays (verify_lens.cpp has the rule); MapVerifier::verify's for such cameras.
+VerifyResult verifyLensMap(const Checker& checker, const Camera& camera, const DepthMap& map);
+
 // Throws Error unless `map` is camera.width() × camera.height() with a value per pixel.
 void requireMapFits(const Camera& camera, const DepthMap& map);
 // The map's values its quantity cannot hold (kindOfDepthValue), counted into `report`

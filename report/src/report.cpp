@@ -337,7 +337,8 @@ std::string formatSummary(const CheckReport& report, const std::string& comparin
     std::snprintf(line, sizeof line, "  max %.3g q, p99 %.3g q; max / tolerance %.3g\n", c.maxErrorQuanta,
                   c.p99ErrorQuanta, c.maxErrorOverTolerance);
     out << line;
-    std::snprintf(line, sizeof line, "  relative eye-z error: max %.3g, p99 %.3g\n", c.maxRelativeEyeZError,
+    std::snprintf(line, sizeof line, "  relative %s error: max %.3g, p99 %.3g\n",
+                  cam.projection.type == ProjectionType::NonLinear ? "distance" : "eye-z", c.maxRelativeEyeZError,
                   c.p99RelativeEyeZError);
     out << line;
     if (c.biasSamples > 0) {

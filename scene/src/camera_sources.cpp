@@ -96,9 +96,40 @@ bool clippedRange(const ClipVertex (&corner)[3], double& lo, double& hi)
 
 }  // namespace
 
+namespace {
+
+// A lens camera's near and far are distances along its rays (camera.h): the nearest and farthest
+// any part of the scene can be from the eye, bounded by the boxes of its chunks of triangles (a
+// box holding the eye bounds the nearest at 0). Rays are traced in double between them, so a
+// generous range costs no precision.
+SceneNearFar lensNearFar(const Scene& scene, const Camera& camera)
+{
+    const glm::dvec3 eye(camera.worldFromEye[3]);
+    const std::shared_ptr<const TriangleChunks> chunks = scene.chunks ? scene.chunks : triangleChunksOf(scene);
+    double lo = INFINITY, hi = 0;
+    for (std::size_t c = 0; c < chunks->lo.size(); ++c) {
+        const glm::dvec3 a(chunks->lo[c]), b(chunks->hi[c]);
+        lo = std::min(lo, glm::length(glm::clamp(eye, a, b) - eye));
+        hi = std::max(hi, glm::length(glm::max(glm::abs(a - eye), glm::abs(b - eye))));
+    }
+    if (!(hi > 0)) throw Error("scene '" + scene.name + "' has no extent around the camera: near and far cannot be taken from it");
+    SceneNearFar planes;
+    planes.far = hi * 1.01;
+    planes.near = lo * 0.99;
+    const double floor = planes.far * 1e-7;
+    if (!(planes.near >= floor)) {
+        planes.near = floor;
+        planes.note = "the scene's bounds reach the eye, so near (a distance along the rays) is held at far/1e7";
+    }
+    return planes;
+}
+
+}  // namespace
+
 SceneNearFar sceneNearFar(const Scene& scene, const CameraSpec& spec)
 {
     const Camera camera(spec);  // its near and far may be placeholders: the side planes do not depend on them
+    if (camera.lens()) return lensNearFar(scene, camera);
     const glm::dmat4 clipFromWorld = camera.clipFromEye * camera.eyeFromWorld;
     const glm::dvec4 eyeZRow(camera.eyeFromWorld[0][2] * camera.convention().eyeForwardZ,
                              camera.eyeFromWorld[1][2] * camera.convention().eyeForwardZ,
@@ -273,11 +304,21 @@ CameraForMap completeCameraForMap(const ImportedCamera& camera, const Scene* sce
                 sizedSpec.width = given.width.value_or(sizedSpec.width), sizedSpec.height = given.height.value_or(sizedSpec.height);
                 if (camera.projectionForSize) sizedSpec.projection = camera.projectionForSize(sizedSpec.width, sizedSpec.height);
                 const Camera c(sizedSpec);
-                if (sizedSpec.projection.isPerspective()) {
+                if (c.lens()) {
+                    // a lens's near and far are distances (camera.h): mapEyeZ holds the map's distances
+                } else if (sizedSpec.projection.isPerspective()) {
                     const double n = c.nearDistance();
                     const double x = std::max(std::abs(c.left()), std::abs(c.right())), y = std::max(std::abs(c.top()), std::abs(c.bottom()));
                     lo *= n / std::sqrt(x * x + y * y + n * n);
                 }
+            }
+            if (quantity == DepthQuantity::EyeZ && camera.spec.projection.type == ProjectionType::NonLinear) {
+                // A lens's near and far are distances: an eye-z z lies on a ray at distance z / cos θ,
+                // θ up to the field's angle (at most 89.9°, beyond which eye-z does not exist).
+                CameraSpec sizedSpec = camera.spec;
+                sizedSpec.width = given.width.value_or(sizedSpec.width), sizedSpec.height = given.height.value_or(sizedSpec.height);
+                if (camera.projectionForSize) sizedSpec.projection = camera.projectionForSize(sizedSpec.width, sizedSpec.height);
+                hi /= std::cos(std::min(Camera(sizedSpec).lens()->fieldAngle(), 89.9 * 3.14159265358979323846 / 180));
             }
             given.mapEyeZ = std::pair{lo, hi};
         }

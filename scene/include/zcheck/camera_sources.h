@@ -43,7 +43,8 @@ SceneNearFar sceneNearFar(const Scene& scene, const CameraSpec& spec);
 
 // What the user gives beside a camera file (--near, --far, --width, --height, a depth map's size),
 // and the eye-z range a depth map holds (its eye-z values, or its distances times the cosine of
-// the widest ray's angle), which near and far must also cover.
+// the widest ray's angle), which near and far must also cover. (A lens model's near and far are
+// distances along its rays: for its camera, mapEyeZ is the map's range of distances.)
 struct CameraCompletion {
     std::optional<double> near, far;
     std::optional<int> width, height;

@@ -1,0 +1,288 @@
+// Verifying a map made through a lens model (lens.h): there is no depth buffer and no raster
+// route, so the map is compared with the ray route as distances along the pixels' rays.
+//
+// Per pixel, with d the distance along the pixel centre's ray (an eye-z map's value divided by
+// the ray's cosine to the axis, cos θ):
+//   both hit     |d_map − d_ray| ≤ C·q + S·m + E: q the map's storage step at its value (its
+//                file's, or binary32's; for eye-z, divided by cos θ), C = 1 for integer storage
+//                and 4 for floating point (mapTolerance), m = |∂d/∂x| + |∂d/∂y| on the truth's
+//                plane (the rays through the centre ± ½ px; a map sampled up to S off the centre
+//                in both axes), S = 2^-8, E = 16·2^-52·d. Beyond it, a surface a ray within S of
+//                the centre meets (8 rays around it) whose tolerance holds d_map explains it
+//                (an edge); otherwise a depth error.
+//   one hits     explained when the coverage changes within S of the centre: the truth alone —
+//                one of the 8 rays misses; the map alone — one of them meets a surface whose
+//                tolerance holds d_map. Holes the map declares (--allow-holes) are holes.
+//   outside      the lens's field: no ray, so no truth; a map depth there is unexplained.
+// Window and NDC maps cannot come from a lens (no depth buffer); eye-z does not exist 90° or
+// more off the axis, so an eye-z value there is out of range. Declared accuracies other than the
+// storage grid (--rel-tolerance, --abs-tolerance, noise) are not judged for lens models yet, and
+// refused rather than taken on trust.
+#include "verify_estimators.h"
+
+#include "numerics.h"
+#include "zcheck/detail/clock.h"
+#include "zcheck/error.h"
+#include "zcheck/inverse_projection.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <mutex>
+
+namespace zcheck {
+
+namespace {
+
+constexpr double kSnap = 1.0 / 256;  // S: a map sampled up to 2^-8 px off the centre
+
+// The distance along a unit world ray from `origin` to a triangle's plane (NaN if parallel).
+double planeDistance(const Scene& scene, std::uint32_t primitive, const glm::dvec3& origin, const glm::dvec3& direction)
+{
+    const glm::uvec3 t = scene.triangles[primitive];
+    const glm::dvec3 a(scene.positions[t[0]]), b(scene.positions[t[1]]), c(scene.positions[t[2]]);
+    const glm::dvec3 normal = glm::cross(b - a, c - a);
+    const double s = glm::dot(normal, a - origin) / glm::dot(normal, direction);
+    return std::isfinite(s) ? s : NAN;
+}
+
+struct LensPixel {
+    PixelClass pixelClass = PixelClass::BothMiss;
+    double truth = NAN, map = NAN;  // distances
+    double quantum = 0;  // the map's storage step there, as a distance
+    double errorQuanta = 0, tolerance = 0, errorOverTolerance = 0;
+    std::uint32_t primitive = kNoPrimitive;  // the surface the map is taken to show
+    bool outOfRange = false;
+};
+
+class LensPixelJudge {
+public:
+    LensPixelJudge(const Checker& checker, const Camera& camera, const DepthMap& map, const RenderResult& truth)
+        : scene_(checker.scene()), rays_(checker.rayRenderer()), camera_(camera), map_(map), truth_(truth),
+          eye_(camera.worldFromEye[3]), constant_(mapTolerance(map).storageConstant)
+    {
+    }
+
+    LensPixel judge(int col, int row) const
+    {
+        LensPixel out;
+        const std::size_t i = std::size_t(row) * camera_.width() + col;
+        const glm::dvec2 pWindow = windowFromPixelCentre(camera_, col, row);
+        const std::optional<glm::dvec3> dEye = eyeDirectionThroughWindow(camera_, pWindow);
+        const double value = map_.value[i];
+        const DepthValueKind kind = kindOfDepthValue(camera_, map_.quantity, value);
+        out.outOfRange = kind == DepthValueKind::OutOfRange;
+        const bool mapHasDepth = kind == DepthValueKind::Depth;
+        if (!dEye) {  // outside the lens's field: no truth; a depth there is the map's invention
+            out.pixelClass = mapHasDepth ? PixelClass::RasterOnly : PixelClass::BothMiss;
+            out.map = mapHasDepth ? value : NAN;
+            return out;
+        }
+        const double cosine = camera_.eyeZOf(*dEye);
+        const bool eyeZ = map_.quantity == DepthQuantity::EyeZ;
+        const bool mapHit = mapHasDepth && (!eyeZ || cosine > 0);
+        if (mapHasDepth && !mapHit) out.outOfRange = true;  // eye-z 90° or more off the axis
+        const double perValue = eyeZ ? 1 / cosine : 1.0;  // distance per unit of the map's value
+        const ValueAccuracy accuracy = map_.accuracyAt(i);
+        const double step = std::max(accuracy.step > 0 ? accuracy.step : binary32Step(value), accuracy.grid);
+        out.map = mapHit ? value * perValue : NAN;
+        const bool truthHit = truth_.hit(i);
+        out.truth = truthHit ? truth_.windowDepth.value[i] : NAN;
+        const glm::dvec3 direction(camera_.worldFromEye * glm::dvec4(*dEye, 0.0));
+        const double quantum = step * perValue;
+        out.quantum = quantum;
+        if (truthHit && mapHit) {
+            const std::uint32_t primitive = truth_.primitiveId[i];
+            const double error = out.map - out.truth;
+            out.tolerance = toleranceOn(primitive, pWindow, quantum, out.truth);
+            out.errorQuanta = std::abs(error) / quantum;
+            out.errorOverTolerance = std::abs(error) / out.tolerance;
+            out.primitive = primitive;
+            if (std::abs(error) <= out.tolerance) {
+                out.pixelClass = PixelClass::Agree;
+            } else if (otherSurfaceHolds(pWindow, direction, primitive, out.map, quantum)) {
+                out.pixelClass = PixelClass::EdgeSurface;
+            } else {
+                out.pixelClass = PixelClass::DepthError;
+            }
+        } else if (truthHit) {
+            const bool edge = anyRayAround(pWindow, [](std::uint32_t seen) { return seen == kNoPrimitive; });
+            out.pixelClass = edge ? PixelClass::RayOnlyEdge : map_.accuracy.allowHoles ? PixelClass::Hole : PixelClass::RayOnly;
+        } else if (mapHit) {
+            const bool edge = otherSurfaceHolds(pWindow, direction, kNoPrimitive, out.map, quantum);
+            out.pixelClass = edge ? PixelClass::RasterOnlyEdge : PixelClass::RasterOnly;
+        }
+        return out;
+    }
+
+private:
+    static double binary32Step(double value)
+    {
+        const float magnitude = std::fabs(float(value));
+        return double(std::nextafter(magnitude, INFINITY)) - double(magnitude);
+    }
+
+    // C·q + S·m + E on `primitive`'s plane at the pixel centre pWindow.
+    double toleranceOn(std::uint32_t primitive, const glm::dvec2& pWindow, double quantum, double distance) const
+    {
+        double slope = 0;
+        for (const glm::dvec2 axis : {glm::dvec2(0.5, 0), glm::dvec2(0, 0.5)}) {
+            const std::optional<glm::dvec3> before = worldDirection(pWindow - axis), after = worldDirection(pWindow + axis);
+            if (!before || !after) return INFINITY;  // at the field's edge: the slope cannot be bounded
+            slope += std::abs(planeDistance(scene_, primitive, eye_, *after) - planeDistance(scene_, primitive, eye_, *before));
+        }
+        if (!std::isfinite(slope)) slope = INFINITY;
+        return constant_ * quantum + kSnap * slope + 16 * 0x1p-52 * distance;
+    }
+
+    std::optional<glm::dvec3> worldDirection(const glm::dvec2& pWindow) const
+    {
+        const std::optional<glm::dvec3> dEye = eyeDirectionThroughWindow(camera_, pWindow);
+        if (!dEye) return std::nullopt;
+        return glm::dvec3(camera_.worldFromEye * glm::dvec4(*dEye, 0.0));
+    }
+
+    // The 8 rays S around the centre (those inside the field): whether `test` holds for one.
+    template <class Test>
+    bool anyRayAround(const glm::dvec2& pWindow, Test&& test) const
+    {
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                if (dx == 0 && dy == 0) continue;
+                const glm::dvec2 p = pWindow + kSnap * glm::dvec2(dx, dy);
+                if (!eyeDirectionThroughWindow(camera_, p)) continue;
+                if (test(rays_.primitiveAt(camera_, p))) return true;
+            }
+        return false;
+    }
+
+    // Whether a surface other than `except` that a ray within S of the centre meets holds the
+    // map's distance within its tolerance, measured along the centre's ray.
+    bool otherSurfaceHolds(const glm::dvec2& pWindow, const glm::dvec3& direction, std::uint32_t except, double mapDistance,
+                           double quantum) const
+    {
+        return anyRayAround(pWindow, [&](std::uint32_t seen) {
+            if (seen == kNoPrimitive || seen == except) return false;
+            const double there = planeDistance(scene_, seen, eye_, direction);
+            return std::isfinite(there) && std::abs(mapDistance - there) <= toleranceOn(seen, pWindow, quantum, there);
+        });
+    }
+
+    const Scene& scene_;
+    const RayRenderer& rays_;
+    const Camera& camera_;
+    const DepthMap& map_;
+    const RenderResult& truth_;
+    glm::dvec3 eye_;
+    double constant_;
+};
+
+// A pixel as the report shows it: the truth as the ray, the map as the second route (distances).
+PixelFinding finding(const LensPixel& p, int col, int row)
+{
+    return {col, row, p.pixelClass, p.truth, p.map, p.errorQuanta, p.quantum > 0 ? p.tolerance / p.quantum : 0,
+            p.pixelClass == PixelClass::RasterOnly || p.pixelClass == PixelClass::RasterOnlyEdge ? kNoPrimitive : p.primitive,
+            p.primitive};
+}
+
+void requireJudgedDeclarations(const Camera& camera, const DepthMap& map)
+{
+    const MapAccuracy& a = map.accuracy;
+    if (a.relative > 0 || a.absolute > 0 || a.noise.any())
+        throw Error("a declared accuracy (" + a.options() + ") is not judged for a lens model (" +
+                    camera.lens()->spec().model +
+                    ") yet, and zcheck does not take it on trust: verify the map as it is stored");
+}
+
+}  // namespace
+
+VerifyResult verifyLensMap(const Checker& checker, const Camera& camera, const DepthMap& map)
+{
+    requireMapFits(camera, map);
+    requireJudgedDeclarations(camera, map);
+    const int W = camera.width(), H = camera.height();
+    VerifyResult run;
+    run.truth = checker.renderRay(camera);
+    const auto start = Clock::now();
+    const LensPixelJudge judge(checker, camera, map, run.truth);
+    std::vector<LensPixel> pixels(std::size_t(W) * H);
+    tbb::parallel_for(0, H, [&](int row) {
+        for (int col = 0; col < W; ++col) pixels[std::size_t(row) * W + col] = judge.judge(col, row);
+    });
+
+    // The report, in scan order.
+    Comparison& comparison = run.comparison;
+    ComparisonReport& c = comparison.report;
+    c.width = W, c.height = H;
+    comparison.pixelClass.resize(pixels.size());
+    comparison.errorOverTolerance.assign(pixels.size(), 0.0f);
+    run.map = RenderResult::cleared(W, H, camera.clearDepth());
+    run.mapError.assign(pixels.size(), NAN);
+    std::vector<double> quanta, relative, absolute, relativeToTruth;
+    MapErrors& e = run.report.mapErrors;
+    e.quantity = toString(map.quantity);
+    for (std::size_t i = 0; i < pixels.size(); ++i) {
+        const LensPixel& p = pixels[i];
+        const int col = int(i % W), row = int(i / W);
+        comparison.pixelClass[i] = p.pixelClass;
+        comparison.errorOverTolerance[i] = float(p.errorOverTolerance);
+        if (std::isfinite(p.map)) run.map.windowDepth.value[i] = p.map, run.map.primitiveId[i] = p.primitive == kNoPrimitive ? kUnknownPrimitive : p.primitive;
+        if (p.outOfRange && c.outOfRange++ == 0)
+            c.outOfRangeCol = col, c.outOfRangeRow = row, c.outOfRangeValue = map.storedOf(map.value[i]);
+        switch (p.pixelClass) {
+        case PixelClass::BothMiss: ++c.bothMiss; break;
+        case PixelClass::Agree: ++c.bothHit, ++c.agree; break;
+        case PixelClass::EdgeSurface: ++c.bothHit, ++c.edgeSurface; break;
+        case PixelClass::DepthError: ++c.bothHit, ++c.depthErrors; break;
+        case PixelClass::RayOnlyEdge: ++c.rayOnly, ++c.coverageExplained; break;
+        case PixelClass::Hole: ++c.rayOnly, ++c.coverageExplained, ++c.holes; break;
+        case PixelClass::RayOnly: ++c.rayOnly, ++c.coverageUnexplained; break;
+        case PixelClass::RasterOnlyEdge: ++c.rasterOnly, ++c.coverageExplained; break;
+        case PixelClass::RasterOnly: ++c.rasterOnly, ++c.coverageUnexplained; break;
+        default: break;
+        }
+        if (isUnexplained(p.pixelClass)) {
+            if (c.unexplainedSamples.size() < 20)
+                c.unexplainedSamples.push_back(finding(p, col, row));
+            if (c.unexplainedMaxCol < 0) c.unexplainedMinCol = col, c.unexplainedMinRow = row;
+            c.unexplainedMinCol = std::min(c.unexplainedMinCol, col), c.unexplainedMaxCol = std::max(c.unexplainedMaxCol, col);
+            c.unexplainedMinRow = std::min(c.unexplainedMinRow, row), c.unexplainedMaxRow = std::max(c.unexplainedMaxRow, row);
+        }
+        if (p.pixelClass != PixelClass::Agree && p.pixelClass != PixelClass::DepthError) continue;
+        quanta.push_back(p.errorQuanta);
+        relative.push_back(std::abs(p.map - p.truth) / p.truth);
+        if (p.errorOverTolerance >= c.maxErrorOverTolerance) c.maxErrorOverTolerance = p.errorOverTolerance, c.worst = finding(p, col, row);
+        // The map's error in its own units: distance, or eye-z (the truth's distance times cos θ).
+        const double perValue = map.value[i] > 0 ? p.map / map.value[i] : 1.0;
+        const double truthValue = p.truth / perValue, error = map.value[i] - truthValue;
+        run.mapError[i] = float(error);
+        absolute.push_back(std::abs(error));
+        relativeToTruth.push_back(std::abs(error / truthValue));
+        if (std::abs(error) > e.maxAbs || e.worstCol < 0)
+            e.maxAbs = std::abs(error), e.worstCol = col, e.worstRow = row, e.worstMap = map.value[i], e.worstTrue = truthValue;
+    }
+    c.maxErrorQuanta = quanta.empty() ? 0 : *std::max_element(quanta.begin(), quanta.end());
+    c.p99ErrorQuanta = quantileOf(quanta, 0.99);
+    c.maxRelativeEyeZError = relative.empty() ? 0 : *std::max_element(relative.begin(), relative.end());
+    c.p99RelativeEyeZError = quantileOf(relative, 0.99);
+    e.compared = std::int64_t(absolute.size());
+    e.p99Abs = quantileOf(absolute, 0.99), e.medianAbs = quantileOf(absolute, 0.5);
+    e.p99Rel = quantileOf(relativeToTruth, 0.99), e.medianRel = quantileOf(relativeToTruth, 0.5);
+    e.maxRel = relativeToTruth.empty() ? 0 : *std::max_element(relativeToTruth.begin(), relativeToTruth.end());
+    if (map.accuracy.allowHoles && c.holes * 2 > c.bothHit + c.holes)
+        c.declaredAccuracyRefused = "holes allowed, but the map holds nothing where " + std::to_string(c.holes) +
+                                    " of the " + std::to_string(c.bothHit + c.holes) + " pixels that see the surface are";
+    run.report.timings.compareMs = millisecondsSince(start);
+    run.report.timings.traceMs = run.truth.renderMilliseconds;
+    run.report.timings.bvhBuildMs = checker.bvhBuildMilliseconds();
+    run.report.describeInputs(checker.scene(), camera, mapTolerance(map));
+    run.report.declared = map.accuracy;
+    run.report.secondRoute = "map";
+    run.report.outOfRangeRule = toString(map.quantity) + " map of a lens model holds values > 0" +
+                                std::string(map.quantity == DepthQuantity::EyeZ ? ", on rays less than 90° off the axis" : "");
+    run.report.comparison = c;
+    return run;
+}
+
+}  // namespace zcheck
