@@ -105,8 +105,10 @@ int runCameraCommand(const CameraCommandOptions& o)
     if (!clipKnown) out["camera"]["projection"]["near"] = nullptr, out["camera"]["projection"]["far"] = nullptr;
     out["notes"] = cameraNotes(spec);
     const ProjectionType type = spec.projection.type;
-    if (type == ProjectionType::Perspective || type == ProjectionType::Frustum || type == ProjectionType::Pinhole ||
-        type == ProjectionType::Lens)
+    const bool hasK = camera.lens() ? camera.lens()->info().hasFocal && std::string(camera.lens()->info().params[0]) == "fx"
+                                    : type == ProjectionType::Perspective || type == ProjectionType::Frustum ||
+                                          type == ProjectionType::Pinhole || type == ProjectionType::Lens;
+    if (hasK)  // a lens model's K (its distortion is in "camera"'s "lens")
         out["intrinsics"] = {{"opencv", intrinsicsJson(camera, 0.0)}, {"colmap", intrinsicsJson(camera, 0.5)},
                              {"definition", "pixels; opencv: the top-left pixel's centre is (0, 0), colmap (and "
                                             "nerfstudio): it is (0.5, 0.5)"}};
@@ -121,7 +123,7 @@ int runCameraCommand(const CameraCommandOptions& o)
         nlohmann::json m = matricesJson(Camera(in));
         if (!clipKnown)
             for (const char* key : {"clip_from_eye", "eye_from_clip", "clip_from_world", "near", "far"}) m.erase(key);
-        if (!clipKnown) m["native"].erase("clip_from_eye");
+        if (!clipKnown && m.contains("native")) m["native"].erase("clip_from_eye");  // a lens model has no native block
         matrices[name] = m;
     }
     out["matrices"] = matrices;

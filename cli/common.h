@@ -30,6 +30,7 @@ Command addCheckCommand(CLI::App& app);
 Command addMatricesCommand(CLI::App& app);
 Command addPrecisionCommand(CLI::App& app);
 Command addUnprojectCommand(CLI::App& app);
+Command addRemapCommand(CLI::App& app);
 Command addExportCommand(CLI::App& app);
 Command addVerifyCommand(CLI::App& app);
 Command addSuiteCommand(CLI::App& app);

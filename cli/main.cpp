@@ -22,7 +22,7 @@ int main(int argc, char** argv)
     app.require_subcommand(1);
     app.set_version_flag("--version", std::string(zcheck::kVersion));
     const Command commands[] = {addCheckCommand(app),  addMatricesCommand(app), addPrecisionCommand(app),
-                                addUnprojectCommand(app), addExportCommand(app), addVerifyCommand(app),
+                                addUnprojectCommand(app), addRemapCommand(app), addExportCommand(app), addVerifyCommand(app),
                                 addSuiteCommand(app),  addBenchCommand(app),    addCameraCommand(app),
                                 addDatasetCommand(app),  addFormatsCommand(app)};
 

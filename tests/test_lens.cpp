@@ -8,6 +8,7 @@
 #include "zcheck/lens.h"
 #include "zcheck/map_verifier.h"
 #include "zcheck/pose.h"
+#include "zcheck/remap.h"
 #include "zcheck/scene.h"
 #include "zcheck/verify_map.h"
 
@@ -395,4 +396,67 @@ TEST_CASE("verify of a lens camera's map: a depth outside the lens's field is th
     const VerifyResult invented = verifier.verify(camera, map);
     REQUIRE(!invented.report.comparison.consistent());
     REQUIRE(invented.comparison.pixelClass[0] == PixelClass::RasterOnly);
+}
+
+TEST_CASE("remap: a map moved to another camera with the same centre is the other camera's render", "[lens][remap]")
+{
+    const Checker checker(builtinScene("default"));
+    CameraSpec fisheyeSpec;
+    fisheyeSpec.convention = Convention::preset("opencv");
+    fisheyeSpec.width = 400, fisheyeSpec.height = 400;
+    fisheyeSpec.projection.type = ProjectionType::NonLinear;
+    fisheyeSpec.projection.lens = {"opencv_fisheye", {120, 120, 199.5, 199.5, 0.021, -0.004, 7e-4, -1e-4}};
+    fisheyeSpec.projection.near = 0.05, fisheyeSpec.projection.far = 100;
+    fisheyeSpec.view = View::lookAt({1.2, 2.4, 5.5}, {-0.3, 0.9, -4.0}, {0, 1, 0});
+    const Camera fisheye(fisheyeSpec);
+    CameraSpec pinholeSpec = fisheyeSpec;  // the same centre, turned a little, another convention
+    pinholeSpec.convention = Convention::preset("opengl");
+    pinholeSpec.width = 320, pinholeSpec.height = 240;
+    pinholeSpec.projection = PinholeIntrinsics{260, 260, 159.5, 119.5, 0}.projection(0.05, 100, "K");
+    pinholeSpec.view = View::lookAt({1.2, 2.4, 5.5}, {-0.1, 0.7, -4.0}, {0, 1, 0});
+    const Camera pinhole(pinholeSpec);
+    const auto values = [&](const Camera& camera, ExportQuantity q) { return checker.render(camera, q, Route::Ray).value; };
+
+    // The same camera: every value comes back (nearest samples the pixel's own centre).
+    const std::vector<double> distance = values(fisheye, ExportQuantity::Distance);
+    const RemappedMap same = remapDepthMap(fisheye, distance, DepthQuantity::Distance, fisheye, DepthQuantity::Distance,
+                                           RemapSampling::Nearest);
+    for (std::size_t i = 0; i < distance.size(); ++i)
+        if (std::isfinite(distance[i])) REQUIRE(same.values[i] == Approx(distance[i]).epsilon(1e-12));
+
+    // Fisheye distance → pinhole eye-z, on planes: the pinhole's own render, to binary64 rounding.
+    const RemappedMap moved = remapDepthMap(fisheye, distance, DepthQuantity::Distance, pinhole, DepthQuantity::EyeZ,
+                                            RemapSampling::Plane);
+    const std::vector<double> truth = values(pinhole, ExportQuantity::EyeZ);
+    std::size_t compared = 0, exact = 0;
+    for (std::size_t i = 0; i < truth.size(); ++i) {
+        if (!std::isfinite(truth[i]) || !std::isfinite(moved.values[i])) continue;
+        ++compared;
+        exact += std::abs(moved.values[i] - truth[i]) <= 1e-9 * truth[i];
+    }
+    REQUIRE(moved.unseen == 0);
+    REQUIRE(compared > 40000);
+    REQUIRE(exact > compared / 2);  // all but the pixels whose 2×2 samples straddle an edge or a facet's crease
+    // Nearest instead: never across an edge, but off by the sample's offset on slanted surfaces.
+    const RemappedMap nearest = remapDepthMap(fisheye, distance, DepthQuantity::Distance, pinhole, DepthQuantity::EyeZ,
+                                              RemapSampling::Nearest);
+    std::size_t nearestExact = 0;
+    for (std::size_t i = 0; i < truth.size(); ++i)
+        if (std::isfinite(truth[i]) && std::isfinite(nearest.values[i]))
+            nearestExact += std::abs(nearest.values[i] - truth[i]) <= 1e-9 * truth[i];
+    REQUIRE(nearestExact < exact / 10);
+
+    // The quantity converted per ray: a pinhole's eye-z map moved to itself as distance is its distance render.
+    const RemappedMap asDistance = remapDepthMap(pinhole, truth, DepthQuantity::EyeZ, pinhole, DepthQuantity::Distance,
+                                                 RemapSampling::Nearest);
+    const std::vector<double> pinholeDistance = values(pinhole, ExportQuantity::Distance);
+    for (std::size_t i = 0; i < truth.size(); ++i)
+        if (std::isfinite(truth[i])) REQUIRE(asDistance.values[i] == Approx(pinholeDistance[i]).epsilon(1e-12));
+
+    // Another centre: refused.
+    CameraSpec moved2 = pinholeSpec;
+    moved2.view = View::lookAt({1.2, 2.5, 5.5}, {-0.3, 0.9, -4.0}, {0, 1, 0});
+    REQUIRE_THROWS_WITH(remapDepthMap(fisheye, distance, DepthQuantity::Distance, Camera(moved2), DepthQuantity::EyeZ,
+                                      RemapSampling::Plane),
+                        Catch::Contains("the two cameras' centres differ"));
 }

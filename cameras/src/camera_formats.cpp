@@ -23,6 +23,7 @@ const CameraFormat& nerfstudioFormat();  // format_nerfstudio.cpp
 const CameraFormat& opencvFormat();      // format_opencv.cpp
 const CameraFormat& rosFormat();         // format_opencv.cpp
 const CameraFormat& metashapeFormat();   // format_metashape.cpp
+const CameraFormat& kalibrFormat();      // format_kalibr.cpp
 }  // namespace formats
 
 namespace {
@@ -30,7 +31,8 @@ namespace {
 std::vector<const CameraFormat*> builtInFormats()
 {
     using namespace formats;
-    return {&zcheckFormat(), &colmapFormat(), &nerfstudioFormat(), &opencvFormat(), &rosFormat(), &metashapeFormat()};
+    return {&zcheckFormat(), &colmapFormat(), &nerfstudioFormat(), &opencvFormat(), &rosFormat(), &metashapeFormat(),
+            &kalibrFormat()};
 }
 
 void sortByPriority(std::vector<const CameraFormat*>& rows)

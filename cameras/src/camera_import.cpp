@@ -123,20 +123,6 @@ std::vector<std::string> pathAliases(const std::string& path)
     return out;
 }
 
-std::string distortionRefusal(const std::string& where, const std::string& model,
-                              const std::vector<std::pair<std::string, double>>& coefficients)
-{
-    std::string listed;
-    bool any = false;
-    for (const auto& [name, value] : coefficients) {
-        listed += (listed.empty() ? "" : ", ") + name + " = " + formatNumber(value);
-        any = any || value != 0;
-    }
-    if (!any) return "";
-    return where + ": camera model " + model + " has lens distortion (" + listed +
-           "): zcheck checks linear projections; undistort the depth map and give its pinhole camera";
-}
-
 std::string exactNumber(double value)
 {
     char text[40];

@@ -18,11 +18,51 @@
 // All little-endian. Every count is checked against the bytes present before anything is
 // allocated, and every message names the file and the line (text) or byte offset (binary).
 //
-// Camera models: SIMPLE_PINHOLE and PINHOLE are pinholes; SIMPLE_RADIAL, RADIAL, OPENCV,
-// FULL_OPENCV, FOV, SIMPLE_DIVISION, DIVISION and EUCM are pinholes when their distortion
-// coefficients are all zero (EUCM: alpha = 0); the fisheye models never are (with zero
-// coefficients they are still equidistant). A camera that is not a pinhole is kept with its
-// refusal (camera_import.h): only the images that use it fail.
+// Camera models (COLMAP src/colmap/sensor/models.h, read at commit 5d968cf3 of 2026-08-08: each
+// model's parameter list, ImgFromCam and Distortion), as zcheck lens models (lens.h), the
+// parameters after fx, fy, cx, cy (f, cx, cy) kept in COLMAP's order:
+//
+//   SIMPLE_PINHOLE, PINHOLE       pinhole
+//   SIMPLE_RADIAL, RADIAL         opencv k1 (k2): m·(1 + k1r² + k2r⁴) on m = (x/z, y/z), fx = fy = f
+//   OPENCV                        opencv k1 k2 p1 p2 (OpenCV's tangential pairing: 2p1xy + p2(r²+2x²))
+//   FULL_OPENCV                   opencv k1 k2 p1 p2 k3 k4 k5 k6 (OpenCV's order; rational radial)
+//   OPENCV_FISHEYE                opencv_fisheye k1..k4: θ·(1 + k1θ² + … + k4θ⁸) on the equidistant point
+//   SIMPLE_RADIAL_FISHEYE,        opencv_fisheye k1 (k2): θ·(1 + k1θ² + k2θ⁴), the same polynomial cut
+//   RADIAL_FISHEYE                short
+//   SIMPLE_FISHEYE, FISHEYE       opencv_fisheye with no coefficients: equidistant, still a fisheye
+//   THIN_PRISM_FISHEYE            thin_prism_fisheye k1 k2 p1 p2 k3 k4 sx1 sy1: radial, tangential and
+//                                 prism all on the equidistant point
+//   RAD_TAN_THIN_PRISM_FISHEYE    fisheye624 k0..k5 p0 p1 s0..s3: tangential and prism on the point after
+//                                 the radial polynomial, p0 with r² + 2x² (Aria's FISHEYE624, same order)
+//   FOV                           fov omega: r ↦ atan(2r·tan(ω/2))/ω. The formula is even in ω and COLMAP's
+//                                 bundle adjustment leaves ω negative at times (colmap issue 1261): |ω|
+//   SIMPLE_DIVISION, DIVISION     division k: the ray through m is (m, 1 + k|m|²)
+//   EUCM                          eucm alpha beta: m = (x, y)/(α·√(β(x²+y²) + z²) + (1 − α)z)
+//   EQUIRECTANGULAR (id 17)       equirectangular −180..180° longitude, −90..90° latitude; its
+//                                 parameters w, h are the image size its mapping spans
+// COLMAP's pixel coordinates put the image's top-left corner at (0, 0) (models.h's convention
+// note), as zcheck's image coordinates do: cx, cy move by ½ into the lens's OpenCV coordinates.
+// A non-fisheye model whose distortion is nothing (every coefficient 0; FOV ω = 0, its pinhole
+// limit; EUCM α = 0 with β ≥ 0) is a linear pinhole. A camera zcheck cannot use (a lens that
+// folds inside the image or is out of its parameters' ranges, an EQUIRECTANGULAR whose w, h are
+// not the camera's size) is kept with its refusal (camera_import.h): only the images that use it
+// fail. Malformed input (a parameter count, a number, a focal length ≤ 0) fails the whole model.
+//
+// Writing (zcheck camera --to colmap): a linear camera as PINHOLE; a lens as the COLMAP model of
+// the same formula: opencv as OPENCV (k1 k2 p1 p2) or FULL_OPENCV (any of k3..k6 nonzero),
+// brown_conrady and metashape_frame without k4 likewise (Metashape's f + b1, f as fx, fy, its
+// P1, P2 as OpenCV's p2, p1), metashape_fisheye as OPENCV_FISHEYE (P1 = P2 = 0) or
+// THIN_PRISM_FISHEYE, opencv_fisheye, thin_prism_fisheye, fisheye624, fov, division and eucm as
+// theirs, the whole-sphere equirectangular as EQUIRECTANGULAR W H W H. The rest (thin prism or
+// tilt in opencv, an r⁸ term on the perspective point, Metashape's skew b2, unified, double
+// sphere, equisolid, a partial panorama) is refused naming the model and the coefficient.
+//
+// Where COLMAP and zcheck part (beyond what a sane calibration's image shows): COLMAP's ImgFromCam
+// rejects points with z ≤ ε for every model but DIVISION and EQUIRECTANGULAR, and its fisheyes'
+// CamFromImg do not lift pixels beyond θ = 90°; zcheck's lens keeps a fisheye's or EUCM's field
+// out to where the model stops being one-to-one, past 90° where the coefficients allow. COLMAP's
+// FOV Distortion, for |ω| < 0.01, uses the series of the inverse map (1 − ω²/12 + ω²r²/3, where
+// the forward map's is 1 + ω²/12 − ω²r²/3); zcheck uses the closed form, as COLMAP's CamFromImg does.
 #include "formats.h"
 
 #include "zcheck/camera.h"
@@ -33,10 +73,12 @@
 
 #include <sys/stat.h>
 
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <map>
 #include <sstream>
+#include <utility>
 
 namespace zcheck::formats {
 
@@ -44,35 +86,50 @@ const CameraFormat& colmapFormat();
 
 namespace {
 
+using Coefficients = std::vector<double>;
+
+bool allZero(const Coefficients& c)
+{
+    for (double v : c)
+        if (v != 0) return false;
+    return true;
+}
+// EUCM with α = 0 is m = (x, y)/z for any β ≥ 0 (β < 0 is out of COLMAP's range and zcheck's).
+bool eucmIsPinhole(const Coefficients& c) { return c[0] == 0 && c[1] >= 0; }
+
 struct ModelInfo {
     int id;
     const char* name;
-    int focals;                           // 1: f for fx and fy; 2: fx, fy
-    std::vector<const char*> distortion;  // the coefficients after fx, fy, cx, cy (or f, cx, cy)
-    const char* nonLinear;                // not a pinhole for any coefficients: why ("a fisheye")
+    std::vector<const char*> params;  // COLMAP's, in order (models.h, InitializeParamsInfo)
+    int focals;                       // 1: f for fx and fy; 2: fx, fy; 0: none (a panorama)
+    const char* lens;                 // the zcheck lens model of its coefficients; nullptr: a pinhole
+    bool (*isPinhole)(const Coefficients&);  // when its coefficients make it linear; nullptr: never
 };
 
 const std::vector<ModelInfo>& models()
 {
     static const std::vector<ModelInfo> table = {
-        {0, "SIMPLE_PINHOLE", 1, {}, nullptr},
-        {1, "PINHOLE", 2, {}, nullptr},
-        {2, "SIMPLE_RADIAL", 1, {"k"}, nullptr},
-        {3, "RADIAL", 1, {"k1", "k2"}, nullptr},
-        {4, "OPENCV", 2, {"k1", "k2", "p1", "p2"}, nullptr},
-        {5, "OPENCV_FISHEYE", 2, {"k1", "k2", "k3", "k4"}, "a fisheye (equidistant) projection"},
-        {6, "FULL_OPENCV", 2, {"k1", "k2", "p1", "p2", "k3", "k4", "k5", "k6"}, nullptr},
-        {7, "FOV", 2, {"omega"}, nullptr},
-        {8, "SIMPLE_RADIAL_FISHEYE", 1, {"k"}, "a fisheye (equidistant) projection"},
-        {9, "RADIAL_FISHEYE", 1, {"k1", "k2"}, "a fisheye (equidistant) projection"},
-        {10, "THIN_PRISM_FISHEYE", 2, {"k1", "k2", "p1", "p2", "k3", "k4", "sx1", "sy1"}, "a fisheye (equidistant) projection"},
-        {11, "RAD_TAN_THIN_PRISM_FISHEYE", 2,
-         {"k0", "k1", "k2", "k3", "k4", "k5", "p0", "p1", "s0", "s1", "s2", "s3"}, "a fisheye (equidistant) projection"},
-        {12, "SIMPLE_DIVISION", 1, {"k"}, nullptr},
-        {13, "DIVISION", 2, {"k"}, nullptr},
-        {14, "SIMPLE_FISHEYE", 1, {}, "a fisheye (equidistant) projection"},
-        {15, "FISHEYE", 2, {}, "a fisheye (equidistant) projection"},
-        {16, "EUCM", 2, {"alpha", "beta"}, nullptr},
+        {0, "SIMPLE_PINHOLE", {"f", "cx", "cy"}, 1, nullptr, allZero},
+        {1, "PINHOLE", {"fx", "fy", "cx", "cy"}, 2, nullptr, allZero},
+        {2, "SIMPLE_RADIAL", {"f", "cx", "cy", "k"}, 1, "opencv", allZero},
+        {3, "RADIAL", {"f", "cx", "cy", "k1", "k2"}, 1, "opencv", allZero},
+        {4, "OPENCV", {"fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2"}, 2, "opencv", allZero},
+        {5, "OPENCV_FISHEYE", {"fx", "fy", "cx", "cy", "k1", "k2", "k3", "k4"}, 2, "opencv_fisheye", nullptr},
+        {6, "FULL_OPENCV", {"fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3", "k4", "k5", "k6"}, 2, "opencv", allZero},
+        {7, "FOV", {"fx", "fy", "cx", "cy", "omega"}, 2, "fov", allZero},
+        {8, "SIMPLE_RADIAL_FISHEYE", {"f", "cx", "cy", "k"}, 1, "opencv_fisheye", nullptr},
+        {9, "RADIAL_FISHEYE", {"f", "cx", "cy", "k1", "k2"}, 1, "opencv_fisheye", nullptr},
+        {10, "THIN_PRISM_FISHEYE", {"fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3", "k4", "sx1", "sy1"}, 2,
+         "thin_prism_fisheye", nullptr},
+        {11, "RAD_TAN_THIN_PRISM_FISHEYE",
+         {"fx", "fy", "cx", "cy", "k0", "k1", "k2", "k3", "k4", "k5", "p0", "p1", "s0", "s1", "s2", "s3"}, 2, "fisheye624",
+         nullptr},
+        {12, "SIMPLE_DIVISION", {"f", "cx", "cy", "k"}, 1, "division", allZero},
+        {13, "DIVISION", {"fx", "fy", "cx", "cy", "k"}, 2, "division", allZero},
+        {14, "SIMPLE_FISHEYE", {"f", "cx", "cy"}, 1, "opencv_fisheye", nullptr},
+        {15, "FISHEYE", {"fx", "fy", "cx", "cy"}, 2, "opencv_fisheye", nullptr},
+        {16, "EUCM", {"fx", "fy", "cx", "cy", "alpha", "beta"}, 2, "eucm", eucmIsPinhole},
+        {17, "EQUIRECTANGULAR", {"w", "h"}, 0, "equirectangular", nullptr},
     };
     return table;
 }
@@ -91,7 +148,15 @@ const ModelInfo* modelByName(const std::string& name)
     return nullptr;
 }
 
-std::size_t paramCount(const ModelInfo& m) { return std::size_t(m.focals + 2) + m.distortion.size(); }
+std::size_t paramCount(const ModelInfo& m) { return m.params.size(); }
+
+// "fx, fy, cx, cy": a model's parameters, for messages.
+std::string paramNames(const ModelInfo& m)
+{
+    std::string out;
+    for (const char* name : m.params) out += (out.empty() ? "" : ", ") + std::string(name);
+    return out;
+}
 
 std::string modelNames()
 {
@@ -100,47 +165,67 @@ std::string modelNames()
     return out;
 }
 
+// COLMAP's EQUIRECTANGULAR (EquirectangularCameraModel::ImgFromCam): x = (atan2(u, w)/2π + ½)·w_param,
+// y = (½ − atan2(−v, √(u² + w²))/π)·h_param, so over an image of w_param × h_param pixels it is
+// zcheck's equirectangular across the whole sphere.
+const LensSpec kFullSphere{"equirectangular", {-180, 180, -90, 90}};
+
 struct ColmapCamera {
     std::int64_t width = 0, height = 0;
-    PinholeIntrinsics intrinsics;
-    std::string refusal;  // not a pinhole
+    Projection projection;  // a pinhole or a lens model (the pinhole of its K when it is refused)
+    std::string refusal;    // why the images that use it cannot be checked; "" none
 };
 
-// A camera's intrinsics, or why they are not a pinhole's. `where` names the line or record,
-// which an impossible value (a focal length ≤ 0, a principal point beyond what binary32 rays
-// can hold) is refused with, whichever image uses the camera.
+// A camera as zcheck sees it. `where` names the line or record. An impossible value (a focal
+// length ≤ 0, a principal point beyond what binary32 rays can hold) throws, whichever image
+// uses the camera; a lens zcheck refuses (LensModel's own rules) becomes the camera's refusal.
 ColmapCamera cameraOf(const ModelInfo& model, std::int64_t width, std::int64_t height, const std::vector<double>& p,
                       const std::string& where)
 {
-    {
-        const std::size_t f = std::size_t(model.focals);
-        CameraSpec spec;
-        spec.convention = Convention::preset("opencv");
-        spec.width = int(width), spec.height = int(height);
-        spec.view.hasMatrix = true;
+    ColmapCamera camera;
+    camera.width = width, camera.height = height;
+    CameraSpec spec;
+    spec.convention = Convention::preset("opencv");
+    spec.width = int(width), spec.height = int(height);
+    spec.view.hasMatrix = true;
+    const auto validated = [&](const Projection& projection) {
+        spec.projection = projection;
+        const Camera built(spec);
+        return projection;
+    };
+    if (model.focals == 0) {  // EQUIRECTANGULAR: w, h
+        Projection panorama;
+        panorama.type = ProjectionType::NonLinear;
+        panorama.lens = kFullSphere;
+        panorama.near = kPlaceholderNear, panorama.far = kPlaceholderFar;
         try {
-            spec.projection = PinholeIntrinsics{p[0], p[f == 1 ? 0 : 1], p[f], p[f + 1], 0.5}.projection(
-                kPlaceholderNear, kPlaceholderFar, "intrinsics");
-            Camera validated(spec);
+            camera.projection = validated(panorama);
         } catch (const Error& e) {
             throw Error(where + ": " + e.what());
         }
+        if (p[0] != double(width) || p[1] != double(height))
+            camera.refusal = where + ": camera model EQUIRECTANGULAR has w = " + formatNumber(p[0]) + ", h = " +
+                             formatNumber(p[1]) + " for an image of " + std::to_string(width) + "x" +
+                             std::to_string(height) + ": COLMAP spreads longitude -180..180° over w pixels and latitude "
+                             "90..-90° over h, which would not span this image; zcheck reads it with w, h the "
+                             "camera's width and height";
+        return camera;
     }
-    ColmapCamera camera;
-    camera.width = width, camera.height = height;
     const std::size_t f = std::size_t(model.focals);
-    camera.intrinsics = {p[0], p[f == 1 ? 0 : 1], p[f], p[f + 1], 0.5};
-    std::vector<std::pair<std::string, double>> coefficients;
-    for (std::size_t i = 0; i < model.distortion.size(); ++i) coefficients.emplace_back(model.distortion[i], p[f + 2 + i]);
-    if (model.nonLinear) {
-        camera.refusal = where + ": camera model " + model.name + " is " + model.nonLinear +
-                         ", not a pinhole: zcheck checks linear projections; undistort the depth map and give its "
-                         "pinhole camera";
-    } else if (std::string(model.name) == "EUCM") {
-        if (p[f + 2] != 0)  // alpha = 0 makes EUCM a pinhole whatever beta is
-            camera.refusal = distortionRefusal(where, model.name, {coefficients[0]});
-    } else {
-        camera.refusal = distortionRefusal(where, model.name, coefficients);
+    const PinholeIntrinsics k{p[0], p[f == 1 ? 0 : 1], p[f], p[f + 1], 0.5};
+    try {
+        camera.projection = validated(k.projection(kPlaceholderNear, kPlaceholderFar, "intrinsics"));
+    } catch (const Error& e) {
+        throw Error(where + ": " + e.what());
+    }
+    Coefficients coefficients(p.begin() + std::ptrdiff_t(f + 2), p.end());
+    if (!model.lens || (model.isPinhole && model.isPinhole(coefficients))) return camera;
+    if (std::string(model.name) == "FOV") coefficients[0] = std::abs(coefficients[0]);
+    try {
+        camera.projection =
+            validated(k.lensProjection(model.lens, coefficients, kPlaceholderNear, kPlaceholderFar, "intrinsics"));
+    } catch (const Error& e) {
+        camera.refusal = where + ": camera model " + model.name + ": " + e.what();
     }
     return camera;
 }
@@ -221,7 +306,8 @@ std::map<std::int64_t, ColmapCamera> readCamerasText(const std::string& path)
                            height = file.integer(i, t[3], "HEIGHT", Camera::kMaxImageSide, 1);
         if (t.size() - 4 != paramCount(*model))
             file.fail(i, std::string("camera model ") + model->name + " takes " + std::to_string(paramCount(*model)) +
-                             " parameters, the line has " + std::to_string(t.size() - 4));
+                             " parameters, the line has " + std::to_string(t.size() - 4) + " (" + model->name + ": " +
+                             paramNames(*model) + ")");
         std::vector<double> params;
         for (std::size_t k = 4; k < t.size(); ++k) params.push_back(file.number(i, t[k], "parameter " + std::to_string(k - 3)));
         if (cameras.count(id)) file.fail(i, "CAMERA_ID " + std::to_string(id) + " appears twice");
@@ -321,7 +407,7 @@ std::map<std::int64_t, ColmapCamera> readCamerasBinary(const std::string& path)
         const ModelInfo* model = modelById(modelId);
         if (!model)
             file.fail(what + " (camera " + std::to_string(id) + ") has model id " + std::to_string(modelId) +
-                      ", which zcheck does not know (COLMAP's 0..16: " + modelNames() + ")");
+                      ", which zcheck does not know (COLMAP's 0..17: " + modelNames() + ")");
         const std::uint64_t width = file.read<std::uint64_t>(what), height = file.read<std::uint64_t>(what);
         if (!Camera::isImageSide(double(width)) || !Camera::isImageSide(double(height)))
             file.fail(what + " (camera " + std::to_string(id) + ") has the size " + std::to_string(width) + "x" +
@@ -420,14 +506,19 @@ CameraSet readColmapModel(const std::string& path)
         spec.convention = opencv;
         spec.width = int(intrinsics.width), spec.height = int(intrinsics.height);
         try {
-            spec.projection = intrinsics.intrinsics.projection(kPlaceholderNear, kPlaceholderFar, "intrinsics");
+            spec.projection = intrinsics.projection;
             double departure = 0;
             const glm::dmat4 camFromWorld = poseFromRotationTranslation(
                 rotationFromQuaternion(image.q[0], image.q[1], image.q[2], image.q[3], "qvec", &departure),
                 {image.t[0], image.t[1], image.t[2]});
             spec.view = viewFromPose(camFromWorld, PoseDirection::CameraFromWorld, opencv, opencv, "qvec, tvec");
             spec.view.rotationDeparture = std::max(spec.view.rotationDeparture, departure);
-            Camera validated(spec);
+            // The lens was validated with its camera (cameraOf); the pose is validated here with a
+            // linear stand-in, so that a model of thousands of images builds its lens once.
+            CameraSpec pose = spec;
+            if (pose.projection.type == ProjectionType::NonLinear)
+                pose.projection = Projection::perspective(60, kPlaceholderNear, kPlaceholderFar);
+            Camera validated(pose);
         } catch (const Error& e) {
             throw Error(image.where + ": " + e.what());
         }
@@ -436,18 +527,100 @@ CameraSet readColmapModel(const std::string& path)
     return set;
 }
 
-// cameras.txt (one PINHOLE camera, cx = W/2 centred) and images.txt (world-to-camera qvec and
-// tvec in OpenCV axes, the image named `name`).
+// The COLMAP model that holds a camera exactly, and its parameters: PINHOLE for a linear camera;
+// for a lens model the COLMAP model of the same formula (cameraOf's table read backwards), the
+// principal point moved to COLMAP's corner-origin pixels. Throws naming the lens model (and the
+// coefficient) where COLMAP has none.
+std::pair<const ModelInfo*, std::vector<double>> colmapModelOf(const Camera& camera)
+{
+    const LensModel* lens = camera.lens();
+    if (!lens) {
+        const PinholeIntrinsics k = pinholeIntrinsicsOf(camera, 0.5);
+        return {modelByName("PINHOLE"), {k.fx, k.fy, k.cx, k.cy}};
+    }
+    const std::string& name = lens->spec().model;
+    const std::vector<double>& q = lens->spec().params;  // every parameter, in the model's order (lens.h)
+    const auto refuse = [&](const std::string& why) -> std::pair<const ModelInfo*, std::vector<double>> {
+        throw Error("cannot write lens model " + name + " as a COLMAP camera: " + why);
+    };
+    const auto nonzero = [&](std::size_t from, std::size_t to) -> const char* {  // the first nonzero of q[from, to)
+        for (std::size_t i = from; i < to; ++i)
+            if (q[i] != 0) return lens->info().params[i];
+        return nullptr;
+    };
+    const auto named = [&](const char* model, std::vector<double> coefficients) {
+        const PinholeIntrinsics k = pinholeIntrinsicsOf(camera, 0.5);
+        std::vector<double> params = {k.fx, k.fy, k.cx, k.cy};
+        params.insert(params.end(), coefficients.begin(), coefficients.end());
+        return std::pair{modelByName(model), params};
+    };
+    const auto slice = [&](std::size_t from, std::size_t to) {
+        return std::vector<double>(q.begin() + std::ptrdiff_t(from), q.begin() + std::ptrdiff_t(to));
+    };
+    if (name == "opencv") {  // fx fy cx cy k1 k2 p1 p2 k3 k4 k5 k6 s1 s2 s3 s4 tau_x tau_y
+        if (const char* c = nonzero(12, 18))
+            return refuse(std::string(c) + " = " + formatNumber(lens->param(c)) +
+                          ": COLMAP's OPENCV and FULL_OPENCV have no thin prism (s1..s4) or tilt (tau_x, tau_y)");
+        return nonzero(8, 12) ? named("FULL_OPENCV", slice(4, 12)) : named("OPENCV", slice(4, 8));
+    }
+    if (name == "brown_conrady") {  // fx fy cx cy k1 k2 k3 k4 p1 p2: OpenCV's with k3 and an r⁸ term k4
+        if (q[7] != 0)
+            return refuse("k4 = " + formatNumber(q[7]) + ": COLMAP's models have no r⁸ term on the perspective point");
+        if (q[6] != 0) return named("FULL_OPENCV", {q[4], q[5], q[8], q[9], q[6], 0, 0, 0});
+        return named("OPENCV", {q[4], q[5], q[8], q[9]});
+    }
+    if (name == "metashape_frame" || name == "metashape_fisheye") {
+        // f cx cy b1 b2 k1 k2 k3 k4 p1 p2: fx = f + b1, fy = f, skew b2, and Metashape's P1 is
+        // OpenCV's p2 (lens.h) — OpenCV's models with the pair swapped, where b2 is 0.
+        if (q[4] != 0) return refuse("b2 = " + formatNumber(q[4]) + ": COLMAP's models have no skew");
+        const std::vector<double> k = {q[0] + q[3], q[0], q[1] + 0.5, q[2] + 0.5};
+        const auto withK = [&](const char* model, const std::vector<double>& coefficients) {
+            std::vector<double> params = k;
+            params.insert(params.end(), coefficients.begin(), coefficients.end());
+            return std::pair{modelByName(model), params};
+        };
+        if (name == "metashape_fisheye") {  // KB on the equidistant point, tangential on it too
+            if (q[9] == 0 && q[10] == 0) return withK("OPENCV_FISHEYE", {q[5], q[6], q[7], q[8]});
+            return withK("THIN_PRISM_FISHEYE", {q[5], q[6], q[10], q[9], q[7], q[8], 0, 0});
+        }
+        if (q[8] != 0)
+            return refuse("k4 = " + formatNumber(q[8]) + ": COLMAP's models have no r⁸ term on the perspective point");
+        if (q[7] != 0) return withK("FULL_OPENCV", {q[5], q[6], q[10], q[9], q[7], 0, 0, 0});
+        return withK("OPENCV", {q[5], q[6], q[10], q[9]});
+    }
+    if (name == "opencv_fisheye") return named("OPENCV_FISHEYE", slice(4, 8));
+    if (name == "thin_prism_fisheye") return named("THIN_PRISM_FISHEYE", slice(4, 12));
+    if (name == "fisheye624") return named("RAD_TAN_THIN_PRISM_FISHEYE", slice(4, 16));
+    if (name == "fov") return named("FOV", slice(4, 5));
+    if (name == "division") return named("DIVISION", slice(4, 5));
+    if (name == "eucm") return named("EUCM", slice(4, 6));
+    if (name == "equirectangular") {
+        if (lens->spec() != kFullSphere)
+            return refuse("it spans longitude " + formatNumber(q[0]) + ".." + formatNumber(q[1]) + "° and latitude " +
+                          formatNumber(q[2]) + ".." + formatNumber(q[3]) +
+                          "°; COLMAP's EQUIRECTANGULAR spans the whole sphere, -180..180° and -90..90°");
+        return {modelByName("EQUIRECTANGULAR"), {double(camera.width()), double(camera.height())}};
+    }
+    return refuse("COLMAP has no camera model of its formula (it has OPENCV, FULL_OPENCV, OPENCV_FISHEYE, "
+                  "THIN_PRISM_FISHEYE, RAD_TAN_THIN_PRISM_FISHEYE, FOV, DIVISION, EUCM and EQUIRECTANGULAR: zcheck's "
+                  "opencv without thin prism or tilt, brown_conrady and metashape_frame without k4, metashape_* "
+                  "without b2, opencv_fisheye, thin_prism_fisheye, fisheye624, fov, division, eucm and the "
+                  "whole-sphere equirectangular)");
+}
+
+// cameras.txt (one camera: PINHOLE, or the COLMAP model of its lens; cx = W/2 centred) and
+// images.txt (world-to-camera qvec and tvec in OpenCV axes, the image named `name`).
 std::vector<CameraFileText> writeColmapModel(const Camera& camera, const std::string& name)
 {
-    const PinholeIntrinsics k = pinholeIntrinsicsOf(camera, 0.5);
+    const auto [model, params] = colmapModelOf(camera);
+    std::string line =
+        "1 " + std::string(model->name) + " " + std::to_string(camera.width()) + " " + std::to_string(camera.height());
+    for (double value : params) line += " " + exactNumber(value);
     const glm::dmat4 m = camFromWorldIn(camera, Convention::preset("opencv"));
     const glm::dvec4 q = quaternionFromRotation(glm::dmat3(m));  // (w, x, y, z)
     const std::string cameras = "# Camera list with one line of data per camera:\n"
                                 "#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n"
-                                "# Number of cameras: 1\n"
-                                "1 PINHOLE " + std::to_string(camera.width()) + " " + std::to_string(camera.height()) + " " +
-                                exactNumber(k.fx) + " " + exactNumber(k.fy) + " " + exactNumber(k.cx) + " " + exactNumber(k.cy) + "\n";
+                                "# Number of cameras: 1\n" + line + "\n";
     const std::string images = "# Image list with two lines of data per image:\n"
                                "#   IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME\n"
                                "#   POINTS2D[] as (X, Y, POINT3D_ID)\n"

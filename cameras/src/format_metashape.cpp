@@ -2,10 +2,19 @@
 // "Agisoft XML"), as Metashape defines it (user manual, appendix "Camera models"; the export
 // scripts Agisoft publishes):
 //
-//   sensors  <sensor id type="frame"> with <calibration class="adjusted"> (else the only one):
-//            <resolution width height>, f, cx, cy as offsets from the image centre, b1
-//            (affinity), b2 (skew), k1..k4, p1..p4; absent parameters are 0.
-//            fx = f + b1, fy = f, principal point (W/2 + cx, H/2 + cy)
+//   sensors  <sensor id type="frame|fisheye|spherical"> with <calibration class="adjusted">
+//            (else the only one): <resolution width height>, f, cx, cy as offsets from the image
+//            centre, b1 (affinity), b2 (skew), k1..k4, p1..p4; absent parameters are 0.
+//            frame: u = W/2 + cx + x'(f + b1) + y'·b2, v = H/2 + cy + y'·f, x', y' the Brown
+//            polynomial of (X/Z, Y/Z) with P1 on r² + 2x² (OpenCV's p2) → lens metashape_frame
+//            [f, cx, cy, b1, b2, k1..k4, p1, p2], cx, cy moved to zcheck's W/2 + cx − ½; with every
+//            k, p and b2 zero, a pinhole fx = f + b1, fy = f
+//            fisheye: the same on the equidistant point (X, Y)·θ/r → lens metashape_fisheye
+//            spherical: no calibration (nerfstudio's metashape_utils.py reads it so, with its
+//            EQUIRECTANGULAR fl_x = W/2, cx = W/2, fl_y = H, cy = H/2 in the camera's own axes;
+//            Agisoft's render_spherical_panorama.py renders one with f = H/π and W = 2H): the
+//            whole sphere, longitude atan2(X, Z) 0 at the image's centre column, the top row up
+//            (−Y) → lens equirectangular −180..180, −90..90
 //   pixels   the image's top-left corner is (0, 0): the top-left pixel's centre is (0.5, 0.5)
 //   cameras  <camera id sensor_id [component_id] label [enabled="false"]>, also one level down
 //            in a <group>; <transform>: 16 numbers, row-major, camera-to-chunk
@@ -15,17 +24,22 @@
 //            internal coordinates (noted)
 //
 // Disabled cameras are skipped, as Metashape's own exporters skip them. A camera the file cannot
-// give a pinhole for keeps its refusal (dataset frames record it and go on): one not aligned
-// (no <transform>), a rig's secondary camera (master_id), one whose sensor is not a frame
-// camera, has no calibration, or has lens distortion (any nonzero k or p) or skew (b2).
-// PhotoScan's older calibrations (fx, fy instead of f) are refused: their model differs.
+// give a camera for keeps its refusal (dataset frames record it and go on): one not aligned
+// (no <transform>), a rig's secondary camera (master_id), one whose sensor is of another type
+// (cylindrical, rpc), has no calibration, or has p3, p4 (a factor on the tangential terms the
+// lens models do not have); a spherical sensor whose image is not 2:1 or whose calibration is not
+// the plain sphere. PhotoScan's older calibrations (fx, fy instead of f) are refused: their model
+// differs.
 #include "formats.h"
 
 #include "zcheck/detail/xml_lite.h"
 #include "zcheck/error.h"
 #include "zcheck/input_file.h"
+#include "zcheck/lens.h"
 #include "zcheck/pose.h"
 
+#include <algorithm>
+#include <cmath>
 #include <map>
 #include <optional>
 
@@ -39,7 +53,7 @@ using xml::Element;
 
 // A sensor's calibration as the cameras on it need it: the projection, or why there is none.
 struct Sensor {
-    PinholeIntrinsics intrinsics;
+    Projection projection;
     int width = 0, height = 0;
     std::string refusal;
 };
@@ -161,45 +175,117 @@ private:
         }
     }
 
+    const Element& resolutionOf(const Element& sensor, const Element* calibration) const
+    {
+        const Element* resolution = calibration ? calibration->child("resolution") : nullptr;
+        if (!resolution) resolution = sensor.child("resolution");
+        if (!resolution) fail(calibration ? *calibration : sensor, "has no <resolution> (nor has its sensor)");
+        return *resolution;
+    }
+
     Sensor sensorOf(const Element& element, const std::string& id) const
     {
         Sensor sensor;
         const std::string where = source() + ": sensor " + id;
-        const std::string* type = element.attribute("type");
-        if (type && *type != "frame") {
-            sensor.refusal = where + " is a " + *type + " camera, not a frame (pinhole) camera: zcheck checks linear "
-                                     "projections; undistort the depth map and give its pinhole camera";
+        const std::string* typeAttribute = element.attribute("type");
+        const std::string type = typeAttribute ? *typeAttribute : "frame";
+        if (type != "frame" && type != "fisheye" && type != "spherical") {
+            sensor.refusal = where + " (line " + std::to_string(element.line) + ") is a " + type +
+                             " camera: zcheck reads Metashape's frame, fisheye and spherical sensors";
             return sensor;
         }
         const Element* calibration = calibrationOf(element);
+        if (type == "spherical") return sphericalSensor(element, calibration, where);
         if (!calibration) {
             sensor.refusal = where + " has no calibration (or several, none adjusted): align the cameras first";
             return sensor;
         }
         if (calibration->child("fx") || calibration->child("fy"))
             fail(*calibration, "gives fx, fy (PhotoScan's older model): re-export the cameras with Metashape");
-        const Element* resolution = calibration->child("resolution");
-        if (!resolution) resolution = element.child("resolution");
-        if (!resolution) fail(*calibration, "has no <resolution> (nor has its sensor)");
-        sensor.width = pixels(*resolution, "width"), sensor.height = pixels(*resolution, "height");
+        const Element& resolution = resolutionOf(element, calibration);
+        sensor.width = pixels(resolution, "width"), sensor.height = pixels(resolution, "height");
         const auto value = [&](const char* name) {
             const Element* child = calibration->child(name);
             return child ? number(*child) : 0.0;
         };
         const Element* f = calibration->child("f");
         if (!f) fail(*calibration, "has no <f>");
-        std::vector<std::pair<std::string, double>> distortion;
-        for (const char* name : {"k1", "k2", "k3", "k4", "p1", "p2", "p3", "p4"}) distortion.emplace_back(name, value(name));
-        sensor.refusal = distortionRefusal(where, "frame", distortion);
+        const std::string at = where + " (calibration, line " + std::to_string(calibration->line) + ")";
+        for (const char* name : {"p3", "p4"})
+            if (value(name) != 0) {
+                sensor.refusal = at + " has " + name + " = " + formatNumber(value(name)) +
+                                 ": Metashape's factor 1 + P3·r² + P4·r⁴ on the tangential terms is in no lens model "
+                                 "zcheck has";
+                return sensor;
+            }
         const double focal = number(*f), b1 = value("b1"), b2 = value("b2");
-        const double k[3][3] = {{focal + b1, b2, sensor.width / 2.0 + value("cx")},
-                                {0, focal, sensor.height / 2.0 + value("cy")},
-                                {0, 0, 1}};
-        try {
-            sensor.intrinsics = PinholeIntrinsics::fromK(k, 0.5, "calibration (f + b1, b2, f, W/2 + cx, H/2 + cy)");
-        } catch (const Error& e) {
-            if (sensor.refusal.empty()) sensor.refusal = where + ": " + e.what();
+        std::vector<double> distortion;
+        bool distorted = false;
+        for (const char* name : {"k1", "k2", "k3", "k4", "p1", "p2"}) {
+            distortion.push_back(value(name));
+            distorted = distorted || distortion.back() != 0;
         }
+        try {
+            if (type == "frame" && !distorted && b2 == 0) {
+                const double k[3][3] = {{focal + b1, 0, sensor.width / 2.0 + value("cx")},
+                                        {0, focal, sensor.height / 2.0 + value("cy")},
+                                        {0, 0, 1}};
+                sensor.projection = PinholeIntrinsics::fromK(k, 0.5, "calibration (f + b1, f, W/2 + cx, H/2 + cy)")
+                                        .projection(kPlaceholderNear, kPlaceholderFar, "calibration");
+            } else {
+                // The lens's f, cx, cy, b1, b2, k1..k4, p1, p2, cx and cy in zcheck's pixel
+                // coordinates (the top-left pixel's centre at 0, 0): W/2 + cx − ½.
+                std::vector<double> params = {focal, sensor.width / 2.0 + value("cx") - 0.5,
+                                              sensor.height / 2.0 + value("cy") - 0.5, b1, b2};
+                params.insert(params.end(), distortion.begin(), distortion.end());
+                sensor.projection = lensProjection(type == "frame" ? "metashape_frame" : "metashape_fisheye", params);
+                const LensModel validated(sensor.projection.lens, sensor.width, sensor.height);
+            }
+        } catch (const Error& e) {
+            sensor.refusal = at + ": " + e.what();
+        }
+        return sensor;
+    }
+
+    static Projection lensProjection(const std::string& model, const std::vector<double>& params)
+    {
+        Projection p;
+        p.type = ProjectionType::NonLinear;
+        p.lens = {model, params};
+        p.near = kPlaceholderNear, p.far = kPlaceholderFar;
+        return p;
+    }
+
+    // A spherical sensor: the whole sphere over a 2:1 image (the module comment's sources).
+    Sensor sphericalSensor(const Element& element, const Element* calibration, const std::string& where) const
+    {
+        Sensor sensor;
+        const Element& resolution = resolutionOf(element, calibration);
+        sensor.width = pixels(resolution, "width"), sensor.height = pixels(resolution, "height");
+        const std::string at = where + " (spherical, line " + std::to_string(element.line) + ")";
+        if (sensor.width != 2 * sensor.height) {
+            sensor.refusal = at + " is " + std::to_string(sensor.width) + "x" + std::to_string(sensor.height) +
+                             ": Metashape's spherical image is read as the whole sphere, 2:1 (width = 2 x height)";
+            return sensor;
+        }
+        if (calibration) {  // only the sphere's own: f = H/π pixels per radian, nothing else
+            for (const Element& child : calibration->children) {
+                static const char* const kParameters[] = {"f",  "cx", "cy", "b1", "b2", "k1", "k2",
+                                                          "k3", "k4", "p1", "p2", "p3", "p4"};
+                if (std::find(std::begin(kParameters), std::end(kParameters), child.name) == std::end(kParameters))
+                    continue;
+                const double value = number(child);
+                const double expected = child.name == "f" ? sensor.height / M_PI : 0.0;
+                if (std::abs(value - expected) > 1e-9 * std::max(1.0, expected)) {
+                    sensor.refusal = at + ": its calibration (line " + std::to_string(child.line) + ") gives " +
+                                     child.name + " = " + formatNumber(value) +
+                                     "; zcheck reads a spherical sensor as the plain sphere (f = H/π = " +
+                                     formatNumber(sensor.height / M_PI) + ", every other parameter 0)";
+                    return sensor;
+                }
+            }
+        }
+        sensor.projection = lensProjection("equirectangular", {-180, 180, -90, 90});
         return sensor;
     }
 
@@ -262,7 +348,7 @@ private:
         spec.convention = opencv;
         spec.width = k.width, spec.height = k.height;
         try {
-            spec.projection = k.intrinsics.projection(kPlaceholderNear, kPlaceholderFar, "calibration");
+            spec.projection = k.projection;
             spec.view = viewFromPose(worldFromCamera(element, *transform, chunk), PoseDirection::WorldFromCamera, opencv,
                                      opencv, "<transform>");
             Camera validated(spec);
@@ -329,8 +415,8 @@ const CameraFormat& metashapeFormat()
         f.aliases = {"photoscan"};
         f.title = "Metashape cameras.xml";
         f.extensions = {".xml"};
-        f.files = "Agisoft Metashape's XML camera export: frame sensors, each camera's camera-to-chunk transform and "
-                  "the chunk's (disabled cameras skipped)";
+        f.files = "Agisoft Metashape's XML camera export: frame, fisheye and spherical sensors, each camera's "
+                  "camera-to-chunk transform and the chunk's (disabled cameras skipped)";
         f.example = "cameras.xml#IMG_0001.JPG";
         f.priority = 35;
         f.detects = detectsMetashape;

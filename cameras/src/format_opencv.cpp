@@ -5,8 +5,17 @@
 //   intrinsics  camera_matrix (or K, cameraMatrix), a 3x3 !!opencv-matrix {rows, cols, dt, data}
 //               or a plain list; keys matched ignoring case (older samples wrote Camera_Matrix)
 //   size        image_width, image_height (or width, height, or image_size [w, h])
-//   distortion  distortion_coefficients (or D, dist_coeffs, distCoeffs): all zero, or the
-//               camera is refused
+//   distortion  distortion_coefficients (or D, dist_coeffs, distCoeffs, distortion), one row or
+//               one column, as cv::projectPoints takes them (calib3d calibration.cpp,
+//               cvProjectPoints2Internal): 4, 5, 8, 12 or 14 values k1 k2 p1 p2 [k3 [k4 k5 k6
+//               [s1 s2 s3 s4 [τx τy]]]] → lens opencv, the same order; all zero (or none, or an
+//               empty list) → a linear pinhole; another count is refused
+//   fisheye     fisheye_model: 1 beside them (the calibration tutorial's sample,
+//               samples/cpp/tutorial_code/calib3d/camera_calibration/camera_calibration.cpp,
+//               saveCameraParams, writes its Calibrate_UseFisheyeModel setting as FileStorage
+//               writes a bool: 0 or 1; a JSON true or false is read as 1 or 0): cv::fisheye's 4,
+//               k1 k2 k3 k4 → lens opencv_fisheye, zero or not (an equidistant fisheye is no
+//               pinhole); fisheye_model 1 without distortion_coefficients is refused
 //   pose        optional, world-to-camera as solvePnP returns it: R (3x3, or a rotation
 //               vector) and T (or t, tvec), or rvec and tvec (Rodrigues); without one the
 //               camera's own frame is the world
@@ -21,9 +30,18 @@
 //   pixels      the centre of the top-left pixel is (0, 0): a centred camera has cx = (W−1)/2
 //
 // ROS CameraInfo (REP 104 and the message's comments):
-//   K           intrinsics of the raw (distorted) image; D its distortion (distortion_model
-//               plumb_bob, rational_polynomial: all zero or refused; equidistant: a fisheye,
-//               refused)
+//   K           intrinsics of the raw (distorted) image; D its distortion by distortion_model
+//               (sensor_msgs distortion_models.hpp and CameraInfo.msg; image_geometry hands D to
+//               cv::projectPoints or cv::fisheye::projectPoints unchanged):
+//                 plumb_bob            5: k1 k2 t1 t2 k3              → lens opencv
+//                 rational_polynomial  8: k1 k2 t1 t2 k3 k4 k5 k6     → lens opencv
+//                 equidistant          4: k1 k2 k3 k4 (cv::fisheye)   → lens opencv_fisheye
+//               plumb_bob and rational_polynomial with D all zero (of any length, or empty, as
+//               image_geometry's fromCameraInfo reads it): a linear pinhole; no
+//               distortion_model key: plumb_bob (camera_calibration_parsers'
+//               readCalibrationYml); an empty one with D zero or empty: a pinhole. Another
+//               count, an unknown (or empty, with D not zero) name, a lens that folds: the raw
+//               camera is refused (the rectified one stays)
 //   P           3x4 projection of the rectified image: intrinsics fx' cx' fy' cy' and, for a
 //               stereo pair's second camera, Tx = −fx'·B, Ty
 //   frame       the optical frame (x right, y down, z forward) is the world: no pose
@@ -38,6 +56,7 @@
 #include "zcheck/camera.h"
 #include "zcheck/error.h"
 #include "zcheck/input_file.h"
+#include "zcheck/lens.h"
 #include "zcheck/pose.h"
 
 #include <algorithm>
@@ -46,6 +65,7 @@
 #include <filesystem>
 #include <optional>
 #include <sstream>
+#include <tuple>
 
 namespace zcheck::formats {
 
@@ -121,6 +141,24 @@ struct Matrix {
         return true;
     }
 };
+
+bool allZero(const std::vector<double>& values)
+{
+    return std::all_of(values.begin(), values.end(), [](double v) { return v == 0; });
+}
+
+// A camera's lens as its file gives it: none (a linear pinhole), or a lens model of lens.h and
+// its coefficients in the model's order (after fx, fy, cx, cy).
+struct Distortion {
+    std::string model;  // "" none, "opencv", "opencv_fisheye"
+    std::vector<double> coefficients;
+};
+
+// OpenCV's counts of distortion coefficients (cvProjectPoints2Internal): k1 k2 p1 p2, then k3;
+// k4 k5 k6 (CALIB_RATIONAL_MODEL); s1..s4 (CALIB_THIN_PRISM_MODEL); τx τy (CALIB_TILTED_MODEL).
+constexpr std::size_t kOpenCvCounts[] = {4, 5, 8, 12, 14};
+constexpr const char* kOpenCvCountRule =
+    "OpenCV's calib3d takes 4, 5, 8, 12 or 14: k1 k2 p1 p2 [k3 [k4 k5 k6 [s1 s2 s3 s4 [tau_x tau_y]]]]";
 
 class CalibrationReader {
 public:
@@ -253,16 +291,22 @@ private:
         }
     }
 
-    std::vector<std::pair<std::string, double>> named(const Matrix& d, const std::vector<const char*>& names) const
+    // Distortion coefficients: one row or one column of numbers (an empty list: none).
+    std::vector<double> coefficients(const Node& d, const std::string& dKey) const
     {
-        std::vector<std::pair<std::string, double>> out;
-        for (std::size_t i = 0; i < d.values.size(); ++i)
-            out.emplace_back(i < names.size() ? names[i] : "d[" + std::to_string(i) + "]", d.values[i]);
-        return out;
+        const Matrix m = matrix(d, dKey);
+        if (m.rows > 1 && m.cols > 1)
+            fail("'" + dKey + "' is " + std::to_string(m.rows) + "x" + std::to_string(m.cols) +
+                 ": distortion coefficients are one row or one column");
+        return m.values;
     }
 
+    // The camera of K and the pose, and its lens when `lens` names one (its errors, a lens that
+    // folds inside the image, say, prefixed with `lensKey`): thrown, or with `refuseLens` kept as
+    // the camera's refusal (a CameraInfo's raw camera: the rectified one stays usable).
     ImportedCamera camera(const std::string& name, int width, int height, const PinholeIntrinsics& k, const glm::dmat4& camFromWorld,
-                          const std::string& poseName) const
+                          const std::string& poseName, const Distortion& lens = {}, const std::string& lensKey = "",
+                          bool refuseLens = false) const
     {
         ImportedCamera out;
         out.name = name;
@@ -277,7 +321,30 @@ private:
         } catch (const Error& e) {
             fail(e.what());
         }
+        if (!lens.model.empty()) {
+            try {
+                const Projection withLens =
+                    k.lensProjection(lens.model, lens.coefficients, kPlaceholderNear, kPlaceholderFar, lensKey);
+                requireLens(withLens.lens, width, height);
+                spec.projection = withLens;
+            } catch (const Error& e) {
+                const std::string why = source() + ": " + lensKey + ": " + e.what();
+                if (!refuseLens) throw Error(why);
+                out.refusal = why;  // the camera stays the pinhole of K
+            }
+        }
         return out;
+    }
+
+    // The lens validated for the image as a Camera validates it (LensModel; the rest of the
+    // camera is the pinhole's, validated before), once per lens and size: calibration.cpp's
+    // views share theirs.
+    void requireLens(const LensSpec& lens, int width, int height) const
+    {
+        for (const auto& [valid, w, h] : validLenses_)
+            if (valid == lens && w == width && h == height) return;
+        const LensModel model(lens, width, height);
+        validLenses_.emplace_back(lens, width, height);
     }
 
     // ---- OpenCV ---------------------------------------------------------------------
@@ -335,25 +402,66 @@ private:
         return poseOf(matrix(*r, rKey), rKey, matrix(*t, tKey), tKey);
     }
 
-    // One camera of the file: K, its distortion (refused unless zero), the pose, and the size or,
-    // without one, the depth map's (the projection does not depend on it: K is in pixels).
+    // camera_calibration.cpp's fisheye_model (the file comment): whether cv::fisheye calibrated
+    // the camera. FileStorage writes the bool as 0 or 1; a JSON true or false reads as 1 or 0.
+    bool fisheyeModel() const
+    {
+        const Node* node = root_.findIgnoringCase("fisheye_model");
+        if (!node) return false;
+        std::string text;
+        if (node->kind == Node::Kind::Scalar) {
+            text = node->scalar;
+            const auto space = [](unsigned char c) { return std::isspace(c) != 0; };
+            while (!text.empty() && space(text.back())) text.pop_back();
+            text.erase(text.begin(), std::find_if_not(text.begin(), text.end(), space));
+            double value = 0;
+            if (text == "true" || (parseFiniteNumber(text, value) && value == 1)) return true;
+            if (text == "false" || (parseFiniteNumber(text, value) && value == 0)) return false;
+        }
+        fail("'fisheye_model' (line " + std::to_string(node->line) + ") must be 0 or 1 (whether cv::fisheye calibrated the camera), got " +
+             (node->kind == Node::Kind::Scalar ? "'" + printableExcerpt(text, 20) + "'" : std::string("a list or map")));
+    }
+
+    // The lens of distortion coefficients `d` (the file comment's rule), and fisheye_model's.
+    Distortion openCvDistortion(const Node* d, const std::string& dKey) const
+    {
+        const bool fisheye = fisheyeModel();
+        if (!d) {
+            if (fisheye)
+                fail("fisheye_model is 1 but there are no distortion_coefficients: cv::fisheye takes 4 (k1, k2, k3, k4)");
+            return {};
+        }
+        const std::vector<double> values = coefficients(*d, dKey);
+        const std::size_t n = values.size();
+        if (fisheye) {
+            if (n != 4)
+                fail("'" + dKey + "' holds " + std::to_string(n) +
+                     " coefficients; with fisheye_model 1 (cv::fisheye) it takes 4: k1, k2, k3, k4");
+            return {"opencv_fisheye", values};
+        }
+        if (n == 0) return {};  // OpenCV reads an empty distCoeffs as zeros
+        if (std::find(std::begin(kOpenCvCounts), std::end(kOpenCvCounts), n) == std::end(kOpenCvCounts))
+            fail("'" + dKey + "' holds " + std::to_string(n) + " coefficients; " + kOpenCvCountRule);
+        if (allZero(values)) return {};
+        return {"opencv", values};
+    }
+
+    // One camera of the file: K, its distortion (a lens; none when zero), the pose, and the size
+    // or, without one, the depth map's (the projection does not depend on it: K is in pixels).
     ImportedCamera openCvCamera(const std::string& name, const Node& k, const std::string& kKey, const Node* d,
                                 const std::string& dKey, const glm::dmat4& camFromWorld, const std::string& poseName) const
     {
         const PinholeIntrinsics intrinsics = intrinsicsOf(shaped(k, kKey, 3, 3), kKey);
+        const Distortion lens = openCvDistortion(d, dKey);
         const std::optional<std::pair<int, int>> size = imageSize();
         // Without a size, a placeholder the principal point centres (a map's size replaces it).
         const int width = size ? size->first : std::clamp(int(std::lround(2 * intrinsics.cx + 1)), 1, Camera::kMaxImageSide);
         const int height = size ? size->second : std::clamp(int(std::lround(2 * intrinsics.cy + 1)), 1, Camera::kMaxImageSide);
-        ImportedCamera imported = camera(name, width, height, intrinsics, camFromWorld, poseName);
+        ImportedCamera imported = camera(name, width, height, intrinsics, camFromWorld, poseName, lens, dKey);
         if (!size) {
             imported.hasImageSize = false;
             imported.projectionForSize = [projection = imported.spec.projection](int, int) { return projection; };
         }
-        if (d)
-            imported.refusal = distortionRefusal(source(), "OpenCV",
-                                                 named(matrix(*d, dKey), {"k1", "k2", "p1", "p2", "k3", "k4", "k5", "k6", "s1",
-                                                                          "s2", "s3", "s4", "tx", "ty"}));
         return imported;
     }
 
@@ -443,6 +551,50 @@ private:
 
     // ---- ROS --------------------------------------------------------------------------
 
+    // D by distortion_model (the file comment's table): the lens, or with `refusal` set why the
+    // raw camera cannot be used.
+    Distortion rosDistortion(const Node* d, const std::string& dKey, std::string& refusal) const
+    {
+        struct Model {
+            const char* name;
+            std::size_t count;
+            const char* lens;
+            const char* coefficients;
+        };
+        static const Model models[] = {{"plumb_bob", 5, "opencv", "k1, k2, t1, t2, k3"},
+                                       {"rational_polynomial", 8, "opencv", "k1, k2, t1, t2, k3, k4, k5, k6"},
+                                       {"equidistant", 4, "opencv_fisheye", "k1, k2, k3, k4"}};
+        const std::string known =
+            "plumb_bob (5: k1, k2, t1, t2, k3), rational_polynomial (8: k1, k2, t1, t2, k3, k4, k5, k6) or equidistant "
+            "(4: k1, k2, k3, k4)";
+        std::string name = "plumb_bob";  // readCalibrationYml: a file without distortion_model is plumb_bob
+        if (const Node* m = root_.findIgnoringCase("distortion_model")) {
+            if (m->kind != Node::Kind::Scalar)
+                fail("'distortion_model' (line " + std::to_string(m->line) + ") must be a name: " + known);
+            name = m->scalar;
+        }
+        const std::vector<double> values = d ? coefficients(*d, dKey) : std::vector<double>{};
+        const Model* model = nullptr;
+        for (const Model& row : models)
+            if (name == row.name) model = &row;
+        if (!model) {
+            if (name.empty() && allZero(values)) return {};  // the message's default: no model, no distortion
+            refusal = source() + ": distortion_model " + (name.empty() ? "is empty" : "'" + printableExcerpt(name, 40) + "' is unknown") +
+                      ": zcheck reads " + known;
+            return {};
+        }
+        const bool fisheye = std::string(model->lens) == "opencv_fisheye";
+        // image_geometry (PinholeCameraModel::fromCameraInfo): D all zero, whatever its length,
+        // is no distortion. Not for the fisheye: cv::fisheye with zeros is still equidistant.
+        if (!fisheye && allZero(values)) return {};
+        if (values.size() != model->count) {
+            refusal = source() + ": " + dKey + " holds " + std::to_string(values.size()) + " coefficients; distortion_model " +
+                      model->name + " takes " + std::to_string(model->count) + " (" + model->coefficients + ")";
+            return {};
+        }
+        return {model->lens, values};
+    }
+
     CameraSet readRos() const
     {
         // The calibration file's keys, else the message's (ROS 1 upper case, ROS 2 lower case).
@@ -483,19 +635,14 @@ private:
 
         CameraSet set;
         set.path = path_, set.defaultCamera = 0;
-        ImportedCamera raw = camera("raw", width, height, intrinsicsOf(K, kKey), glm::dmat4(1.0), "pose");
-        std::string model = "plumb_bob";
-        if (const Node* m = root_.findIgnoringCase("distortion_model"); m && m->kind == Node::Kind::Scalar && !m->scalar.empty())
-            model = m->scalar;
-        raw.refusal = refusal;
-        if (raw.refusal.empty() && model == "equidistant")
-            raw.refusal = source() + ": distortion_model equidistant is a fisheye projection, not a pinhole: zcheck checks "
-                                     "linear projections; give the rectified camera (FILE#rectified) for a rectified image";
-        if (raw.refusal.empty() && d) {
-            raw.refusal = distortionRefusal(source(), model,
-                                            named(matrix(*d, dKey), {"k1", "k2", "p1", "p2", "k3", "k4", "k5", "k6"}));
-            if (!raw.refusal.empty()) raw.refusal += " (a rectified image's camera is P: FILE#rectified)";
-        }
+        std::string unreadable;  // D that is no lens zcheck reads
+        const Distortion lens = rosDistortion(d, dKey, unreadable);
+        ImportedCamera raw = camera("raw", width, height, intrinsicsOf(K, kKey), glm::dmat4(1.0), "pose", lens, dKey, true);
+        if (raw.refusal.empty()) raw.refusal = unreadable;
+        if (!refusal.empty())
+            raw.refusal = refusal;
+        else if (!raw.refusal.empty())
+            raw.refusal += " (a rectified image's camera is P: FILE#rectified)";
         raw.spec.notes.push_back(source() + ": the optical frame (x right, y down, z forward) is the world");
         set.cameras.push_back(raw);
 
@@ -532,6 +679,7 @@ private:
     std::string path_;
     bool ros_;
     Node root_;
+    mutable std::vector<std::tuple<LensSpec, int, int>> validLenses_;
 };
 
 
@@ -543,19 +691,49 @@ std::string opencvMatrix(const char* key, int rows, int cols, const std::vector<
            "\n   dt: d\n   data: [ " + data + " ]\n";
 }
 
-// camera.yml, FileStorage YAML: camera_matrix (cx = (W−1)/2 centred), zero distortion,
-// image_width, image_height, R and T world-to-camera.
+// The distortion coefficients OpenCV has for a camera's lens: none for a pinhole (written as
+// five zeros, as calibration.cpp's files have them); lens opencv's in the shortest of OpenCV's
+// counts that holds every nonzero one; opencv_fisheye's four, with `fisheye` set. Any other
+// model is refused.
+std::vector<double> openCvCoefficients(const Camera& camera, bool& fisheye)
+{
+    fisheye = false;
+    const LensModel* lens = camera.lens();
+    if (!lens) return {0, 0, 0, 0, 0};
+    const std::string& model = lens->spec().model;
+    const std::vector<double>& q = lens->spec().params;  // every parameter (LensModel writes the defaults out)
+    if (model == "opencv") {
+        std::size_t needed = 0;
+        for (std::size_t i = 4; i < q.size(); ++i)
+            if (q[i] != 0) needed = i - 3;
+        const std::size_t n = *std::find_if(std::begin(kOpenCvCounts), std::end(kOpenCvCounts),
+                                            [&](std::size_t count) { return count >= needed; });
+        return std::vector<double>(q.begin() + 4, q.begin() + 4 + std::ptrdiff_t(n));
+    }
+    if (model == "opencv_fisheye") {
+        fisheye = true;
+        return std::vector<double>(q.begin() + 4, q.begin() + 8);
+    }
+    throw Error("OpenCV has no " + model + " lens model: an OpenCV calibration file holds lens opencv (calib3d's k1 k2 p1 p2 "
+                "k3 ... tau_y) or opencv_fisheye (cv::fisheye's k1..k4, fisheye_model: 1)");
+}
+
+// camera.yml, FileStorage YAML: camera_matrix (cx = (W−1)/2 centred), distortion_coefficients
+// (and fisheye_model: 1 for cv::fisheye's, as camera_calibration.cpp writes it), image_width,
+// image_height, R and T world-to-camera.
 std::vector<CameraFileText> writeOpenCv(const Camera& camera, const std::string&)
 {
+    bool fisheye = false;
+    const std::vector<double> d = openCvCoefficients(camera, fisheye);
     const PinholeIntrinsics k = pinholeIntrinsicsOf(camera, 0.0);
     const glm::dmat4 m = camFromWorldIn(camera, Convention::preset("opencv"));
     std::vector<double> r;
     for (int row = 0; row < 3; ++row)
         for (int col = 0; col < 3; ++col) r.push_back(m[col][row]);
     return {{"camera.yml", "%YAML:1.0\n---\nimage_width: " + std::to_string(camera.width()) + "\nimage_height: " +
-                               std::to_string(camera.height()) + "\n" +
+                               std::to_string(camera.height()) + "\n" + (fisheye ? "fisheye_model: 1\n" : "") +
                                opencvMatrix("camera_matrix", 3, 3, {k.fx, 0, k.cx, 0, k.fy, k.cy, 0, 0, 1}) +
-                               opencvMatrix("distortion_coefficients", 5, 1, {0, 0, 0, 0, 0}) + opencvMatrix("R", 3, 3, r) +
+                               opencvMatrix("distortion_coefficients", int(d.size()), 1, d) + opencvMatrix("R", 3, 3, r) +
                                opencvMatrix("T", 3, 1, {m[3][0], m[3][1], m[3][2]})}};
 }
 

@@ -23,12 +23,6 @@ std::string pathBeside(const std::string& file, const std::string& relative);
 // its file name, and that name's stem.
 std::vector<std::string> pathAliases(const std::string& path);
 
-// Why a camera with nonzero distortion coefficients cannot be used, naming the model and every
-// coefficient: "<where>: camera model OPENCV has lens distortion (k1 = 0.1, ...): zcheck checks
-// linear projections; undistort the depth map and give its pinhole camera". "" when all are 0.
-std::string distortionRefusal(const std::string& where, const std::string& model,
-                              const std::vector<std::pair<std::string, double>>& coefficients);
-
 // For writers: every digit a double needs to read back as itself ("%.17g", −0 written as 0).
 std::string exactNumber(double value);
 // The camera's pose in `axes`' eye space, world-to-camera.

@@ -336,7 +336,7 @@ Camera::Camera(const CameraSpec& spec) : spec_(spec)
     validate(spec_);
     const Projection& p = spec_.projection;
     if (p.type == ProjectionType::NonLinear) {
-        lens_ = std::make_shared<const LensModel>(p.lens, spec_.width, spec_.height);
+        lens_ = LensModel::shared(p.lens, spec_.width, spec_.height);
         spec_.projection.lens = lens_->spec();  // every parameter, the defaults written out
     }
     const Convention& c = spec_.convention;

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <mutex>
 
 namespace zcheck {
 
@@ -251,6 +253,21 @@ LensModel::LensModel(const LensSpec& spec, int width, int height) : spec_(spec),
     untilt_ = glm::inverse(tilt_);
     findField();
     requireNoFoldInImage();
+}
+
+std::shared_ptr<const LensModel> LensModel::shared(const LensSpec& spec, int width, int height)
+{
+    static std::mutex mutex;
+    static std::map<std::string, std::weak_ptr<const LensModel>> made;
+    std::string key = spec.model + "/" + std::to_string(width) + "x" + std::to_string(height);
+    key.append(reinterpret_cast<const char*>(spec.params.data()), spec.params.size() * sizeof(double));
+    std::lock_guard<std::mutex> lock(mutex);
+    if (const std::shared_ptr<const LensModel> existing = made[key].lock()) return existing;
+    auto lens = std::make_shared<const LensModel>(spec, width, height);
+    made[key] = lens;
+    if (made.size() > 256)  // forget the models nobody holds any more
+        for (auto it = made.begin(); it != made.end();) it = it->second.expired() ? made.erase(it) : std::next(it);
+    return lens;
 }
 
 double LensModel::param(const std::string& name) const
@@ -543,9 +560,12 @@ void LensModel::findField()
             }
             return true;
         };
+        // A pinhole's plane is unbounded: scanned out to 10⁴ (89.994° off the axis), beyond which
+        // no image reaches.
+        const double outermost = std::min(fieldRadius_, 1e4);
         double inside = 0;
-        for (double r = 1e-3; inside < fieldRadius_; r *= 1.02) {
-            const double ring = std::min(r, fieldRadius_);
+        for (double r = 1e-3; inside < outermost; r *= 1.02) {
+            const double ring = std::min(r, outermost);
             if (!positiveOn(ring)) {
                 double outside = ring;
                 for (int i = 0; i < 40; ++i) {

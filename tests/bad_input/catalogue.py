@@ -1168,10 +1168,11 @@ import_case("colmap-txt-duplicate-camera-id",
 import_case("colmap-txt-image-names-missing-camera",
             colmap_text(images="1 1 0 0 0 0 0 3 1 img_000.png\n\n2 1 0 0 0 0 0 4 7 img_001.png\n\n"),
             "model#img_000.png", r"images\.txt'? line 3.*CAMERA_ID 7.*not in", cmd="camera")
-import_case("colmap-txt-opencv-distorted", colmap_text("1 OPENCV 64 48 50 50 32 24 0.1 0 0 0\n"),
-            "model#img_000.png", r"images\.txt'? line 2.*OPENCV.*k1 = 0\.1.*(distortion|pinhole)", cmd="camera")
-import_case("colmap-txt-fisheye", colmap_text("1 OPENCV_FISHEYE 64 48 50 50 32 24 0 0 0 0\n"),
-            "model#img_001.png", r"images\.txt'? line 4.*OPENCV_FISHEYE.*(fisheye|not a pinhole)", cmd="export")
+import_case("colmap-txt-opencv-folds", colmap_text("1 OPENCV 64 48 50 50 32 24 -2.5 0 0 0\n"),
+            "model#img_000.png", r"cameras\.txt'? line 1.*OPENCV.*lens model opencv folds", cmd="camera")
+import_case("colmap-txt-fisheye-window-export", colmap_text("1 OPENCV_FISHEYE 64 48 50 50 32 24 0 0 0 0\n"),
+            "model#img_001.png", r"quantity window: a lens model \(opencv_fisheye\) has no depth buffer",
+            extra=["--quantity", "window"], cmd="export")
 import_case("colmap-txt-width-0", colmap_text("1 PINHOLE 0 48 50 50 32 24\n"), "model#img_000.png",
             rf"{CT}.*line 1.*WIDTH.*'?0'?.*1\.\.16384")
 import_case("colmap-txt-negative-focal-length", colmap_text("1 PINHOLE 64 48 -50 50 32 24\n"), "model#img_000.png",
@@ -1203,10 +1204,12 @@ import_case("transforms-matrix-scaled-rotation",
             rf"{TJ}.*frames\[0\]\.transform_matrix.*(scale|rigid|orthonormal|not a rotation)", cmd="unproject")
 import_case("transforms-w-640.5", {"t.json": transforms(w=640.5)}, "t.json#0",
             rf"{TJ}.*'w'.*whole number.*640\.5")
-import_case("transforms-fisheye-camera-model", {"t.json": transforms(frame_patch={"camera_model": "OPENCV_FISHEYE"})},
-            "t.json#0", rf"{TJ}.*frames\[0\].*OPENCV_FISHEYE.*(fisheye|not a pinhole)", cmd="camera")
-import_case("transforms-nonzero-k1", {"t.json": transforms(k1=0.05)}, "t.json#images/frame_000.png",
-            rf"{TJ}.*frames\[0\].*distortion.*k1 = 0\.05")
+import_case("transforms-vr180-camera-model", {"t.json": transforms(frame_patch={"camera_model": "VR180_L"})},
+            "t.json#0", rf"{TJ}.*VR180_L.*starts its rays 32 mm", cmd="camera")
+import_case("transforms-distortion-params-count", {"t.json": transforms(distortion_params=[0.1, 0, 0])},
+            "t.json#0", rf"{TJ}.*holds 3 numbers; camera_model OPENCV takes 6", cmd="camera")
+import_case("transforms-lens-folds", {"t.json": transforms(k1=-3.0)}, "t.json#0",
+            rf"{TJ}.*lens model brown_conrady folds", cmd="camera")
 # OpenCV FileStorage YAML and XML
 import_case("opencv-yaml-no-camera-matrix", {"c.yml": opencv_yaml(drop=("camera_matrix",))}, "c.yml",
             r"'c\.yml'.*no camera matrix")
@@ -1234,7 +1237,23 @@ import_case("opencv-xml-deep-nesting", {"c.xml": opencv_xml("<a>" + "<b>" * 1000
 import_case("opencv-json-deep-nesting", {"c.json": '{"camera_matrix": ' + "[" * 100000 + "]" * 100000 + "}\n"},
             "c.json", r"'c\.json'.*(nested|deeper|depth)", extra=["--camera-format", "opencv"], limit=HOSTILE,
             rss=HOSTILE_RSS, cmd="camera")
+def opencv_yaml_distortion(values, fisheye=False):
+    """opencv_yaml with `values` as its distortion_coefficients (one row), and fisheye_model: 1."""
+    text = opencv_yaml().replace("   cols: 5\n   dt: d\n   data: [ 0., 0., 0., 0., 0. ]",
+                                 f"   cols: {len(values)}\n   dt: d\n   data: [ " + ", ".join(str(v) for v in values) + " ]")
+    return text + ("fisheye_model: 1\n" if fisheye else "")
+
+
+import_case("opencv-yaml-distortion-count", {"c.yml": opencv_yaml_distortion([0.1, 0, 0, 0, 0, 0])}, "c.yml",
+            r"'c\.yml'.*holds 6 coefficients; OpenCV's calib3d takes 4, 5, 8, 12 or 14", cmd="camera")
+import_case("opencv-yaml-fisheye-count", {"c.yml": opencv_yaml_distortion([0.1, 0, 0, 0, 0], fisheye=True)}, "c.yml",
+            r"'c\.yml'.*fisheye.*4", cmd="camera")
+import_case("opencv-yaml-lens-folds", {"c.yml": opencv_yaml_distortion([-3.0, 0, 0, 0])}, "c.yml",
+            r"'c\.yml'.*lens model opencv folds", cmd="camera")
 # ROS CameraInfo
+import_case("ros-unknown-distortion-model",
+            {"c.yaml": ros_yaml().replace("distortion_model: plumb_bob", "distortion_model: pinhole_fancy")},
+            "c.yaml#raw", r"'c\.yaml'.*distortion_model 'pinhole_fancy' is unknown", cmd="camera")
 import_case("ros-k-zero-uncalibrated", {"c.yaml": ROS_UNCALIBRATED}, "c.yaml", r"'c\.yaml'.*K\[0\].*uncalibrated",
             cmd="camera")
 import_case("ros-binning", {"c.yaml": ros_yaml(extra=("binning_x: 2", "binning_y: 1"))}, "c.yaml",

@@ -139,3 +139,96 @@ def test_lens_camera_refuses_window_depth_and_names_the_model():
     assert np.isnan(wide.unproject(edge, [2.0], "eye-z", space="eye")).all()
     point = wide.unproject(edge, [2.0], "distance", space="eye")[0]
     assert point[2] < 0 and abs(np.linalg.norm(point) - 2.0) < 1e-12
+
+
+def write_with_cv2_filestorage(path, K, D, fisheye=False):
+    """A calibration file as OpenCV itself writes one (cv2.FileStorage, YAML or XML by the name)."""
+    fs = cv2.FileStorage(str(path), cv2.FILE_STORAGE_WRITE)
+    fs.write("image_width", W)
+    fs.write("image_height", H)
+    if fisheye:
+        fs.write("fisheye_model", 1)  # as camera_calibration.cpp writes its fisheye flag
+    fs.write("camera_matrix", K)
+    fs.write("distortion_coefficients", D.reshape(-1, 1))
+    fs.release()
+
+
+def assert_projects_as(camera, pts, theirs, least_seen):
+    mine = camera.project(pts, space="eye")
+    seen = ~np.isnan(mine[:, 0])
+    assert seen.sum() >= least_seen
+    scale = np.maximum(1.0, np.abs(theirs[seen]))
+    assert np.max(np.abs(mine[seen] - theirs[seen]) / scale) <= 1e-9
+
+
+@pytest.mark.parametrize("n,suffix", [(4, "yml"), (5, "xml"), (8, "yml"), (12, "xml"), (14, "yml")])
+def test_opencv_file_written_by_cv2_reads_as_cv2_projects(tmp_path, n, suffix):
+    """zcheck's OpenCV reader (format_opencv.cpp): a file cv2.FileStorage wrote, read by
+    Camera.from_file, projects points where cv2.projectPoints puts them."""
+    rng = np.random.default_rng(3000 + n)
+    written = iter(range(1000))
+
+    def make(rng):
+        K, D = random_K(rng), random_D(rng, n)
+        path = tmp_path / f"calib_{next(written)}.{suffix}"
+        write_with_cv2_filestorage(path, K, D)
+        return zcheck.Camera.from_file(str(path), near=0.1, far=100.0), K, D
+
+    for camera, K, D in cameras(rng, make, count=5):
+        assert camera.lens["model"] == "opencv"
+        pts = points_in_view(rng, 200, math.radians(45))
+        theirs = cv2.projectPoints(pts.reshape(-1, 1, 3), np.zeros(3), np.zeros(3), K, D)[0].reshape(-1, 2)
+        assert_projects_as(camera, pts, theirs, 100)
+
+
+def test_opencv_fisheye_file_written_by_cv2_reads_as_cv2_fisheye_projects(tmp_path):
+    rng = np.random.default_rng(3100)
+    written = iter(range(1000))
+
+    def make(rng):
+        K = random_K(rng)
+        D = np.array([rng.uniform(-0.05, 0.05), rng.uniform(-0.02, 0.02), rng.uniform(-0.005, 0.005),
+                      rng.uniform(-0.001, 0.001)])
+        path = tmp_path / f"fisheye_{next(written)}.yml"
+        write_with_cv2_filestorage(path, K, D, fisheye=True)
+        return zcheck.Camera.from_file(str(path), near=0.1, far=100.0), K, D
+
+    for camera, K, D in cameras(rng, make, count=5):
+        assert camera.lens["model"] == "opencv_fisheye"
+        pts = points_in_view(rng, 200, math.radians(85))
+        theirs = cv2.fisheye.projectPoints(pts.reshape(-1, 1, 3), np.zeros(3), np.zeros(3), K, D)[0].reshape(-1, 2)
+        assert_projects_as(camera, pts, theirs, 150)
+
+
+@pytest.mark.parametrize("model,n", [("plumb_bob", 5), ("rational_polynomial", 8), ("equidistant", 4)])
+def test_ros_camera_info_reads_as_image_geometry_projects(tmp_path, model, n):
+    """A ROS CameraInfo file (camera_calibration_parsers' layout): image_geometry hands D to
+    cv2.projectPoints (plumb_bob, rational_polynomial) or cv2.fisheye.projectPoints (equidistant);
+    zcheck's raw camera agrees, and the rectified one (P) stays a pinhole."""
+    rng = np.random.default_rng(3200 + n)
+    fisheye = model == "equidistant"
+    written = iter(range(1000))
+    numbers = lambda values: ", ".join(repr(float(v)) for v in values)
+
+    def make(rng):
+        K = random_K(rng)
+        D = np.array([rng.uniform(-0.05, 0.05), rng.uniform(-0.02, 0.02), rng.uniform(-0.005, 0.005),
+                      rng.uniform(-0.001, 0.001)]) if fisheye else random_D(rng, n)
+        path = tmp_path / f"camera_{next(written)}.yaml"
+        path.write_text(f"image_width: {W}\nimage_height: {H}\ncamera_name: cam\n"
+                        f"camera_matrix:\n  rows: 3\n  cols: 3\n  data: [{numbers(K.ravel())}]\n"
+                        f"distortion_model: {model}\n"
+                        f"distortion_coefficients:\n  rows: 1\n  cols: {n}\n  data: [{numbers(D)}]\n"
+                        "rectification_matrix:\n  rows: 3\n  cols: 3\n  data: [1, 0, 0, 0, 1, 0, 0, 0, 1]\n"
+                        f"projection_matrix:\n  rows: 3\n  cols: 4\n"
+                        f"  data: [{numbers(K[0])}, 0, {numbers(K[1])}, 0, 0, 0, 1, 0]\n")
+        rectified = zcheck.Camera.from_file(f"{path}#rectified", format="ros", near=0.1, far=100.0)
+        assert rectified.lens is None
+        return zcheck.Camera.from_file(f"{path}#raw", format="ros", near=0.1, far=100.0), K, D
+
+    for camera, K, D in cameras(rng, make, count=3):
+        assert camera.lens["model"] == ("opencv_fisheye" if fisheye else "opencv")
+        pts = points_in_view(rng, 200, math.radians(45))
+        project = cv2.fisheye.projectPoints if fisheye else cv2.projectPoints
+        theirs = project(pts.reshape(-1, 1, 3), np.zeros(3), np.zeros(3), K, D)[0].reshape(-1, 2)
+        assert_projects_as(camera, pts, theirs, 100)

@@ -25,9 +25,10 @@
 //
 // What a file does not say is not invented: near and far (no format but zcheck's and glTF's
 // has them) are left for the user or the scene to give (hasClipPlanes), an image size some
-// instant-ngp files omit is taken from the depth map (hasImageSize), and a camera with lens
-// distortion or a fisheye model is kept with the reason it cannot be used (refusal), so that a
-// dataset's other frames still run. Bad input throws Error naming the file, the line or key
+// instant-ngp files omit is taken from the depth map (hasImageSize), and a camera the reader
+// cannot use (a lens no lens model holds, one that folds inside its image) is kept with the
+// reason (refusal), so that a dataset's other frames still run. Lens distortion, fisheyes and
+// panoramas are lens models (lens.h): ProjectionType::NonLinear. Bad input throws Error naming the file, the line or key
 // and the rule.
 #include "zcheck/camera.h"
 #include "zcheck/camera_formats.h"

@@ -43,6 +43,7 @@
 //   if (auto dCam = lens.directionFromImage({960.5, 540.5})) ...  // unit ray, camera frame
 #include <glm/glm.hpp>
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -82,6 +83,10 @@ public:
     // unified ξ ≥ 0; EUCM α ∈ [0, 1], β > 0; double sphere α ∈ [0, 1], ξ in (−1, 1); panorama
     // ranges within 360° × 180°), a field of no width, and a lens that folds inside the image.
     LensModel(const LensSpec& spec, int width, int height);
+    // The model for (spec, width, height), built once and shared while anyone holds it: the cameras
+    // of a dataset's frames that share intrinsics share one, and its field's search. Thread-safe;
+    // throws as the constructor does.
+    static std::shared_ptr<const LensModel> shared(const LensSpec& spec, int width, int height);
 
     const LensSpec& spec() const { return spec_; }
     const LensModelInfo& info() const { return *info_; }

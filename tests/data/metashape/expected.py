@@ -15,7 +15,13 @@ frames_v2.xml 2.x style: the same similarity is <components>/<component id="0">/
 Both files must give the same expected.json.
 
 expected.json is then computed from the XML text as a reader would (ElementTree parse, the
-numbers as written), and checked against the designed world poses.
+numbers as written), and checked against the designed world poses. Projections use the camera
+models of Metashape's manual (appendix "Camera models"), written out in numpy below:
+frame_project (frame sensors: Brown polynomial with P1 on r^2 + 2x^2, u = w/2 + cx + x'(f + b1)
++ y' b2, v = h/2 + cy + y' f), fisheye_project (the same on the equidistant point), and
+spherical_project (a spherical sensor without calibration: the whole sphere, longitude
+atan2(X, Z) = 0 at the centre column, the top row up; the convention nerfstudio's
+metashape_utils.py reads, see NOTES.md).
 """
 import json
 import math
@@ -32,9 +38,15 @@ W, H = 640, 480
 F, CX, CY, B1, B2 = 600.5, 3.5, -2.25, 0.0, 0.0
 # sensor 0, calibration class="initial" (written first; must NOT be used)
 F_INITIAL, CX_INITIAL, CY_INITIAL = 585.0, 0.0, 0.0
-# sensor 1: distorted (nonzero k1..p2) -> its cameras must be refused
-F1, CX1, CY1 = 610.25, 1.5, -0.75
-K1_1, K2_1, K3_1, P1_1, P2_1 = -0.0523, 0.0117, -0.0009, 0.00041, -0.00023
+# sensor 1: a distorted frame camera (nonzero k1..k4, p1, p2, b1, b2): lens metashape_frame
+F1, CX1, CY1, B1_1, B2_1 = 610.25, 1.5, -0.75, 0.8, -0.35
+K1_1, K2_1, K3_1, K4_1, P1_1, P2_1 = -0.0523, 0.0117, -0.0009, 0.00013, 0.00041, -0.00023
+# sensor 3: a fisheye (equidistant) camera: lens metashape_fisheye
+F3, CX3, CY3, B1_3, B2_3 = 201.5, -2.25, 1.75, 0.6, -0.2
+K1_3, K2_3, K3_3, K4_3, P1_3, P2_3 = 0.021, -0.004, 0.0007, -0.0001, 0.0002, -0.0001
+# sensor 4: a spherical camera (no calibration), 2:1: lens equirectangular over the sphere
+W4, H4 = 1024, 512
+# sensor 5: a cylindrical camera -> its cameras must be refused
 
 # chunk similarity: world = s * R @ p + t
 AXIS = np.array([1.0, 2.0, 2.0]) / 3.0   # unit axis
@@ -80,9 +92,21 @@ CAMERAS = [
     dict(id=3, label="IMG_0004.JPG", sensor=0, group=True, enabled="false", aligned=True, az=220.0, el=15.0, roll=0.0),
     dict(id=4, label="IMG_0005.JPG", sensor=0, group=False, enabled=None, aligned=False, az=260.0, el=20.0, roll=0.0),
     dict(id=5, label="IMG_0101.JPG", sensor=1, group=False, enabled=None, aligned=True, az=300.0, el=25.0, roll=0.0),
+    dict(id=6, label="IMG_0201.JPG", sensor=3, group=False, enabled=None, aligned=True, az=30.0, el=40.0, roll=12.0),
+    dict(id=7, label="IMG_0301.JPG", sensor=4, group=False, enabled=None, aligned=True, az=110.0, el=5.0, roll=-20.0),
+    dict(id=8, label="IMG_0401.JPG", sensor=5, group=False, enabled=None, aligned=True, az=190.0, el=15.0, roll=0.0),
 ]
 
 PROBE_POINTS = [[0.0, 0.0, 0.0], [0.3, -0.2, 0.4], [-0.5, 0.25, -0.1]]
+
+# More probes for the lens cameras, as directions in the camera frame (angle from the axis in
+# degrees, azimuth in degrees) at distance 3: to the image's edges for the frame camera, to 80
+# degrees for the fisheye (Metashape's fisheye formula divides by Z), all round for the sphere.
+LENS_PROBES = {
+    1: [(10, 30), (20, 135), (26, -60), (30, 200), (32, 37)],
+    3: [(15, 20), (40, 100), (60, -150), (75, 260), (80, 45)],
+    4: [(50, 10), (90, 60), (120, 200), (160, -45), (179, 30), (30, 250)],
+}
 
 R_CHUNK = rodrigues(AXIS, ANGLE_DEG)
 
@@ -94,6 +118,17 @@ def designed_world_from_camera(cam):
     m[:3, :3] = r
     m[:3, 3] = c
     return m
+
+
+def lens_probe_points(cam):
+    """World points of the camera's LENS_PROBES (sensor's), from the designed pose."""
+    wc = designed_world_from_camera(cam)
+    out = []
+    for theta_deg, phi_deg in LENS_PROBES.get(cam["sensor"], []):
+        th, ph = math.radians(theta_deg), math.radians(phi_deg)
+        d = np.array([math.sin(th) * math.cos(ph), math.sin(th) * math.sin(ph), math.cos(th)])
+        out.append((wc[:3, :3] @ (3.0 * d) + wc[:3, 3]).tolist())
+    return out
 
 
 def internal_camera_transform(world_from_camera):
@@ -125,7 +160,7 @@ def spd(seed, scale):
 def sensors_xml(v2):
     extra = '        <black_level>0 0 0</black_level>\n        <sensitivity>1 1 1</sensitivity>\n' if v2 else ""
     cov0 = np.diag([0.61, 0.094, 0.088]) + 0.001
-    return f"""    <sensors next_id="3">
+    return f"""    <sensors next_id="6">
       <sensor id="0" label="Synthetic 4.8mm (4.8mm)" type="frame">
         <resolution width="{W}" height="{H}"/>
         <property name="pixel_width" value="0.0080000000000000002"/>
@@ -184,9 +219,12 @@ def sensors_xml(v2):
           <f>{num(F1)}</f>
           <cx>{num(CX1)}</cx>
           <cy>{num(CY1)}</cy>
+          <b1>{num(B1_1)}</b1>
+          <b2>{num(B2_1)}</b2>
           <k1>{num(K1_1)}</k1>
           <k2>{num(K2_1)}</k2>
           <k3>{num(K3_1)}</k3>
+          <k4>{num(K4_1)}</k4>
           <p1>{num(P1_1)}</p1>
           <p2>{num(P2_1)}</p2>
         </calibration>
@@ -194,6 +232,55 @@ def sensors_xml(v2):
           <params>f cx cy k1 k2 k3 p1 p2</params>
           <coeffs>{nums(np.diag([0.7, 0.1, 0.1, 1e-6, 2e-6, 3e-6, 1e-8, 1e-8]))}</coeffs>
         </covariance>
+      </sensor>
+      <sensor id="3" label="Fisheye 1.8mm (1.8mm)" type="fisheye">
+        <resolution width="{W}" height="{H}"/>
+        <property name="pixel_width" value="0.0080000000000000002"/>
+        <property name="pixel_height" value="0.0080000000000000002"/>
+        <property name="focal_length" value="1.8"/>
+        <property name="layer_index" value="0"/>
+        <bands>
+          <band label="Red"/>
+          <band label="Green"/>
+          <band label="Blue"/>
+        </bands>
+        <data_type>uint8</data_type>
+        <calibration type="fisheye" class="adjusted">
+          <resolution width="{W}" height="{H}"/>
+          <f>{num(F3)}</f>
+          <cx>{num(CX3)}</cx>
+          <cy>{num(CY3)}</cy>
+          <b1>{num(B1_3)}</b1>
+          <b2>{num(B2_3)}</b2>
+          <k1>{num(K1_3)}</k1>
+          <k2>{num(K2_3)}</k2>
+          <k3>{num(K3_3)}</k3>
+          <k4>{num(K4_3)}</k4>
+          <p1>{num(P1_3)}</p1>
+          <p2>{num(P2_3)}</p2>
+        </calibration>
+{extra}        <covariance>
+          <params>f cx cy k1 k2 k3 k4 p1 p2</params>
+          <coeffs>{nums(np.diag([0.5, 0.1, 0.1, 1e-6, 2e-6, 3e-6, 4e-6, 1e-8, 1e-8]))}</coeffs>
+        </covariance>
+      </sensor>
+      <sensor id="4" label="unknown" type="spherical">
+        <resolution width="{W4}" height="{H4}"/>
+        <property name="layer_index" value="0"/>
+        <bands>
+          <band label="Red"/>
+          <band label="Green"/>
+          <band label="Blue"/>
+        </bands>
+        <data_type>uint8</data_type>
+{extra}      </sensor>
+      <sensor id="5" label="Cylindrical" type="cylindrical">
+        <resolution width="{W}" height="{H}"/>
+        <property name="layer_index" value="0"/>
+        <calibration type="cylindrical" class="adjusted">
+          <resolution width="{W}" height="{H}"/>
+          <f>{num(W / (2 * math.pi))}</f>
+        </calibration>
       </sensor>
       <sensor id="2" label="unknown" type="frame">
         <resolution width="1920" height="1080"/>
@@ -235,7 +322,7 @@ def camera_xml(cam, v2, indent):
 
 
 def cameras_xml(v2):
-    out = '    <cameras next_id="6" next_group_id="1">\n'
+    out = '    <cameras next_id="9" next_group_id="1">\n'
     top = [c for c in CAMERAS if not c["group"]]
     grp = [c for c in CAMERAS if c["group"]]
     out += camera_xml(top[0], v2, 6)
@@ -336,6 +423,43 @@ def similarity_from(tr):
     return m, r, t, s
 
 
+# ------------------------------------------------------- camera models ----
+def metashape_polynomial(x, y, k, p1, p2):
+    """Metashape's Brown polynomial (manual, appendix "Camera models"): P1 goes with r^2 + 2x^2."""
+    r2 = x * x + y * y
+    radial = 1 + k[0] * r2 + k[1] * r2 ** 2 + k[2] * r2 ** 3 + k[3] * r2 ** 4
+    xp = x * radial + p1 * (r2 + 2 * x * x) + 2 * p2 * x * y
+    yp = y * radial + p2 * (r2 + 2 * y * y) + 2 * p1 * x * y
+    return xp, yp
+
+
+def frame_project(X, c):
+    """Frame camera: x = X/Z, y = Y/Z; u = w/2 + cx + x'f + x'B1 + y'B2, v = h/2 + cy + y'f."""
+    x, y = X[0] / X[2], X[1] / X[2]
+    xp, yp = metashape_polynomial(x, y, c["k"], c["p1"], c["p2"])
+    return [c["w"] * 0.5 + c["cx"] + xp * c["f"] + xp * c["b1"] + yp * c["b2"], c["h"] * 0.5 + c["cy"] + yp * c["f"]]
+
+
+def fisheye_project(X, c):
+    """Fisheye camera: x0 = X/Z, y0 = Y/Z, r0 = |(x0, y0)|, (x, y) = (x0, y0) atan(r0)/r0, then the
+    frame camera's polynomial and affine on (x, y)."""
+    x0, y0 = X[0] / X[2], X[1] / X[2]
+    r0 = math.hypot(x0, y0)
+    scale = math.atan(r0) / r0 if r0 > 0 else 1.0
+    xp, yp = metashape_polynomial(x0 * scale, y0 * scale, c["k"], c["p1"], c["p2"])
+    return [c["w"] * 0.5 + c["cx"] + xp * c["f"] + xp * c["b1"] + yp * c["b2"], c["h"] * 0.5 + c["cy"] + yp * c["f"]]
+
+
+def spherical_project(X, w, h):
+    """Spherical camera (no calibration), as nerfstudio's metashape_utils.py reads it: its
+    EQUIRECTANGULAR with fl_x = w/2, cx = w/2, fl_y = h, cy = h/2 on the camera's own axes, i.e.
+    longitude atan2(X, Z), latitude atan2(-Y, |(X, Z)|), u = w/2 + w lon/(2 pi), v = h/2 - h lat/pi."""
+    lon = math.atan2(X[0], X[2])
+    lat = math.atan2(-X[1], math.hypot(X[0], X[2]))
+    return [w / 2 + w * lon / (2 * math.pi), h / 2 - h * lat / math.pi]
+
+
+# ---------------------------------------------------------------- reader ----
 def read_expected(path):
     root = ET.parse(path).getroot()
     chunk = root.find("chunk")
@@ -358,15 +482,15 @@ def read_expected(path):
         label = cam.get("label")
         e = {"camera_id": int(cam.get("id")), "sensor_id": int(cam.get("sensor_id"))}
         s_el, cal = sensors[cam.get("sensor_id")]
+        kind = s_el.get("type", "frame")
         if cam.get("enabled", "true") in ("false", "0"):
             e.update(usable=False, reason="disabled")
         elif cam.find("transform") is None:
             e.update(usable=False, reason="not_aligned")
-        elif cal is None:
+        elif kind not in ("frame", "fisheye", "spherical"):
+            e.update(usable=False, reason="sensor_type")
+        elif cal is None and kind != "spherical":
             e.update(usable=False, reason="sensor_not_calibrated")
-        elif any(cal.find(k) is not None and float(cal.find(k).text) != 0.0
-                 for k in ("k1", "k2", "k3", "k4", "p1", "p2", "p3", "p4")):
-            e.update(usable=False, reason="sensor_has_distortion")
         else:
             e["usable"] = True
             e["reason"] = "ok"
@@ -374,13 +498,29 @@ def read_expected(path):
         if not e["usable"]:
             continue
 
-        w = int(cal.find("resolution").get("width"))
-        h = int(cal.find("resolution").get("height"))
-        get = lambda k: float(cal.find(k).text) if cal.find(k) is not None else 0.0
-        f, cx, cy, b1, b2 = get("f"), get("cx"), get("cy"), get("b1"), get("b2")
-        e.update(width=w, height=h, fx=f + b1, fy=f, skew=b2,
-                 cx=w / 2 + cx, cy=h / 2 + cy,
-                 cx_pixel_center_zero=w / 2 + cx - 0.5, cy_pixel_center_zero=h / 2 + cy - 0.5)
+        if kind == "spherical":
+            w = int(s_el.find("resolution").get("width"))
+            h = int(s_el.find("resolution").get("height"))
+            e.update(width=w, height=h, sensor_type=kind, cx=w / 2, cy=h / 2,
+                     lens={"model": "equirectangular", "params": [-180.0, 180.0, -90.0, 90.0]})
+            project = lambda X: spherical_project(X, w, h)
+        else:
+            w = int(cal.find("resolution").get("width"))
+            h = int(cal.find("resolution").get("height"))
+            get = lambda k: float(cal.find(k).text) if cal.find(k) is not None else 0.0
+            c = dict(w=w, h=h, f=get("f"), cx=get("cx"), cy=get("cy"), b1=get("b1"), b2=get("b2"),
+                     k=[get("k1"), get("k2"), get("k3"), get("k4")], p1=get("p1"), p2=get("p2"))
+            e.update(width=w, height=h, sensor_type=kind, fx=c["f"] + c["b1"], fy=c["f"], skew=c["b2"],
+                     cx=w / 2 + c["cx"], cy=h / 2 + c["cy"],
+                     cx_pixel_center_zero=w / 2 + c["cx"] - 0.5, cy_pixel_center_zero=h / 2 + c["cy"] - 0.5)
+            distorted = any(v != 0 for v in c["k"] + [c["p1"], c["p2"]])
+            if kind == "fisheye" or distorted or c["b2"] != 0:
+                e["lens"] = {"model": "metashape_" + kind,
+                             "params": [c["f"], w / 2 + c["cx"] - 0.5, h / 2 + c["cy"] - 0.5, c["b1"], c["b2"]]
+                             + c["k"] + [c["p1"], c["p2"]]}
+            else:
+                e["lens"] = None  # a pinhole: fx = f + b1, fy = f
+            project = (lambda X, c=c: fisheye_project(X, c)) if kind == "fisheye" else (lambda X, c=c: frame_project(X, c))
 
         t_cam = floats(cam.find("transform").text).reshape(4, 4)   # row-major
         comp_id = cam.get("component_id")
@@ -401,14 +541,11 @@ def read_expected(path):
         e["world_from_camera"] = wfc.tolist()
         e["camera_from_world"] = view.tolist()
         e["camera_center_world"] = wfc[:3, 3].tolist()
+        design = next(d for d in CAMERAS if d["label"] == label)
         projs = []
-        for p in PROBE_POINTS:
+        for p in PROBE_POINTS + lens_probe_points(design):
             x = view @ np.array(p + [1.0])
-            xn, yn = x[0] / x[2], x[1] / x[2]
-            # Metashape frame model with zero distortion: u = w/2 + cx + x'(f + b1) + y' b2
-            u = w / 2 + cx + xn * (f + b1) + yn * b2
-            v = h / 2 + cy + yn * f
-            projs.append({"world": p, "depth": x[2], "pixel": [u, v]})
+            projs.append({"world": p, "depth": x[2], "pixel": project(x[:3])})
         e["projections"] = projs
     return out
 
@@ -443,6 +580,26 @@ def main():
         u, v = e["projections"][0]["pixel"]
         assert abs(u - e["cx"]) < 1e-9 and abs(v - e["cy"]) < 1e-9, (u, v)
 
+    # independent check 3: each spherical pixel, sent back through nerfstudio's own ray for an
+    # EQUIRECTANGULAR camera (cameras.py, _generate_rays_from_coords: theta = -pi (x - cx)/fx,
+    # phi = pi (0.5 + (y - cy)/fy), direction (-sin theta sin phi, cos phi, -cos theta sin phi) in
+    # OpenGL axes) with metashape_utils.py's fl_x = w/2, cx = w/2, fl_y = h, cy = h/2, is the
+    # direction of the probe in the camera frame (OpenCV axes: y and z negated).
+    for c in CAMERAS:
+        e = cams[c["label"]]
+        if not e["usable"] or e["sensor_type"] != "spherical":
+            continue
+        w, h = e["width"], e["height"]
+        view = np.array(e["camera_from_world"])
+        for probe in e["projections"]:
+            x, y = probe["pixel"]
+            theta = -math.pi * (x - w / 2) / (w / 2)
+            phi = math.pi * (0.5 + (y - h / 2) / h)
+            gl = np.array([-math.sin(theta) * math.sin(phi), math.cos(phi), -math.cos(theta) * math.sin(phi)])
+            cv = gl * np.array([1.0, -1.0, -1.0])
+            d = (view @ np.array(probe["world"] + [1.0]))[:3]
+            assert np.allclose(cv, d / np.linalg.norm(d), atol=1e-12), (c["label"], probe)
+
     expected = {
         "source": "frames.xml (frames_v2.xml gives the same values)",
         "generated_by": "expected.py (numpy " + np.__version__ + ")",
@@ -458,8 +615,13 @@ def main():
             "world": "world = s * R @ p + t with the chunk transform (rotation R, translation t, scale s) "
                      "and p the chunk-internal coordinates in which <camera><transform> is written; "
                      "world_from_camera = [R @ Rc | s * R @ tc + t] for <camera><transform> = [Rc | tc]",
-            "projections": "pixel = Metashape frame model (zero distortion) of the world point; "
-                           "depth = z in camera coordinates",
+            "projections": "pixel = the sensor's Metashape camera model (frame_project, fisheye_project, "
+                           "spherical_project in expected.py) of the world point, in the pixel coordinates "
+                           "above; depth = z in camera coordinates",
+            "lens": "zcheck's lens (model and parameters) the camera reads as; null for a pinhole. "
+                    "metashape_frame/metashape_fisheye: f, cx, cy, b1, b2, k1..k4, p1, p2 with cx, cy "
+                    "in the OpenCV convention (w/2 + <cx> - 0.5); equirectangular: longitude and "
+                    "latitude ranges in degrees",
         },
         "chunk_transform": {
             "rotation": R_CHUNK.tolist(),
