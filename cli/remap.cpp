@@ -18,6 +18,7 @@
 #include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 
 namespace zcheck::cli {
 
@@ -28,6 +29,7 @@ struct RemapOptions {
     std::string depthMap, quantity, toQuantity, output, sampling = "plane", scene;
     DepthMapOptions reading;
     double scale = 0;
+    std::optional<double> undistort;  // alpha: the target is the source lens undistorted (remap.h)
 };
 
 // What the remapped map is against the target camera's own render: |remapped − rendered| over the
@@ -66,7 +68,8 @@ int runRemapCommand(const RemapOptions& o)
 {
     if (o.output.empty()) throw Error("remap needs -o FILE (.exr, .pfm, .npy, .tif, or .png with --out-scale)");
     if (o.depthMap.empty()) throw Error("remap needs --depth-map FILE, the map to move");
-    if (o.to.reference.empty()) throw Error("remap needs --to-camera FILE, the camera to move the map to");
+    if (o.to.reference.empty() == !o.undistort)
+        throw Error("remap needs one of --to-camera FILE (the camera to move the map to) and --undistort ALPHA");
     const RemapSampling sampling = remapSamplingFromName(o.sampling, "--sampling");
     CameraOptions fromOptions = o.from;
     std::string quantityName = o.quantity;
@@ -77,7 +80,7 @@ int runRemapCommand(const RemapOptions& o)
     const DepthQuantity toQuantity = depthQuantityFromName(o.toQuantity.empty() ? quantityName : o.toQuantity);
     OutputFiles outputs;
     outputs.addInput(cameraInputPath(fromOptions));
-    outputs.addInput(cameraInputPath(o.to));
+    if (!o.to.reference.empty()) outputs.addInput(cameraInputPath(o.to));
     outputs.addInput(o.depthMap);
     outputs.addInput(o.reading.sidecar);
     if (!o.scene.empty()) outputs.addInput(o.scene);
@@ -96,7 +99,7 @@ int runRemapCommand(const RemapOptions& o)
     CameraOptions toOptions = o.to;
     if (!toOptions.near) toOptions.near = from.nearDistance();
     if (!toOptions.far) toOptions.far = from.farDistance();
-    const Camera to(cameraSpecFrom(toOptions));
+    const Camera to(o.undistort ? undistortedCameraSpec(from, *o.undistort) : cameraSpecFrom(toOptions));
     for (const Camera* camera : {&from, &to})
         if (!camera->lens() && !camera->spec().projection.isPerspective())
             throw Error("remap needs cameras with a centre of projection; a " + toString(camera->spec().projection.type) +
@@ -170,6 +173,9 @@ Command addRemapCommand(CLI::App& app)
     addDepthMapOptions(command, o->reading);
     command->add_option("--to-camera", o->to.reference, "FILE[#FRAME]: the camera to move the map to (any camera format)")
         ->check(kNonEmptyPath);
+    command->add_option("--undistort", o->undistort,
+                        "ALPHA in [0, 1]: the target is the source lens undistorted to a pinhole of the same size, its\n"
+                        "K as OpenCV's getOptimalNewCameraMatrix chooses it (0: only pixels every edge sees; 1: all)");
     command->add_option("--to-camera-format", o->to.format, "the target camera file's format, when its content should not decide");
     command->add_option("--to-quantity", o->toQuantity, "what the new map holds (default: --quantity)");
     command->add_option("--sampling", o->sampling,

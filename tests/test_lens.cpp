@@ -16,6 +16,7 @@
 
 #include <cmath>
 #include <functional>
+#include <algorithm>
 #include <random>
 
 using namespace zcheck;
@@ -459,4 +460,96 @@ TEST_CASE("remap: a map moved to another camera with the same centre is the othe
     REQUIRE_THROWS_WITH(remapDepthMap(fisheye, distance, DepthQuantity::Distance, Camera(moved2), DepthQuantity::EyeZ,
                                       RemapSampling::Plane),
                         Catch::Contains("the two cameras' centres differ"));
+}
+
+namespace {
+
+// A map of `quantity` rendered by the ray route through `made`, as a renderer would store it (binary32, 0 a miss).
+DepthMap mapThrough(const Checker& checker, const CameraSpec& made, DepthQuantity quantity)
+{
+    const Camera camera(made);
+    const QuantityImage image = checker.render(camera, exportQuantityOf(quantity), Route::Ray);
+    std::vector<double> values(image.value.size());
+    for (std::size_t i = 0; i < values.size(); ++i) values[i] = std::isfinite(image.value[i]) ? double(float(image.value[i])) : 0.0;
+    return DepthMap::exact(camera.width(), camera.height(), quantity, values);
+}
+
+CameraSpec lensSpec(LensSpec lens, int width = 200, int height = 150)
+{
+    CameraSpec spec;
+    spec.convention = Convention::preset("opencv");
+    spec.width = width, spec.height = height;
+    spec.projection.type = ProjectionType::NonLinear;
+    spec.projection.lens = std::move(lens);
+    spec.projection.near = 0.05, spec.projection.far = 100;
+    spec.view = View::lookAt({1.2, 2.4, 5.5}, {-0.3, 0.9, -4.0}, {0, 1, 0});
+    return spec;
+}
+
+}  // namespace
+
+TEST_CASE("--diagnose names the lens family's mistakes", "[lens][diagnose]")
+{
+    const Checker checker(builtinScene("default"));
+    const MapVerifier verifier(checker);
+    const LensSpec declared{"opencv", {140, 140, 99.5, 74.5, -0.2, 0.05, 0.003, -0.002, -0.01}};
+    const CameraSpec declaredSpec = lensSpec(declared);
+    const Camera camera(declaredSpec);
+    struct Case {
+        const char* name;
+        CameraSpec made;
+        DepthQuantity quantity = DepthQuantity::Distance;
+        DepthQuantity declaredQuantity = DepthQuantity::Distance;
+    };
+    CameraSpec pinhole = declaredSpec;
+    pinhole.projection = PinholeIntrinsics{140, 140, 99.5, 74.5, 0}.projection(0.05, 100, "K");
+    std::vector<Case> cases = {
+        {"distortion-ignored", pinhole},
+        {"undistorted-new-k", undistortedCameraSpec(camera, 0.0)},
+        {"coefficient-order", lensSpec({"opencv", {140, 140, 99.5, 74.5, -0.2, 0.05, -0.01, 0.003, -0.002}})},
+        {"tangential-swapped", lensSpec({"opencv", {140, 140, 99.5, 74.5, -0.2, 0.05, -0.002, 0.003, -0.01}})},
+        {"distortion-signs-flipped", lensSpec({"opencv", {140, 140, 99.5, 74.5, 0.2, -0.05, -0.003, 0.002, 0.01}})},
+        {"eye-z-as-distance", declaredSpec, DepthQuantity::EyeZ, DepthQuantity::Distance},
+        {"fitted-radial-distortion", lensSpec({"opencv", {140, 140, 99.5, 74.5, -0.23, 0.065, 0.003, -0.002, -0.01}})},
+    };
+    for (const Case& c : cases) {
+        INFO(c.name);
+        DepthMap map = mapThrough(checker, c.made, c.quantity);
+        map.quantity = c.declaredQuantity;
+        REQUIRE(!verifier.verify(camera, map).report.comparison.consistent());
+        const std::vector<Hypothesis> diagnosis = verifier.diagnose(camera, map);
+        REQUIRE(!diagnosis.empty());
+        INFO("first: " << diagnosis.front().name << " (" << diagnosis.front().variant << "), unexplained "
+                       << diagnosis.front().unexplained);
+        REQUIRE(diagnosis.front().name == c.name);
+        REQUIRE(diagnosis.front().explains());
+        if (std::string(c.name) == "fitted-radial-distortion") {
+            REQUIRE(diagnosis.front().fitted.at(0).value == Approx(-0.23).margin(2e-3));
+            REQUIRE(diagnosis.front().fitted.at(1).value == Approx(0.065).margin(1e-2));
+        }
+    }
+    // A fisheye read as another fisheye.
+    const Camera fisheye(lensSpec({"opencv_fisheye", {70, 70, 99.5, 74.5, 0.01, -0.002}}));
+    DepthMap equisolidMap = mapThrough(checker, lensSpec({"equisolid", {70, 70, 99.5, 74.5}}), DepthQuantity::Distance);
+    const std::vector<Hypothesis> fisheyeDiagnosis = verifier.diagnose(fisheye, equisolidMap);
+    REQUIRE(fisheyeDiagnosis.front().name == "fisheye-model");
+    REQUIRE(fisheyeDiagnosis.front().variant == "equisolid");
+    REQUIRE(fisheyeDiagnosis.front().explains());
+}
+
+TEST_CASE("--diagnose of a pinhole's map made through a lens fits the lens it left out", "[lens][diagnose]")
+{
+    const Checker checker(builtinScene("default"));
+    const MapVerifier verifier(checker);
+    CameraSpec pinhole = lensSpec({"opencv", {140, 140, 99.5, 74.5}});
+    pinhole.projection = PinholeIntrinsics{140, 140, 99.5, 74.5, 0}.projection(0.05, 100, "K");
+    const DepthMap map = mapThrough(checker, lensSpec({"opencv", {140, 140, 99.5, 74.5, -0.15, 0.03}}), DepthQuantity::EyeZ);
+    const Camera camera(pinhole);
+    REQUIRE(!verifier.verify(camera, map).report.comparison.consistent());
+    const std::vector<Hypothesis> diagnosis = verifier.diagnose(camera, map);
+    const auto fit = std::find_if(diagnosis.begin(), diagnosis.end(), [](const Hypothesis& h) { return h.name == "fitted-radial-distortion"; });
+    REQUIRE(fit != diagnosis.end());
+    REQUIRE(fit->explains());
+    REQUIRE(fit == diagnosis.begin());
+    REQUIRE(fit->fitted.at(0).value == Approx(-0.15).margin(2e-3));
 }

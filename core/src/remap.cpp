@@ -73,6 +73,53 @@ void requireSharedCentre(const Camera& from, const Camera& to)
 
 }  // namespace
 
+CameraSpec undistortedCameraSpec(const Camera& camera, double alpha)
+{
+    const LensModel* lens = camera.lens();
+    if (!lens) throw Error("the camera has no lens to undistort (its projection is " + toString(camera.spec().projection.type) + ")");
+    if (!(alpha >= 0 && alpha <= 1)) throw Error("alpha must lie in [0, 1], got " + formatNumber(alpha));
+    const int W = camera.width(), H = camera.height();
+    constexpr int kGrid = 9;
+    glm::dvec2 plane[kGrid][kGrid];
+    for (int j = 0; j < kGrid; ++j)
+        for (int i = 0; i < kGrid; ++i) {
+            // OpenCV's points (i·W/8, j·H/8) in its pixel coordinates (calib3d's icvGetRectangles: from
+            // the top-left pixel's centre to a pixel past the last one's); zcheck's image point is +½.
+            const glm::dvec2 pImage(i * double(W) / (kGrid - 1) + 0.5, j * double(H) / (kGrid - 1) + 0.5);
+            const std::optional<glm::dvec3> ray = lens->directionFromImage(pImage);
+            if (!ray || !(ray->z > 1e-9))
+                throw Error("lens model " + lens->spec().model + ": pixel (" + formatNumber(pImage.x - 0.5) + ", " +
+                            formatNumber(pImage.y - 0.5) + ") has " + (ray ? "a ray 90° or more off the axis" : "no ray") +
+                            ", which no pinhole image holds: undistort to a camera of your own (--to-camera)");
+            plane[j][i] = glm::dvec2(*ray) / ray->z;
+        }
+    double outerX0 = INFINITY, outerX1 = -INFINITY, outerY0 = INFINITY, outerY1 = -INFINITY;
+    double innerX0 = -INFINITY, innerX1 = INFINITY, innerY0 = -INFINITY, innerY1 = INFINITY;
+    for (int j = 0; j < kGrid; ++j)
+        for (int i = 0; i < kGrid; ++i) {
+            const glm::dvec2 p = plane[j][i];
+            outerX0 = std::min(outerX0, p.x), outerX1 = std::max(outerX1, p.x);
+            outerY0 = std::min(outerY0, p.y), outerY1 = std::max(outerY1, p.y);
+            if (i == 0) innerX0 = std::max(innerX0, p.x);
+            if (i == kGrid - 1) innerX1 = std::min(innerX1, p.x);
+            if (j == 0) innerY0 = std::max(innerY0, p.y);
+            if (j == kGrid - 1) innerY1 = std::min(innerY1, p.y);
+        }
+    if (!(innerX1 > innerX0 && innerY1 > innerY0))
+        throw Error("lens model " + lens->spec().model + ": its undistorted border holds no rectangle");
+    const double fx0 = (W - 1) / (innerX1 - innerX0), fy0 = (H - 1) / (innerY1 - innerY0);
+    const double fx1 = (W - 1) / (outerX1 - outerX0), fy1 = (H - 1) / (outerY1 - outerY0);
+    const double fx = fx0 * (1 - alpha) + fx1 * alpha, fy = fy0 * (1 - alpha) + fy1 * alpha;
+    const double cx = -fx0 * innerX0 * (1 - alpha) - fx1 * outerX0 * alpha;
+    const double cy = -fy0 * innerY0 * (1 - alpha) - fy1 * outerY0 * alpha;
+    CameraSpec spec = camera.spec();
+    spec.projection = Projection{};
+    spec.projection.type = ProjectionType::Pinhole;
+    spec.projection.fx = fx, spec.projection.fy = fy, spec.projection.cx = cx, spec.projection.cy = cy;
+    spec.projection.near = camera.nearDistance(), spec.projection.far = camera.farDistance();
+    return spec;
+}
+
 RemappedMap remapDepthMap(const Camera& from, const std::vector<double>& values, DepthQuantity fromQuantity,
                           const Camera& to, DepthQuantity toQuantity, RemapSampling sampling)
 {

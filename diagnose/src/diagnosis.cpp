@@ -77,6 +77,9 @@ public:
             judgeReadingPairs();
             judgeCameraPairs();
             if (!anyExplains()) fitAfterClosestReading();
+            // Last: a lens the camera left out (a map made through a distorted camera).
+            if (!anyExplains())
+                if (std::optional<Hypothesis> lens = fitRadialDistortion(verifier_, camera_, map_)) out_.push_back(std::move(*lens));
         }
         suggestTolerance();
         if (!explained) flagEmptyMap();
@@ -500,6 +503,7 @@ void Diagnosis::rank()
 std::vector<Hypothesis> MapVerifier::diagnose(const Camera& camera, const DepthMap& map) const
 {
     requireMapFits(camera, map);
+    if (camera.lens()) return diagnoseLensMap(*this, camera, map);
     return Diagnosis(*this, camera, map).run();
 }
 

@@ -17,10 +17,12 @@
 // comparison every verification and every reading of a diagnosis runs (verifyAgainst).
 // and the sampled screen that rules a hypothesis out before its full comparison
 // (screenUnexplained). White-box tests include this header through their own include path.
+#include "zcheck/hypothesis.h"
 #include "zcheck/verify.h"
 
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -63,6 +65,15 @@ RenderResult renderResultFromMap(const PixelJudge& judge, const DepthMap& map, c
 // A map made through a lens model (camera.lens()) against the ray route, compared as distances
 // along the pixels' rays (verify_lens.cpp has the rule); MapVerifier::verify's for such cameras.
 VerifyResult verifyLensMap(const Checker& checker, const Camera& camera, const DepthMap& map);
+
+// The mistakes of the lens family for a map judged through a lens camera, ranked (the consistent
+// first); MapVerifier::diagnose's for such cameras (diagnose_lens.cpp lists them).
+class MapVerifier;
+std::vector<Hypothesis> diagnoseLensMap(const MapVerifier& verifier, const Camera& camera, const DepthMap& map);
+// k1, k2 of a radial lens fitted to an eye-z or distance map — the declared lens's own, or OpenCV's
+// around a pinhole's K (a lens the camera left out) — and verified in full; none when the fit
+// finds nothing (or the camera is neither).
+std::optional<Hypothesis> fitRadialDistortion(const MapVerifier& verifier, const Camera& camera, const DepthMap& map);
 
 // Throws Error unless `map` is camera.width() × camera.height() with a value per pixel.
 void requireMapFits(const Camera& camera, const DepthMap& map);

@@ -95,7 +95,9 @@ public:
         if (truthHit && mapHit) {
             const std::uint32_t primitive = truth_.primitiveId[i];
             const double error = out.map - out.truth;
-            out.tolerance = toleranceOn(primitive, pWindow, quantum, out.truth);
+            // The slope's share only where the storage's alone does not hold the error (4 rays).
+            const double storage = constant_ * quantum + 16 * 0x1p-52 * out.truth;
+            out.tolerance = std::abs(error) <= storage ? storage : toleranceOn(primitive, pWindow, quantum, out.truth);
             out.errorQuanta = std::abs(error) / quantum;
             out.errorOverTolerance = std::abs(error) / out.tolerance;
             out.primitive = primitive;

@@ -6,6 +6,7 @@
 #include "zcheck/camera_file.h"
 #include "zcheck/inverse_projection.h"
 #include "zcheck/pose.h"
+#include "zcheck/remap.h"
 
 #include <pybind11/stl.h>
 
@@ -192,6 +193,13 @@ camera's eye plane, outside a lens's field. Points beyond the image's edges keep
 ("eye-z", "distance"; "window", "ndc" for cameras with a depth buffer, not lens models). NaN
 where a value is a miss (0, inf, NaN, the clear value) or out of range, where a pixel has no
 ray (outside a lens's field) and where eye-z is not defined (a lens's ray 90° or more off the axis).)doc")
+        .def(
+            "undistorted", [](const Camera& c, double alpha) { return Camera(undistortedCameraSpec(c, alpha)); },
+            py::arg("alpha") = 0.0,
+            R"doc(The pinhole this lens camera's image undistorts to, at the same size and pose, its K chosen as
+cv2.getOptimalNewCameraMatrix(K, D, size, alpha) chooses it (0: only pixels every image edge sees;
+1: every source pixel). zcheck.Error for a camera without a lens, or one whose image holds a ray
+90° or more off the axis. `zcheck remap --undistort ALPHA` moves a depth map onto it.)doc")
         .def_property_readonly("lens", &lensDict,
                                "The lens model as a dict (\"model\" and each parameter by name), or None for a linear "
                                "projection.")

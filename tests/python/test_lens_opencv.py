@@ -232,3 +232,40 @@ def test_ros_camera_info_reads_as_image_geometry_projects(tmp_path, model, n):
         project = cv2.fisheye.projectPoints if fisheye else cv2.projectPoints
         theirs = project(pts.reshape(-1, 1, 3), np.zeros(3), np.zeros(3), K, D)[0].reshape(-1, 2)
         assert_projects_as(camera, pts, theirs, 100)
+
+
+def test_undistorted_camera_is_getoptimalnewcameramatrix():
+    """Camera.undistorted(alpha) computes OpenCV's getOptimalNewCameraMatrix (calib3d's rectangles
+    of a 9x9 grid of undistorted pixels): exactly, against the same rectangles computed here from
+    OpenCV's undistortion run to convergence; and to 1 % against cv2's own function, whose
+    undistortion stops after 5 fixed-point iterations."""
+    rng = np.random.default_rng(77)
+    compared_with_cv2 = 0
+    for trial in range(20):
+        K = random_K(rng)
+        mild = 0.1 if trial % 2 else 1.0  # half of them mild enough for cv2's 5 iterations
+        D = mild * np.array([rng.uniform(-0.2, 0.0), rng.uniform(0.0, 0.05), rng.uniform(-1e-3, 1e-3),
+                      rng.uniform(-1e-3, 1e-3), rng.uniform(-0.005, 0.005)])
+        camera = zcheck.Camera.from_opencv(K, np.eye(3), np.zeros(3), W, H, D=D)
+        u, v = np.meshgrid(np.arange(9) * W / 8, np.arange(9) * H / 8)  # calib3d's icvGetRectangles' grid
+        grid = np.column_stack([u.ravel(), v.ravel()]).reshape(-1, 1, 2)
+        plane = cv2.undistortPointsIter(grid, K, D, None, None,
+                                        (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 1000, 1e-15)).reshape(9, 9, 2)
+        outer = plane[..., 0].min(), plane[..., 0].max(), plane[..., 1].min(), plane[..., 1].max()
+        inner = plane[:, 0, 0].max(), plane[:, -1, 0].min(), plane[0, :, 1].max(), plane[-1, :, 1].min()
+        for alpha in (0.0, 0.5, 1.0):
+            p = camera.undistorted(alpha).to_dict()["projection"]
+            fx0, fy0 = (W - 1) / (inner[1] - inner[0]), (H - 1) / (inner[3] - inner[2])
+            fx1, fy1 = (W - 1) / (outer[1] - outer[0]), (H - 1) / (outer[3] - outer[2])
+            expected = [fx0 * (1 - alpha) + fx1 * alpha, fy0 * (1 - alpha) + fy1 * alpha,
+                        -fx0 * inner[0] * (1 - alpha) - fx1 * outer[0] * alpha,
+                        -fy0 * inner[2] * (1 - alpha) - fy1 * outer[2] * alpha]
+            assert np.allclose([p["fx"], p["fy"], p["cx"], p["cy"]], expected, rtol=1e-9, atol=1e-7)
+            # cv2's own function, where its 5-iteration undistortion of the grid has converged.
+            plane5 = cv2.undistortPoints(grid, K, D).reshape(9, 9, 2)
+            if np.max(np.abs(plane5 - plane)) < 1e-6:
+                theirs = cv2.getOptimalNewCameraMatrix(K, D, (W, H), alpha)[0]
+                assert np.allclose([p["fx"], p["fy"], p["cx"], p["cy"]],
+                                   [theirs[0, 0], theirs[1, 1], theirs[0, 2], theirs[1, 2]], rtol=1e-6)
+                compared_with_cv2 += 1
+    assert compared_with_cv2 >= 3

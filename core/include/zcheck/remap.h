@@ -40,6 +40,15 @@ struct RemappedMap {
     std::size_t nearestAtEdges = 0;    // plane sampling: samples not on one plane, taken nearest
 };
 
+// The pinhole a lens camera's image is undistorted to, at the same size and pose, its K chosen as
+// OpenCV's getOptimalNewCameraMatrix chooses it (calib3d, centerPrincipalPoint false): the rays of
+// a 9×9 grid of points (OpenCV's (i·W/8, j·H/8), i, j = 0…8) on the plane z = 1; alpha 0 keeps
+// only what every edge sees (the largest rectangle inside the undistorted border), 1 every source
+// pixel (the rectangle around them all), between them linearly. Throws Error for a camera without
+// a lens, and for a lens whose grid holds a pixel with no ray or a ray 90° or more off the axis
+// (no pinhole image holds it: a fisheye past 180°, a panorama).
+CameraSpec undistortedCameraSpec(const Camera& lensCamera, double alpha);
+
 RemappedMap remapDepthMap(const Camera& from, const std::vector<double>& values, DepthQuantity fromQuantity,
                           const Camera& to, DepthQuantity toQuantity, RemapSampling sampling);
 
