@@ -488,7 +488,7 @@ CameraSpec lensSpec(LensSpec lens, int width = 200, int height = 150)
 
 }  // namespace
 
-TEST_CASE("--diagnose names the lens family's mistakes", "[lens][diagnose]")
+TEST_CASE("the diagnosis names the lens family's mistakes", "[lens][diagnose]")
 {
     const Checker checker(builtinScene("default"));
     const MapVerifier verifier(checker);
@@ -537,7 +537,7 @@ TEST_CASE("--diagnose names the lens family's mistakes", "[lens][diagnose]")
     REQUIRE(fisheyeDiagnosis.front().explains());
 }
 
-TEST_CASE("--diagnose of a pinhole's map made through a lens fits the lens it left out", "[lens][diagnose]")
+TEST_CASE("the diagnosis of a pinhole's map made through a lens fits the lens it left out", "[lens][diagnose]")
 {
     const Checker checker(builtinScene("default"));
     const MapVerifier verifier(checker);

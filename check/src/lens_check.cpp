@@ -57,7 +57,7 @@ CheckResult Checker::checkLens(const Camera& camera, const CheckOptions& options
             const std::size_t i = std::size_t(row) * W + col;
             const glm::dvec2 centre(col + 0.5, row + 0.5);
             PixelClass pixelClass = PixelClass::BothMiss;
-            if (const std::optional<glm::dvec3> ray = lens.directionFromImage(centre)) {
+            if (const std::optional<glm::dvec3> ray = lens.directionAtPixel(col, row)) {
                 ++c.inField;
                 const std::optional<glm::dvec2> back = lens.imageFromDirection(*ray);
                 const double roundTrip = back ? glm::length(*back - centre) : INFINITY;

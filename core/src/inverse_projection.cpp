@@ -19,8 +19,11 @@ glm::dvec4 clipFromWindow(const Camera& camera, const glm::dvec3& pWindow)
 // A lens camera's unit direction through a window point, eye space; NaN outside the field.
 glm::dvec3 lensEyeDirection(const Camera& camera, const glm::dvec2& pWindow)
 {
-    const std::optional<glm::dvec3> dLens =
-        camera.lens()->directionFromImage({pWindow.x, camera.imageYFromWindowY(pWindow.y)});
+    const glm::dvec2 pImage(pWindow.x, camera.imageYFromWindowY(pWindow.y));
+    const double col = pImage.x - 0.5, row = pImage.y - 0.5;  // a pixel centre: the lens's table
+    const std::optional<glm::dvec3> dLens = col == std::floor(col) && row == std::floor(row)
+                                                ? camera.lens()->directionAtPixel(int(col), int(row))
+                                                : camera.lens()->directionFromImage(pImage);
     return dLens ? camera.eyeFromLensFrame(*dLens) : glm::dvec3(NAN);
 }
 

@@ -7,6 +7,7 @@
 #include <limits>
 #include <map>
 #include <mutex>
+#include <thread>
 
 namespace zcheck {
 
@@ -614,6 +615,30 @@ void LensModel::requireNoFoldInImage() const
                 "° from the axis, inside the image: pixel (" + std::to_string(int(std::floor(edge.x))) + ", " +
                 std::to_string(int(std::floor(edge.y))) + ") on the principal point's " +
                 (nearest < 2 ? "row" : "column") + " lies beyond it; the coefficients do not describe this image");
+}
+
+// ---- the table of pixel rays --------------------------------------------------------------
+
+std::optional<glm::dvec3> LensModel::directionAtPixel(int col, int row) const
+{
+    if (col < 0 || row < 0 || col >= width_ || row >= height_) return directionFromImage({col + 0.5, row + 0.5});
+    std::call_once(tableOnce_, [&] {
+        table_.resize(std::size_t(width_) * height_);
+        const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+        std::vector<std::thread> workers;
+        for (unsigned t = 0; t < threads; ++t)
+            workers.emplace_back([&, t] {
+                for (int r = int(t); r < height_; r += int(threads))
+                    for (int c = 0; c < width_; ++c) {
+                        const std::optional<glm::dvec3> d = directionFromImage({c + 0.5, r + 0.5});
+                        table_[std::size_t(r) * width_ + c] = d ? *d : glm::dvec3(NAN);
+                    }
+            });
+        for (std::thread& worker : workers) worker.join();
+    });
+    const glm::dvec3& d = table_[std::size_t(row) * width_ + col];
+    if (std::isnan(d.x)) return std::nullopt;
+    return d;
 }
 
 // ---- the whole chain ----------------------------------------------------------------------

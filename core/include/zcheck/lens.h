@@ -44,6 +44,7 @@
 #include <glm/glm.hpp>
 
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -100,6 +101,12 @@ public:
     // field (or where the inverse does not converge: then the pixel is outside it too).
     std::optional<glm::dvec3> directionFromImage(const glm::dvec2& pImage) const;
 
+    // The unit direction through pixel (col, row)'s centre, as directionFromImage gives it, from a
+    // table of every pixel's built on the first call (on every core) and kept with the model: 24
+    // bytes a pixel, shared by every camera — every frame of a dataset — with these intrinsics
+    // (LensModel::shared). Empty outside the field; a pixel outside the image is computed.
+    std::optional<glm::dvec3> directionAtPixel(int col, int row) const;
+
     // The largest angle from the axis (radians) the field reaches; for the panorama, π.
     double fieldAngle() const { return fieldAngle_; }
     // Whether a direction's angle from the axis can exceed 90°, where eye-z is not defined.
@@ -154,6 +161,8 @@ private:
     double fieldRadius_ = 0;   // ρ(θ_max): the undistorted plane's radius at the field's edge
     bool fieldEndsInFold_ = false;  // the field ends where the distortion folds, not where the profile ends
     glm::dmat3 tilt_{1.0}, untilt_{1.0};
+    mutable std::once_flag tableOnce_;
+    mutable std::vector<glm::dvec3> table_;  // directionAtPixel's, NaN outside the field
 };
 
 }  // namespace zcheck
