@@ -115,6 +115,19 @@ const std::vector<ModelDraw>& draws()
     return table;
 }
 
+// A lens camera of builtin:default's kind: OpenCV axes, near 0.05, far 100 (distances), the view given.
+CameraSpec lensSpec(LensSpec lens, int width = 200, int height = 150, const View& view = View::lookAt({1.2, 2.4, 5.5}, {-0.3, 0.9, -4.0}, {0, 1, 0}))
+{
+    CameraSpec spec;
+    spec.convention = Convention::preset("opencv");
+    spec.width = width, spec.height = height;
+    spec.projection.type = ProjectionType::NonLinear;
+    spec.projection.lens = std::move(lens);
+    spec.projection.near = 0.05, spec.projection.far = 100;
+    spec.view = view;
+    return spec;
+}
+
 glm::dvec3 direction(double theta, double phi) { return {std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)}; }
 
 }  // namespace
@@ -335,13 +348,8 @@ TEST_CASE("verify of a lens camera's map: the truth passes, a distortion mistake
 {
     const Checker checker(builtinScene("default"));
     const MapVerifier verifier(checker);
-    CameraSpec spec;
-    spec.convention = Convention::preset("opencv");
-    spec.width = 320, spec.height = 240;
-    spec.projection.type = ProjectionType::NonLinear;
-    spec.projection.lens = {"opencv", {210, 210, 159.5, 119.5, -0.25, 0.08, 1e-3, -5e-4}};
-    spec.projection.near = 0.05, spec.projection.far = 100;
-    spec.view = View::lookAt({0.3, 0.8, 2.5}, {0, 0, 0}, {0, 1, 0});
+    const CameraSpec spec = lensSpec({"opencv", {210, 210, 159.5, 119.5, -0.25, 0.08, 1e-3, -5e-4}}, 320, 240,
+                                     View::lookAt({0.3, 0.8, 2.5}, {0, 0, 0}, {0, 1, 0}));
     const Camera camera(spec);
     for (const DepthQuantity quantity : {DepthQuantity::Distance, DepthQuantity::EyeZ}) {
         INFO(toString(quantity));
@@ -377,15 +385,10 @@ TEST_CASE("verify of a lens camera's map: a depth outside the lens's field is th
 {
     const Checker checker(builtinScene("default"));
     const MapVerifier verifier(checker);
-    CameraSpec spec;
-    spec.convention = Convention::preset("opencv");
-    spec.width = 320, spec.height = 240;
-    spec.projection.type = ProjectionType::NonLinear;
     // The fold at r = 1/√(3·0.2): 130 px from the centre at fx = 150, beyond the nearest edge
     // (120 px) but not the corners.
-    spec.projection.lens = {"opencv", {150, 150, 159.5, 119.5, -0.2}};
-    spec.projection.near = 0.05, spec.projection.far = 100;
-    spec.view = View::lookAt({0.3, 0.8, 2.5}, {0, 0, 0}, {0, 1, 0});
+    const CameraSpec spec = lensSpec({"opencv", {150, 150, 159.5, 119.5, -0.2}}, 320, 240,
+                                     View::lookAt({0.3, 0.8, 2.5}, {0, 0, 0}, {0, 1, 0}));
     const Camera camera(spec);
     REQUIRE(!camera.lens()->directionFromImage({0.5, 0.5}).has_value());
     const QuantityImage truth = checker.render(camera, ExportQuantity::Distance, Route::Ray);
@@ -474,17 +477,6 @@ DepthMap mapThrough(const Checker& checker, const CameraSpec& made, DepthQuantit
     return DepthMap::exact(camera.width(), camera.height(), quantity, values);
 }
 
-CameraSpec lensSpec(LensSpec lens, int width = 200, int height = 150)
-{
-    CameraSpec spec;
-    spec.convention = Convention::preset("opencv");
-    spec.width = width, spec.height = height;
-    spec.projection.type = ProjectionType::NonLinear;
-    spec.projection.lens = std::move(lens);
-    spec.projection.near = 0.05, spec.projection.far = 100;
-    spec.view = View::lookAt({1.2, 2.4, 5.5}, {-0.3, 0.9, -4.0}, {0, 1, 0});
-    return spec;
-}
 
 }  // namespace
 

@@ -98,6 +98,18 @@ bool clippedRange(const ClipVertex (&corner)[3], double& lo, double& hi)
 
 namespace {
 
+// Near and far around the scene's nearest and farthest [lo, hi]: 1 % beyond each, near held at
+// far/10⁷ or more — `floorNote` says so when it is.
+SceneNearFar planesAround(double lo, double hi, const std::string& floorNote)
+{
+    SceneNearFar planes;
+    planes.far = hi * 1.01;
+    planes.near = lo * 0.99;
+    const double floor = planes.far * 1e-7;
+    if (!(planes.near >= floor)) planes.near = floor, planes.note = floorNote;
+    return planes;
+}
+
 // A lens camera's near and far are distances along its rays (camera.h): the nearest and farthest
 // any part of the scene can be from the eye, bounded by the boxes of its chunks of triangles (a
 // box holding the eye bounds the nearest at 0). Rays are traced in double between them, so a
@@ -113,15 +125,7 @@ SceneNearFar lensNearFar(const Scene& scene, const Camera& camera)
         hi = std::max(hi, glm::length(glm::max(glm::abs(a - eye), glm::abs(b - eye))));
     }
     if (!(hi > 0)) throw Error("scene '" + scene.name + "' has no extent around the camera: near and far cannot be taken from it");
-    SceneNearFar planes;
-    planes.far = hi * 1.01;
-    planes.near = lo * 0.99;
-    const double floor = planes.far * 1e-7;
-    if (!(planes.near >= floor)) {
-        planes.near = floor;
-        planes.note = "the scene's bounds reach the eye, so near (a distance along the rays) is held at far/1e7";
-    }
-    return planes;
+    return planesAround(lo, hi, "the scene's bounds reach the eye, so near (a distance along the rays) is held at far/1e7");
 }
 
 }  // namespace
@@ -201,15 +205,7 @@ SceneNearFar sceneNearFar(const Scene& scene, const CameraSpec& spec)
     if (!(hi > 0))
         throw Error("the camera sees none of scene '" + scene.name +
                     "', so near and far cannot be taken from it (is the pose inverted, or in other axes?)");
-    SceneNearFar planes;
-    planes.far = hi * 1.01;
-    planes.near = lo * 0.99;
-    const double floor = planes.far * 1e-7;
-    if (!(planes.near >= floor)) {
-        planes.near = floor;
-        planes.note = "the scene reaches the eye (eye-z " + formatNumber(std::max(lo, 0.0)) + "), so near is held at far/1e7";
-    }
-    return planes;
+    return planesAround(lo, hi, "the scene reaches the eye (eye-z " + formatNumber(std::max(lo, 0.0)) + "), so near is held at far/1e7");
 }
 
 ImportedCamera importCamera(const std::string& reference, const CameraFormat* format)
