@@ -502,6 +502,7 @@ TEST_CASE("the diagnosis names the lens family's mistakes", "[lens][diagnose]")
         {"tangential-swapped", lensSpec({"opencv", {140, 140, 99.5, 74.5, -0.2, 0.05, -0.002, 0.003, -0.01}})},
         {"distortion-signs-flipped", lensSpec({"opencv", {140, 140, 99.5, 74.5, 0.2, -0.05, -0.003, 0.002, 0.01}})},
         {"eye-z-as-distance", declaredSpec, DepthQuantity::EyeZ, DepthQuantity::Distance},
+        {"half-pixel", lensSpec({"opencv", {140, 140, 100, 75, -0.2, 0.05, 0.003, -0.002, -0.01}})},
         {"fitted-radial-distortion", lensSpec({"opencv", {140, 140, 99.5, 74.5, -0.23, 0.065, 0.003, -0.002, -0.01}})},
     };
     for (const Case& c : cases) {
@@ -520,6 +521,13 @@ TEST_CASE("the diagnosis names the lens family's mistakes", "[lens][diagnose]")
             REQUIRE(diagnosis.front().fitted.at(1).value == Approx(0.065).margin(1e-2));
         }
     }
+    // The map's rows bottom to top.
+    DepthMap upsideDown = mapThrough(checker, declaredSpec, DepthQuantity::Distance);
+    for (int row = 0; row < upsideDown.height / 2; ++row)
+        for (int col = 0; col < upsideDown.width; ++col)
+            std::swap(upsideDown.value[std::size_t(row) * upsideDown.width + col],
+                      upsideDown.value[std::size_t(upsideDown.height - 1 - row) * upsideDown.width + col]);
+    REQUIRE(verifier.diagnose(camera, upsideDown).front().name == "y-flip");
     // A fisheye read as another fisheye.
     const Camera fisheye(lensSpec({"opencv_fisheye", {70, 70, 99.5, 74.5, 0.01, -0.002}}));
     DepthMap equisolidMap = mapThrough(checker, lensSpec({"equisolid", {70, 70, 99.5, 74.5}}), DepthQuantity::Distance);

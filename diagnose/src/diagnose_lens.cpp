@@ -10,6 +10,8 @@
 //   tangential-swapped        p1 and p2 exchanged (Metashape's P1 is OpenCV's p2)
 //   distortion-signs-flipped  every distortion coefficient negated (undistortion's for distortion's)
 //   fisheye-model             a fisheye read as another: equidistant, equisolid, stereographic
+//   y-flip, x-flip, half-pixel, cx-cy-swapped   the catalogue's mistakes of the image and the
+//                             principal point, as a lens map shows them
 //   distance-as-eye-z, eye-z-as-distance   the map's values taken for the other quantity
 //   fitted-radial-distortion  k1, k2 of a radial lens with the camera's K fitted to the map (rays
 //                             traced per sample, Levenberg–Marquardt), then verified in full
@@ -35,7 +37,22 @@ struct LensCandidate {
     std::string name, variant, explanation;
     std::optional<CameraSpec> camera;   // the camera the renderer used; none: the declared one
     std::optional<DepthQuantity> quantity;  // the map's values read as this quantity; none: as declared
+    int flip = 0;                       // the map's rows (1) or columns (2) read in the other order
 };
+
+// The map with its rows (flip 1) or columns (flip 2) in the other order.
+DepthMap flipped(const DepthMap& map, int flip)
+{
+    DepthMap out = map;
+    for (int row = 0; row < map.height; ++row)
+        for (int col = 0; col < map.width; ++col) {
+            const int fromRow = flip == 1 ? map.height - 1 - row : row, fromCol = flip == 2 ? map.width - 1 - col : col;
+            out.value[std::size_t(row) * map.width + col] = map.value[std::size_t(fromRow) * map.width + fromCol];
+            if (!map.valueStep.empty())
+                out.valueStep[std::size_t(row) * map.width + col] = map.valueStep[std::size_t(fromRow) * map.width + fromCol];
+        }
+    return out;
+}
 
 std::string coefficientText(const LensSpec& lens, const std::vector<std::size_t>& which)
 {
@@ -163,6 +180,27 @@ std::vector<LensCandidate> lensCandidates(const Camera& camera, const DepthMap& 
             out.push_back({"fisheye-model", label, std::string("consistent if the fisheye was rendered ") + label +
                                                        " (same K) where " + spec.model + " was declared",
                            withLens(camera, other), std::nullopt});
+        }
+    }
+    // The generic mistakes of the catalogue's names that a lens map shows alike: the image flipped,
+    // the principal point half a pixel off (COLMAP's corner-based cx, cy taken as OpenCV's) or
+    // its coordinates exchanged.
+    out.push_back({"y-flip", "", "consistent if the map's rows are read bottom to top (a bottom-left image origin)",
+                   std::nullopt, std::nullopt, 1});
+    out.push_back({"x-flip", "", "consistent if the map is mirrored left to right", std::nullopt, std::nullopt, 2});
+    if (hasK) {
+        for (const double shift : {0.5, -0.5}) {
+            LensSpec moved = spec;
+            moved.params[2] += shift, moved.params[3] += shift;
+            out.push_back({"half-pixel", shift > 0 ? "+0.5" : "-0.5",
+                           std::string("consistent if the principal point is ") + (shift > 0 ? "half a pixel further" : "half a pixel nearer") +
+                               " from the top-left corner (pixel centres counted from 0.5 or from 0)",
+                           withLens(camera, moved), std::nullopt});
+        }
+        if (spec.params[2] != spec.params[3]) {
+            LensSpec swapped = spec;
+            std::swap(swapped.params[2], swapped.params[3]);
+            out.push_back({"cx-cy-swapped", "", "consistent if cx and cy were exchanged", withLens(camera, swapped), std::nullopt});
         }
     }
     // The values taken for the other quantity.
@@ -319,7 +357,7 @@ std::vector<Hypothesis> diagnoseLensMap(const MapVerifier& verifier, const Camer
     tbb::parallel_for(std::size_t(0), candidates.size(), [&](std::size_t k) {
         const LensCandidate& c = candidates[k];
         try {
-            DepthMap reread = map;
+            DepthMap reread = c.flip ? flipped(map, c.flip) : map;
             if (c.quantity) reread.quantity = *c.quantity;
             const Camera used(c.camera ? *c.camera : camera.spec());
             judgedOnes[k] = judged(verifier, used, reread, c.name, c.variant, c.explanation);
