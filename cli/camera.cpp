@@ -105,7 +105,7 @@ int runCameraCommand(const CameraCommandOptions& o)
     if (!clipKnown) out["camera"]["projection"]["near"] = nullptr, out["camera"]["projection"]["far"] = nullptr;
     out["notes"] = cameraNotes(spec);
     const ProjectionType type = spec.projection.type;
-    const bool hasK = camera.lens() ? camera.lens()->info().hasFocal && std::string(camera.lens()->info().params[0]) == "fx"
+    const bool hasK = camera.lens() ? camera.lens()->info().startsWithK()
                                     : type == ProjectionType::Perspective || type == ProjectionType::Frustum ||
                                           type == ProjectionType::Pinhole || type == ProjectionType::Lens;
     if (hasK)  // a lens model's K (its distortion is in "camera"'s "lens")

@@ -161,7 +161,7 @@ LensSpec readLens(ObjectReader lens, const Projection& pinhole, bool fromPinhole
     if (!info) lens.failKey("model", spec.model.empty() ? "is missing (" + lensModelNames() + ")"
                                                          : "must be one of " + lensModelNames() + ", got '" + spec.model + "'");
     const double fromProjection[4] = {pinhole.fx, pinhole.fy, pinhole.cx, pinhole.cy};
-    const bool hasK = info->hasFocal && std::string(info->params[0]) == "fx";
+    const bool hasK = info->startsWithK();
     if (fromPinhole && !hasK)
         lens.failKey("model", "'" + spec.model + "' does not take a pinhole's fx, fy, cx, cy: give the projection only "
                               "near and far, and every parameter in the lens");
@@ -375,7 +375,7 @@ json toJson(const CameraSpec& spec)
     case ProjectionType::NonLinear: {
         // K in a pinhole projection where the model has it, the rest in "lens" (readLens).
         const LensModelInfo& info = *lensModelNamed(p.lens.model);
-        const bool hasK = info.hasFocal && std::string(info.params[0]) == "fx";
+        const bool hasK = info.startsWithK();
         lens["model"] = p.lens.model;
         if (hasK)
             projection["type"] = "pinhole", projection["fx"] = p.lens.params[0], projection["fy"] = p.lens.params[1],

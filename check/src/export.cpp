@@ -24,9 +24,9 @@ QuantityImage quantityImage(const Scene& scene, const Camera& camera, const Rend
     case ExportQuantity::PrimitiveId: image.channels = {"id"}, image.unit = "triangle index (uint32)", image.missValue = double(kNoPrimitive); break;
     }
     const std::size_t C = image.channels.size();
-    if (const LensModel* lens = camera.lens(); lens && (quantity == ExportQuantity::Window || quantity == ExportQuantity::Ndc))
-        throw Error("quantity " + toString(quantity) + ": a lens model (" + lens->spec().model +
-                    ") has no depth buffer, so no window or ndc depth; export eye-z or distance");
+    if (quantity == ExportQuantity::Window || quantity == ExportQuantity::Ndc)
+        requireQuantityOf(camera, quantity == ExportQuantity::Window ? DepthQuantity::Window : DepthQuantity::Ndc,
+                          "quantity " + toString(quantity));
     if (quantity == ExportQuantity::PrimitiveId) {
         image.id.assign(route.primitiveId.begin(), route.primitiveId.end());
         return image;

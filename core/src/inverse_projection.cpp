@@ -19,11 +19,7 @@ glm::dvec4 clipFromWindow(const Camera& camera, const glm::dvec3& pWindow)
 // A lens camera's unit direction through a window point, eye space; NaN outside the field.
 glm::dvec3 lensEyeDirection(const Camera& camera, const glm::dvec2& pWindow)
 {
-    const glm::dvec2 pImage(pWindow.x, camera.imageYFromWindowY(pWindow.y));
-    const double col = pImage.x - 0.5, row = pImage.y - 0.5;  // a pixel centre: the lens's table
-    const std::optional<glm::dvec3> dLens = col == std::floor(col) && row == std::floor(row)
-                                                ? camera.lens()->directionAtPixel(int(col), int(row))
-                                                : camera.lens()->directionFromImage(pImage);
+    const std::optional<glm::dvec3> dLens = camera.lens()->directionThrough({pWindow.x, camera.imageYFromWindowY(pWindow.y)});
     return dLens ? camera.eyeFromLensFrame(*dLens) : glm::dvec3(NAN);
 }
 
@@ -248,6 +244,13 @@ double distanceOfEyePoint(const Camera& camera, const glm::dvec3& pEye)
     return glm::length(pEye - eyePlaneRayFrom(eyeRayThroughWindow(camera, {pWindow.x, pWindow.y})).origin);
 }
 
+void requireQuantityOf(const Camera& camera, DepthQuantity quantity, const std::string& name)
+{
+    if (camera.lens() && (quantity == DepthQuantity::Window || quantity == DepthQuantity::Ndc))
+        throw Error(name + ": a lens model (" + camera.lens()->spec().model +
+                    ") has no depth buffer, so no window or ndc depth: give eye-z or distance");
+}
+
 void requireDepthValue(const Camera& camera, DepthQuantity quantity, double value, const std::string& name)
 {
     const std::string given = name + " " + formatNumber(value) + " (" + toString(quantity) + ")";
@@ -257,9 +260,7 @@ void requireDepthValue(const Camera& camera, DepthQuantity quantity, double valu
         if (!(value > 0)) throw Error(given + " must be > 0: the point must lie in front of the eye");
         return;
     }
-    if (camera.lens())
-        throw Error(given + ": a lens model (" + camera.lens()->spec().model +
-                    ") has no depth buffer, so no window or ndc depth: give eye-z or distance");
+    requireQuantityOf(camera, quantity, given);
     const auto [lo, hi] = depthValueBounds(camera, quantity);
     if (!(value >= lo && value <= hi)) throw Error(given + " must lie in " + depthValueRange(camera, quantity));
 }

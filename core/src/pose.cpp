@@ -208,7 +208,7 @@ PinholeIntrinsics pinholeIntrinsicsOf(const Camera& camera, double pixelCenter)
     const ProjectionType type = camera.spec().projection.type;
     if (const LensModel* lens = camera.lens()) {  // a lens model's fx, fy, cx, cy, where it has them
         const LensModelInfo& info = lens->info();
-        if (!info.hasFocal || std::string(info.params[0]) != "fx")
+        if (!info.startsWithK())
             throw Error("lens model " + lens->spec().model + " has no pinhole intrinsics fx, fy, cx, cy");
         const std::vector<double>& q = lens->spec().params;
         return {q[0], q[1], q[2] + pixelCenter, q[3] + pixelCenter, pixelCenter};

@@ -128,8 +128,7 @@ RemappedMap remapDepthMap(const Camera& from, const std::vector<double>& values,
                     "x" + std::to_string(from.height()) + " camera");
     requireSharedCentre(from, to);
     for (const auto& [camera, quantity, role] : {std::tuple{&from, fromQuantity, "source"}, std::tuple{&to, toQuantity, "target"}})
-        if (camera->lens() && (quantity == DepthQuantity::Window || quantity == DepthQuantity::Ndc))
-            requireDepthValue(*camera, quantity, 0.5, std::string("the ") + role + " quantity");  // refused: no depth buffer
+        requireQuantityOf(*camera, quantity, std::string("the ") + role + " quantity " + toString(quantity));
     const glm::dmat3 fromEyeFromToEye = glm::dmat3(from.eyeFromWorld) * glm::dmat3(to.worldFromEye);  // rotations
     RemappedMap out;
     out.values.assign(std::size_t(to.width()) * to.height(), missValue(to, toQuantity));

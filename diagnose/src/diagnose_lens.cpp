@@ -89,7 +89,7 @@ std::vector<LensCandidate> lensCandidates(const Camera& camera, const DepthMap& 
     const LensModel& lens = *camera.lens();
     const LensSpec& spec = lens.spec();
     const LensModelInfo& info = lens.info();
-    const bool hasK = info.hasFocal && std::string(info.params[0]) == "fx";
+    const bool hasK = info.startsWithK();
     if (hasK) {
         CameraSpec pinhole = camera.spec();
         pinhole.projection = Projection{};

@@ -85,7 +85,7 @@ public:
         if (mapHasDepth && !mapHit) out.outOfRange = true;  // eye-z 90° or more off the axis
         const double perValue = eyeZ ? 1 / cosine : 1.0;  // distance per unit of the map's value
         const ValueAccuracy accuracy = map_.accuracyAt(i);
-        const double step = std::max(accuracy.step > 0 ? accuracy.step : binary32Step(value), accuracy.grid);
+        const double step = std::max(accuracy.step > 0 ? accuracy.step : storageQuantum(DepthFormat::Float32, value), accuracy.grid);
         out.map = mapHit ? value * perValue : NAN;
         const bool truthHit = truth_.hit(i);
         out.truth = truthHit ? truth_.windowDepth.value[i] : NAN;
@@ -119,12 +119,6 @@ public:
     }
 
 private:
-    static double binary32Step(double value)
-    {
-        const float magnitude = std::fabs(float(value));
-        return double(std::nextafter(magnitude, INFINITY)) - double(magnitude);
-    }
-
     // C·q + S·m + E on `primitive`'s plane at the pixel centre pWindow.
     double toleranceOn(std::uint32_t primitive, const glm::dvec2& pWindow, double quantum, double distance) const
     {

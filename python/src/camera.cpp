@@ -112,8 +112,7 @@ py::array_t<double> unproject(const Camera& camera, const py::object& pixels, co
     const DoubleArray d = asDoubles(numericArray(depth, "Camera.unproject: depth"));
     const py::ssize_t n = p.shape(0);
     if (d.size() != n) fail("Camera.unproject: depth holds " + std::to_string(d.size()) + " values for " + std::to_string(n) + " pixels");
-    if (camera.lens() && (quantity == DepthQuantity::Window || quantity == DepthQuantity::Ndc))
-        requireDepthValue(camera, quantity, 0.5, "Camera.unproject: quantity");  // refused: no depth buffer
+    requireQuantityOf(camera, quantity, "Camera.unproject: quantity " + quantityName);
     py::array_t<double> out({n, py::ssize_t(3)});
     auto o = out.mutable_unchecked<2>();
     const auto in = p.unchecked<2>();

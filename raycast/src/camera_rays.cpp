@@ -94,11 +94,7 @@ std::optional<EyePlaneRay> CameraRays::worldRay(const glm::dvec2& pImage) const
 {
     if (fromMatrix_) return worldEyePlaneRayThroughWindow(camera_, {pImage.x, camera_.windowYFromImageY(pImage.y)});
     if (lens_) {
-        // A pixel centre's ray from the lens's table (LensModel::directionAtPixel), any other point's computed.
-        const double col = pImage.x - 0.5, row = pImage.y - 0.5;
-        const std::optional<glm::dvec3> dLens = col == std::floor(col) && row == std::floor(row)
-                                                    ? lens_->directionAtPixel(int(col), int(row))
-                                                    : lens_->directionFromImage(pImage);
+        const std::optional<glm::dvec3> dLens = lens_->directionThrough(pImage);
         if (!dLens) return std::nullopt;
         // The lens frame is x right, y down, z forward: world = x·right − y·up + z·forward.
         const Projection& p = camera_.spec().projection;

@@ -118,6 +118,9 @@ std::optional<glm::dvec3> eyePointFromDepth(const Camera& camera, const glm::dve
 // the eye, or anything not finite (stricter than kindOfDepthValue: no slack). `name` begins the message ("--depth 2 (window) must lie in
 // [0, 1], the camera's depth range").
 void requireDepthValue(const Camera& camera, DepthQuantity quantity, double value, const std::string& name);
+// Refuses (throws Error beginning with `name`) a quantity the camera cannot produce at all: window
+// and ndc of a lens model, which has no depth buffer. requireDepthValue checks it first.
+void requireQuantityOf(const Camera& camera, DepthQuantity quantity, const std::string& name);
 
 // The point seen at window point (x, y) at depth `value` of `quantity`, in both spaces and
 // both depths: what `zcheck unproject --pixel --depth` and Python's Camera.point_at give.

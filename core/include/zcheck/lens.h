@@ -43,6 +43,7 @@
 //   if (auto dCam = lens.directionFromImage({960.5, 540.5})) ...  // unit ray, camera frame
 #include <glm/glm.hpp>
 
+#include <cmath>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -67,7 +68,10 @@ struct LensModelInfo {
     const char* formula;    // the forward map, one line, for docs and --help
     std::vector<const char*> params;  // in order: "fx", "fy", "cx", "cy", "k1", ...
     int required;           // the first `required` parameters must be given; the rest default to 0
-    bool hasFocal;          // fx, fy, cx, cy are its first four parameters (all but panoramas)
+    bool hasFocal;          // it has a focal length and a principal point (all but panoramas)
+    // Its first four parameters are OpenCV's fx, fy, cx, cy (a K beside its coefficients; not
+    // Metashape's f, cx, cy, b1, b2 nor a panorama's ranges).
+    bool startsWithK() const { return hasFocal && std::string(params[0]) == "fx"; }
 };
 
 const std::vector<LensModelInfo>& lensModels();
@@ -106,6 +110,13 @@ public:
     // bytes a pixel, shared by every camera — every frame of a dataset — with these intrinsics
     // (LensModel::shared). Empty outside the field; a pixel outside the image is computed.
     std::optional<glm::dvec3> directionAtPixel(int col, int row) const;
+    // directionFromImage, a pixel centre's from that table (the ray route's and verify's points).
+    std::optional<glm::dvec3> directionThrough(const glm::dvec2& pImage) const
+    {
+        const double col = pImage.x - 0.5, row = pImage.y - 0.5;
+        if (col == std::floor(col) && row == std::floor(row)) return directionAtPixel(int(col), int(row));
+        return directionFromImage(pImage);
+    }
 
     // The largest angle from the axis (radians) the field reaches; for the panorama, π.
     double fieldAngle() const { return fieldAngle_; }
