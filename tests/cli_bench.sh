@@ -61,6 +61,49 @@ ref = json.load(open(sys.argv[1]))["reference"]
 assert "llvmpipe_skipped" in ref or ref["llvmpipe_agreement"] > 0.99, ref
 PY
 
+# A lens camera (the bench's fisheye workload in small: the terrain 2 wide, the eye 0.2 above
+# it, every hit within far): no raster route; the ray table, the rays made from it, the export,
+# and Embree on the same rays (every pixel's primitive as the ray route's).
+cat > "$tmp/fisheye.json" <<'JSON'
+{ "convention": "opencv", "image": {"width": 160, "height": 120},
+  "projection": {"type": "pinhole", "fx": 50, "fy": 50, "cx": 79.5, "cy": 59.5, "near": 0.001, "far": 10},
+  "lens": {"model": "opencv_fisheye", "k1": 0.02, "k2": -0.004, "k3": 0.0007, "k4": -0.0001},
+  "view": {"eye": [0, 0.2, 0], "target": [0, 0, 0], "up": [0, 0, 1]} }
+JSON
+"$zcheck" bench --scene "builtin:terrain?n=60&size=2" --camera "$tmp/fisheye.json" --repeat 2 --threads 2 > "$tmp/lens.txt"
+grep -qE "^zcheck bench: builtin:terrain\?n=60&size=2, 6962 triangles, 160x120, lens model opencv_fisheye, distance, 2 threads, 2 repeats, consistent$" "$tmp/lens.txt"
+for phase in "ray table" trace "depth trace" rays "lens check" export "warm export"; do
+    grep -qE "^$phase +median +[0-9.]+ ms +best +[0-9.]+ ms" "$tmp/lens.txt"
+done
+grep -qE "^raster +does not apply" "$tmp/lens.txt"
+if grep -qE "^compare |compare/" "$tmp/lens.txt"; then echo "a lens bench printed the raster comparison"; exit 1; fi
+ASAN_OPTIONS="${ASAN_OPTIONS:-}:detect_leaks=0" \
+    "$zcheck" bench --scene "builtin:terrain?n=60&size=2" --camera "$tmp/fisheye.json" --repeat 2 --reference --json > "$tmp/lens.json"
+python3 - "$tmp/lens.json" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1]))
+assert r["lens"] == "opencv_fisheye", r
+lp = r["lens_phases"]
+for name in ("ray_table", "rays", "depth_trace", "export", "export_trace", "export_write", "warm_export"):
+    assert len(lp[name]["ms"]) == 2 and 0 < lp[name]["best_ms"] <= lp[name]["median_ms"], (name, lp[name])
+# The one-shot export contains its trace and its write.
+assert min(lp["export"]["ms"]) >= 0.9 * (lp["export_trace"]["best_ms"] + lp["export_write"]["best_ms"]), lp
+assert r["memory_budget_mib"] == (150 * r["triangles"] + (32 + 24 + 24) * 160 * 120) / 2**20
+ref = r["reference"]
+assert "does not apply" in ref["llvmpipe_skipped"], ref
+assert ref["embree_agreement"] > 0.99, ref["embree_agreement"]
+ratios = r["ratios"]
+assert ratios["trace-throughput/embree"]["target"] == 0.8 and ratios["trace-throughput/embree"]["bound"] == "at least"
+assert abs(ratios["rays/trace"]["value"] - lp["rays"]["median_ms"] / lp["depth_trace"]["median_ms"]) < 1e-9
+assert abs(ratios["trace-throughput/embree"]["value"] - ref["embree_trace"]["median_ms"] / lp["depth_trace"]["median_ms"]) < 1e-9
+assert ratios["warm-export-seconds"]["target"] == 0.5
+assert not any(name.startswith(("compare", "whole", "warm-compare", "warm-trace")) for name in ratios), ratios
+PY
+# Embree's yardstick traces the ray route's rays: a pinhole's agree too.
+python3 -c "import json,sys; a=json.load(open(sys.argv[1]))['reference']['embree_agreement']; assert a > 0.99, a" "$tmp/bench.json"
+
+expect_error 2 "workload 'fisheye'.*terrain-1M-1080p, fisheye-1M-1080p or panorama-1M-1920x960" bench --workload fisheye
+expect_error 2 "workload fisheye-1M-1080p names its own scene and camera" bench --workload fisheye-1M-1080p --scene builtin:default
 expect_error 2 "repeat" bench --repeat 0
 expect_error 2 "width" bench --width 0
 expect_error 2 "scene 'builtin:terrain\?size=0'.*size" bench --scene "builtin:terrain?size=0"

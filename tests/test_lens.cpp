@@ -111,6 +111,26 @@ const std::vector<ModelDraw>& draws()
              const double lonMin = uniform(r, -180, 180 - lon), latMin = uniform(r, -90, 90 - lat);
              return std::vector<double>{lonMin, lonMin + lon, latMin, latMin + lat};
          }},
+        // Blender's panoramic cameras: fisheye_fov up to 2π, shift in image widths and heights,
+        // sensors after the fit with pixels of aspect 0.9–1.1.
+        {"blender_fisheye_equidistant",
+         [](std::mt19937_64& r) { return std::vector<double>{uniform(r, 0.5, 2 * kPi), uniform(r, -0.2, 0.2), uniform(r, -0.2, 0.2)}; }},
+        {"blender_fisheye_equisolid",
+         [](std::mt19937_64& r) {
+             const double width = uniform(r, 20, 40);
+             return std::vector<double>{uniform(r, 6, 16), uniform(r, 1, 2 * kPi), width, width * kHeight / kWidth * uniform(r, 0.9, 1.1),
+                                        uniform(r, -0.2, 0.2), uniform(r, -0.2, 0.2)};
+         }},
+        {"blender_fisheye_lens_polynomial",
+         [](std::mt19937_64& r) {
+             const double width = uniform(r, 20, 40);
+             return std::vector<double>{0.0, uniform(r, -0.09, -0.04), uniform(r, -5e-4, 5e-4), uniform(r, -1e-5, 1e-5),
+                                        uniform(r, -1e-7, 1e-7), uniform(r, 1.5, kPi), width,
+                                        width * kHeight / kWidth * uniform(r, 0.9, 1.1), uniform(r, -0.2, 0.2), uniform(r, -0.2, 0.2)};
+         }},
+        {"blender_mirror_ball", [](std::mt19937_64& r) { return std::vector<double>{uniform(r, -0.2, 0.2), uniform(r, -0.2, 0.2)}; }},
+        {"blender_equiangular_cubemap_face",
+         [](std::mt19937_64& r) { return std::vector<double>{uniform(r, -0.5, 0.5), uniform(r, -0.5, 0.5)}; }},
     };
     return table;
 }
@@ -552,4 +572,98 @@ TEST_CASE("the diagnosis of a pinhole's map made through a lens fits the lens it
     REQUIRE(fit->explains());
     REQUIRE(fit == diagnosis.begin());
     REQUIRE(fit->fitted.at(0).value == Approx(-0.15).margin(2e-3));
+}
+
+// Blender Cycles 3.4's panoramic cameras, by hand from the formulas of its kernel
+// (kernel/camera/projection.h, *_to_direction) in zcheck's axes: x right, y down, z forward;
+// u = x/W + shift_x, v = 1 − y/H + shift_y (Blender's v grows upwards).
+TEST_CASE("Blender's panoramic cameras project as Cycles renders them, by hand", "[lens][blender]")
+{
+    const double W = kWidth, H = kHeight;
+    const auto lens = [&](const char* model, std::vector<double> params) { return LensModel({model, std::move(params)}, kWidth, kHeight); };
+    const auto near = [](const glm::dvec3& a, const glm::dvec3& b) { return glm::length(a - b) <= 1e-12; };
+    const glm::dvec3 ahead(0, 0, 1);
+    // The image's centre looks straight ahead, for every type.
+    for (const LensModel& l : {lens("blender_fisheye_equidistant", {3.0}), lens("blender_fisheye_equisolid", {10.5, kPi, 36, 27}),
+                               lens("blender_fisheye_lens_polynomial", {0, -0.05, 1e-4, 0, 0, 3.0, 36, 27}),
+                               lens("blender_mirror_ball", {}), lens("blender_equiangular_cubemap_face", {})}) {
+        INFO(l.spec().model);
+        REQUIRE(near(l.directionFromImage({W / 2, H / 2}).value(), ahead));
+        const glm::dvec2 centre = l.imageFromDirection(ahead).value();
+        REQUIRE(std::abs(centre.x - W / 2) <= 1e-9);
+        REQUIRE(std::abs(centre.y - H / 2) <= 1e-9);
+    }
+
+    // Equidistant, fov 3 rad: r = 2|(u − ½, v − ½)|, θ = r·fov/2; the right edge's middle is the
+    // ellipse's edge, 1.5 rad to the right; the bottom edge's middle 1.5 rad down.
+    const LensModel equidistant = lens("blender_fisheye_equidistant", {3.0});
+    REQUIRE(near(equidistant.directionFromImage({W, H / 2}).value(), {std::sin(1.5), 0, std::cos(1.5)}));
+    REQUIRE(near(equidistant.directionFromImage({W / 2, H}).value(), {0, std::sin(1.5), std::cos(1.5)}));
+    // Halfway to the right edge: θ = 0.75.
+    REQUIRE(near(equidistant.directionFromImage({0.75 * W, H / 2}).value(), {std::sin(0.75), 0, std::cos(0.75)}));
+    // Outside the ellipse (the corners) no ray; past fov/2 no pixel.
+    REQUIRE(!equidistant.directionFromImage({0.95 * W, 0.95 * H}).has_value());
+    REQUIRE(!equidistant.imageFromDirection({std::sin(1.51), 0, std::cos(1.51)}).has_value());
+    // fov π: camera right (90°) lands on the right edge.
+    REQUIRE(lens("blender_fisheye_equidistant", {kPi}).imageFromDirection({1, 0, 0}).value().x == Approx(W).epsilon(1e-14));
+
+    // Equisolid, f = 10.5 mm on a 36 × 27 mm fitted sensor: R = 2f·sin(θ/2) mm from the centre, 90°
+    // right at x = W·(½ + 21·sin 45° / 36).
+    const LensModel equisolid = lens("blender_fisheye_equisolid", {10.5, kPi, 36, 27});
+    REQUIRE(equisolid.imageFromDirection({1, 0, 0}).value().x == Approx(W * (0.5 + 21 * std::sin(kPi / 4) / 36)).epsilon(1e-14));
+    // Straight down at 60°: R = 21·sin 30° = 10.5 mm on the 27 mm height.
+    REQUIRE(equisolid.imageFromDirection({0, std::sin(kPi / 3), std::cos(kPi / 3)}).value().y ==
+            Approx(H * (0.5 + 10.5 / 27)).epsilon(1e-14));
+    // fov 2 rad: the circle's rim at R = 21·sin(½) mm; just inside a ray at 1 rad, just outside none.
+    const LensModel equisolidNarrow = lens("blender_fisheye_equisolid", {10.5, 2.0, 36, 27});
+    const double rim = 21 * std::sin(0.5) / 36 * W;
+    REQUIRE(std::acos(equisolidNarrow.directionFromImage({W / 2 + rim - 1e-6, H / 2}).value().z) == Approx(1.0).epsilon(1e-6));
+    REQUIRE(!equisolidNarrow.directionFromImage({W / 2 + rim + 1e-6, H / 2}).has_value());
+
+    // Lens polynomial θ = −(k0 + k1R + k2R²): k1 = −0.05, k2 = 1e-4, R = 8 mm → θ = 0.3936 rad.
+    const LensModel polynomial = lens("blender_fisheye_lens_polynomial", {0, -0.05, 1e-4, 0, 0, 3.0, 36, 27});
+    const double theta = 0.05 * 8 - 1e-4 * 64;
+    REQUIRE(near(polynomial.directionFromImage({W / 2 + 8.0 / 36 * W, H / 2}).value(), {std::sin(theta), 0, std::cos(theta)}));
+    const glm::dvec2 p = polynomial.imageFromDirection({0, std::sin(theta), std::cos(theta)}).value();
+    REQUIRE(std::abs(p.x - W / 2) <= 1e-9);
+    REQUIRE(std::abs(p.y - (H / 2 + 8.0 / 27 * H)) <= 1e-9);
+    // k0 = −0.01: θ = 0.01 at the centre, so the directions within 0.01 rad of the axis have no pixel.
+    const LensModel biased = lens("blender_fisheye_lens_polynomial", {-0.01, -0.05, 0, 0, 0, 3.0, 36, 27});
+    REQUIRE(!biased.imageFromDirection({std::sin(0.005), 0, std::cos(0.005)}).has_value());
+    REQUIRE(biased.imageFromDirection({std::sin(0.06), 0, std::cos(0.06)}).value().x == Approx(W / 2 + 1.0 / 36 * W).epsilon(1e-12));
+
+    // Mirror ball: camera right at u = ½ + ½/√2; straight back no pixel; past the disc no ray.
+    const LensModel ball = lens("blender_mirror_ball", {});
+    REQUIRE(ball.imageFromDirection({1, 0, 0}).value().x == Approx(W * (0.5 + 0.5 / std::sqrt(2.0))).epsilon(1e-14));
+    REQUIRE(near(ball.directionFromImage({W * (0.5 + 0.5 / std::sqrt(2.0)), H / 2}).value(), {1, 0, 0}));
+    REQUIRE(!ball.imageFromDirection({0, 0, -1}).has_value());
+    REQUIRE(!ball.directionFromImage({0.5, 0.5}).has_value());
+
+    // Cubemap face: 45° right at the right edge; tan(22.5°) down at three quarters of the height.
+    const LensModel face = lens("blender_equiangular_cubemap_face", {});
+    REQUIRE(face.imageFromDirection({1, 0, 1}).value().x == Approx(W).epsilon(1e-14));
+    REQUIRE(face.imageFromDirection({0, std::tan(kPi / 8), 1}).value().y == Approx(0.75 * H).epsilon(1e-14));
+    REQUIRE(!face.imageFromDirection({1, 0, -0.1}).has_value());
+    // Shift (whole widths and heights): shift_x = 0.1 moves the view right, the axis to u − shift_x
+    // = 0.4 of the width; shift_y = 0.1 moves it up, the axis 0.1 of the height lower.
+    const glm::dvec2 shifted = lens("blender_equiangular_cubemap_face", {0.1, 0.1}).imageFromDirection(ahead).value();
+    REQUIRE(shifted.x == Approx(0.4 * W).epsilon(1e-14));
+    REQUIRE(shifted.y == Approx(0.6 * H).epsilon(1e-14));
+}
+
+TEST_CASE("Blender's panoramic cameras refuse what Cycles' formulas cannot hold one-to-one", "[lens][blender]")
+{
+    const auto make = [](const char* model, std::vector<double> params) { return LensModel({model, std::move(params)}, kWidth, kHeight); };
+    REQUIRE_THROWS_WITH(make("blender_fisheye_equidistant", {7.0}), Catch::Contains("'fisheye_fov' must lie in (0, 2π]"));
+    REQUIRE_THROWS_WITH(make("blender_fisheye_equisolid", {0.0, 3.0, 36, 27}), Catch::Contains("'fisheye_lens' must be > 0"));
+    REQUIRE_THROWS_WITH(make("blender_fisheye_equisolid", {10.5, 3.0, 36, 0}), Catch::Contains("'fitted_sensor_height' must be > 0"));
+    REQUIRE_THROWS_WITH(make("blender_equiangular_cubemap_face", {0.6, 0}), Catch::Contains("'shift_x' must lie within ±0.5"));
+    REQUIRE_THROWS_WITH(make("blender_fisheye_lens_polynomial", {0.01, -0.05, 0, 0, 0, 3.0, 36, 27}),
+                        Catch::Contains("'fisheye_polynomial_k0' must be ≤ 0"));
+    REQUIRE_THROWS_WITH(make("blender_fisheye_lens_polynomial", {0, 0.05, 0, 0, 0, 3.0, 36, 27}),
+                        Catch::Contains("'fisheye_polynomial_k1' must be < 0"));
+    // θ' = 0.05 − 2·0.005·R vanishes at R = 5 mm, well inside a 36 × 27 mm image, at θ = 0.125 < 1.5.
+    REQUIRE_THROWS_WITH(make("blender_fisheye_lens_polynomial", {0, -0.05, 0.005, 0, 0, 3.0, 36, 27}),
+                        Catch::Contains("stops increasing at R = 5 mm"));
+    REQUIRE_THROWS_WITH(make("blender_fisheye_equidistant", {}), Catch::Contains("takes 1 to 3 parameters, got 0"));
 }

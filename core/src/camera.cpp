@@ -305,10 +305,10 @@ Window imageWindow(const CameraSpec& spec, double aspect, const LensModel* lens)
         return {-right, right, -top, top};
     }
     case ProjectionType::NonLinear: {
-        // The linear part (camera.h): the pinhole of the model's fx, fy, cx, cy; for a panorama a
-        // 90° view.
+        // The linear part (camera.h): the pinhole of the model's fx, fy, cx, cy; for a panorama (and
+        // Blender's panoramic cameras, which have no focal length) a 90° view.
         const LensModel::Terms& t = lens->terms();
-        if (lens->isPanorama()) return {-n, n, -n * spec.height / spec.width, n * spec.height / spec.width};
+        if (lens->isPanorama() || !lens->info().hasFocal) return {-n, n, -n * spec.height / spec.width, n * spec.height / spec.width};
         const double W = spec.width, H = spec.height;
         return {n * (-0.5 - t.cx) / t.fx, n * (W - 0.5 - t.cx) / t.fx, -n * (H - 0.5 - t.cy) / t.fy, n * (t.cy + 0.5) / t.fy};
     }

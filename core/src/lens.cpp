@@ -146,6 +146,48 @@ const std::vector<ModelRow>& rows()
              const double toRad = kPi / 180;
              t.lonMin = p[0] * toRad, t.lonMax = p[1] * toRad, t.latMin = p[2] * toRad, t.latMax = p[3] * toRad;
          }},
+        // Blender Cycles 3.4's panoramic cameras (lens.h's module comment; kernel/camera/projection.h,
+        // the *_to_direction functions, which are what Cycles renders). (a, b) = (x/W + shift_x − ½,
+        // y/H − shift_y − ½): the offset from the image's centre in widths and heights, right and down.
+        {{"blender_fisheye_equidistant", "Blender Cycles fisheye equidistant",
+          "q = 2·(a, b); θ = |q|·fisheye_fov/2 toward q; no ray for |q| > 1 (an ellipse touching the borders)",
+          {"fisheye_fov", "shift_x", "shift_y"}, 1, false},
+         [](const double* p, Terms& t) {
+             t.blender = Terms::Blender::FisheyeEquidistant;
+             t.fisheyeFov = p[0], t.shiftX = p[1], t.shiftY = p[2];
+         }},
+        {{"blender_fisheye_equisolid", "Blender Cycles fisheye equisolid",
+          "m = (a·Sw, b·Sh) mm; θ = 2·asin(|m|/(2·fisheye_lens)) toward m; no ray for |m| > 2·fisheye_lens·sin(fisheye_fov/4)",
+          {"fisheye_lens", "fisheye_fov", "fitted_sensor_width", "fitted_sensor_height", "shift_x", "shift_y"}, 4, false},
+         [](const double* p, Terms& t) {
+             t.blender = Terms::Blender::FisheyeEquisolid;
+             t.fisheyeLens = p[0], t.fisheyeFov = p[1], t.sensorWidth = p[2], t.sensorHeight = p[3];
+             t.shiftX = p[4], t.shiftY = p[5];
+         }},
+        {{"blender_fisheye_lens_polynomial", "Blender Cycles fisheye lens polynomial",
+          "m = (a·Sw, b·Sh) mm, R = |m|; θ = −(k0 + k1R + k2R² + k3R³ + k4R⁴) toward m; no ray past fisheye_fov/2",
+          {"fisheye_polynomial_k0", "fisheye_polynomial_k1", "fisheye_polynomial_k2", "fisheye_polynomial_k3",
+           "fisheye_polynomial_k4", "fisheye_fov", "fitted_sensor_width", "fitted_sensor_height", "shift_x", "shift_y"},
+          8, false},
+         [](const double* p, Terms& t) {
+             t.blender = Terms::Blender::FisheyeLensPolynomial;
+             for (int i = 0; i < 5; ++i) t.polynomial[i] = p[i];
+             t.fisheyeFov = p[5], t.sensorWidth = p[6], t.sensorHeight = p[7], t.shiftX = p[8], t.shiftY = p[9];
+         }},
+        {{"blender_mirror_ball", "Blender Cycles mirror ball",
+          "q = 2·(a, b); θ = 2·asin|q| toward q (the disc's rim looks straight back); no ray for |q| ≥ 1",
+          {"shift_x", "shift_y"}, 0, false},
+         [](const double* p, Terms& t) {
+             t.blender = Terms::Blender::MirrorBall;
+             t.shiftX = p[0], t.shiftY = p[1];
+         }},
+        {{"blender_equiangular_cubemap_face", "Blender Cycles equiangular cubemap face",
+          "the ray (tan(a·π/2), tan(b·π/2), 1): a 90° × 90° face, equiangular per axis; no ray for |a| or |b| ≥ 1",
+          {"shift_x", "shift_y"}, 0, false},
+         [](const double* p, Terms& t) {
+             t.blender = Terms::Blender::CubemapFace;
+             t.shiftX = p[0], t.shiftY = p[1];
+         }},
     };
     return table;
 }
@@ -215,6 +257,10 @@ LensModel::LensModel(const LensSpec& spec, int width, int height) : spec_(spec),
             throw Error(where + ": '" + info_->params[i] + "' must be a finite number, got " + formatNumber(spec.params[i]));
     spec_.params.resize(n, 0.0);
     row->terms(spec_.params.data(), terms_);
+    if (terms_.blender != Terms::Blender::None) {
+        setUpBlender();
+        return;
+    }
     panorama_ = !info_->hasFocal;
     const auto require = [&](bool ok, const char* param, const std::string& rule, double value) {
         if (!ok) throw Error(where + ": '" + param + "' " + rule + ", got " + formatNumber(value));
@@ -253,6 +299,7 @@ LensModel::LensModel(const LensSpec& spec, int width, int height) : spec_(spec),
     tilt_ = tiltMatrix(t.tauX, t.tauY);
     untilt_ = glm::inverse(tilt_);
     findField();
+    if (std::isfinite(fieldRadius_)) fieldDistortedRadius_ = distortedRadius(fieldRadius_);
     requireNoFoldInImage();
 }
 
@@ -387,13 +434,17 @@ double LensModel::radialFactor(double r2) const
 }
 
 namespace {
-// d(N/D)/d(r²).
-double radialFactorSlope(const Terms& t, double r2)
+// N/D and its slope d(N/D)/d(r²), with one division.
+struct RadialFactor {
+    double value, slope;
+};
+RadialFactor radialFactorAndSlope(const Terms& t, double r2)
 {
     double n = 0, d = 0, dn = 0, dd = 0;
     for (int i = 5; i >= 0; --i) n = (n + t.numerator[i]) * r2, dn = dn * r2 + (i + 1) * t.numerator[i];
     for (int i = 2; i >= 0; --i) d = (d + t.denominator[i]) * r2, dd = dd * r2 + (i + 1) * t.denominator[i];
-    return (dn * (1 + d) - (1 + n) * dd) / ((1 + d) * (1 + d));
+    const double overD = 1 / (1 + d), value = (1 + n) * overD;
+    return {value, (dn - value * dd) * overD};
 }
 
 // Tangential and thin prism terms at q, and their Jacobian.
@@ -423,7 +474,8 @@ glm::dvec2 LensModel::distortPlane(const glm::dvec2& m) const
 
 glm::dmat2 LensModel::planeJacobian(const glm::dvec2& m) const
 {
-    const double r2 = glm::dot(m, m), f = radialFactor(r2), slope = radialFactorSlope(terms_, r2);
+    const double r2 = glm::dot(m, m);
+    const auto [f, slope] = radialFactorAndSlope(terms_, r2);
     const glm::dmat2 radial(f + 2 * m.x * m.x * slope, 2 * m.x * m.y * slope, 2 * m.x * m.y * slope,
                             f + 2 * m.y * m.y * slope);
     if (terms_.tangentialAfterRadial) return (glm::dmat2(1.0) + tangentialPrismJacobian(terms_, m * f)) * radial;
@@ -432,53 +484,84 @@ glm::dmat2 LensModel::planeJacobian(const glm::dvec2& m) const
 
 std::optional<glm::dvec2> LensModel::undistortPlane(const glm::dvec2& target) const
 {
+    return undistortPlane(target, nullptr);
+}
+
+std::optional<glm::dvec2> LensModel::undistortPlane(const glm::dvec2& target, InverseHint* hint) const
+{
     if (planeIsIdentity()) return target;
     const double fMax = std::max(terms_.fx, terms_.fy);
     const auto closeEnough = [&](double residual, double size) {
         return residual * fMax <= kInverseTolerancePx || residual <= 8 * std::numeric_limits<double>::epsilon() * std::max(1.0, size);
     };
+    const double rt = std::sqrt(target.x * target.x + target.y * target.y);
+    if (!std::isfinite(rt)) return std::nullopt;
+    // From a neighbour's answer: radially, its radius moved by the step between the two targets'
+    // radii over the radial map's slope there; in the plane, its point moved by the step between
+    // the two targets scaled by its ratio of undistorted to distorted radius.
+    const bool hinted = hint && hint->valid;
+    const double hintRatio = hinted ? glm::length(hint->undistorted) / glm::length(hint->distorted) : 1.0;
+    double slopeAtAnswer = 0;
+    const auto remember = [&](const glm::dvec2& answer) {
+        if (hint) hint->distorted = target, hint->undistorted = answer, hint->radialSlope = slopeAtAnswer, hint->valid = rt > 0;
+        return answer;
+    };
+    if (hint) hint->valid = false;
     // One unknown, the radius, on [0, fieldRadius_] where the radial map increases: Newton's
     // steps kept inside the bracket (bisection when one would leave it). The answer when the
-    // distortion is radial, else the start of Newton in the plane.
-    const double rt = std::hypot(target.x, target.y);
+    // distortion is radial, else (without a hint) the start of Newton in the plane.
     std::optional<double> radius;
+    const bool radial = planeIsRadial();
     if (rt == 0) {
         radius = 0.0;
-    } else {
+    } else if (radial || !hinted) {
         double lo = 0, hi = std::isfinite(fieldRadius_) ? fieldRadius_ : std::max(1.0, 2 * rt);
         while (std::isinf(fieldRadius_) && distortedRadius(hi) < rt && hi < 1e300) hi *= 2;
-        if (!(distortedRadius(hi) >= rt)) {
-            if (closeEnough(rt - distortedRadius(hi), rt)) radius = hi;
+        const double reach = std::isfinite(fieldRadius_) ? fieldDistortedRadius_ : distortedRadius(hi);
+        if (!(reach >= rt)) {
+            if (closeEnough(rt - reach, rt)) radius = hi;
         } else {
-            double r = std::min(rt, hi);
+            double r = rt;
+            if (hinted && hint->radialSlope > 0)
+                r = glm::length(hint->undistorted) + (rt - glm::length(hint->distorted)) / hint->radialSlope;
+            else if (hinted)
+                r = rt * hintRatio;
+            if (!(r > lo && r < hi)) r = std::min(rt, hi);
             for (int iteration = 0; iteration < 200; ++iteration) {
-                const double g = distortedRadius(r) - rt;
-                if (closeEnough(std::abs(g), rt)) break;
+                const double r2 = r * r;
+                const auto [f, slope] = radialFactorAndSlope(terms_, r2);
+                const double g = r * f - rt, radialSlope = f + 2 * r2 * slope;
+                if (closeEnough(std::abs(g), rt)) {
+                    radius = r, slopeAtAnswer = radialSlope;
+                    break;
+                }
                 (g > 0 ? hi : lo) = r;
-                const double r2 = r * r, slope = radialFactor(r2) + 2 * r2 * radialFactorSlope(terms_, r2);
-                double next = r - g / slope;
+                double next = r - g / radialSlope;
                 if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
                 if (next == r) break;
                 r = next;
             }
-            if (closeEnough(std::abs(distortedRadius(r) - rt), rt)) radius = r;
         }
     }
-    if (planeIsRadial()) {
+    if (radial) {
         if (!radius) return std::nullopt;
-        return rt == 0 ? target : target * (*radius / rt);
+        return remember(rt == 0 ? target : target * (*radius / rt));
     }
-    // In the plane: Newton on the Jacobian from the radial answer, the step halved while it does
-    // not reduce the residual or would leave the field's disc.
-    const double start = radius ? *radius : std::min(rt, 0.99 * fieldRadius_);
-    glm::dvec2 m = rt > 0 ? target * (start / rt) : target;
+    // In the plane: Newton on the Jacobian from the hint or the radial answer, the step halved
+    // while it does not reduce the residual or would leave the field's disc.
+    glm::dvec2 m = target;
+    if (hinted)
+        m = hint->undistorted + (target - hint->distorted) * hintRatio;
+    else if (rt > 0)
+        m = target * ((radius ? *radius : std::min(rt, 0.99 * fieldRadius_)) / rt);
+    if (!(glm::length(m) <= fieldRadius_)) m *= 0.99 * fieldRadius_ / glm::length(m);
     glm::dvec2 error = distortPlane(m) - target;
     const double size = rt;
     for (int iteration = 0; iteration < 100; ++iteration) {
         if (closeEnough(glm::length(error), size)) break;
         const glm::dmat2 jacobian = planeJacobian(m);
         const double det = glm::determinant(jacobian);
-        if (!(std::abs(det) > 0) || !std::isfinite(det)) return std::nullopt;
+        if (!(std::abs(det) > 0) || !std::isfinite(det)) break;
         glm::dvec2 step = glm::inverse(jacobian) * error;
         bool improved = false;
         for (int halving = 0; halving < 40 && !improved; ++halving, step *= 0.5) {
@@ -489,8 +572,233 @@ std::optional<glm::dvec2> LensModel::undistortPlane(const glm::dvec2& target) co
         }
         if (!improved) break;
     }
-    if (!closeEnough(glm::length(error), size)) return std::nullopt;
-    return m;
+    if (closeEnough(glm::length(error), size)) return remember(m);
+    // Newton from a neighbour's answer can stall where the radial start would not (a fold
+    // between them): start again without it.
+    if (hinted) return undistortPlane(target, nullptr);
+    return std::nullopt;
+}
+
+// ---- Blender Cycles' panoramic cameras ----------------------------------------------------
+// lens.h's module comment; the formulas are Cycles 3.4's *_to_direction functions (what it
+// renders), turned into zcheck's camera frame (Blender's camera space with y and z negated) and
+// image (rows from the top), and their exact inverses — not Cycles 3.4's direction_to_* functions,
+// which mirror the fisheyes in u.
+
+void LensModel::setUpBlender()
+{
+    using Blender = Terms::Blender;
+    const Terms& t = terms_;
+    const std::string where = "lens model " + spec_.model;
+    const auto require = [&](bool ok, const char* param, const std::string& rule, double value) {
+        if (!ok) throw Error(where + ": '" + param + "' " + rule + ", got " + formatNumber(value));
+    };
+    const bool fisheye = t.blender == Blender::FisheyeEquidistant || t.blender == Blender::FisheyeEquisolid ||
+                         t.blender == Blender::FisheyeLensPolynomial;
+    // Past 2π (Blender allows 10π) the angle from the axis passes π and the rays repeat.
+    if (fisheye)
+        require(t.fisheyeFov > 0 && t.fisheyeFov <= 2 * kPi, "fisheye_fov", "must lie in (0, 2π] radians", t.fisheyeFov);
+    if (t.blender == Blender::FisheyeEquisolid) require(t.fisheyeLens > 0, "fisheye_lens", "must be > 0 (mm)", t.fisheyeLens);
+    if (t.blender == Blender::FisheyeEquisolid || t.blender == Blender::FisheyeLensPolynomial) {
+        require(t.sensorWidth > 0, "fitted_sensor_width", "must be > 0 (mm)", t.sensorWidth);
+        require(t.sensorHeight > 0, "fitted_sensor_height", "must be > 0 (mm)", t.sensorHeight);
+    }
+    // Cycles' face is tan of (u − ½)·π/2: past a shift of ½ the image reaches 90° off the axis and
+    // the tangent wraps, repeating the face.
+    if (t.blender == Blender::CubemapFace) {
+        require(std::abs(t.shiftX) <= 0.5, "shift_x", "must lie within ±0.5 (beyond, the face's rays repeat)", t.shiftX);
+        require(std::abs(t.shiftY) <= 0.5, "shift_y", "must lie within ±0.5 (beyond, the face's rays repeat)", t.shiftY);
+    }
+    switch (t.blender) {
+    case Blender::FisheyeEquidistant: fieldAngle_ = t.fisheyeFov / 2, fieldRadius_ = 1; break;
+    case Blender::FisheyeEquisolid:
+        fieldAngle_ = t.fisheyeFov / 2, fieldRadius_ = 2 * t.fisheyeLens * std::sin(t.fisheyeFov / 4);
+        break;
+    case Blender::MirrorBall: fieldAngle_ = kPi, fieldRadius_ = 1; break;
+    case Blender::CubemapFace: fieldAngle_ = kHalfPi, fieldRadius_ = INFINITY; break;
+    case Blender::FisheyeLensPolynomial: {
+        // θ(R) must start at or beyond the axis (k0 ≤ 0: θ(0) = −k0) and increase (k1 < 0); the
+        // field is [0, R_max], R_max where θ reaches fisheye_fov/2. Scanned over [0, 2·R_image] in
+        // 8192 steps (R_image: the image corner farthest from the centre), the ends refined by
+        // bisection: a fold (θ' ≤ 0) before fisheye_fov/2 inside the image, or θ back within
+        // fisheye_fov/2 beyond R_max inside the image, would give pixels rays the field cannot hold.
+        const double half = t.fisheyeFov / 2;
+        require(t.polynomial[0] <= 0, "fisheye_polynomial_k0",
+                "must be ≤ 0 (θ = −k0 at the centre; a negative θ there folds the image through its axis)", t.polynomial[0]);
+        require(t.polynomial[1] < 0, "fisheye_polynomial_k1", "must be < 0 (θ = −(k0 + k1·R + …) must grow from the centre)",
+                t.polynomial[1]);
+        require(polynomialAngle(0) < half, "fisheye_polynomial_k0", "must be > −fisheye_fov/2 (else no pixel has a ray)",
+                t.polynomial[0]);
+        double imageRadius = 0;
+        for (const double a : {t.shiftX - 0.5, t.shiftX + 0.5})
+            for (const double b : {-t.shiftY - 0.5, -t.shiftY + 0.5})
+                imageRadius = std::max(imageRadius, std::hypot(a * t.sensorWidth, b * t.sensorHeight));
+        const double scanEnd = 2 * imageRadius;
+        constexpr int kSteps = 8192;
+        double radiusMax = scanEnd;
+        bool folds = false;
+        double previous = 0;
+        for (int i = 1; i <= kSteps; ++i) {
+            const double r = scanEnd * i / kSteps;
+            const bool fold = !(polynomialSlope(r) > 0), past = !(polynomialAngle(r) < half);
+            if (!fold && !past) {
+                previous = r;
+                continue;
+            }
+            double lo = previous, hi = r;
+            for (int k = 0; k < 80; ++k) {
+                const double mid = 0.5 * (lo + hi);
+                const bool stop = fold ? !(polynomialSlope(mid) > 0) : !(polynomialAngle(mid) < half);
+                (stop ? hi : lo) = mid;
+            }
+            radiusMax = lo, folds = fold;
+            break;
+        }
+        char at[64];
+        std::snprintf(at, sizeof at, "%.6g mm", radiusMax);
+        if (folds && radiusMax < imageRadius)
+            throw Error(where + ": θ(R) = −(k0 + k1·R + … + k4·R⁴) stops increasing at R = " + at +
+                        ", inside the image and short of fisheye_fov/2: the lens folds (its rays repeat)");
+        if (!folds)
+            for (int i = 1; i <= kSteps; ++i) {
+                const double r = radiusMax + (imageRadius - radiusMax) * i / kSteps;
+                if (r > imageRadius) break;
+                if (std::abs(polynomialAngle(r)) <= half)
+                    throw Error(where + ": θ(R) comes back within fisheye_fov/2 beyond its field's edge (R = " + at +
+                                "), inside the image: those pixels would have rays again");
+            }
+        fieldRadius_ = radiusMax;
+        fieldAngle_ = polynomialAngle(radiusMax);
+        break;
+    }
+    case Blender::None: break;
+    }
+}
+
+double LensModel::polynomialAngle(double r) const
+{
+    const double* k = terms_.polynomial;
+    return -(k[0] + r * (k[1] + r * (k[2] + r * (k[3] + r * k[4]))));
+}
+
+double LensModel::polynomialSlope(double r) const
+{
+    const double* k = terms_.polynomial;
+    return -(k[1] + r * (2 * k[2] + r * (3 * k[3] + r * 4 * k[4])));
+}
+
+std::optional<double> LensModel::polynomialRadius(double theta) const
+{
+    // Newton's method on θ(R) − θ, kept inside the bracket [lo, hi] that holds the root (θ increases
+    // on the field): a step that would leave it bisects instead. Converged when the step left is
+    // within kInverseTolerancePx (R's residual / θ' in pixels, at W/Sw and H/Sh pixels a mm) or the
+    // bracket has shrunk to rounding.
+    constexpr double kSlack = 1e-12;  // rad: within rounding of the field's ends counts as on them
+    double lo = 0, hi = fieldRadius_;
+    const double thetaLo = polynomialAngle(lo), thetaHi = polynomialAngle(hi);
+    if (theta < thetaLo - kSlack || theta > thetaHi + kSlack) return std::nullopt;
+    if (theta <= thetaLo) return lo;
+    if (theta >= thetaHi) return hi;
+    const double pxPerMm = std::max(width_ / terms_.sensorWidth, height_ / terms_.sensorHeight);
+    double r = std::clamp((theta - thetaLo) / polynomialSlope(0), lo, hi);
+    for (int iteration = 0; iteration < 200; ++iteration) {
+        const double residual = polynomialAngle(r) - theta, slope = polynomialSlope(r);
+        if (std::abs(residual) / slope * pxPerMm <= kInverseTolerancePx) return r;
+        (residual > 0 ? hi : lo) = r;
+        if (hi - lo <= 4 * std::numeric_limits<double>::epsilon() * hi) return r;
+        double next = r - residual / slope;
+        if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+        r = next;
+    }
+    return std::nullopt;
+}
+
+std::optional<glm::dvec2> LensModel::blenderImageFromDirection(const glm::dvec3& u) const
+{
+    using Blender = Terms::Blender;
+    const Terms& t = terms_;
+    constexpr double kSlack = 1e-12;  // rad: within rounding of the field's edge counts as on it
+    const double lateral = std::hypot(u.x, u.y);
+    const double theta = std::atan2(lateral, u.z);
+    const glm::dvec2 toward = lateral > 0 ? glm::dvec2(u.x, u.y) / lateral : glm::dvec2(1, 0);  // (cos ψ, sin ψ)
+    glm::dvec2 offset;  // (a, b)
+    switch (t.blender) {
+    case Blender::FisheyeEquidistant:
+        if (theta > fieldAngle_ + kSlack) return std::nullopt;
+        offset = toward * (theta / t.fisheyeFov);
+        break;
+    case Blender::FisheyeEquisolid: {
+        if (theta > fieldAngle_ + kSlack) return std::nullopt;
+        const double radius = 2 * t.fisheyeLens * std::sin(theta / 2);
+        offset = {radius * toward.x / t.sensorWidth, radius * toward.y / t.sensorHeight};
+        break;
+    }
+    case Blender::FisheyeLensPolynomial: {
+        const std::optional<double> radius = polynomialRadius(theta);
+        if (!radius || (*radius == 0 && t.polynomial[0] != 0)) return std::nullopt;
+        offset = {*radius * toward.x / t.sensorWidth, *radius * toward.y / t.sensorHeight};
+        break;
+    }
+    case Blender::MirrorBall: {
+        // |q| = sin(θ/2) = lateral / (2 cos(θ/2)), and 2 cos(θ/2) = √(2(1 + z)): no trigonometry.
+        const double twoCos = std::sqrt(2 * (1 + u.z));
+        if (!(twoCos > 0)) return std::nullopt;  // straight back: the whole rim
+        offset = glm::dvec2(u.x, u.y) * (0.5 / twoCos);
+        break;
+    }
+    case Blender::CubemapFace:
+        if (!(u.z > 0)) return std::nullopt;
+        offset = glm::dvec2(std::atan2(u.x, u.z), std::atan2(u.y, u.z)) * (2 / kPi);
+        break;
+    case Blender::None: return std::nullopt;
+    }
+    return glm::dvec2((offset.x + 0.5 - t.shiftX) * width_, (offset.y + 0.5 + t.shiftY) * height_);
+}
+
+std::optional<glm::dvec3> LensModel::blenderDirectionFromImage(const glm::dvec2& p) const
+{
+    using Blender = Terms::Blender;
+    const Terms& t = terms_;
+    const glm::dvec2 offset(p.x / width_ + t.shiftX - 0.5, p.y / height_ - t.shiftY - 0.5);  // (a, b)
+    // The direction at angle θ from +z toward the plane point m (≠ 0).
+    const auto at = [](double theta, const glm::dvec2& m) {
+        const double r = glm::length(m);
+        if (r == 0) return glm::dvec3(0, 0, 1);
+        return glm::dvec3(m * (std::sin(theta) / r), std::cos(theta));
+    };
+    switch (t.blender) {
+    case Blender::FisheyeEquidistant: {
+        const glm::dvec2 q = 2.0 * offset;
+        const double r = glm::length(q);
+        if (r > 1) return std::nullopt;
+        return at(r * t.fisheyeFov / 2, q);
+    }
+    case Blender::FisheyeEquisolid: {
+        const glm::dvec2 m(offset.x * t.sensorWidth, offset.y * t.sensorHeight);
+        const double r = glm::length(m);
+        if (r > fieldRadius_) return std::nullopt;
+        return at(2 * std::asin(r / (2 * t.fisheyeLens)), m);
+    }
+    case Blender::FisheyeLensPolynomial: {
+        const glm::dvec2 m(offset.x * t.sensorWidth, offset.y * t.sensorHeight);
+        const double r = glm::length(m);
+        // At the very centre a θ = −k0 ≠ 0 has no azimuth: no ray (Cycles divides 0 by 0 there).
+        if (r > fieldRadius_ || (r == 0 && t.polynomial[0] != 0)) return std::nullopt;
+        return at(polynomialAngle(r), m);
+    }
+    case Blender::MirrorBall: {
+        // |q| = sin(θ/2): the direction (2√(1 − |q|²)·q, 1 − 2|q|²).
+        const glm::dvec2 q = 2.0 * offset;
+        const double s2 = glm::dot(q, q);
+        if (!(s2 < 1)) return std::nullopt;
+        return glm::dvec3(q * (2 * std::sqrt(1 - s2)), 1 - 2 * s2);
+    }
+    case Blender::CubemapFace:
+        if (!(std::abs(offset.x) < 1 && std::abs(offset.y) < 1)) return std::nullopt;
+        return glm::normalize(glm::dvec3(std::tan(offset.x * kPi / 2), std::tan(offset.y * kPi / 2), 1.0));
+    case Blender::None: break;
+    }
+    return std::nullopt;
 }
 
 // ---- the valid field ----------------------------------------------------------------------
@@ -622,23 +930,30 @@ void LensModel::requireNoFoldInImage() const
 std::optional<glm::dvec3> LensModel::directionAtPixel(int col, int row) const
 {
     if (col < 0 || row < 0 || col >= width_ || row >= height_) return directionFromImage({col + 0.5, row + 0.5});
+    const glm::dvec3& d = pixelDirections()[std::size_t(row) * width_ + col];
+    if (std::isnan(d.x)) return std::nullopt;
+    return d;
+}
+
+const glm::dvec3* LensModel::pixelDirections() const
+{
     std::call_once(tableOnce_, [&] {
         table_.resize(std::size_t(width_) * height_);
         const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
         std::vector<std::thread> workers;
         for (unsigned t = 0; t < threads; ++t)
             workers.emplace_back([&, t] {
-                for (int r = int(t); r < height_; r += int(threads))
+                for (int r = int(t); r < height_; r += int(threads)) {
+                    InverseHint hint;
                     for (int c = 0; c < width_; ++c) {
-                        const std::optional<glm::dvec3> d = directionFromImage({c + 0.5, r + 0.5});
+                        const std::optional<glm::dvec3> d = directionFromImage({c + 0.5, r + 0.5}, &hint);
                         table_[std::size_t(r) * width_ + c] = d ? *d : glm::dvec3(NAN);
                     }
+                }
             });
         for (std::thread& worker : workers) worker.join();
     });
-    const glm::dvec3& d = table_[std::size_t(row) * width_ + col];
-    if (std::isnan(d.x)) return std::nullopt;
-    return d;
+    return table_.data();
 }
 
 // ---- the whole chain ----------------------------------------------------------------------
@@ -647,6 +962,7 @@ std::optional<glm::dvec2> LensModel::imageFromDirection(const glm::dvec3& d) con
 {
     const double length = glm::length(d);
     if (!(length > 0) || !std::isfinite(length)) return std::nullopt;
+    if (terms_.blender != Terms::Blender::None) return blenderImageFromDirection(d / length);
     if (panorama_) {
         const Terms& t = terms_;
         double lon = std::atan2(d.x, d.z);
@@ -659,7 +975,7 @@ std::optional<glm::dvec2> LensModel::imageFromDirection(const glm::dvec3& d) con
         return glm::dvec2(width_ * (lon - t.lonMin) / (t.lonMax - t.lonMin), height_ * (t.latMax - lat) / (t.latMax - t.latMin));
     }
     const glm::dvec3 u = d / length;
-    const double lateral = std::hypot(u.x, u.y);
+    const double lateral = std::sqrt(u.x * u.x + u.y * u.y);  // a unit vector's: no overflow, and hypot's cost spared
     const double theta = std::atan2(lateral, u.z);
     if (theta > fieldAngle_) return std::nullopt;
     glm::dvec2 m(0.0);
@@ -678,7 +994,13 @@ std::optional<glm::dvec2> LensModel::imageFromDirection(const glm::dvec3& d) con
 
 std::optional<glm::dvec3> LensModel::directionFromImage(const glm::dvec2& p) const
 {
+    return directionFromImage(p, nullptr);
+}
+
+std::optional<glm::dvec3> LensModel::directionFromImage(const glm::dvec2& p, InverseHint* hint) const
+{
     const Terms& t = terms_;
+    if (t.blender != Terms::Blender::None) return blenderDirectionFromImage(p);
     if (panorama_) {
         if (!(p.x >= 0 && p.x <= width_ && p.y >= 0 && p.y <= height_)) return std::nullopt;
         const double lon = t.lonMin + p.x / width_ * (t.lonMax - t.lonMin);
@@ -692,7 +1014,7 @@ std::optional<glm::dvec3> LensModel::directionFromImage(const glm::dvec2& p) con
         const glm::dvec3 q = untilt_ * glm::dvec3(md, 1.0);
         md = glm::dvec2(q) / q.z;
     }
-    const std::optional<glm::dvec2> m = undistortPlane(md);
+    const std::optional<glm::dvec2> m = undistortPlane(md, hint);
     if (!m) return std::nullopt;
     const double r = glm::length(*m);
     if (r > fieldRadius_) return std::nullopt;

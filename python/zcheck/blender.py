@@ -47,9 +47,28 @@ camera.cc), which Cycles repeats in `blender_camera_viewplane` (intern/cycles/bl
     allows (measured with the Position pass in tests/blender). Depth of field and motion blur
     move the rays off the pinhole: their depth maps differ from it.
 
-Not supported, and refused with zcheck.Error naming the setting: panoramic cameras (type
-"PANO"), a render border (`render.use_border`: the image then covers part of the frame), and
-multi-view / stereo rendering (`render.use_multiview`: each view has its own camera).
+Panoramic cameras (type "PANO", Cycles 3.4: `cam.data.cycles.panorama_type`; Blender 4's
+`cam.data.panorama_type` is read too) become lens cameras, the model of each type Cycles's kernel
+renders (kernel/camera/projection.h, the *_to_direction functions; lens.h and docs/camera.md):
+EQUIRECTANGULAR -> "equirectangular" (latitude/longitude ranges in degrees, moved by the shift),
+FISHEYE_EQUIDISTANT -> "blender_fisheye_equidistant", FISHEYE_EQUISOLID ->
+"blender_fisheye_equisolid", FISHEYE_LENS_POLYNOMIAL -> "blender_fisheye_lens_polynomial",
+MIRRORBALL -> "blender_mirror_ball", EQUIANGULAR_CUBEMAP_FACE ->
+"blender_equiangular_cubemap_face". For them shift_x and shift_y are in whole image widths and
+heights (Cycles's panoramic viewplane is [shift_x, 1 + shift_x] x [shift_y, 1 + shift_y]), and the
+equisolid and polynomial fisheyes take the sensor after Cycles's own sensor fit
+(`blender_camera_sync`: AUTO fits sensor_width to the longer side, horizontal only when strictly
+wider). Their Z pass is not planar: it is the Euclidean distance from the camera's centre,
+zcheck's "distance" (`camera_z_depth`), at the pixel centre; pixels with no ray (outside a
+fisheye's circle or a mirror ball's disc) hold 1e10 like the background, so give miss=">=1e9".
+
+Not supported, and refused with zcheck.Error naming the setting: a render border
+(`render.use_border`: the image then covers part of the frame), multi-view / stereo rendering
+(`render.use_multiview`: each view has its own camera), and the panoramic settings no one-to-one
+lens holds: a mirrored equirectangular range (longitude_max <= longitude_min, likewise
+latitude), a shift that takes an equirectangular image past a pole or beyond +-360 degrees, a
+fisheye_fov beyond 2 pi, a cubemap face shifted beyond 0.5, a lens polynomial with k0 > 0 or one
+that folds inside the image (the lens model's message, which names the parameter).
 """
 
 import json as _json
@@ -61,7 +80,7 @@ import numpy as _np
 
 from . import Camera, Error
 
-__all__ = ["camera_from_object", "write_cameras"]
+__all__ = ["camera_from_object", "depth_quantity", "write_cameras"]
 
 
 def _image_size(render):
@@ -109,10 +128,96 @@ def _fit_and_viewfac(cam, width, height, aspect_x, aspect_y):
     return fit, sensor, viewfac, ycor
 
 
+def _panoramic_settings(cam):
+    """Where the panoramic settings live: the camera data itself in Blender 4 (panorama_type moved
+there), Cycles's add-on settings `cam.cycles` in 3.x."""
+    if hasattr(cam, "panorama_type"):
+        return cam
+    settings = getattr(cam, "cycles", None)
+    if settings is None or not hasattr(settings, "panorama_type"):
+        raise Error(f"Blender camera data '{cam.name}' is panoramic but has no panorama_type (is the Cycles "
+                    f"add-on enabled?)")
+    return settings
+
+
+def _fitted_sensor(cam, width, height, aspect_x, aspect_y):
+    """Cycles's sensor size (mm) for its panoramic fisheyes, after its sensor fit
+    (`blender_camera_sync`, intern/cycles/blender/camera.cpp): with xr = width * pixel_aspect_x and
+    yr = height * pixel_aspect_y, AUTO fits sensor_width to the horizontal only when xr > yr
+    (strictly), HORIZONTAL fits sensor_width, VERTICAL sensor_height; the other side follows the
+    displayed aspect, so the fisheye's circle is round on the displayed image."""
+    xr, yr = width * aspect_x, height * aspect_y
+    if cam.sensor_fit == "AUTO":
+        horizontal, size = xr > yr, cam.sensor_width
+    elif cam.sensor_fit == "HORIZONTAL":
+        horizontal, size = True, cam.sensor_width
+    else:
+        horizontal, size = False, cam.sensor_height
+    if horizontal:
+        return float(size), float(size) * yr / xr
+    return float(size) * xr / yr, float(size)
+
+
+def _panoramic_lens(obj, cam, scene, width, height, where):
+    """The zcheck lens object (dict) of a panoramic camera (the module's docstring)."""
+    settings = _panoramic_settings(cam)
+    kind = settings.panorama_type
+    shift_x, shift_y = float(cam.shift_x), float(cam.shift_y)
+    if kind == "EQUIRECTANGULAR":
+        # Cycles: longitude = longitude_min + u * (max - min), u = x/W + shift_x; latitude =
+        # latitude_min + v * (max - min), v = 1 - y/H + shift_y: the shift moves both ranges.
+        lon_min, lon_max = float(settings.longitude_min), float(settings.longitude_max)
+        lat_min, lat_max = float(settings.latitude_min), float(settings.latitude_max)
+        if not lon_max > lon_min:
+            raise Error(f"{where}: longitude_max ({_math.degrees(lon_max):g} deg) is not greater than longitude_min "
+                        f"({_math.degrees(lon_min):g} deg): a mirrored panorama, which zcheck does not model")
+        if not lat_max > lat_min:
+            raise Error(f"{where}: latitude_max ({_math.degrees(lat_max):g} deg) is not greater than latitude_min "
+                        f"({_math.degrees(lat_min):g} deg): a mirrored panorama, which zcheck does not model")
+        lon_span, lat_span = lon_max - lon_min, lat_max - lat_min
+        lon = [_math.degrees(lon_min + shift_x * lon_span), _math.degrees(lon_max + shift_x * lon_span)]
+        lat = [_math.degrees(lat_min + shift_y * lat_span), _math.degrees(lat_max + shift_y * lat_span)]
+        if lat[0] < -90 - 1e-9 or lat[1] > 90 + 1e-9:
+            raise Error(f"{where}: shift_y {shift_y:g} takes the panorama's latitudes to {lat[0]:g}..{lat[1]:g} deg, "
+                        f"past a pole, where Cycles's rows repeat other rows' rays")
+        if lon[0] < -360 or lon[1] > 360:
+            raise Error(f"{where}: shift_x {shift_x:g} takes the panorama's longitudes to {lon[0]:g}..{lon[1]:g} deg, "
+                        f"beyond +-360 deg")
+        # Rounding in the conversion must not step over the poles the model refuses to pass.
+        lat = [max(lat[0], -90.0), min(lat[1], 90.0)]
+        return {"model": "equirectangular", "lon_min_deg": lon[0], "lon_max_deg": lon[1],
+                "lat_min_deg": lat[0], "lat_max_deg": lat[1]}
+    shift = {"shift_x": shift_x, "shift_y": shift_y}
+    if kind == "FISHEYE_EQUIDISTANT":
+        return {"model": "blender_fisheye_equidistant", "fisheye_fov": float(settings.fisheye_fov), **shift}
+    if kind in ("FISHEYE_EQUISOLID", "FISHEYE_LENS_POLYNOMIAL"):
+        sensor_w, sensor_h = _fitted_sensor(cam, width, height, scene.render.pixel_aspect_x,
+                                            scene.render.pixel_aspect_y)
+        sensor = {"fitted_sensor_width": sensor_w, "fitted_sensor_height": sensor_h}
+        if kind == "FISHEYE_EQUISOLID":
+            return {"model": "blender_fisheye_equisolid", "fisheye_lens": float(settings.fisheye_lens),
+                    "fisheye_fov": float(settings.fisheye_fov), **sensor, **shift}
+        k = {f"fisheye_polynomial_k{i}": float(getattr(settings, f"fisheye_polynomial_k{i}")) for i in range(5)}
+        return {"model": "blender_fisheye_lens_polynomial", **k, "fisheye_fov": float(settings.fisheye_fov),
+                **sensor, **shift}
+    if kind == "MIRRORBALL":
+        return {"model": "blender_mirror_ball", **shift}
+    if kind == "EQUIANGULAR_CUBEMAP_FACE":
+        return {"model": "blender_equiangular_cubemap_face", **shift}
+    raise Error(f"{where}: panorama_type '{kind}' is not one zcheck models (EQUIRECTANGULAR, FISHEYE_EQUIDISTANT, "
+                f"FISHEYE_EQUISOLID, FISHEYE_LENS_POLYNOMIAL, MIRRORBALL, EQUIANGULAR_CUBEMAP_FACE)")
+
+
+def depth_quantity(obj):
+    """What Cycles's Z pass holds for camera object `obj`: "distance" (from the camera's centre,
+    `camera_z_depth`) for a panoramic camera, "eye-z" (planar) for perspective and orthographic."""
+    return "distance" if obj.data.type == "PANO" else "eye-z"
+
+
 def camera_from_object(obj, scene):
     """A zcheck.Camera for a Blender camera object as `scene` renders it.
 
-obj:   a camera object (obj.type "CAMERA") whose data is of type "PERSP" or "ORTHO"; its pose is
+obj:   a camera object (obj.type "CAMERA") whose data is of type "PERSP", "ORTHO" or "PANO"; its pose is
        obj.matrix_world as it is now (call scene.frame_set(f) first for frame f), scale removed
        as Blender removes it.
 scene: the scene whose render settings size the image: resolution_x/y, resolution_percentage,
@@ -128,9 +233,11 @@ VERTICAL, else sensor_width (AUTO too, whichever way it fits):
   orthographic ones an orthographic box (camera units)
        right, left = shift_x * ortho_scale +- ortho_scale * width / (2 viewfac),
        top, bottom = shift_y * ortho_scale +- ortho_scale * ycor * height / (2 viewfac).
+  panoramic ones a lens camera (the module's docstring), projection near and far only.
 Near and far are clip_start and clip_end; the convention "opengl" (Blender's camera axes).
-Raises zcheck.Error, naming the camera, for another kind of object, a panoramic camera, a render
-border, multi-view rendering, a scale-0 axis or a pose that is sheared or mirrored.
+Raises zcheck.Error, naming the camera, for another kind of object, a render border, multi-view
+rendering, a scale-0 axis, a pose that is sheared or mirrored, or panoramic settings no lens model
+holds (the module's docstring).
     """
     if getattr(obj, "type", None) != "CAMERA":
         raise Error(f"Blender object '{getattr(obj, 'name', obj)}' is of type {getattr(obj, 'type', None)!r}, "
@@ -138,9 +245,9 @@ border, multi-view rendering, a scale-0 axis or a pose that is sheared or mirror
     cam = obj.data
     render = scene.render
     where = f"Blender camera '{obj.name}'"
-    if cam.type not in ("PERSP", "ORTHO"):
-        raise Error(f"{where} is of type '{cam.type}' (panoramic): zcheck models pinhole (PERSP) and "
-                    f"orthographic (ORTHO) cameras only")
+    if cam.type not in ("PERSP", "ORTHO", "PANO"):
+        raise Error(f"{where} is of type '{cam.type}': zcheck models perspective (PERSP), orthographic (ORTHO) "
+                    f"and panoramic (PANO) cameras")
     if render.use_border:
         raise Error(f"{where}: scene '{scene.name}' renders a border (render.use_border): the image covers "
                     f"part of the camera's frame; turn the border off to render frames for zcheck")
@@ -152,6 +259,17 @@ border, multi-view rendering, a scale-0 axis or a pose that is sheared or mirror
     fit, sensor, viewfac, ycor = _fit_and_viewfac(cam, width, height, render.pixel_aspect_x, render.pixel_aspect_y)
     near, far = float(cam.clip_start), float(cam.clip_end)
     world_from_cam = _world_from_camera(obj)
+
+    if cam.type == "PANO":
+        # Cycles's panoramic frame is Blender's camera turned (blender_camera_matrix); the formulas
+        # of the lens models are written back in Blender's camera axes, zcheck's "opengl" eye.
+        return Camera.from_dict({
+            "convention": "opengl",
+            "image": {"width": width, "height": height},
+            "projection": {"near": near, "far": far},
+            "lens": _panoramic_lens(obj, cam, scene, width, height, where),
+            "view": {"world_from_eye": world_from_cam.reshape(-1).tolist(), "layout": "row-major", "vectors": "column"},
+        }, source=where)
 
     if cam.type == "PERSP":
         # BKE_camera_params_compute_viewplane, perspective: the viewplane lies at distance
@@ -194,7 +312,7 @@ border, multi-view rendering, a scale-0 axis or a pose that is sheared or mirror
     }, source=where)
 
 
-def write_cameras(path, frames, *, scene=None, depth="depth_{frame:04d}.exr", quantity="eye-z", miss=None,
+def write_cameras(path, frames, *, scene=None, depth="depth_{frame:04d}.exr", quantity=None, miss=None,
                   channel=None, name="frame_{frame:04d}"):
     """Write an animation's cameras as a zcheck manifest (JSON Lines, one frame a line), for
 `zcheck dataset verify PATH --scene MESH`.
@@ -208,7 +326,8 @@ scene:    the scene (default: bpy.context.scene).
 depth:    each frame's depth map file, a str.format pattern of `frame`, relative to the manifest's
           folder as the manifest reader resolves it ("depth_{frame:04d}.exr" for a render output
           path "//depth_####.exr" beside the manifest).
-quantity: what the maps hold ("eye-z" for Blender's Z pass).
+quantity: what the maps hold; None: what Cycles's Z pass holds for the frame's camera
+          (depth_quantity: "eye-z", or "distance" for a panoramic camera).
 miss:     the stored value marking "no surface" (">=1e9" for the Z pass's 1e10), or None.
 channel:  the channel to read ("ViewLayer.Depth.Z"), or None for the reader's choice (the one
           channel named as depth).
@@ -239,7 +358,7 @@ when a frame has no active camera or its camera cannot be converted (camera_from
             record = {"frame": name.format(frame=frame),
                       "camera": _json.loads(camera.to_json()),  # the camera file's JSON, as written
                       "depth": depth.format(frame=frame),
-                      "quantity": quantity}
+                      "quantity": quantity if quantity is not None else depth_quantity(obj)}
             if miss is not None:
                 record["miss"] = miss
             if channel is not None:

@@ -9,6 +9,7 @@ CameraRays::CameraRays(const Camera& camera)
 {
     const CameraSpec& spec = camera.spec();
     const Convention& c = spec.convention;
+    eyeUpY_ = c.eyeUpY, eyeForwardZ_ = c.eyeForwardZ;
     if (spec.view.hasMatrix) {
         // The rows of eyeFromWorld are the eye axes in world space (x right, y = eyeUpY·up,
         // z = eyeForwardZ·forward); the eye is where it maps to the origin.
@@ -23,6 +24,7 @@ CameraRays::CameraRays(const Camera& camera)
         up_ = glm::cross(right_, forward_);
         eye_ = spec.view.eye;
     }
+    if (lens_) lensTable_ = lens_->pixelDirections();
     if (fromMatrix_ || lens_) return;
     // The depth mapping of the header, folded into window = A + B/d (perspective) or A + B·d
     // (parallel): z_ndc = a + b/d or a + b·d, then window = rangeMin + (z_ndc − ndcZMin)·s.
@@ -42,13 +44,6 @@ CameraRays::CameraRays(const Camera& camera)
     const double scale = (depth.rangeMax - depth.rangeMin) / (1.0 - ndcZMin);
     depthA_ = depth.rangeMin + (a - ndcZMin) * scale;
     depthB_ = b * scale;
-}
-
-glm::dvec3 CameraRays::eyeFromWorld(const glm::dvec3& pWorld) const
-{
-    const Convention& c = camera_.convention();
-    const glm::dvec3 v = pWorld - eye_;
-    return {glm::dot(v, right_), c.eyeUpY * glm::dot(v, up_), c.eyeForwardZ * glm::dot(v, forward_)};
 }
 
 void CameraRays::eyeRay(const glm::dvec2& pImage, glm::dvec3& origin, glm::dvec3& direction) const
@@ -94,10 +89,17 @@ std::optional<EyePlaneRay> CameraRays::worldRay(const glm::dvec2& pImage) const
 {
     if (fromMatrix_) return worldEyePlaneRayThroughWindow(camera_, {pImage.x, camera_.windowYFromImageY(pImage.y)});
     if (lens_) {
-        const std::optional<glm::dvec3> dLens = lens_->directionThrough(pImage);
+        const Projection& p = camera_.spec().projection;
+        const double col = pImage.x - 0.5, row = pImage.y - 0.5;
+        glm::dvec3 direction;
+        if (col == std::floor(col) && row == std::floor(row) && col >= 0 && row >= 0 && col < camera_.width() &&
+            row < camera_.height()) {  // a pixel centre: from the table
+            if (!lensDirectionAtPixel(int(col), int(row), direction)) return std::nullopt;
+            return EyePlaneRay{eye_, direction, p.near, p.far};
+        }
+        const std::optional<glm::dvec3> dLens = lens_->directionFromImage(pImage);
         if (!dLens) return std::nullopt;
         // The lens frame is x right, y down, z forward: world = x·right − y·up + z·forward.
-        const Projection& p = camera_.spec().projection;
         return EyePlaneRay{eye_, glm::normalize(dLens->x * right_ - dLens->y * up_ + dLens->z * forward_), p.near, p.far};
     }
     glm::dvec3 origin, direction;

@@ -208,29 +208,29 @@ RenderResult RayRenderer::render(const Camera& camera, const RayFaults& fault, E
     const auto start = Clock::now();
     const int W = camera.width(), H = camera.height();
     RenderResult result = RenderResult::allocated(W, H);  // traceRect writes every pixel, hit or not
-    if (eyePoints == EyePoints::Keep) result.pEye.assign(std::size_t(W) * H, glm::dvec3(NAN));
+    if (eyePoints == EyePoints::Keep) result.pEye.resize(std::size_t(W) * H);  // uninitialised: traceRect writes each
     // 64×64 regions in parallel (a region's set-up, the camera's rays, is made once). Each is
     // traced into a buffer of the worker's own and then copied into the image a row at a time:
     // written straight into the image, a packet's four rows went to eight cache lines far apart
     // that were not in the cache, and the stores waiting on them stalled the packets behind
     // (the trace 88–92 → 70–79 ms for the speed workload); streaming stores where they can
-    // (large_buffer.h) made it ~5 % faster again. Eye points, rarely asked for, are written straight.
+    // (large_buffer.h) made it ~5 % faster again. Eye points too (a lens check's trace, whose
+    // eye points written straight cost it a third more: 128 against 91 ms on the panorama workload).
     const TileGrid regions(W, H, kRegion);
     tbb::parallel_for(0, regions.count(), [&](int region) {
         const PixelRect rect = regions.rect(region);
         const std::size_t first = regions.firstPixel(region);
-        if (eyePoints == EyePoints::Keep) {
-            traceRect(camera, rect, result.windowDepth.value.data() + first, result.primitiveId.data() + first,
-                      std::size_t(W), fault, result.pEye.data() + first);
-            return;
-        }
         alignas(64) thread_local double depth[kRegion * kRegion];
         alignas(64) thread_local std::uint32_t primitive[kRegion * kRegion];
-        traceRect(camera, rect, depth, primitive, kRegion, fault, nullptr);
+        alignas(64) thread_local glm::dvec3 eye[kRegion * kRegion];
+        const bool keep = eyePoints == EyePoints::Keep;
+        traceRect(camera, rect, depth, primitive, kRegion, fault, keep ? eye : nullptr);
         for (int r = 0; r < rect.height(); ++r) {
             const std::size_t to = first + std::size_t(r) * std::size_t(W), from = std::size_t(r) * kRegion;
             copyRowStreaming(depth + from, std::size_t(rect.width()), result.windowDepth.value.data() + to);
             copyRowStreaming(primitive + from, std::size_t(rect.width()), result.primitiveId.data() + to);
+            if (keep)
+                copyRowStreaming(&eye[from].x, 3 * std::size_t(rect.width()), &result.pEye[to].x);  // x, y, z doubles
         }
         finishStreamingCopies();
     });
@@ -328,6 +328,28 @@ ZCHECK_ALWAYS_INLINE inline void raysOfPacket(PacketInFlight& p, const std::opti
         }
         const float nearT = float(setUp.near), farT = std::isinf(setUp.far) ? INFINITY : float(setUp.far);
         for (int k = 0; k < kPacketRays; ++k) ray.tnear[k] = nearT, ray.tfar[k] = farT;
+    } else if (cameraRays.lens()) {  // t is the distance along a unit ray from the eye
+        const glm::dvec3& eye = cameraRays.eye();
+        const float nearT = float(setUp.near), farT = std::isinf(setUp.far) ? INFINITY : float(setUp.far);
+        for (int k = 0; k < kPacketRays; ++k) {
+            if (!p.valid[k]) continue;
+            // A pixel centre (every lane but a fault's shifted one) from the lens's table.
+            const int col = int(p.imageX[k]), row = int(p.imageY[k]);
+            glm::dvec3 direction;
+            if (col + 0.5 == p.imageX[k] && row + 0.5 == p.imageY[k] && col < setUp.W && row < setUp.H) {
+                if (!cameraRays.lensDirectionAtPixel(col, row, direction)) {
+                    p.valid[k] = 0;  // outside the lens's field: no ray, a miss (embreeLanesOfPacket fills the lane)
+                    continue;
+                }
+            } else if (const std::optional<EyePlaneRay> ray1 = cameraRays.worldRay(p.pImage(k))) {
+                direction = ray1->direction;
+            } else {
+                p.valid[k] = 0;
+                continue;
+            }
+            for (int c = 0; c < 3; ++c) p.lane[c][k] = eye[c], p.lane[3 + c][k] = direction[c];
+            ray.tnear[k] = nearT, ray.tfar[k] = farT;
+        }
     } else {
         for (int k = 0; k < kPacketRays; ++k) {
             if (!p.valid[k]) continue;

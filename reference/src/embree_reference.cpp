@@ -10,6 +10,9 @@
 #include <xmmintrin.h>
 
 #include <chrono>
+#include <cmath>
+#include <optional>
+#include <vector>
 
 namespace zcheck::reference {
 
@@ -85,10 +88,28 @@ double EmbreeReference::trace(const Camera& camera, std::vector<std::uint32_t>& 
 {
     const int W = camera.width(), H = camera.height();
     primitiveId.resize(std::size_t(W) * H);
-    // The rays affine in the pixel (set up outside the timing), in binary32 and the scene-centred frame.
-    const AffineRays rays = yardstickRays(camera);
-    const glm::vec3 o00(rays.originAt({0.5, 0.5}) - embree_->frameOrigin), d00(rays.directionAt({0.5, 0.5}));
+    // The rays (set up outside the timing) in binary32 and the scene-centred frame: affine in the
+    // pixel, or a lens model's from a table of every pixel's direction (NaN outside its field).
+    const bool lens = camera.lens() != nullptr;
+    const AffineRays rays = lens ? AffineRays{} : yardstickRays(camera);
     const glm::vec3 dOdx(rays.originPerX), dOdy(rays.originPerY), dDdx(rays.directionPerX), dDdy(rays.directionPerY);
+    glm::vec3 o00(rays.originAt({0.5, 0.5}) - embree_->frameOrigin), d00(rays.directionAt({0.5, 0.5}));
+    std::vector<glm::vec3> directions;
+    if (lens) {
+        const CameraRays cameraRays(camera);
+        directions.resize(std::size_t(W) * H);
+        tbb::parallel_for(0, H, [&](int row) {
+            for (int col = 0; col < W; ++col) {
+                const std::optional<EyePlaneRay> ray = cameraRays.worldRay({col + 0.5, row + 0.5});
+                directions[std::size_t(row) * W + col] = ray ? glm::vec3(ray->direction) : glm::vec3(NAN);
+            }
+        });
+        for (std::size_t i = 0; i < directions.size(); ++i)  // every ray starts at the eye
+            if (const std::optional<EyePlaneRay> ray = cameraRays.worldRay({i % W + 0.5, i / W + 0.5})) {
+                o00 = glm::vec3(ray->origin - embree_->frameOrigin);
+                break;
+            }
+    }
 
     const int tilesX = (W + kTile - 1) / kTile, tilesY = (H + kTile - 1) / kTile;
     RTCScene scene = embree_->scene;
@@ -100,6 +121,7 @@ double EmbreeReference::trace(const Camera& camera, std::vector<std::uint32_t>& 
         rtcInitIntersectContext(&context);
         context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
         alignas(64) int valid[16];
+        bool inImage[16];
         alignas(64) RTCRayHit16 packet;
         for (int tile = tiles.begin(); tile != tiles.end(); ++tile) {
             const int tileX = (tile % tilesX) * kTile, tileY = (tile / tilesX) * kTile;
@@ -107,9 +129,18 @@ double EmbreeReference::trace(const Camera& camera, std::vector<std::uint32_t>& 
                 for (int px = 0; px < kTile; px += kPacket) {
                     for (int k = 0; k < 16; ++k) {
                         const int col = tileX + px + k % kPacket, row = tileY + py + k / kPacket;
-                        valid[k] = (col < W && row < H) ? -1 : 0;
+                        inImage[k] = col < W && row < H;
+                        valid[k] = inImage[k] ? -1 : 0;
                         const float x = float(col), y = float(row);
-                        const glm::vec3 o = o00 + x * dOdx + y * dOdy, d = d00 + x * dDdx + y * dDdy;
+                        glm::vec3 o = o00, d;
+                        if (!lens) {
+                            o = o00 + x * dOdx + y * dOdy, d = d00 + x * dDdx + y * dDdy;
+                        } else if (valid[k]) {
+                            d = directions[std::size_t(row) * W + col];
+                            if (std::isnan(d.x)) valid[k] = 0, d = glm::vec3(0, 0, 1);
+                        } else {
+                            d = glm::vec3(0, 0, 1);
+                        }
                         packet.ray.org_x[k] = o.x, packet.ray.org_y[k] = o.y, packet.ray.org_z[k] = o.z;
                         packet.ray.dir_x[k] = d.x, packet.ray.dir_y[k] = d.y, packet.ray.dir_z[k] = d.z;
                         packet.ray.tnear[k] = 0.0f;
@@ -121,8 +152,8 @@ double EmbreeReference::trace(const Camera& camera, std::vector<std::uint32_t>& 
                         packet.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
                     }
                     rtcIntersect16(valid, scene, &context, &packet);
-                    for (int k = 0; k < 16; ++k)
-                        if (valid[k])
+                    for (int k = 0; k < 16; ++k)  // a lens's pixel outside its field: no ray, nothing hit
+                        if (inImage[k])
                             primitiveId[std::size_t(tileY + py + k / kPacket) * W + tileX + px + k % kPacket] =
                                 packet.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID ? 0xFFFFFFFFu : packet.hit.primID[k];
                 }

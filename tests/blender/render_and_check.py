@@ -30,7 +30,8 @@ Writes into OUTDIR:
   manifest_{tall,square}[_flipped].jsonl   each render's own part of those two
   checks.json                   the second route, the sample positions (below) and the
                                 messages of what camera_from_object refuses: a panoramic
-                                camera, a sheared pose, a render border
+                                camera with a mirrored longitude range, a sheared pose, a
+                                render border
 
 The second route: Blender's own projection, bpy_extras.object_utils.world_to_camera_view (built
 on Camera.view_frame, i.e. BKE_camera_view_frame_ex, not on the viewplane code zcheck.blender
@@ -322,8 +323,12 @@ def refusals(scene):
         raise RuntimeError(f"refusal '{case}': camera_from_object accepted camera '{obj.name}'")
 
     messages = {}
+    # Panoramic cameras are lens cameras now (tests/blender/render_panoramic.py); a mirrored
+    # equirectangular range is what no lens model holds.
     pano = add_camera("E_panoramic", type="PANO")
-    messages["panoramic"] = refused("panoramic", pano, "PANO")
+    pano.data.cycles.panorama_type = "EQUIRECTANGULAR"
+    pano.data.cycles.longitude_min, pano.data.cycles.longitude_max = 1.0, -1.0
+    messages["panoramic"] = refused("panoramic", pano, "longitude_max")
     # A camera under a rotated, non-uniformly scaled parent: its matrix_world is sheared, which
     # removing each axis's length (as Blender does) cannot make a rotation.
     parent = bpy.data.objects.new("parent_scaled", None)

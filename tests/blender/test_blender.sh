@@ -116,9 +116,9 @@ assert sorted(refusals) == ["border", "panoramic", "sheared"], refusals
 for case, message in refusals.items():
     print(f"      {case}: {message}")
 EOF
-    pass "camera_from_object refuses a panoramic camera, a sheared pose and a render border by name"
+    pass "camera_from_object refuses a mirrored panorama, a sheared pose and a render border by name"
 else
-    fail "camera_from_object refuses a panoramic camera, a sheared pose and a render border by name"
+    fail "camera_from_object refuses a mirrored panorama, a sheared pose and a render border by name"
 fi
 
 # verify MANIFEST RESULTS: `zcheck dataset verify`, its exit status in $verify_status.

@@ -35,6 +35,20 @@
 // never a garbage ray. A lens that folds before reaching the image's edge along the principal
 // point's row or column is refused when the camera is built.
 //
+// Blender Cycles' panoramic cameras (3.4; the blender_* models) are a branch of their own, not the
+// chain: Blender normalises the image by its width and height, not by a focal length. With x, y an
+// image point, W × H the image, the offset from the image's centre in widths and heights (right,
+// down) is (a, b) = (x/W + shift_x − ½, y/H − shift_y − ½) — Blender's (u − ½, ½ − v), its shift
+// in whole widths and heights — and each model maps (a, b) to a direction at angle θ from +z
+// toward (a, b) (scaled per axis where it says so): fisheye equidistant q = 2(a, b), θ =
+// |q|·fisheye_fov/2, no ray for |q| > 1 (an ellipse touching the borders when W ≠ H); fisheye
+// equisolid m = (a·Sw, b·Sh) mm, θ = 2·asin(|m|/2f), no ray for |m| > 2f·sin(fisheye_fov/4);
+// fisheye lens polynomial m as equisolid, θ = −(k0 + k1|m| + … + k4|m|⁴), no ray past fisheye_fov/2;
+// mirror ball q = 2(a, b), |q| = sin(θ/2), no ray for |q| ≥ 1; equiangular cubemap face (tan(aπ/2),
+// tan(bπ/2), 1), no ray for |a| or |b| ≥ 1. Every inverse is closed form but the polynomial's,
+// Newton's method on the radius bracketed by its field (convergence: within kInverseTolerancePx).
+// The equirectangular panorama is Blender's too, its ranges moved by the shift (zcheck.blender).
+//
 // Models are data: lensModels() lists them with their parameters in order; a model's
 // parameters are given by name (missing trailing ones are 0 where the row says so).
 //
@@ -105,11 +119,15 @@ public:
     // field (or where the inverse does not converge: then the pixel is outside it too).
     std::optional<glm::dvec3> directionFromImage(const glm::dvec2& pImage) const;
 
-    // The unit direction through pixel (col, row)'s centre, as directionFromImage gives it, from a
-    // table of every pixel's built on the first call (on every core) and kept with the model: 24
-    // bytes a pixel, shared by every camera — every frame of a dataset — with these intrinsics
+    // The unit direction through pixel (col, row)'s centre, directionFromImage's to within its
+    // convergence test, from a table of every pixel's built on the first call (on every core, each
+    // pixel's Newton started from its left neighbour's answer) and kept with the model: 24 bytes a
+    // pixel, shared by every camera — every frame of a dataset — with these intrinsics
     // (LensModel::shared). Empty outside the field; a pixel outside the image is computed.
     std::optional<glm::dvec3> directionAtPixel(int col, int row) const;
+    // That table itself, built on the first call: width × height unit directions, row by row from
+    // the top, NaN outside the field (the ray route reads it per lane).
+    const glm::dvec3* pixelDirections() const;
     // directionFromImage, a pixel centre's from that table (the ray route's and verify's points).
     std::optional<glm::dvec3> directionThrough(const glm::dvec2& pImage) const
     {
@@ -118,7 +136,8 @@ public:
         return directionFromImage(pImage);
     }
 
-    // The largest angle from the axis (radians) the field reaches; for the panorama, π.
+    // The largest angle from the axis (radians) the field reaches; for the panorama, π. (A Blender
+    // lens polynomial with k0 < 0 also has no pixel for the directions within −k0 of the axis.)
     double fieldAngle() const { return fieldAngle_; }
     // Whether a direction's angle from the axis can exceed 90°, where eye-z is not defined.
     bool seesBehind() const { return fieldAngle_ > kHalfPi; }
@@ -143,6 +162,14 @@ public:
         double fx = 1, fy = 1, skew = 0, cx = 0, cy = 0;
         // panorama: longitude and latitude ranges, radians
         double lonMin = 0, lonMax = 0, latMin = 0, latMax = 0;
+        // Blender Cycles' panoramic cameras (module comment): the type, and its settings as Blender
+        // names them — fisheye_fov (radians), fisheye_lens (mm), the sensor after Blender's sensor
+        // fit (mm), the lens polynomial's k0..k4 (radians per mmⁱ), shift in widths and heights.
+        enum class Blender { None, FisheyeEquidistant, FisheyeEquisolid, FisheyeLensPolynomial, MirrorBall, CubemapFace };
+        Blender blender = Blender::None;
+        double fisheyeFov = 0, fisheyeLens = 0, sensorWidth = 0, sensorHeight = 0;
+        double polynomial[5] = {0, 0, 0, 0, 0};
+        double shiftX = 0, shiftY = 0;
     };
     const Terms& terms() const { return terms_; }
 
@@ -154,6 +181,16 @@ public:
     std::optional<glm::dvec2> undistortPlane(const glm::dvec2& mDistorted) const;
 
 private:
+    // A neighbouring image point's inverse, where the next point's Newton starts (the table's scan
+    // along a row): from there it takes one or two steps instead of four or five. The answer is
+    // the same to within the convergence test from any start: inside the field the root is unique.
+    struct InverseHint {
+        glm::dvec2 distorted{0.0}, undistorted{0.0};
+        double radialSlope = 0;  // d|m'|/d|m| there, when the distortion is radial (else 0)
+        bool valid = false;
+    };
+    std::optional<glm::dvec2> undistortPlane(const glm::dvec2& mDistorted, InverseHint* hint) const;
+    std::optional<glm::dvec3> directionFromImage(const glm::dvec2& pImage, InverseHint* hint) const;
     bool planeIsIdentity() const;
     bool planeIsRadial() const;
     double radialFactor(double r2) const;  // N(r²)/D(r²)
@@ -162,6 +199,15 @@ private:
     void findField();
     bool profileEndsAt(double theta) const;  // whether θ is at (or past) the profile's own end
     void requireNoFoldInImage() const;
+    // Blender's panoramic cameras (module comment): the settings' rules and the field; the two
+    // directions; the lens polynomial θ(R) = −(k0 + k1R + … + k4R⁴), its slope, and its inverse on
+    // the field [0, fieldRadius_] (empty outside it).
+    void setUpBlender();
+    std::optional<glm::dvec2> blenderImageFromDirection(const glm::dvec3& unit) const;
+    std::optional<glm::dvec3> blenderDirectionFromImage(const glm::dvec2& pImage) const;
+    double polynomialAngle(double radiusMm) const;
+    double polynomialSlope(double radiusMm) const;
+    std::optional<double> polynomialRadius(double theta) const;
 
     LensSpec spec_;
     int width_ = 0, height_ = 0;
@@ -169,7 +215,8 @@ private:
     Terms terms_;
     bool panorama_ = false;
     double fieldAngle_ = 0;    // θ_max
-    double fieldRadius_ = 0;   // ρ(θ_max): the undistorted plane's radius at the field's edge
+    double fieldRadius_ = 0;   // ρ(θ_max): the undistorted plane's radius at the field's edge (Blender's: |q|, or mm)
+    double fieldDistortedRadius_ = INFINITY;  // |m'| there, where the radial map reaches (∞: no bound)
     bool fieldEndsInFold_ = false;  // the field ends where the distortion folds, not where the profile ends
     glm::dmat3 tilt_{1.0}, untilt_{1.0};
     mutable std::once_flag tableOnce_;

@@ -56,6 +56,19 @@ public:
     std::optional<AffineRays> affine() const;
     // A lens model's camera (its route's depth is the distance along a unit ray).
     const LensModel* lens() const { return lens_; }
+    // A lens camera's world direction through pixel (col, row)'s centre, worldRay's without its
+    // call: the lens's table (LensModel::pixelDirections) turned into the world, not normalised
+    // again (the turn is orthonormal to rounding: unit within a few ulp); false outside the
+    // field. The pixel must lie in the image. The eye is every lens ray's origin, near and far
+    // its [tNear, tFar]. (Inline: the trace calls it per lane.)
+    bool lensDirectionAtPixel(int col, int row, glm::dvec3& direction) const
+    {
+        const glm::dvec3& d = lensTable_[std::size_t(row) * std::size_t(camera_.width()) + std::size_t(col)];
+        if (std::isnan(d.x)) return false;
+        direction = d.x * right_ - d.y * up_ + d.z * forward_;  // lens frame: x right, y down, z forward
+        return true;
+    }
+    const glm::dvec3& eye() const { return eye_; }
 
     // The viewing ray through image point pImage (pixels; x right, y down from the top-left
     // corner), in world space: origin on the eye plane, unit direction, [tNear, tFar]
@@ -63,7 +76,11 @@ public:
     // model's point outside its field.
     std::optional<EyePlaneRay> worldRay(const glm::dvec2& pImage) const;
     // Eye-space point (the convention's eye axes) of a world point.
-    glm::dvec3 eyeFromWorld(const glm::dvec3& pWorld) const;
+    glm::dvec3 eyeFromWorld(const glm::dvec3& pWorld) const
+    {
+        const glm::dvec3 v = pWorld - eye_;
+        return {glm::dot(v, right_), eyeUpY_ * glm::dot(v, up_), eyeForwardZ_ * glm::dot(v, forward_)};
+    }
     // Eye-z (along the viewing axis) of a world point.
     double eyeZ(const glm::dvec3& pWorld) const { return glm::dot(pWorld - eye_, forward_); }
     // The window depth of the point at eye-z `eyeZ` on the ray through image point pImage, in
@@ -156,10 +173,12 @@ private:
 
     const Camera& camera_;
     const LensModel* lens_;                // a lens model's camera: its own rays
+    const glm::dvec3* lensTable_ = nullptr;  // and its table of pixel directions
     bool fromMatrix_;                     // raw-matrix projection: the inverse-projection module
     bool parallel_ = false;               // orthographic or oblique: window depth affine in eye-z
     double depthA_ = 0, depthB_ = 0;      // window depth = A + B/eyeZ, or A + B·eyeZ when parallel
     glm::dvec3 eye_, right_, up_, forward_;  // the view as world-space axes
+    double eyeUpY_ = 1, eyeForwardZ_ = -1;   // the convention's eye axes along up and forward
 };
 
 }  // namespace zcheck

@@ -6,7 +6,10 @@
 //   - its own BVH with the ray route's settings (robust, medium quality), timed;
 //   - one ray per pixel centre, generated in binary32 as an affine function of the pixel
 //     (the ray route's AffineRays, camera_rays.h, or for a raw matrix the affine rays through
-//     three pixels' rays; unnormalised, t ∈ [0, ∞));
+//     three pixels' rays; unnormalised, t ∈ [0, ∞)); for a lens model, no such function
+//     exists: every pixel's world direction is computed before the clock starts (the ray
+//     route's, CameraRays::worldRay, in binary32) and read from that table, a pixel outside
+//     the lens's field an invalid lane;
 //   - 8×8 tiles in parallel with TBB, each traced as four 4×4 packets with rtcIntersect16 and a
 //     coherent context; the primitive id stored per pixel into a buffer allocated beforehand.
 // Not done: no clip planes, no double-precision hit, no depth.
