@@ -10,6 +10,8 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 "$zcheck" suite --quick --models "$models" --out "$tmp/run" > "$tmp/table.txt"
 grep -q "verdict    PASSED" "$tmp/table.txt"
+grep -q "^lens configurations: 5 consistent of 5 (lens check and clean map; false positives: 0)" "$tmp/table.txt"
+! grep -q "MISSED\|MISNAMED\|FALSE POSITIVE" "$tmp/table.txt"
 "$zcheck" suite --quick --models "$models" --json > "$tmp/printed.json"
 python3 - "$tmp" <<'PY'
 import json, sys
@@ -29,12 +31,38 @@ for name, row in r["detection"].items():
     assert row["detected"] == row["applicable"], (name, row)
 # Every fault is applicable somewhere even in the quick subset.
 assert all(row["applicable"] > 0 for row in r["detection"].values()), r["detection"]
+# The lens part (suite.h): 5 lens cameras on builtin:default, each clean and with every mistake of
+# the lens family injected; none a false positive, every applicable mistake detected and named.
+lens = r["lens"]
+assert lens["passed"] is True and lens["false_positives"] == 0 and lens["missed_faults"] == 0 and lens["misnamed_faults"] == 0, lens["detection"]
+models = sorted({c["model"] for c in lens["configurations"]})
+assert models == ["double_sphere", "equirectangular", "opencv", "opencv rational", "opencv_fisheye"], models
+for c in lens["configurations"]:
+    assert c["clean"]["check_consistent"] and c["clean"]["map_consistent"], c["label"]
+    assert c["camera"]["lens"]["model"] == c["model"].split(" ")[0], c["camera"]
+    for name, m in c["mistakes"].items():
+        assert m["result"] in ("detected", "not applicable", "-"), (c["label"], name, m)
+        assert m["named"] == (m["result"] == "detected"), (c["label"], name, m)
+names = {row["name"] for row in lens["detection"].values()}
+family = {"distortion-ignored", "undistorted-new-k", "coefficient-order", "tangential-swapped", "distortion-signs-flipped",
+          "fisheye-model", "y-flip", "x-flip", "half-pixel", "cx-cy-swapped", "distance-as-eye-z", "eye-z-as-distance"}
+assert names == family, names ^ family
+for key, row in lens["detection"].items():
+    assert row["detected"] == row["applicable"] == row["named"] and row["applicable"] > 0, (key, row)
+assert sum(row["applicable"] for row in lens["detection"].values()) >= 50, lens["detection"]
 html = open(f"{tmp}/suite.html").read()
+assert "<h2>Lens cameras</h2>" in html
 assert "<h1>zcheck suite: PASSED</h1>" in html and "http" not in html.replace("charset", "")
 PY
 # --filter narrows the matrix; a filter matching nothing is a usage error.
 "$zcheck" suite --quick --models "$models" --filter "pinhole" > "$tmp/pinhole.txt"
 grep -q "configurations x 21 faults" "$tmp/pinhole.txt"
+grep -q "^lens configurations: 0 consistent of 0" "$tmp/pinhole.txt"
+# ... and applies to the lens part: its labels name the lens model.
+"$zcheck" suite --quick --models "$models" --filter "opencv_fisheye" > "$tmp/fisheye.txt"
+grep -q "^lens configurations: 1 consistent of 1 " "$tmp/fisheye.txt"
+grep -q "^fisheye-model  *equisolid  *1 / 1  *0  *1 / 1" "$tmp/fisheye.txt"
+grep -q "verdict    PASSED" "$tmp/fisheye.txt"
 set +e
 "$zcheck" suite --quick --models "$models" --filter "no such configuration" > /dev/null 2>&1
 status=$?

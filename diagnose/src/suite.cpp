@@ -101,7 +101,7 @@ std::string SuiteConfig::label() const
                                               : "");
 }
 
-std::vector<SuiteConfig> suiteConfigurations(bool quick, const std::string& modelsDir)
+std::vector<std::string> suiteScenes(bool quick, const std::string& modelsDir)
 {
     std::vector<std::string> scenes = quick ? std::vector<std::string>{"builtin:default", "builtin:near-crossing"}
                                             : std::vector<std::string>{"builtin:default", "builtin:terrain?n=96",
@@ -111,6 +111,17 @@ std::vector<SuiteConfig> suiteConfigurations(bool quick, const std::string& mode
             scenes.push_back((std::filesystem::path(modelsDir) / model).string());
             if (quick) break;
         }
+    return scenes;
+}
+
+std::string suiteSceneLabel(const std::string& scenePath)
+{
+    return isBuiltinSceneName(scenePath) ? scenePath : std::filesystem::path(scenePath).filename().string();
+}
+
+std::vector<SuiteConfig> suiteConfigurations(bool quick, const std::string& modelsDir)
+{
+    const std::vector<std::string> scenes = suiteScenes(quick, modelsDir);
     const std::vector<std::pair<int, int>> sizes = {{320, 240}, {333, 257}, {256, 256}, {160, 300}};
     const std::vector<std::string>& conventions = Convention::presetNames();
     const DepthFormat formats[] = {DepthFormat::Float32, DepthFormat::Unorm24, DepthFormat::Unorm16};
@@ -118,7 +129,7 @@ std::vector<SuiteConfig> suiteConfigurations(bool quick, const std::string& mode
     std::vector<SuiteConfig> configs;
     for (std::size_t si = 0; si < scenes.size(); ++si) {
         const Scene scene = loadScene(scenes[si]);
-        const std::string sceneLabel = isBuiltinSceneName(scenes[si]) ? scenes[si] : std::filesystem::path(scenes[si]).filename().string();
+        const std::string sceneLabel = suiteSceneLabel(scenes[si]);
         for (int v = 0; v < variants; ++v) {
             const auto [width, height] = sizes[(si + std::size_t(v)) % sizes.size()];
             const std::vector<NamedCamera> models = cameraModels(scene, width, height);

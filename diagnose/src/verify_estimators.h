@@ -66,6 +66,15 @@ RenderResult renderResultFromMap(const PixelJudge& judge, const DepthMap& map, c
 // along the pixels' rays (verify_lens.cpp has the rule); MapVerifier::verify's for such cameras.
 VerifyResult verifyLensMap(const Checker& checker, const Camera& camera, const DepthMap& map);
 
+// verifyLensMap's rule on the pixels of a grid, one every `stride` columns and rows (the
+// centre of each stride × stride block): how many it judged, compared (either side sees a
+// surface) and found unexplained. The diagnosis rules hypotheses out on it before verifying
+// the rest in full.
+struct LensSample {
+    std::int64_t judged = 0, compared = 0, unexplained = 0;
+};
+LensSample judgeLensMapOnGrid(const Checker& checker, const Camera& camera, const DepthMap& map, int stride);
+
 // The mistakes of the lens family for a map judged through a lens camera, ranked (the consistent
 // first); MapVerifier::diagnose's for such cameras (diagnose_lens.cpp lists them).
 class MapVerifier;

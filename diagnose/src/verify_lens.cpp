@@ -193,6 +193,27 @@ void requireJudgedDeclarations(const Camera& camera, const DepthMap& map)
 
 }  // namespace
 
+LensSample judgeLensMapOnGrid(const Checker& checker, const Camera& camera, const DepthMap& map, int stride)
+{
+    requireMapFits(camera, map);
+    const RenderResult truth = checker.renderRay(camera);
+    const LensPixelJudge judge(checker, camera, map, truth);
+    const int W = camera.width(), H = camera.height();
+    const int rows = (H + stride - 1) / stride;
+    std::vector<LensSample> perRow(static_cast<std::size_t>(rows));
+    tbb::parallel_for(0, rows, [&](int r) {
+        for (int col = stride / 2; col < W; col += stride) {
+            const PixelClass c = judge.judge(col, std::min(H - 1, r * stride + stride / 2)).pixelClass;
+            perRow[std::size_t(r)].judged += 1;
+            perRow[std::size_t(r)].compared += c != PixelClass::BothMiss;
+            perRow[std::size_t(r)].unexplained += isUnexplained(c);
+        }
+    });
+    LensSample out;
+    for (const LensSample& r : perRow) out.judged += r.judged, out.compared += r.compared, out.unexplained += r.unexplained;
+    return out;
+}
+
 VerifyResult verifyLensMap(const Checker& checker, const Camera& camera, const DepthMap& map)
 {
     requireMapFits(camera, map);
