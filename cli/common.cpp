@@ -1,6 +1,8 @@
 #include "common.h"
 
 #include "zcheck/camera_file.h"
+#include "zcheck/detail/camera_json.h"
+#include "zcheck/version.h"
 #include "zcheck/camera_sources.h"
 #include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
@@ -8,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 
 namespace zcheck::cli {
 
@@ -267,6 +270,48 @@ DepthMapReading DepthMapOptions::reading(const std::string& quantityName) const
     if (!miss.empty()) r.miss = MissRule::parse(miss);
     r.accuracy = accuracy;
     return sidecar.empty() ? r : withSidecar(r, sidecar);
+}
+
+nlohmann::json depthFileSidecar(const std::string& output, const std::string& format, const Camera& camera,
+                                const std::vector<QuantityImage>& images, double scale, glm::dvec2 sampleOffset)
+{
+    const auto numberOrName = [](double v) {  // JSON has no inf or NaN
+        if (std::isnan(v)) return nlohmann::json("nan");
+        if (std::isinf(v)) return nlohmann::json(v > 0 ? "inf" : "-inf");
+        return nlohmann::json(v);
+    };
+    const bool png = format == "png";
+    nlohmann::json channels = nlohmann::json::array();
+    for (const QuantityImage& image : images)
+        for (const std::string& name : image.channels) {
+            nlohmann::json channel = {{"name", name},
+                                      {"quantity", toString(image.quantity)},
+                                      {"unit", image.unit},
+                                      {"type", png ? "uint16" : image.quantity == ExportQuantity::PrimitiveId ? "uint32" : "float32"},
+                                      {"miss_value", png ? nlohmann::json(0) : numberOrName(image.missValue)}};
+            if (png) channel["stored_as"] = "round(value * scale); 0 = miss";
+            channels.push_back(channel);
+        }
+    const std::string orientation =
+        format == "pfm" ? "row 0 is the top row of the picture as a standard reader returns it; the file stores rows "
+                          "bottom to top, as the PFM specification says"
+                        : "row 0 (the first row stored and read) is the top row of the picture";
+    return {
+        {"zcheck_version", kVersion},
+        {"file", std::filesystem::path(output).filename().string()},
+        {"format", format},
+        {"width", camera.width()},
+        {"height", camera.height()},
+        {"orientation", orientation},
+        {"pixel_centres", "pixel (col,row) samples image point (col + 0.5 + dx, row + 0.5 + dy) from the top-left "
+                          "corner, x right, y down"},
+        {"sample_offset", {sampleOffset.x, sampleOffset.y}},
+        {"channels", channels},
+        {"scale", png ? nlohmann::json(scale) : nlohmann::json(nullptr)},
+        {"convention", camera.convention().name},
+        {"camera", toJson(camera.spec())},
+        {"matrices", matricesJson(camera)},
+    };
 }
 
 }  // namespace zcheck::cli

@@ -1,11 +1,13 @@
 #pragma once
 // What every subcommand shares: exit statuses, option validators, the scene-and-camera
-// options, the thread limit, and the check/verify --out folder.
+// options, the thread limit, the check/verify --out folder, and a depth file's sidecar.
 #include "zcheck/camera_sources.h"
 #include "zcheck/checker.h"
 #include "zcheck/depth_map_reading.h"
+#include "zcheck/quantity.h"
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 #include <tbb/global_control.h>
 
 #include <functional>
@@ -120,6 +122,14 @@ void requireSidecarCameraAgrees(const CameraSpec& used, const CameraOptions& cam
                                 DepthQuantity quantity);
 // --quantum, --rel-tolerance, --abs-tolerance, --allow-holes (MapAccuracy), in their own help group.
 void addAccuracyOptions(CLI::App* command, MapAccuracy& accuracy);
+
+// The sidecar (FILE.json) of a depth file `output` that writeDepthMapFile wrote as `format` from
+// `images` of `camera`: what a reader needs to read it back — format, size, orientation, pixel
+// centres (moved by `sampleOffset`, image pixels), each channel's quantity, unit, type and miss
+// value, the PNG scale, the convention, the camera and its matrices. Export and remap add their own
+// keys.
+nlohmann::json depthFileSidecar(const std::string& output, const std::string& format, const Camera& camera,
+                                const std::vector<QuantityImage>& images, double scale, glm::dvec2 sampleOffset = {0, 0});
 
 // "1,2.5,3" → {1, 2.5, 3}; throws Error naming `option` for anything that is not a number.
 std::vector<double> parseNumberList(const std::string& text, const std::string& option);

@@ -4,12 +4,11 @@
 
 #include "zcheck/atomic_file.h"
 #include "zcheck/departure.h"
-#include "zcheck/detail/camera_json.h"
+#include "zcheck/detail/json.h"
 #include "zcheck/error.h"
 #include "zcheck/export.h"
 #include "zcheck/mesh_loader.h"
 #include "zcheck/png_file.h"
-#include "zcheck/version.h"
 
 #include <cmath>
 #include <filesystem>
@@ -26,13 +25,6 @@ struct ExportOptions {
     std::vector<double> sampleOffset;  // image pixels (x right, y down) from the pixel centre
     int threads = 0;
 };
-
-nlohmann::json numberOrName(double v)
-{
-    if (std::isnan(v)) return "nan";
-    if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
-    return v;
-}
 
 int runExportCommand(const ExportOptions& o)
 {
@@ -67,41 +59,11 @@ int runExportCommand(const ExportOptions& o)
     std::string format;
     outputs.write(o.output, [&](const std::string& temporary) { format = writeDepthMapFile(temporary, images, o.scale); });
 
-    nlohmann::json channels = nlohmann::json::array();
-    for (const auto& image : images)
-        for (const auto& name : image.channels) {
-            nlohmann::json channel = {{"name", name},
-                                      {"quantity", toString(image.quantity)},
-                                      {"unit", image.unit},
-                                      {"type", format == "png" ? "uint16" : image.quantity == ExportQuantity::PrimitiveId ? "uint32" : "float32"},
-                                      {"miss_value", format == "png" ? nlohmann::json(0) : numberOrName(image.missValue)}};
-            if (format == "png") channel["stored_as"] = "round(value * scale); 0 = miss";
-            channels.push_back(channel);
-        }
-    const std::string orientation =
-        format == "pfm" ? "row 0 is the top row of the picture as a standard reader returns it; the file stores rows "
-                          "bottom to top, as the PFM specification says"
-                        : "row 0 (the first row stored and read) is the top row of the picture";
-    nlohmann::json sidecar = {
-        {"zcheck_version", kVersion},
-        {"file", std::filesystem::path(o.output).filename().string()},
-        {"format", format},
-        {"width", camera.width()},
-        {"height", camera.height()},
-        {"orientation", orientation},
-        {"pixel_centres", "pixel (col,row) samples image point (col + 0.5 + dx, row + 0.5 + dy) from the top-left "
-                          "corner, x right, y down"},
-        {"sample_offset", {sampling.sampleOffset.x, sampling.sampleOffset.y}},
-        {"channels", channels},
-        {"scale", format == "png" ? nlohmann::json(o.scale) : nlohmann::json(nullptr)},
-        {"backend", o.backend},
-        {"scene", scene.name},
-        {"convention", spec.convention.name},
-        {"depth", {{"format", toString(spec.depth.format)}, {"reversed", spec.depth.reversed},
-                   {"range", {spec.depth.rangeMin, spec.depth.rangeMax}}, {"clear_value", camera.clearDepth()}}},
-        {"camera", toJson(spec)},
-        {"matrices", matricesJson(camera)},
-    };
+    nlohmann::json sidecar = depthFileSidecar(o.output, format, camera, images, o.scale, sampling.sampleOffset);
+    sidecar["backend"] = o.backend;
+    sidecar["scene"] = scene.name;
+    sidecar["depth"] = {{"format", toString(spec.depth.format)}, {"reversed", spec.depth.reversed},
+                        {"range", {spec.depth.rangeMin, spec.depth.rangeMax}}, {"clear_value", camera.clearDepth()}};
     outputs.writeText(o.output + ".json", prettyJson(sidecar) + "\n");
     if (!o.preview.empty())
         outputs.write(o.preview, [&](const std::string& temporary) {

@@ -12,7 +12,6 @@
 #include "zcheck/inverse_projection.h"
 #include "zcheck/mesh_loader.h"
 #include "zcheck/remap.h"
-#include "zcheck/version.h"
 
 #include <algorithm>
 #include <cmath>
@@ -106,14 +105,7 @@ int runRemapCommand(const RemapOptions& o)
                         " projection's rays are parallel");
 
     const RemappedMap remapped = remapDepthMap(from, made.map.value, quantity, to, toQuantity, sampling);
-    QuantityImage image;
-    image.quantity = exportQuantityOf(toQuantity);
-    image.width = to.width(), image.height = to.height();
-    image.channels = {channelNameOf(image.quantity)};
-    image.unit = toQuantity == DepthQuantity::EyeZ ? "scene units (planar depth)"
-                 : toQuantity == DepthQuantity::Distance ? "scene units (range)"
-                 : toQuantity == DepthQuantity::Window ? "depth-buffer value" : "NDC z";
-    image.missValue = toQuantity == DepthQuantity::Window ? to.clearDepth() : toQuantity == DepthQuantity::Ndc ? to.ndcZFar() : INFINITY;
+    QuantityImage image = quantityImageShape(to, exportQuantityOf(toQuantity));
     image.value = remapped.values;
     std::string format;
     outputs.write(o.output, [&](const std::string& temporary) { format = writeDepthMapFile(temporary, {image}, o.scale); });
@@ -130,26 +122,9 @@ int runRemapCommand(const RemapOptions& o)
         const Checker checker(loadScene(o.scene));
         summary["against_render"] = comparisonWithRender(remapped.values, checker.render(to, image.quantity, Route::Ray), o.scene);
     }
-    nlohmann::json sidecar = {
-        {"zcheck_version", kVersion},
-        {"file", std::filesystem::path(o.output).filename().string()},
-        {"format", format},
-        {"width", to.width()},
-        {"height", to.height()},
-        {"orientation", format == "pfm" ? "row 0 is the top row of the picture as a standard reader returns it"
-                                        : "row 0 (the first row stored and read) is the top row of the picture"},
-        {"pixel_centres", "pixel (col,row) samples image point (col + 0.5, row + 0.5) from the top-left corner, x right, y down"},
-        {"channels", {{{"name", image.channels[0]}, {"quantity", toString(toQuantity)}, {"unit", image.unit},
-                        {"type", format == "png" ? "uint16" : "float32"},
-                        {"miss_value", format == "png" ? nlohmann::json(0)
-                                                       : std::isinf(image.missValue) ? nlohmann::json("inf") : nlohmann::json(image.missValue)}}}},
-        {"scale", format == "png" ? nlohmann::json(o.scale) : nlohmann::json(nullptr)},
-        {"remapped_from", {{"depth_map", o.depthMap}, {"quantity", quantityName}, {"camera", toJson(from.spec())},
-                           {"sampling", o.sampling}}},
-        {"convention", to.convention().name},
-        {"camera", toJson(to.spec())},
-        {"matrices", matricesJson(to)},
-    };
+    nlohmann::json sidecar = depthFileSidecar(o.output, format, to, {image}, o.scale);
+    sidecar["remapped_from"] = {{"depth_map", o.depthMap}, {"quantity", quantityName}, {"camera", toJson(from.spec())},
+                                {"sampling", o.sampling}};
     outputs.writeText(o.output + ".json", prettyJson(sidecar) + "\n");
     outputs.commit();
     std::cout << prettyJson(summary) << "\n";

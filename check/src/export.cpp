@@ -7,12 +7,11 @@
 
 namespace zcheck {
 
-QuantityImage quantityImage(const Scene& scene, const Camera& camera, const RenderResult& route, ExportQuantity quantity)
+QuantityImage quantityImageShape(const Camera& camera, ExportQuantity quantity)
 {
     QuantityImage image;
     image.quantity = quantity;
     image.width = camera.width(), image.height = camera.height();
-    const std::size_t pixels = std::size_t(image.width) * image.height;
     switch (quantity) {
     case ExportQuantity::Window: image.channels = {channelNameOf(quantity)}, image.unit = "depth-buffer value", image.missValue = camera.clearDepth(); break;
     case ExportQuantity::Ndc: image.channels = {channelNameOf(quantity)}, image.unit = "NDC z", image.missValue = camera.ndcZFar(); break;
@@ -23,10 +22,16 @@ QuantityImage quantityImage(const Scene& scene, const Camera& camera, const Rend
     case ExportQuantity::Normal: image.channels = {"N.X", "N.Y", "N.Z"}, image.unit = "unit vector, world space, facing the camera", image.missValue = NAN; break;
     case ExportQuantity::PrimitiveId: image.channels = {"id"}, image.unit = "triangle index (uint32)", image.missValue = double(kNoPrimitive); break;
     }
-    const std::size_t C = image.channels.size();
     if (quantity == ExportQuantity::Window || quantity == ExportQuantity::Ndc)
         requireQuantityOf(camera, quantity == ExportQuantity::Window ? DepthQuantity::Window : DepthQuantity::Ndc,
                           "quantity " + toString(quantity));
+    return image;
+}
+
+QuantityImage quantityImage(const Scene& scene, const Camera& camera, const RenderResult& route, ExportQuantity quantity)
+{
+    QuantityImage image = quantityImageShape(camera, quantity);
+    const std::size_t pixels = std::size_t(image.width) * image.height, C = image.channels.size();
     if (quantity == ExportQuantity::PrimitiveId) {
         image.id.assign(route.primitiveId.begin(), route.primitiveId.end());
         return image;

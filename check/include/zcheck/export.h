@@ -13,4 +13,9 @@ namespace zcheck {
 
 QuantityImage quantityImage(const Scene& scene, const Camera& camera, const RenderResult& route, ExportQuantity quantity);
 
+// The image of `quantity` for `camera` without its values: size, channel names, unit and the
+// value a miss holds (quantityImage's; a depth file's sidecar describes it). Refuses window and
+// NDC depth for a lens camera, which has no depth buffer.
+QuantityImage quantityImageShape(const Camera& camera, ExportQuantity quantity);
+
 }  // namespace zcheck
