@@ -6,6 +6,7 @@
 #include "zcheck/checker.h"
 #include "zcheck/error.h"
 #include "zcheck/lens.h"
+#include "zcheck/lens_mistakes.h"
 #include "zcheck/map_verifier.h"
 #include "zcheck/pose.h"
 #include "zcheck/remap.h"
@@ -301,6 +302,23 @@ TEST_CASE("pixels beyond a fold outside the image's inscribed disc have no ray: 
     REQUIRE(!lens.imageFromDirection(direction(lens.fieldAngle() + 1e-6, 0.3)).has_value());
 }
 
+TEST_CASE("metashape fisheye's field ends at 90 degrees, where the manual's formula stops", "[lens]")
+{
+    // The manual's x0 = X/Z divides by Z: a direction 100° off the axis has no pixel, and the
+    // image's corners beyond 90° (θ = r/f for this equidistant lens: 90° at r = 300·π/2 = 471 px,
+    // the corner 500 px away) have no ray, where the same lens as OpenCV's fisheye has both.
+    const LensModel metashape({"metashape_fisheye", {300, 399.5, 299.5, 0, 0, 0, 0, 0, 0, 0, 0}}, 800, 600);
+    const LensModel kannalaBrandt({"opencv_fisheye", {300, 300, 399.5, 299.5}}, 800, 600);
+    REQUIRE(metashape.fieldAngle() == Approx(kPi / 2).epsilon(1e-12));
+    REQUIRE(!metashape.imageFromDirection(direction(kPi * 100 / 180, 0.3)).has_value());
+    REQUIRE(kannalaBrandt.imageFromDirection(direction(kPi * 100 / 180, 0.3)).has_value());
+    REQUIRE(!metashape.directionFromImage({0.5, 0.5}).has_value());
+    REQUIRE(kannalaBrandt.directionFromImage({0.5, 0.5}).has_value());
+    // Inside 90° both are the equidistant lens.
+    const glm::dvec2 both = metashape.imageFromDirection(direction(1.2, 0.3)).value();
+    REQUIRE(glm::length(both - kannalaBrandt.imageFromDirection(direction(1.2, 0.3)).value()) < 1e-9);
+}
+
 TEST_CASE("a camera file's lens object reads and writes back as itself", "[lens]")
 {
     const std::string text = R"({"convention": "opencv", "image": {"width": 640, "height": 480},
@@ -373,10 +391,7 @@ TEST_CASE("verify of a lens camera's map: the truth passes, a distortion mistake
     const Camera camera(spec);
     for (const DepthQuantity quantity : {DepthQuantity::Distance, DepthQuantity::EyeZ}) {
         INFO(toString(quantity));
-        const QuantityImage truth = checker.render(camera, exportQuantityOf(quantity), Route::Ray);
-        std::vector<double> values(truth.value.size());
-        for (std::size_t i = 0; i < values.size(); ++i) values[i] = std::isinf(truth.value[i]) ? 0.0 : double(float(truth.value[i]));
-        const DepthMap exact = DepthMap::exact(320, 240, quantity, values);
+        const DepthMap exact = renderedMap(checker, camera, quantity);
         const VerifyResult clean = verifier.verify(camera, exact);
         REQUIRE(clean.report.comparison.consistent());
         REQUIRE(clean.report.comparison.agree > 40000);
@@ -490,11 +505,7 @@ namespace {
 // A map of `quantity` rendered by the ray route through `made`, as a renderer would store it (binary32, 0 a miss).
 DepthMap mapThrough(const Checker& checker, const CameraSpec& made, DepthQuantity quantity)
 {
-    const Camera camera(made);
-    const QuantityImage image = checker.render(camera, exportQuantityOf(quantity), Route::Ray);
-    std::vector<double> values(image.value.size());
-    for (std::size_t i = 0; i < values.size(); ++i) values[i] = std::isfinite(image.value[i]) ? double(float(image.value[i])) : 0.0;
-    return DepthMap::exact(camera.width(), camera.height(), quantity, values);
+    return renderedMap(checker, Camera(made), quantity);
 }
 
 

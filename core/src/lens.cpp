@@ -133,6 +133,10 @@ const std::vector<ModelRow>& rows()
          [](const double* p, Terms& t) {
              metashape(p, t);
              t.profile = Profile::Equidistant;
+             // The manual's formula (x0 = X/Z, x = x0·atan(r0)/r0) divides by Z: it defines the
+             // directions up to 90° from the axis and mirrors those beyond. What Metashape does
+             // past 90° is not published, so the field ends there: such pixels have no ray.
+             t.fieldLimit = LensModel::kHalfPi;
          }},
         {{"equisolid", "equisolid-angle fisheye", "m = 2·sin(θ/2)·(cos φ, sin φ)", {"fx", "fy", "cx", "cy"}, 4, true},
          [](const double* p, Terms& t) {
@@ -424,13 +428,18 @@ bool LensModel::planeIsIdentity() const
     return true;
 }
 
+double LensModel::radialDenominator(double r2) const
+{
+    double d = 0;
+    for (int i = 2; i >= 0; --i) d = (d + terms_.denominator[i]) * r2;
+    return 1 + d;
+}
+
 double LensModel::radialFactor(double r2) const
 {
-    const Terms& t = terms_;
-    double n = 0, d = 0;
-    for (int i = 5; i >= 0; --i) n = (n + t.numerator[i]) * r2;
-    for (int i = 2; i >= 0; --i) d = (d + t.denominator[i]) * r2;
-    return (1 + n) / (1 + d);
+    double n = 0;
+    for (int i = 5; i >= 0; --i) n = (n + terms_.numerator[i]) * r2;
+    return (1 + n) / radialDenominator(r2);
 }
 
 namespace {
@@ -820,6 +829,7 @@ void LensModel::findField()
     }
     default: break;
     }
+    if (terms_.fieldLimit > 0) limit = std::min(limit, terms_.fieldLimit);
     // The whole radial map θ ↦ |m'| (profile, then N/D) increases from 0 up to the first θ where
     // it stops: scanned in steps, the end refined by bisection on the sign of its slope.
     const auto radialAt = [&](double theta) { return distortedRadius(profileRadius(theta)); };
@@ -827,12 +837,7 @@ void LensModel::findField()
         const double h = 1e-7 * std::max(theta, 1e-3);
         const double lo = radialAt(theta - h), hi = radialAt(theta + h);
         const double rho = profileRadius(theta);
-        const double d = 1 + [&] {
-            double value = 0;
-            for (int i = 2; i >= 0; --i) value = (value + terms_.denominator[i]) * rho * rho;
-            return value;
-        }();
-        return std::isfinite(lo) && std::isfinite(hi) && hi > lo && d > 0;
+        return std::isfinite(lo) && std::isfinite(hi) && hi > lo && radialDenominator(rho * rho) > 0;
     };
     constexpr int kSteps = 4096;
     double good = 0, bad = -1, previous = 0;

@@ -159,6 +159,7 @@ public:
         double s[4] = {0, 0, 0, 0};                // OpenCV's thin prism s1..s4
         double tauX = 0, tauY = 0;                 // OpenCV's tilt, radians
         bool tangentialAfterRadial = false;        // FISHEYE624: T and S on m·N/D
+        double fieldLimit = 0;                     // the model's own end of the field (radians); 0: its profile's
         double fx = 1, fy = 1, skew = 0, cx = 0, cy = 0;
         // panorama: longitude and latitude ranges, radians
         double lonMin = 0, lonMax = 0, latMin = 0, latMax = 0;
@@ -193,7 +194,8 @@ private:
     std::optional<glm::dvec3> directionFromImage(const glm::dvec2& pImage, InverseHint* hint) const;
     bool planeIsIdentity() const;
     bool planeIsRadial() const;
-    double radialFactor(double r2) const;  // N(r²)/D(r²)
+    double radialFactor(double r2) const;       // N(r²)/D(r²)
+    double radialDenominator(double r2) const;  // D(r²)
     double distortedRadius(double r) const { return r * radialFactor(r * r); }
     glm::dmat2 planeJacobian(const glm::dvec2& m) const;
     void findField();
