@@ -59,6 +59,9 @@ from mathutils import Matrix, Vector
 import zcheck
 import zcheck.blender
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from cycles_depth import set_up_depth_render  # noqa: E402  (beside this script)
+
 # 160x120 rendered. The percentage divides the resolution exactly: world_to_camera_view (the
 # second route) sizes the frame by the resolution before the percentage, Cycles by the rendered
 # size; at 321x241 they differ by up to 0.07 px (Cycles's samples still land on zcheck's centres).
@@ -198,39 +201,6 @@ def set_up_cameras(scene):
     return {"A": a, "B": b, "C": c, "D": d}
 
 
-def set_up_render(scene):
-    scene.render.engine = "CYCLES"
-    scene.cycles.device = "CPU"
-    scene.cycles.samples = 1
-    scene.cycles.use_adaptive_sampling = False
-    scene.cycles.use_denoising = False
-    scene.cycles.max_bounces = 0
-    # The Z pass holds the depth of sample 0, which Cycles (3.0+) aims at the pixel centre
-    # whatever the filter (integrate_camera_sample: filter_u = filter_v = 0.5 for sample 0),
-    # through the filter's importance table. That table has an even size (1024), so its
-    # centre falls between two entries: the sample lands half a table step off the centre,
-    # table width / 2046 in x and in y. The box filter's width is fixed at 1 px (blender/sync.cpp
-    # ignores filter_width for it): 1/2046 = 0.00049 px; Blackman-Harris 1.5 px (the default)
-    # ~0.0005 px; a 0.01 px Gaussian (table width 0.03 px, mass near the middle) ~3e-6 px.
-    # All lie within the 2^-8 px zcheck allows; the Gaussian leaves the least.
-    scene.cycles.pixel_filter_type = "GAUSSIAN"
-    scene.cycles.filter_width = 0.01
-    scene.cycles.seed = 0
-    scene.render.film_transparent = True
-    scene.render.resolution_x, scene.render.resolution_y = RESOLUTION
-    scene.render.resolution_percentage = PERCENTAGE
-    scene.render.use_border = False
-    scene.render.use_compositing = False
-    scene.render.use_sequencer = False
-    layer = scene.view_layers[0]
-    layer.use_pass_z = True
-    layer.use_pass_position = True
-    settings = scene.render.image_settings
-    settings.file_format = "OPEN_EXR_MULTILAYER"
-    settings.color_depth = "32"
-    settings.exr_codec = "ZIP"
-
-
 def render_frames(scene, folder):
     os.makedirs(folder, exist_ok=True)
     for frame in FRAMES:
@@ -358,7 +328,7 @@ def main():
     import_mesh(mesh_path)
     add_ground()
     cameras = set_up_cameras(scene)
-    set_up_render(scene)
+    set_up_depth_render(scene, RESOLUTION, PERCENTAGE, position_pass=True)
     export_world_obj(os.path.join(outdir, "scene.obj"))
 
     points = world_vertices(stride=37)

@@ -44,6 +44,9 @@ from mathutils import Euler
 import zcheck
 import zcheck.blender
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from cycles_depth import set_up_depth_render  # noqa: E402  (beside this script)
+
 CAMERAS = [
     ("equirect", (96, 64), (1, 1), {"panorama_type": "EQUIRECTANGULAR", "latitude_min": math.radians(-70),
                                     "latitude_max": math.radians(75), "longitude_min": math.radians(-150),
@@ -95,26 +98,6 @@ def export_world_obj(path):
             obj.evaluated_get(depsgraph).to_mesh_clear()
 
 
-def set_up_render(scene):
-    scene.render.engine = "CYCLES"
-    scene.cycles.device = "CPU"
-    scene.cycles.samples = 1
-    scene.cycles.use_adaptive_sampling = False
-    scene.cycles.use_denoising = False
-    scene.cycles.max_bounces = 0
-    scene.cycles.pixel_filter_type = "GAUSSIAN"
-    scene.cycles.filter_width = 0.01
-    scene.render.resolution_percentage = 100
-    scene.render.use_border = False
-    scene.render.use_compositing = False
-    scene.render.use_sequencer = False
-    scene.view_layers[0].use_pass_z = True
-    settings = scene.render.image_settings
-    settings.file_format = "OPEN_EXR_MULTILAYER"
-    settings.color_depth = "32"
-    settings.exr_codec = "ZIP"
-
-
 def add_camera(scene, name, pano, data_settings):
     data = bpy.data.cameras.new(name)
     data.type = "PANO"
@@ -156,7 +139,7 @@ def main():
     os.makedirs(out, exist_ok=True)
     scene = bpy.context.scene
     build_scene()
-    set_up_render(scene)
+    set_up_depth_render(scene)
     export_world_obj(os.path.join(out, "scene.obj"))
     cameras = {}
     for frame, (name, size, aspect, pano, data_settings) in enumerate(CAMERAS, start=1):

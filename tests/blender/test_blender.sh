@@ -20,62 +20,16 @@ set -euo pipefail
 zcheck=$1
 models=$2
 here=$(cd "$(dirname "$0")" && pwd)
-blender=${BLENDER:-blender}
-timeout_s=${BLENDER_TIMEOUT:-600}
-if ! command -v "$blender" > /dev/null; then
-    echo "test_blender: skipped: no Blender ('$blender') on this machine"
-    exit 77
-fi
-export PYTHONPATH=${PYTHONPATH:-$(cd "$(dirname "$zcheck")/../python" && pwd)}
-
-tmp=$(mktemp -d)
-blender_pid=
-passed=0
-failed=0
-cleanup() {
-    if [[ -n $blender_pid ]] && kill -0 "$blender_pid" 2> /dev/null; then
-        kill "$blender_pid" 2> /dev/null || true
-    fi
-    if [[ $failed -eq 0 && -z ${KEEP:-} ]]; then rm -rf "$tmp"; else echo "test_blender: renders, logs and results kept in $tmp"; fi
-}
-trap cleanup EXIT
+test_name=test_blender
+default_timeout_s=600
+source "$here/harness.sh"
 out=$tmp/out
 
-pass() { echo "ok    $1"; passed=$((passed + 1)); }
-fail() { echo "FAIL  $*"; failed=$((failed + 1)); }
-finish() {
-    echo "test_blender: $passed passed, $failed failed"
-    exit $((failed > 0 ? 1 : 0))
-}
-
 # --- render: Blender in the background, stopped by its pid if it overruns ---------------------
-# TMPDIR: the folder Blender makes for itself (and leaves behind when stopped) goes with ours.
-TMPDIR=$tmp "$blender" -b --factory-startup --python-exit-code 1 -P "$here/render_and_check.py" -- \
-    "$out" "$models/stanford-bunny.obj" > "$tmp/blender.log" 2>&1 &
-blender_pid=$!
-waited=0
-while kill -0 "$blender_pid" 2> /dev/null && [[ $waited -lt $timeout_s ]]; do
-    sleep 1
-    waited=$((waited + 1))
-done
-if kill -0 "$blender_pid" 2> /dev/null; then
-    kill "$blender_pid"
-    sleep 5
-    kill -9 "$blender_pid" 2> /dev/null || true
-    tail -n 20 "$tmp/blender.log"
-    fail "Blender rendered within ${timeout_s} s (stopped: pid $blender_pid)"
-    blender_pid=
-    finish
-fi
-set +e
-wait "$blender_pid"
-status=$?
-set -e
-blender_pid=
-grep "^render_and_check: " "$tmp/blender.log" | sed 's/^/      /'
-if [[ $status -ne 0 || ! -s $out/manifest.jsonl || ! -s $out/checks.json ]]; then
+run_blender "$here/render_and_check.py" "$out" "$models/stanford-bunny.obj"
+if [[ $blender_status -ne 0 || ! -s $out/manifest.jsonl || ! -s $out/checks.json ]]; then
     tail -n 30 "$tmp/blender.log"
-    fail "Blender rendered the frames and wrote the manifest (exit status $status)"
+    fail "Blender rendered the frames and wrote the manifest (exit status $blender_status)"
     finish
 fi
 pass "Blender rendered 10 frames, exported the scene and wrote the manifest with zcheck.blender"
