@@ -416,6 +416,63 @@ TEST_CASE("verify of a lens camera's map: the truth passes, a distortion mistake
                         Catch::Contains("a window map cannot come from a lens model (opencv)"));
 }
 
+TEST_CASE("verify of a lens camera's map: declared accuracies are judged as a linear camera's, and accept no wrong map", "[lens]")
+{
+    // Regression: a lens map's --quantum widened each pixel's tolerance, but nothing judged the
+    // declaration as a whole — a grid as coarse as the depths (--quantum 5) accepted any map —
+    // and --rel-tolerance, --abs-tolerance and noise were refused outright.
+    const Checker checker(builtinScene("default"));
+    const MapVerifier verifier(checker);
+    const Camera camera(lensSpec({"opencv_fisheye", {180, 180, 159.5, 119.5, 0.02, -0.004}}, 320, 240,
+                                 View::lookAt({0.3, 0.8, 2.5}, {0, 0, 0}, {0, 1, 0})));
+    const auto verdict = [&](DepthMap map, MapAccuracy accuracy) {
+        map.accuracy = accuracy;
+        return verifier.verify(camera, map).report.comparison;
+    };
+    for (const DepthQuantity quantity : {DepthQuantity::Distance, DepthQuantity::EyeZ}) {
+        INFO(toString(quantity));
+        const DepthMap exact = renderedMap(checker, camera, quantity);
+        // Unbiased relative noise of up to ±5·10⁻⁴: rejected as exact, accepted under --rel-tolerance 1e-3.
+        std::mt19937 random(7);
+        std::uniform_real_distribution<double> noise(-5e-4, 5e-4);
+        DepthMap noisy = exact;
+        for (double& v : noisy.value) v = v > 0 ? v * (1 + noise(random)) : v;
+        MapAccuracy relative;
+        relative.relative = 1e-3;
+        REQUIRE(!verdict(noisy, {}).consistent());
+        const ComparisonReport accepted = verdict(noisy, relative);
+        REQUIRE(accepted.consistent());
+        REQUIRE(accepted.agree > 40000);
+        // The same tolerance absorbs no scale: 4·10⁻⁴ long everywhere is within each pixel's
+        // ±10⁻³, and refused as systematic.
+        DepthMap scaled = exact;
+        for (double& v : scaled.value) v *= 1.0004;
+        const ComparisonReport biased = verdict(scaled, relative);
+        REQUIRE(!biased.consistent());
+        REQUIRE_THAT(biased.declaredAccuracyRefused, Catch::Contains("systematic"));
+        // An absolute tolerance likewise: a map 2 mm far with --abs-tolerance 0.005.
+        DepthMap offset = exact;
+        for (double& v : offset.value) v = v > 0 ? v + 0.002 : v;
+        MapAccuracy absolute;
+        absolute.absolute = 0.005;
+        REQUIRE_THAT(verdict(offset, absolute).declaredAccuracyRefused, Catch::Contains("systematic"));
+        // Millimetres: the values rounded to 0.001 pass with --quantum 0.001, not without it; the
+        // exact map with --quantum 0.001 is not on that grid; --quantum 5 is as coarse as the depths.
+        DepthMap millimetres = exact;
+        for (double& v : millimetres.value) v = std::round(v * 1000) / 1000;
+        MapAccuracy grid;
+        grid.quantum = 0.001;
+        REQUIRE(!verdict(millimetres, {}).consistent());
+        REQUIRE(verdict(millimetres, grid).consistent());
+        REQUIRE_THAT(verdict(exact, grid).declaredAccuracyRefused, Catch::Contains("not the map's grid"));
+        MapAccuracy coarse;
+        coarse.quantum = 5;
+        DepthMap fives = exact;
+        for (double& v : fives.value) v = v > 0 ? 5.0 : v;
+        REQUIRE_THAT(verdict(fives, coarse).declaredAccuracyRefused, Catch::Contains("as coarse as the depths"));
+    }
+}
+
 TEST_CASE("verify of a lens camera's map: a depth outside the lens's field is the map's invention", "[lens]")
 {
     const Checker checker(builtinScene("default"));

@@ -435,17 +435,6 @@ double truthValueAt(const Camera& camera, const RenderResult& truth, int col, in
 
 namespace {
 
-// One pixel judgeDeclaredAccuracy weighs, in the map's units.
-struct DeclaredPixel {
-    double error;          // map − truth (the truth rounded to the declared grid, if any)
-    double intrinsic;      // C·q + S·m + E, the tolerance of a map declaring nothing
-    double declared;       // ValueAccuracy::declaredAt
-    double relativeEyeZ;   // the declared accuracy as a fraction of the pixel's eye-z
-    bool onGrid;           // within 1/1000 of Q (or four binary32 spacings) of a multiple of Q
-    int col, row;
-    double value;          // the map's
-};
-
 // The median of one field of `pixels`.
 double medianOfField(const std::vector<DeclaredPixel>& pixels, double DeclaredPixel::*field)
 {
@@ -527,13 +516,7 @@ std::vector<DeclaredPixel> declaredPixels(const PixelJudge& judge, const DepthMa
                 const double z = eyeZOfValue(side);
                 relativeEyeZ = std::max(relativeEyeZ, std::isfinite(z) && z > 0 ? std::abs(z - trueEyeZ) / trueEyeZ : INFINITY);
             }
-            bool onGrid = true;
-            if (Q > 0) {
-                const double u = v - map.offset;
-                const float f = float(std::abs(v));
-                const double spacing = double(std::nextafter(f, INFINITY)) - double(f);
-                onGrid = std::abs(u / Q - std::round(u / Q)) * Q <= std::max(1e-3 * Q, 4 * spacing);
-            }
+            const bool onGrid = Q > 0 ? onDeclaredGrid(v, Q, map.offset) : true;
             // Against the truth as the declared grid rounds it: a rounding's own error is not a bias.
             const double expected = Q > 0 ? std::round((trueValue - map.offset) / Q) * Q + map.offset : trueValue;
             rows[std::size_t(row)].push_back({v - expected, intrinsic, declared, relativeEyeZ, onGrid, col, row, v});
@@ -604,17 +587,31 @@ std::string biasRefusal(double Q, const std::vector<DeclaredPixel>& all)
 
 }  // namespace
 
-void judgeDeclaredAccuracy(const PixelJudge& judge, const DepthMap& map, const RenderResult& truth,
-                           const RenderResult& mapRender, const std::vector<double>& quantum, Comparison& comparison)
+bool onDeclaredGrid(double value, double Q, double offset)
 {
-    std::string& refused = comparison.report.declaredAccuracyRefused;
-    refused = holesRefusal(map, comparison.report);
-    if (!refused.empty() || !map.accuracy.anyAccuracy()) return;
-    const std::vector<DeclaredPixel> all = declaredPixels(judge, map, truth, mapRender, quantum, comparison);
-    if (all.empty()) return;
+    const double u = value - offset;
+    const float f = float(std::abs(value));
+    const double spacing = double(std::nextafter(f, INFINITY)) - double(f);
+    return std::abs(u / Q - std::round(u / Q)) * Q <= std::max(1e-3 * Q, 4 * spacing);
+}
+
+std::string declaredAccuracyRefusal(const DepthMap& map, const ComparisonReport& report, const std::vector<DeclaredPixel>& all)
+{
+    std::string refused = holesRefusal(map, report);
+    if (!refused.empty() || !map.accuracy.anyAccuracy() || all.empty()) return refused;
     refused = coarseRefusal(all);
     if (refused.empty()) refused = gridRefusal(map.accuracy.quantum, all);
     if (refused.empty()) refused = biasRefusal(map.accuracy.quantum, all);
+    return refused;
+}
+
+void judgeDeclaredAccuracy(const PixelJudge& judge, const DepthMap& map, const RenderResult& truth,
+                           const RenderResult& mapRender, const std::vector<double>& quantum, Comparison& comparison)
+{
+    const bool weighs = holesRefusal(map, comparison.report).empty() && map.accuracy.anyAccuracy();
+    const std::vector<DeclaredPixel> all =
+        weighs ? declaredPixels(judge, map, truth, mapRender, quantum, comparison) : std::vector<DeclaredPixel>{};
+    comparison.report.declaredAccuracyRefused = declaredAccuracyRefusal(map, comparison.report, all);
 }
 
 void measureMapErrors(const Camera& camera, const DepthMap& map, VerifyResult& run)

@@ -145,6 +145,24 @@ EdgeTally tallyEdges(const Camera& camera, const RenderResult& truth, const Rend
 void judgeDeclaredAccuracy(const PixelJudge& judge, const DepthMap& map, const RenderResult& truth,
                            const RenderResult& mapRender, const std::vector<double>& quantum, Comparison& comparison);
 
+// One pixel those rules weigh, in the map's units: a pixel compared on depth (Agree,
+// DepthError) where the map shows the truth's own surface and holds a depth of its quantity.
+struct DeclaredPixel {
+    double error;          // map − truth (the truth rounded to the declared grid, if any)
+    double intrinsic;      // C·q + S·m + E, the tolerance of a map declaring nothing
+    double declared;       // ValueAccuracy::declaredAt
+    double relativeEyeZ;   // the declared accuracy as a fraction of the pixel's eye-z
+    bool onGrid;           // within 1/1000 of Q (or four binary32 spacings) of a multiple of Q
+    int col, row;
+    double value;          // the map's
+};
+// Whether `value` (less `offset`) lies on the declared grid Q's multiples, as DeclaredPixel::onGrid says (Q > 0).
+bool onDeclaredGrid(double value, double Q, double offset);
+// The rules above over `all` (in scan order) and the report's holes: why the map's declarations
+// cannot stand, or "" (also when it declares nothing). The one judgement of declared accuracies,
+// for a linear camera's map (judgeDeclaredAccuracy) and a lens camera's (verifyLensMap).
+std::string declaredAccuracyRefusal(const DepthMap& map, const ComparisonReport& report, const std::vector<DeclaredPixel>& all);
+
 // The map's errors in its own units (report.mapErrors, mapError per pixel), from a comparison
 // of it: MapVerifier::verify's last step (a diagnosis's readings skip it).
 void measureMapErrors(const Camera& camera, const DepthMap& map, VerifyResult& run);
