@@ -14,6 +14,7 @@
 #include "zcheck/verify_map.h"
 
 #include <catch2/catch.hpp>
+#include <glm/gtc/matrix_transform.hpp>
 
 #include <cmath>
 #include <functional>
@@ -623,6 +624,42 @@ TEST_CASE("the diagnosis names the lens family's mistakes", "[lens][diagnose]")
     REQUIRE(fisheyeDiagnosis.front().name == "fisheye-model");
     REQUIRE(fisheyeDiagnosis.front().variant == "equisolid");
     REQUIRE(fisheyeDiagnosis.front().explains());
+}
+
+TEST_CASE("the diagnosis of a lens map names what its reading should declare and the pose's mistakes", "[lens][diagnose]")
+{
+    // Regression: the lens diagnosis knew only the lens family, so a fisheye map holding Cycles'
+    // 1e10 where nothing is hit, one rounded to millimetres, or one of a mesh turned Y-up to Z-up
+    // had no name at all.
+    const Checker checker(builtinScene("default"));
+    const MapVerifier verifier(checker);
+    const CameraSpec spec = lensSpec({"opencv_fisheye", {120, 120, 159.5, 119.5, 0.02, -0.004}}, 320, 240,
+                                     View::lookAt({0.3, 0.8, 2.5}, {0, 0, 0}, {0, 1, 0}));
+    const Camera camera(spec);
+    const DepthMap exact = renderedMap(checker, camera, DepthQuantity::Distance);
+    const auto best = [&](const DepthMap& map) {
+        const VerifyResult run = verifier.verify(camera, map);
+        REQUIRE(!run.report.comparison.consistent());
+        const std::vector<Hypothesis> diagnosis = verifier.diagnose(camera, map);
+        REQUIRE(!diagnosis.empty());
+        REQUIRE(diagnosis.front().explains());
+        return diagnosis.front();
+    };
+    DepthMap background = exact;  // Cycles' Z pass: 1e10 where no surface is
+    for (double& v : background.value) v = v > 0 ? v : 1e10;
+    const Hypothesis miss = best(background);
+    REQUIRE(miss.name == "miss-value");
+    REQUIRE_THAT(miss.explanation, Catch::Contains(">=1e9"));
+    DepthMap millimetres = exact;
+    for (double& v : millimetres.value) v = std::round(v * 1000) / 1000;
+    REQUIRE(best(millimetres).name == "quantum");
+    // The renderer's mesh turned −90° about x (Blender's OBJ import: Y-up read as Z-up).
+    CameraSpec turned = spec;
+    turned.view.hasMatrix = true;
+    turned.view.eyeFromWorld = camera.eyeFromWorld * glm::rotate(glm::dmat4(1.0), glm::radians(-90.0), glm::dvec3(1, 0, 0));
+    const Hypothesis upAxis = best(renderedMap(checker, Camera(turned), DepthQuantity::Distance));
+    REQUIRE(upAxis.name == "mesh-up-axis");
+    REQUIRE(upAxis.variant == "−90° about x");
 }
 
 TEST_CASE("the diagnosis of a pinhole's map made through a lens fits the lens it left out", "[lens][diagnose]")

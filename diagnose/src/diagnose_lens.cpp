@@ -4,13 +4,21 @@
 // quantity it wrote, the image order it stored — under which the map is re-read and judged by a
 // full verification (verifyLensMap, or the linear one for a pinhole); the suite injects the same
 // definitions. When none explains the map:
+//   miss-value, quantum, holes   what the map's values say its reading should have declared
+//                             (declared_reading.h: Cycles' 1e10 outside a fisheye's circle, a
+//                             millimetre grid, a sensor's holes), each alone and all together;
+//   the catalogue's pose mistakes  mistakes.h's re-readings that change the view alone (inverted,
+//                             OpenCV/OpenGL axes, a transposed rotation or 4×4, a quaternion's
+//                             order, the translation's units, the mesh's up axis), through the lens;
 //   fitted-radial-distortion  k1, k2 of a radial lens with the camera's K fitted to the map (rays
 //                             traced per sample, Levenberg–Marquardt), then verified in full
 #include "verify_estimators.h"
 
+#include "zcheck/declared_reading.h"
 #include "zcheck/error.h"
 #include "zcheck/inverse_projection.h"
 #include "zcheck/lens_mistakes.h"
+#include "zcheck/mistakes.h"
 #include "zcheck/map_verifier.h"
 #include "zcheck/remap.h"
 
@@ -35,6 +43,103 @@ Hypothesis judged(const MapVerifier& verifier, const Camera& camera, const Depth
     h.unexplained = r.unexplained();
     h.compared = r.bothHit + r.rayOnly + r.rasterOnly;
     return h;
+}
+
+// What the map's values say its reading should have declared, judged through the lens camera:
+// each finding alone, then all of them (Diagnosis::judgeDeclaredReadings's rule for any camera).
+std::vector<Hypothesis> declaredLensReadings(const MapVerifier& verifier, const Camera& camera, const DepthMap& map)
+{
+    const RenderResult truth = verifier.checker().renderRay(camera);
+    ReadingFindings findings = findReading(camera, map, truth);
+    Declared found{findings.missValue.has_value(), findings.grid > 0, false};
+    {  // holes: the pixels only the truth hits left unexplained once the miss value is read as one
+        const VerifyResult run = verifier.verify(camera, declaredReading(map, findings, found));
+        findings.holes = std::count(run.comparison.pixelClass.begin(), run.comparison.pixelClass.end(), PixelClass::RayOnly);
+        found.holes = findings.holes > 0 && !map.accuracy.allowHoles;
+    }
+    std::vector<Declared> readings;
+    for (const auto member : {&Declared::missValue, &Declared::grid, &Declared::holes})
+        if (found.*member) {
+            Declared alone;
+            alone.*member = true;
+            readings.push_back(alone);
+        }
+    if (readings.size() > 1) readings.push_back(found);
+    std::vector<Hypothesis> out(readings.size());
+    tbb::parallel_for(std::size_t(0), readings.size(), [&](std::size_t k) {
+        out[k] = judged(verifier, camera, declaredReading(map, findings, readings[k]), readings[k].name(), "",
+                        "consistent if read as declared: " + describeFindings(findings, readings[k]));
+    });
+    return out;
+}
+
+// The catalogue's re-readings (mistakes.h) that keep the lens, the convention, the map and the
+// truth's sampling and change the view alone: the pose's mistakes, through the lens camera.
+// Those the lens family has its own form of (the image's flips and shifts, the principal point,
+// the quantity) are the lens family's; handedness, a mirrored eye x axis, is its x-flip.
+std::vector<LensMistake> poseMistakes(const Camera& camera, const DepthMap& map)
+{
+    std::vector<LensMistake> out;
+    for (const Mistake& mistake : mistakeCatalogue()) {
+        if (!mistake.reread || mistake.name == "handedness") continue;
+        std::vector<Rereading> readings;
+        try {
+            readings = mistake.reread(camera, map);
+        } catch (const Error&) {
+            continue;
+        }
+        for (const Rereading& r : readings) {
+            if (!r.camera || r.map || !r.truthFaults.none()) continue;
+            const Projection& p = r.camera->projection;
+            const Projection& declared = camera.spec().projection;
+            if (p.type != ProjectionType::NonLinear || !(p.lens == declared.lens) || p.near != declared.near ||
+                p.far != declared.far || r.camera->convention.name != camera.convention().name ||
+                r.camera->width != camera.width() || r.camera->height != camera.height())
+                continue;
+            out.push_back({mistake.name, r.variant, r.explanation, *r.camera, std::nullopt, 0});
+        }
+    }
+    return out;
+}
+
+// Each hypothesis ruled out on a 1-in-16 sample first where it is a lens camera's (see
+// diagnoseLensMap), else judged in full; none where the variant is no valid camera.
+std::vector<Hypothesis> judgedMistakes(const MapVerifier& verifier, const Camera& camera, const DepthMap& map,
+                                       const std::vector<LensMistake>& candidates)
+{
+    std::vector<std::optional<Hypothesis>> judgedOnes(candidates.size());
+    tbb::parallel_for(std::size_t(0), candidates.size(), [&](std::size_t k) {
+        const LensMistake& c = candidates[k];
+        try {
+            DepthMap reread = flippedMap(map, c.flip);
+            if (c.quantity) reread.quantity = *c.quantity;
+            const Camera used(c.camera ? *c.camera : camera.spec());
+            // A lens camera's hypothesis is ruled out on a 1-in-16 sample first (verifyLensMap's
+            // rule): one leaving a fifth of the sampled pixels unexplained cannot explain the map
+            // (explains() allows a tenth, at edges), and most of the catalogue's hypotheses leave
+            // most pixels unexplained. A pinhole's (distortion-ignored, undistorted-new-k) is
+            // judged by the linear verification, in full: its lens twin (opencv without
+            // coefficients) has the same rays but clips at near and far distances where the pinhole
+            // clips at planes, and screening through it ruled out true hypotheses where geometry
+            // crosses the near plane (builtin:near-crossing).
+            constexpr int kStride = 4;
+            const LensSample sample = used.lens() ? judgeLensMapOnGrid(verifier.checker(), used, reread, kStride) : LensSample{};
+            if (sample.unexplained >= 8 && sample.unexplained * 5 > sample.compared) {
+                Hypothesis h;
+                h.name = c.name, h.variant = c.variant, h.explanation = c.explanation;
+                h.estimated = true;
+                h.unexplained = sample.unexplained * kStride * kStride;
+                judgedOnes[k] = std::move(h);
+                return;
+            }
+            judgedOnes[k] = judged(verifier, used, reread, c.name, c.variant, c.explanation);
+        } catch (const Error&) {  // a variant that is no valid camera is no hypothesis
+        }
+    });
+    std::vector<Hypothesis> out;
+    for (auto& h : judgedOnes)
+        if (h) out.push_back(std::move(*h));
+    return out;
 }
 
 }  // namespace
@@ -164,40 +269,13 @@ std::optional<Hypothesis> fitRadialDistortion(const MapVerifier& verifier, const
 
 std::vector<Hypothesis> diagnoseLensMap(const MapVerifier& verifier, const Camera& camera, const DepthMap& map)
 {
-    const std::vector<LensMistake> candidates = lensMistakes(camera, map.quantity);
-    std::vector<std::optional<Hypothesis>> judgedOnes(candidates.size());
-    tbb::parallel_for(std::size_t(0), candidates.size(), [&](std::size_t k) {
-        const LensMistake& c = candidates[k];
-        try {
-            DepthMap reread = flippedMap(map, c.flip);
-            if (c.quantity) reread.quantity = *c.quantity;
-            const Camera used(c.camera ? *c.camera : camera.spec());
-            // A lens camera's hypothesis is ruled out on a 1-in-16 sample first (verifyLensMap's
-            // rule): one leaving a fifth of the sampled pixels unexplained cannot explain the map
-            // (explains() allows a tenth, at edges), and most of the catalogue's hypotheses leave
-            // most pixels unexplained. A pinhole's (distortion-ignored, undistorted-new-k) is
-            // judged by the linear verification, in full: its lens twin (opencv without
-            // coefficients) has the same rays but clips at near and far distances where the pinhole
-            // clips at planes, and screening through it ruled out true hypotheses where geometry
-            // crosses the near plane (builtin:near-crossing).
-            constexpr int kStride = 4;
-            const LensSample sample = used.lens() ? judgeLensMapOnGrid(verifier.checker(), used, reread, kStride) : LensSample{};
-            if (sample.unexplained >= 8 && sample.unexplained * 5 > sample.compared) {
-                Hypothesis h;
-                h.name = c.name, h.variant = c.variant, h.explanation = c.explanation;
-                h.estimated = true;
-                h.unexplained = sample.unexplained * kStride * kStride;
-                judgedOnes[k] = std::move(h);
-                return;
-            }
-            judgedOnes[k] = judged(verifier, used, reread, c.name, c.variant, c.explanation);
-        } catch (const Error&) {  // a variant that is no valid camera is no hypothesis
-        }
-    });
-    std::vector<Hypothesis> out;
-    for (auto& h : judgedOnes)
-        if (h) out.push_back(std::move(*h));
-    if (std::none_of(out.begin(), out.end(), [](const Hypothesis& h) { return h.explains(); }))
+    std::vector<Hypothesis> out = judgedMistakes(verifier, camera, map, lensMistakes(camera, map.quantity));
+    const auto explained = [&] { return std::any_of(out.begin(), out.end(), [](const Hypothesis& h) { return h.explains(); }); };
+    if (!explained()) {
+        for (Hypothesis& h : declaredLensReadings(verifier, camera, map)) out.push_back(std::move(h));
+        for (Hypothesis& h : judgedMistakes(verifier, camera, map, poseMistakes(camera, map))) out.push_back(std::move(h));
+    }
+    if (!explained())
         if (std::optional<Hypothesis> fit = fitRadialDistortion(verifier, camera, map)) out.push_back(std::move(*fit));
     std::stable_sort(out.begin(), out.end(), [](const Hypothesis& a, const Hypothesis& b) {
         if (a.explains() != b.explains()) return a.explains();

@@ -1,6 +1,7 @@
 """A dataset of lens cameras verified as one command: a COLMAP model whose images use an
 OPENCV_FISHEYE and an OPENCV camera, with distance maps rendered through them; one frame's map made
-with the distortion left out is found and named."""
+with the distortion left out, and one made with the next frame's camera (a list shifted by one),
+are found and named."""
 import json
 
 import numpy as np
@@ -40,14 +41,19 @@ def lens_dataset(tmp_path_factory):
         f"{cid} {name} {W} {H} " + " ".join(repr(p) for p in params) + "\n" for cid, (name, params) in LENSES.items()))
     images, depth = [], root / "depth"
     depth.mkdir()
+    def lens_of(i):
+        return LENSES[1 if i % 2 == 0 else 2]
     for i, pose in enumerate(trajectory.poses):
         cid = 1 if i % 2 == 0 else 2
-        name, params = LENSES[cid]
+        name, params = lens_of(i)
         # COLMAP's qvec, tvec of the OpenCV cam_from_world.
         q, t = list(quaternion_of(pose[:3, :3])), list(pose[:3, 3])
         images.append(f"{i + 1} " + " ".join(repr(float(v)) for v in q + t) + f" {cid} frame_{i:03d}.png\n\n")
         distortion = i != 3  # frame 3: rendered through the pinhole of its K, the lens left out
-        distance = checker.render(camera_for(name, params, pose, distortion), "distance", route="ray")
+        camera = camera_for(name, params, pose, distortion)
+        if i == 4:  # frame 4: rendered with frame 5's camera, lens and pose
+            camera = camera_for(*lens_of(5), trajectory.poses[5])
+        distance = checker.render(camera, "distance", route="ray")
         np.save(depth / f"frame_{i:03d}.npy", np.where(np.isfinite(distance), distance, 0).astype(np.float32))
     (model / "images.txt").write_text("".join(images))
     return root
@@ -68,5 +74,8 @@ def test_a_colmap_dataset_of_fisheye_and_distorted_cameras_verifies_and_names_th
         if i == 3:
             assert not record["consistent"], record
             assert record["diagnosis"][0]["hypothesis"] == "distortion-ignored", record["diagnosis"][:2]
+        elif i == 4:
+            assert not record["consistent"], record
+            assert record["diagnosis"][0]["hypothesis"] == "next-frame-camera", record["diagnosis"][:2]
         else:
             assert record["consistent"], record
