@@ -108,6 +108,19 @@ ReadingFindings findReading(const Camera& camera, const DepthMap& map, const Ren
     return out;
 }
 
+std::vector<Declared> Declared::readingsToTry() const
+{
+    std::vector<Declared> readings;
+    for (const auto member : {&Declared::missValue, &Declared::grid, &Declared::holes})
+        if (this->*member) {
+            Declared alone;
+            alone.*member = true;
+            readings.push_back(alone);
+        }
+    if (readings.size() > 1) readings.push_back(*this);
+    return readings;
+}
+
 std::string Declared::name() const
 {
     std::string out;

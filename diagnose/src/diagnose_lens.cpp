@@ -57,14 +57,7 @@ std::vector<Hypothesis> declaredLensReadings(const MapVerifier& verifier, const 
         findings.holes = std::count(run.comparison.pixelClass.begin(), run.comparison.pixelClass.end(), PixelClass::RayOnly);
         found.holes = findings.holes > 0 && !map.accuracy.allowHoles;
     }
-    std::vector<Declared> readings;
-    for (const auto member : {&Declared::missValue, &Declared::grid, &Declared::holes})
-        if (found.*member) {
-            Declared alone;
-            alone.*member = true;
-            readings.push_back(alone);
-        }
-    if (readings.size() > 1) readings.push_back(found);
+    const std::vector<Declared> readings = found.readingsToTry();
     std::vector<Hypothesis> out(readings.size());
     tbb::parallel_for(std::size_t(0), readings.size(), [&](std::size_t k) {
         out[k] = judged(verifier, camera, declaredReading(map, findings, readings[k]), readings[k].name(), "",

@@ -253,14 +253,7 @@ void Diagnosis::judgeDeclaredReadings()
         findings_.holes = std::count(run.comparison.pixelClass.begin(), run.comparison.pixelClass.end(), PixelClass::RayOnly);
         found_.holes = findings_.holes > 0 && !map_.accuracy.allowHoles;
     }
-    std::vector<Declared> readings;  // each finding alone, then all of them
-    for (const auto member : {&Declared::missValue, &Declared::grid, &Declared::holes})
-        if (found_.*member) {
-            Declared alone;
-            alone.*member = true;
-            readings.push_back(alone);
-        }
-    if (readings.size() > 1) readings.push_back(found_);
+    const std::vector<Declared> readings = found_.readingsToTry();
     std::vector<Hypothesis> judged(readings.size());
     tbb::parallel_for(std::size_t(0), readings.size(), [&](std::size_t k) {
         judged[k] = judgeReading(readings[k], declaredReading(map_, findings_, readings[k]), "");

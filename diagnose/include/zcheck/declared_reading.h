@@ -54,6 +54,8 @@ struct Declared {
     bool any() const { return missValue || grid || holes; }
     // "miss-value", "quantum", "holes", joined by " + " ("" for none): the hypothesis's name.
     std::string name() const;
+    // The readings a diagnosis tries for these findings: each alone, then (if more than one) all.
+    std::vector<Declared> readingsToTry() const;
 };
 
 // The findings of a map against the declared camera's ground truth (already rendered).
