@@ -303,6 +303,27 @@ TEST_CASE("pixels beyond a fold outside the image's inscribed disc have no ray: 
     REQUIRE(!lens.imageFromDirection(direction(lens.fieldAngle() + 1e-6, 0.3)).has_value());
 }
 
+TEST_CASE("a lens spec without its trailing zero parameters is written and re-read by the mistakes in full", "[lens]")
+{
+    // Regression (found by AddressSanitizer in the suite's lens part): an opencv lens of 5
+    // coefficients (9 parameters of 18) was written to JSON, and re-read by the lens mistakes, by
+    // the model's 18 indices, reading past the end of its parameters.
+    const CameraSpec spec = lensSpec({"opencv", {140, 140, 99.5, 74.5, -0.2, 0.05, 0.003, -0.002, -0.01}});
+    const Camera camera(spec);
+    const CameraSpec back = cameraSpecFromJsonText(cameraJsonText(spec), "written");
+    REQUIRE(Camera(back).lens()->terms().numerator[0] == -0.2);
+    REQUIRE(Camera(back).lens()->terms().tauX == 0);
+    bool flipped = false;
+    for (const LensMistake& m : lensMistakes(camera, DepthQuantity::Distance))
+        if (m.name == "distortion-signs-flipped") {
+            flipped = true;
+            REQUIRE(m.camera->projection.lens.params[4] == 0.2);
+            REQUIRE(m.camera->projection.lens.params[8] == 0.01);
+            for (std::size_t i = 9; i < m.camera->projection.lens.params.size(); ++i) REQUIRE(m.camera->projection.lens.params[i] == 0);
+        }
+    REQUIRE(flipped);
+}
+
 TEST_CASE("metashape fisheye's field ends at 90 degrees, where the manual's formula stops", "[lens]")
 {
     // The manual's x0 = X/Z divides by Z: a direction 100° off the axis has no pixel, and the

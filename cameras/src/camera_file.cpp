@@ -382,7 +382,9 @@ json toJson(const CameraSpec& spec)
             projection["cx"] = p.lens.params[2], projection["cy"] = p.lens.params[3];
         else
             projection.erase("type");
-        for (std::size_t i = hasK ? 4 : 0; i < info.params.size(); ++i) lens[info.params[i]] = p.lens.params[i];
+        // Every parameter of the model; those a shorter spec leaves out are 0 (lens.h).
+        for (std::size_t i = hasK ? 4 : 0; i < info.params.size(); ++i)
+            lens[info.params[i]] = i < p.lens.params.size() ? p.lens.params[i] : 0.0;
         break;
     }
     case ProjectionType::Perspective:

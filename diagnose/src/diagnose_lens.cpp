@@ -143,7 +143,8 @@ std::optional<Hypothesis> fitRadialDistortion(const MapVerifier& verifier, const
     // radial terms around the pinhole's K.
     LensSpec start;
     if (const LensModel* lens = camera.lens()) {
-        start = lens->spec();
+        start = lens->spec();  // every parameter, the trailing ones a file may leave out 0 (lens.h)
+        start.params.resize(std::max(start.params.size(), lens->info().params.size()), 0.0);
     } else if (camera.spec().projection.type == ProjectionType::Pinhole) {
         const Projection& p = camera.spec().projection;
         start = {"opencv", {p.fx, p.fy, p.cx, p.cy, 0, 0}};

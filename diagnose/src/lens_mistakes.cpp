@@ -45,8 +45,11 @@ std::vector<LensMistake> lensMistakes(const Camera& camera, DepthQuantity declar
 {
     std::vector<LensMistake> out;
     const LensModel& lens = *camera.lens();
-    const LensSpec& spec = lens.spec();
     const LensModelInfo& info = lens.info();
+    // Every parameter of the model, the trailing ones a file may leave out 0 (lens.h): the
+    // mistakes below read and write them by the model's index.
+    LensSpec spec = lens.spec();
+    spec.params.resize(std::max(spec.params.size(), info.params.size()), 0.0);
     const bool hasK = info.startsWithK();
     if (hasK) {
         CameraSpec pinhole = camera.spec();
