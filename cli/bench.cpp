@@ -1,6 +1,7 @@
-// zcheck bench: how fast a whole check runs, phase by phase, and (--reference) how that
-// compares with what the checked pipelines themselves cost: Mesa's llvmpipe drawing the same
-// depth buffer, and Embree tracing the same rays at its best. Not a test: it measures.
+// zcheck bench: how fast a whole check runs, phase by phase, in one kernel form or several side by
+// side (--kernels), and (--reference) how that compares with what the checked pipelines
+// themselves cost: Mesa's llvmpipe drawing the same depth buffer, and Embree tracing the same
+// rays at its best. Not a test: it measures.
 #include "common.h"
 #include "plugin.h"
 
@@ -11,6 +12,7 @@
 #include "zcheck/error.h"
 #include "zcheck/export.h"
 #include "zcheck/gl_reference.h"
+#include "zcheck/kernel_form.h"
 #include "zcheck/large_buffer.h"
 #include "zcheck/mesh_loader.h"
 
@@ -24,9 +26,11 @@
 #include <fstream>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <numeric>
+#include <optional>
 #include <thread>
 #include <type_traits>
 
@@ -264,8 +268,73 @@ struct BenchOptions {
     ImageSize imageSize;
     int repeat = 5;
     int threads = 0;
+    std::string kernels = "auto";
     bool reference = false;
     bool json = false;
+};
+
+constexpr KernelForm kAllForms[] = {KernelForm::Baseline, KernelForm::Avx2, KernelForm::Avx512};
+
+// The forms --kernels names, in its order: `auto` the one kernelForm() gives (ZCHECK_KERNELS or
+// the processor; a bad ZCHECK_KERNELS throws its Error), `all` every form this processor has
+// (baseline, avx2, avx512), else a comma-separated list of forms, each once and each one this
+// processor has. Throws Error naming the value otherwise.
+std::vector<KernelForm> kernelFormsOf(const std::string& kernels)
+{
+    if (kernels == "auto") return {kernelForm()};
+    std::vector<KernelForm> forms;
+    std::string supported;
+    for (KernelForm form : kAllForms)
+        if (kernelFormSupported(form)) forms.push_back(form), supported += (supported.empty() ? "" : ", ") + std::string(nameOf(form));
+    if (kernels == "all") return forms;
+    forms.clear();
+    for (std::size_t begin = 0; begin <= kernels.size();) {
+        const std::size_t end = std::min(kernels.find(',', begin), kernels.size());
+        const std::string name = kernels.substr(begin, end - begin);
+        begin = end + 1;
+        const KernelForm* form = std::find_if(std::begin(kAllForms), std::end(kAllForms),
+                                              [&](KernelForm f) { return name == nameOf(f); });
+        if (form == std::end(kAllForms))
+            throw Error("--kernels '" + kernels + "': '" + name + "' is not a kernel form: give auto, all, or a " +
+                        "comma-separated list of baseline, avx2 and avx512");
+        if (!kernelFormSupported(*form))
+            throw Error("--kernels '" + kernels + "': this processor cannot run the " + name + " form; it has " + supported);
+        if (std::find(forms.begin(), forms.end(), *form) != forms.end())
+            throw Error("--kernels '" + kernels + "' names " + name + " twice: give each form once");
+        forms.push_back(*form);
+    }
+    return forms;
+}
+
+// "avx2", or the forms joined as --kernels takes them: "baseline,avx2,avx512".
+std::string namesOf(const std::vector<KernelForm>& forms)
+{
+    std::string names;
+    for (KernelForm form : forms) names += (names.empty() ? "" : ",") + std::string(nameOf(form));
+    return names;
+}
+
+// ZCHECK_KERNELS set to `form` for this object's lifetime (kernel_form.h: read when a renderer,
+// frame or comparison is made, so a child forked meanwhile runs in that form), then restored as
+// it was (unset if it was). setenv is not thread-safe: made and ended only where no other thread
+// can read the environment (before TBB starts, or with its workers idle).
+class KernelsEnvironment {
+public:
+    explicit KernelsEnvironment(KernelForm form)
+    {
+        if (const char* was = std::getenv("ZCHECK_KERNELS")) previous_ = was;
+        setenv("ZCHECK_KERNELS", nameOf(form), 1);
+    }
+    ~KernelsEnvironment()
+    {
+        if (previous_) setenv("ZCHECK_KERNELS", previous_->c_str(), 1);
+        else unsetenv("ZCHECK_KERNELS");
+    }
+    KernelsEnvironment(const KernelsEnvironment&) = delete;
+    KernelsEnvironment& operator=(const KernelsEnvironment&) = delete;
+
+private:
+    std::optional<std::string> previous_;
 };
 
 // One line a script can split on whitespace: name, median, best, an optional rate.
@@ -289,6 +358,277 @@ struct Ratio {
     bool met() const { return atMost ? value <= target : value >= target; }
 };
 
+// What every form's figures share: the scene and camera measured, and the memory budget.
+struct BenchSetting {
+    int threads;
+    bool lens;         // a lens camera: no raster route, its own costs measured (LensCosts)
+    bool isFile;       // the scene is a file (else built in), fileMB its size
+    double fileMB;
+    double pixels;
+    double bytesPerPixel, budgetMiB;
+};
+
+// One kernel form's measurements: every repeat's whole check (WholeCheck) and, for a lens
+// camera, its own costs (LensCosts), each in a child that ran in this form.
+struct FormPhases {
+    KernelForm form = KernelForm::Baseline;
+    Phase load, bvh, tiles, trace, raster, compare, whole, warmTrace, warmRaster, warmCompare;
+    Phase rayTable, rays, depthTrace, exportOneShot, exportTrace, exportWrite, warmExport;
+    std::size_t triangles = 0;
+    bool consistent = true;  // every repeat's check
+    double peakMiB = 0;      // the largest child's
+};
+
+// One more whole check into `f`, its child forked with ZCHECK_KERNELS = f's form.
+void addWholeCheck(FormPhases& f, const std::string& sceneName, const Camera& camera, int threads)
+{
+    const WholeCheck w = [&] {
+        const KernelsEnvironment inForm(f.form);
+        return wholeCheckInChild(sceneName, camera, threads);
+    }();
+    f.load.ms.push_back(w.loadMs), f.bvh.ms.push_back(w.bvhMs), f.tiles.ms.push_back(w.tilesMs), f.trace.ms.push_back(w.traceMs);
+    f.raster.ms.push_back(w.rasterMs), f.compare.ms.push_back(w.compareMs), f.whole.ms.push_back(w.wholeMs);
+    f.warmTrace.ms.push_back(w.warmTraceMs), f.warmRaster.ms.push_back(w.warmRasterMs);
+    f.warmCompare.ms.push_back(w.warmCompareMs);
+    f.triangles = w.triangles;
+    f.consistent = f.consistent && w.consistent;
+    f.peakMiB = std::max(f.peakMiB, w.peakMiB);
+}
+
+// One more measure of a lens camera's own costs into `f`, its child forked in f's form.
+void addLensCosts(FormPhases& f, const std::string& sceneName, const Camera& camera, int threads)
+{
+    const LensCosts c = [&] {
+        const KernelsEnvironment inForm(f.form);
+        return lensCostsInChild(sceneName, camera, threads);
+    }();
+    f.rayTable.ms.push_back(c.tableMs), f.rays.ms.push_back(c.raysMs), f.exportOneShot.ms.push_back(c.exportMs);
+    f.depthTrace.ms.push_back(c.depthTraceMs);
+    f.exportTrace.ms.push_back(c.exportTraceMs), f.exportWrite.ms.push_back(c.exportWriteMs);
+    f.warmExport.ms.push_back(c.warmExportMs);
+}
+
+// The yardsticks (--reference), measured once for every form: Embree's build and trace, and
+// llvmpipe's draw, each with the share of pixels that agree with zcheck's route.
+struct References {
+    Phase embreeBuild, embreeTrace, glDraw;
+    std::string glRenderer, glSkipped;
+    double glAgreement = NAN, embreeAgreement = NAN;
+};
+
+// The references: Embree's builds each in a child, as the check's are; its trace and
+// llvmpipe's draws repeated in this process (their own buffers reused, at their best). The
+// routes they are compared with run in `form` (every form draws the same pixels).
+References measureReferences(const std::string& sceneName, const Camera& camera, int threads, int repeat, KernelForm form,
+                             bool progress)
+{
+    References ref;
+    const KernelsEnvironment inForm(form);  // before TBB starts here
+    const bool lens = camera.lens() != nullptr;
+    const Scene scene = loadScene(sceneName);
+    if (progress) std::fprintf(stderr, "\rbench: Embree reference%20s", ""), std::fflush(stderr);
+    // Embree's build, like the check's, in a fresh process each time: in this process
+    // its repeats ran on memory earlier builds had faulted in (and varied 142-274 ms).
+    for (int r = 0; r < repeat; ++r)
+        ref.embreeBuild.ms.push_back(inChild<double>(threads, "Embree's reference build", [&] {
+            return reference::EmbreeReference(scene).buildMilliseconds();
+        }).first);
+    const reference::EmbreeReference embree(scene);  // built here only to be traced
+    std::vector<std::uint32_t> primitiveId;
+    embree.trace(camera, primitiveId);  // warm-up
+    for (int r = 0; r < repeat; ++r) ref.embreeTrace.ms.push_back(embree.trace(camera, primitiveId));
+    {  // The same rays? The primitive each pixel's ray hits, against the ray route's.
+        const RenderResult traced = RayRenderer(scene).render(camera);
+        std::size_t same = 0;
+        for (std::size_t i = 0; i < primitiveId.size(); ++i) same += primitiveId[i] == traced.primitiveId[i];
+        ref.embreeAgreement = double(same) / double(primitiveId.size());
+    }
+    if (progress) std::fprintf(stderr, "\rbench: llvmpipe reference%20s", ""), std::fflush(stderr);
+    const reference::GlYardstickFunctions* gl = nullptr;
+    if (lens) ref.glSkipped = "does not apply: a lens model has no projection matrix to draw through";
+    else try {
+        using Entry = const reference::GlYardstickFunctions* (*)();
+        gl = reinterpret_cast<Entry>(pluginEntry("libzcheck_gl_yardstick.so", "zcheck_gl_yardstick"))();
+    } catch (const std::runtime_error& e) {
+        ref.glSkipped = std::string("its plugin is missing (built only where libegl-dev is installed): ") + e.what();
+    }
+    if (gl) {
+        reference::GlDepthInput input;
+        input.positions = &scene.positions[0].x;
+        input.vertexCount = scene.positions.size();
+        input.indices = &scene.triangles[0].x;
+        input.triangleCount = scene.triangles.size();
+        for (int c = 0; c < 4; ++c)
+            for (int k = 0; k < 4; ++k) input.clipFromWorld[std::size_t(4 * c + k)] = camera.clipFromWorld[c][k];
+        input.width = camera.width(), input.height = camera.height();
+        input.reversedZ = camera.depth().reversed;
+        input.zeroToOne = camera.convention().ndcZMin() == 0.0;
+        input.threads = threads;
+        try {
+            const reference::GlDepthTiming drawn = gl->timeDraw(input, repeat);
+            const RenderResult lastRaster = RasterRenderer(scene).render(camera);
+            ref.glDraw.ms = drawn.drawMs;
+            ref.glRenderer = drawn.renderer;
+            // The same picture? Coverage and depth per pixel. OpenGL's window has y up; the
+            // camera's viewport may not (Vulkan, Direct3D, Metal): each pixel is found
+            // through NDC, where both agree.
+            const int W = camera.width(), H = camera.height();
+            auto pixelOf = [&](int glCol, int glRowFromTop) {
+                const glm::dvec2 pNdc(2.0 * (glCol + 0.5) / W - 1.0, 1.0 - 2.0 * (glRowFromTop + 0.5) / H);
+                const glm::dvec4 pWindow = camera.windowFromNdc * glm::dvec4(pNdc, 0.0, 1.0);
+                const int col = int(std::floor(pWindow.x)), row = int(std::floor(camera.imageYFromWindowY(pWindow.y)));
+                return std::size_t(row) * W + col;
+            };
+            std::size_t same = 0;
+            for (int row = 0; row < H && !drawn.depth.empty(); ++row)
+                for (int col = 0; col < W; ++col) {
+                    const float depth = drawn.depth[std::size_t(row) * W + col];
+                    const std::size_t i = pixelOf(col, row);
+                    const bool glHit = depth != float(camera.clearDepth());
+                    same += glHit == lastRaster.hit(i) && (!glHit || std::abs(depth - lastRaster.windowDepth.value[i]) <= 1e-5);
+                }
+            ref.glAgreement = drawn.depth.empty() ? NAN : double(same) / double(drawn.depth.size());
+        } catch (const std::exception& e) {
+            ref.glSkipped = e.what();
+        }
+    }
+    if (progress) std::fprintf(stderr, "\r%50s\r", "");
+    return ref;
+}
+
+// A form's ratios to the targets (docs/speed.md), against the references measured (none
+// without --reference); every form has the same ones, in the same order.
+std::vector<Ratio> ratiosOf(const FormPhases& f, const BenchSetting& s, const References& ref)
+{
+    const bool lens = s.lens;
+    std::vector<Ratio> ratios;
+    if (!lens) ratios.push_back({"compare/(trace+raster)", f.compare.median() / (f.trace.median() + f.raster.median()), 0.10, true});
+    ratios.push_back({"peak-rss/budget", f.peakMiB / s.budgetMiB, 1.0, true});
+    if (lens) {
+        ratios.push_back({"rays/trace", f.rays.median() / f.depthTrace.median(), 0.10, true});
+        ratios.push_back({"warm-export-seconds", f.warmExport.median() / 1e3, 0.5, true});
+    }
+    if (s.isFile) ratios.push_back({"load-MB/s", s.fileMB / (f.load.median() / 1e3), 150.0, false});
+    if (!ref.glDraw.ms.empty()) ratios.push_back({"raster/llvmpipe", f.raster.median() / ref.glDraw.median(), 0.33, true});
+    if (!ref.embreeTrace.ms.empty()) {
+        ratios.push_back({"trace-throughput/embree", ref.embreeTrace.median() / (lens ? f.depthTrace : f.trace).median(),
+                          lens ? 0.8 : 0.9, false});
+        if (!lens)
+            ratios.push_back({"whole/(load+embree-bvh+embree-trace)",
+                              f.whole.median() / (f.load.median() + ref.embreeBuild.median() + ref.embreeTrace.median()), 1.3,
+                              true});
+    }
+    // The same targets for the warm repeat (see WholeCheck): like for like with the
+    // yardsticks, which repeat on buffers they have touched before.
+    if (!lens)
+        ratios.push_back({"warm-compare/(trace+raster)", f.warmCompare.median() / (f.warmTrace.median() + f.warmRaster.median()),
+                          0.10, true});
+    if (!ref.glDraw.ms.empty()) ratios.push_back({"warm-raster/llvmpipe", f.warmRaster.median() / ref.glDraw.median(), 0.33, true});
+    if (!ref.embreeTrace.ms.empty() && !lens)
+        ratios.push_back({"warm-trace-throughput/embree", ref.embreeTrace.median() / f.warmTrace.median(), 0.9, false});
+    return ratios;
+}
+
+nlohmann::ordered_json phaseJson(const Phase& p)
+{
+    return nlohmann::ordered_json{{"median_ms", p.median()}, {"best_ms", p.best()}, {"ms", p.ms}};
+}
+
+// A form's own keys in --json: consistent, its phases, rates, peak RSS and ratios.
+nlohmann::ordered_json formJson(const FormPhases& f, const BenchSetting& s, const References& ref)
+{
+    nlohmann::ordered_json out;
+    out["consistent"] = f.consistent;
+    out["phases"] = {{"load", phaseJson(f.load)},     {"bvh", phaseJson(f.bvh)},         {"tiles", phaseJson(f.tiles)},
+                     {"trace", phaseJson(f.trace)},
+                     {"raster", phaseJson(f.raster)}, {"compare", phaseJson(f.compare)}, {"whole", phaseJson(f.whole)},
+                     {"warm_trace", phaseJson(f.warmTrace)}, {"warm_raster", phaseJson(f.warmRaster)},
+                     {"warm_compare", phaseJson(f.warmCompare)}};
+    if (s.lens)
+        out["lens_phases"] = {{"ray_table", phaseJson(f.rayTable)},         {"rays", phaseJson(f.rays)},
+                              {"depth_trace", phaseJson(f.depthTrace)},
+                              {"export", phaseJson(f.exportOneShot)},       {"export_trace", phaseJson(f.exportTrace)},
+                              {"export_write", phaseJson(f.exportWrite)},   {"warm_export", phaseJson(f.warmExport)}};
+    out["mrays_per_s"] = s.pixels / f.trace.median() / 1e3;
+    out["mtris_per_s"] = double(f.triangles) / f.raster.median() / 1e3;
+    out["peak_rss_mib"] = f.peakMiB;
+    if (s.isFile) out["load_mb_per_s"] = s.fileMB / (f.load.median() / 1e3);
+    out["ratios"] = nlohmann::ordered_json::object();
+    for (const Ratio& r : ratiosOf(f, s, ref))
+        out["ratios"][r.name] = {{"value", r.value}, {"target", r.target}, {"bound", r.atMost ? "at most" : "at least"}, {"met", r.met()}};
+    return out;
+}
+
+// A form's block of lines, from load to peak RSS.
+void printPhases(const FormPhases& f, const BenchSetting& s)
+{
+    const bool lens = s.lens;
+    const double pixels = s.pixels;
+    printPhase("load", f.load, s.isFile ? rate(s.fileMB / (f.load.median() / 1e3), "MB/s") : "(built in)");
+    printPhase("bvh build", f.bvh);
+    if (lens) printPhase("ray table", f.rayTable, rate(pixels / f.rayTable.median() / 1e3, "Mrays/s") + " (built once per intrinsics)");
+    printPhase("trace", f.trace, rate(pixels / f.trace.median() / 1e3, "Mrays/s") + (lens ? " (the table built; eye points kept)" : ""));
+    if (lens) {
+        printPhase("depth trace", f.depthTrace, rate(pixels / f.depthTrace.median() / 1e3, "Mrays/s") + " (the depth alone)");
+        printPhase("rays", f.rays, rate(pixels / f.rays.median() / 1e3, "Mrays/s") + " (every pixel's world ray from the table)");
+        std::printf("%-24s does not apply: a lens model has no projection matrix to rasterize through\n", "raster");
+        printPhase("lens check", f.compare, rate(pixels / f.compare.median() / 1e3, "Mpixels/s") + " (round trip and forward)");
+    } else {
+        printPhase("raster", f.raster, rate(double(f.triangles) / f.raster.median() / 1e3, "Mtris/s"));
+        printPhase("compare", f.compare);
+    }
+    printPhase("whole check", f.whole, "as zcheck check: load + bvh + tile by tile");
+    printPhase("tile by tile", f.tiles, "trace, raster and compare interleaved, nothing kept per pixel");
+    printPhase("warm trace", f.warmTrace, rate(pixels / f.warmTrace.median() / 1e3, "Mrays/s (the check repeated)"));
+    if (lens) {
+        printPhase("warm lens check", f.warmCompare);
+        printPhase("export", f.exportOneShot, "distance to .npy, one-shot: load + bvh + ray table + trace + write");
+        printPhase("export trace", f.exportTrace);
+        printPhase("export write", f.exportWrite);
+        printPhase("warm export", f.warmExport, "trace + write again, the BVH and the ray table kept");
+    } else {
+        printPhase("warm raster", f.warmRaster, rate(double(f.triangles) / f.warmRaster.median() / 1e3, "Mtris/s"));
+        printPhase("warm compare", f.warmCompare);
+    }
+    std::printf("%-24s %.1f MiB   budget %.1f MiB (150 B/triangle + %.0f B/pixel%s)\n", "peak RSS", f.peakMiB, s.budgetMiB,
+                s.bytesPerPixel, lens ? ": 32, 24 for the ray table, 24 for the eye points" : "");
+}
+
+void printReferences(const References& ref, const BenchSetting& s)
+{
+    printPhase("reference embree-bvh", ref.embreeBuild);
+    printPhase("reference embree-trace", ref.embreeTrace,
+               rate(s.pixels / ref.embreeTrace.median() / 1e3, "Mrays/s") +
+                   (s.lens ? " (rtcIntersect16, the rays from a table made before timing), " : " (rtcIntersect16), ") +
+                   rate(100.0 * ref.embreeAgreement, "%") + " pixels hit the ray route's primitive");
+    if (!ref.glDraw.ms.empty())
+        printPhase("reference llvmpipe", ref.glDraw, ref.glRenderer + ", LP_NUM_THREADS=" + std::to_string(s.threads) + ", " +
+                                                         rate(100.0 * ref.glAgreement, "% pixels as zcheck's raster"));
+    else
+        std::printf("%-24s skipped: %s\n", "reference llvmpipe", ref.glSkipped.c_str());
+}
+
+// The ratios of several forms as a table, a column per form and a * after each value that
+// misses its target: 'ratio  baseline  avx2  avx512  target', then '<name> <value>[*]... <bound>'.
+void printRatioTable(const std::vector<FormPhases>& forms, const BenchSetting& s, const References& ref)
+{
+    std::vector<std::vector<Ratio>> ratios;
+    for (const FormPhases& f : forms) ratios.push_back(ratiosOf(f, s, ref));
+    std::printf("%-36s", "ratio");
+    for (const FormPhases& f : forms) std::printf(" %9s ", nameOf(f.form));
+    std::printf("  target\n");
+    bool missed = false;
+    for (std::size_t i = 0; i < ratios.front().size(); ++i) {
+        std::printf("%-36s", ratios.front()[i].name.c_str());
+        for (const std::vector<Ratio>& form : ratios) {
+            std::printf(" %9.3f%c", form[i].value, form[i].met() ? ' ' : '*');
+            missed = missed || !form[i].met();
+        }
+        std::printf("  %s %.2f\n", ratios.front()[i].atMost ? "<=" : ">=", ratios.front()[i].target);
+    }
+    std::printf("%s\n", missed ? "* NOT met: the value misses its target" : "every target met");
+}
+
 int runBenchCommand(const BenchOptions& o)
 {
     const int threads = o.threads > 0 ? o.threads : int(std::max(1u, std::thread::hardware_concurrency()));
@@ -300,6 +640,8 @@ int runBenchCommand(const BenchOptions& o)
     if (!named) throw Error("--workload '" + o.workload + "' is not a named workload: terrain-1M-1080p, fisheye-1M-1080p or panorama-1M-1920x960");
     if (o.workload != kWorkloads[0].name && !workload)
         throw Error("--workload " + o.workload + " names its own scene and camera: give it without --scene and --camera");
+    std::vector<FormPhases> forms;
+    for (KernelForm form : kernelFormsOf(o.kernels)) forms.emplace_back().form = form;
 
     // The camera comes from a first load (a file is read once before timing: cold-cache
     // effects are not what this measures). TBB is not started before the children fork.
@@ -311,142 +653,45 @@ int runBenchCommand(const BenchOptions& o)
     }
     o.imageSize.apply(spec);
     const Camera camera(spec);
+    const bool lens = camera.lens() != nullptr;
     const bool isFile = !isBuiltinSceneName(o.input.scene);
     const double fileMB = isFile ? double(std::filesystem::file_size(o.input.scene)) / 1e6 : 0.0;
 
-    // The whole check, N times, each in a process of its own.
-    Phase load, bvh, tiles, trace, raster, compare, whole, warmTrace, warmRaster, warmCompare;
-    std::size_t triangles = 0;
-    bool consistent = true;
-    double peakMiB = 0;
-    for (int r = 0; r < o.repeat; ++r) {
-        if (progress) std::fprintf(stderr, "\rbench: whole check %d/%d", r + 1, o.repeat), std::fflush(stderr);
-        const WholeCheck w = wholeCheckInChild(o.input.scene, camera, threads);
-        load.ms.push_back(w.loadMs), bvh.ms.push_back(w.bvhMs), tiles.ms.push_back(w.tilesMs), trace.ms.push_back(w.traceMs);
-        raster.ms.push_back(w.rasterMs), compare.ms.push_back(w.compareMs), whole.ms.push_back(w.wholeMs);
-        warmTrace.ms.push_back(w.warmTraceMs), warmRaster.ms.push_back(w.warmRasterMs);
-        warmCompare.ms.push_back(w.warmCompareMs);
-        triangles = w.triangles;
-        consistent = consistent && w.consistent;
-        peakMiB = std::max(peakMiB, w.peakMiB);
-    }
-    // A lens camera's own costs, N times, each in a process of its own.
-    const bool lens = camera.lens() != nullptr;
-    Phase rayTable, rays, depthTrace, exportOneShot, exportTrace, exportWrite, warmExport;
-    for (int r = 0; lens && r < o.repeat; ++r) {
-        if (progress) std::fprintf(stderr, "\rbench: lens rays and export %d/%d", r + 1, o.repeat), std::fflush(stderr);
-        const LensCosts c = lensCostsInChild(o.input.scene, camera, threads);
-        rayTable.ms.push_back(c.tableMs), rays.ms.push_back(c.raysMs), exportOneShot.ms.push_back(c.exportMs);
-        depthTrace.ms.push_back(c.depthTraceMs);
-        exportTrace.ms.push_back(c.exportTraceMs), exportWrite.ms.push_back(c.exportWriteMs), warmExport.ms.push_back(c.warmExportMs);
-    }
-    if (progress) std::fprintf(stderr, "\r%40s\r", "");
-    const auto threadLimit = limitThreads(threads);
-    const double pixels = double(camera.width()) * camera.height();
+    // The whole check, N times per form, each in a process of its own; the forms in turn within
+    // each repeat, so that a slower spell of a shared machine falls on every form alike.
+    const auto formSuffix = [&](const FormPhases& f) {
+        return forms.size() > 1 ? std::string(" (") + nameOf(f.form) + ")" : std::string();
+    };
+    for (int r = 0; r < o.repeat; ++r)
+        for (FormPhases& f : forms) {
+            if (progress)
+                std::fprintf(stderr, "\rbench: whole check %d/%d%s ", r + 1, o.repeat, formSuffix(f).c_str()), std::fflush(stderr);
+            addWholeCheck(f, o.input.scene, camera, threads);
+        }
+    // A lens camera's own costs, as many times, likewise.
+    for (int r = 0; lens && r < o.repeat; ++r)
+        for (FormPhases& f : forms) {
+            if (progress)
+                std::fprintf(stderr, "\rbench: lens rays and export %d/%d%s ", r + 1, o.repeat, formSuffix(f).c_str()),
+                    std::fflush(stderr);
+            addLensCosts(f, o.input.scene, camera, threads);
+        }
+    if (progress) std::fprintf(stderr, "\r%50s\r", "");
+    const std::size_t triangles = forms.front().triangles;
+    const bool consistent = std::all_of(forms.begin(), forms.end(), [](const FormPhases& f) { return f.consistent; });
+    BenchSetting s{threads, lens, isFile, fileMB, double(camera.width()) * camera.height(), 0, 0};
     // A lens camera's check holds two arrays more, 24 bytes a pixel each: the ray table (lens.h)
     // and the trace's eye points, which its forward check projects.
-    const double bytesPerPixel = lens ? 32.0 + 24.0 + 24.0 : 32.0;
-    const double budgetMiB = (150.0 * double(triangles) + bytesPerPixel * pixels) / (1024.0 * 1024.0);
+    s.bytesPerPixel = lens ? 32.0 + 24.0 + 24.0 : 32.0;
+    s.budgetMiB = (150.0 * double(triangles) + s.bytesPerPixel * s.pixels) / (1024.0 * 1024.0);
 
-    // The references: Embree's builds each in a child, as the check's are; its trace and
-    // llvmpipe's draws repeated in this process (their own buffers reused, at their best).
-    Phase embreeBuild, embreeTrace, glDraw;
-    std::string glRenderer, glSkipped;
-    double glAgreement = NAN, embreeAgreement = NAN;
-    if (o.reference) {
-        const Scene scene = loadScene(o.input.scene);
-        if (progress) std::fprintf(stderr, "\rbench: Embree reference%20s", ""), std::fflush(stderr);
-        // Embree's build, like the check's, in a fresh process each time: in this process
-        // its repeats ran on memory earlier builds had faulted in (and varied 142-274 ms).
-        for (int r = 0; r < o.repeat; ++r)
-            embreeBuild.ms.push_back(inChild<double>(threads, "Embree's reference build", [&] {
-                return reference::EmbreeReference(scene).buildMilliseconds();
-            }).first);
-        const reference::EmbreeReference embree(scene);  // built here only to be traced
-        std::vector<std::uint32_t> primitiveId;
-        embree.trace(camera, primitiveId);  // warm-up
-        for (int r = 0; r < o.repeat; ++r) embreeTrace.ms.push_back(embree.trace(camera, primitiveId));
-        {  // The same rays? The primitive each pixel's ray hits, against the ray route's.
-            const RenderResult traced = RayRenderer(scene).render(camera);
-            std::size_t same = 0;
-            for (std::size_t i = 0; i < primitiveId.size(); ++i) same += primitiveId[i] == traced.primitiveId[i];
-            embreeAgreement = double(same) / double(primitiveId.size());
-        }
-        if (progress) std::fprintf(stderr, "\rbench: llvmpipe reference%20s", ""), std::fflush(stderr);
-        const reference::GlYardstickFunctions* gl = nullptr;
-        if (lens) glSkipped = "does not apply: a lens model has no projection matrix to draw through";
-        else try {
-            using Entry = const reference::GlYardstickFunctions* (*)();
-            gl = reinterpret_cast<Entry>(pluginEntry("libzcheck_gl_yardstick.so", "zcheck_gl_yardstick"))();
-        } catch (const std::runtime_error& e) {
-            glSkipped = std::string("its plugin is missing (built only where libegl-dev is installed): ") + e.what();
-        }
-        if (gl) {
-            reference::GlDepthInput input;
-            input.positions = &scene.positions[0].x;
-            input.vertexCount = scene.positions.size();
-            input.indices = &scene.triangles[0].x;
-            input.triangleCount = scene.triangles.size();
-            for (int c = 0; c < 4; ++c)
-                for (int k = 0; k < 4; ++k) input.clipFromWorld[std::size_t(4 * c + k)] = camera.clipFromWorld[c][k];
-            input.width = camera.width(), input.height = camera.height();
-            input.reversedZ = camera.depth().reversed;
-            input.zeroToOne = camera.convention().ndcZMin() == 0.0;
-            input.threads = threads;
-            try {
-                const reference::GlDepthTiming drawn = gl->timeDraw(input, o.repeat);
-                const RenderResult lastRaster = RasterRenderer(scene).render(camera);
-                glDraw.ms = drawn.drawMs;
-                glRenderer = drawn.renderer;
-                // The same picture? Coverage and depth per pixel. OpenGL's window has y up; the
-                // camera's viewport may not (Vulkan, Direct3D, Metal): each pixel is found
-                // through NDC, where both agree.
-                const int W = camera.width(), H = camera.height();
-                auto pixelOf = [&](int glCol, int glRowFromTop) {
-                    const glm::dvec2 pNdc(2.0 * (glCol + 0.5) / W - 1.0, 1.0 - 2.0 * (glRowFromTop + 0.5) / H);
-                    const glm::dvec4 pWindow = camera.windowFromNdc * glm::dvec4(pNdc, 0.0, 1.0);
-                    const int col = int(std::floor(pWindow.x)), row = int(std::floor(camera.imageYFromWindowY(pWindow.y)));
-                    return std::size_t(row) * W + col;
-                };
-                std::size_t same = 0;
-                for (int row = 0; row < H && !drawn.depth.empty(); ++row)
-                    for (int col = 0; col < W; ++col) {
-                        const float depth = drawn.depth[std::size_t(row) * W + col];
-                        const std::size_t i = pixelOf(col, row);
-                        const bool glHit = depth != float(camera.clearDepth());
-                        same += glHit == lastRaster.hit(i) && (!glHit || std::abs(depth - lastRaster.windowDepth.value[i]) <= 1e-5);
-                    }
-                glAgreement = drawn.depth.empty() ? NAN : double(same) / double(drawn.depth.size());
-            } catch (const std::exception& e) {
-                glSkipped = e.what();
-            }
-        }
-        if (progress) std::fprintf(stderr, "\r%40s\r", "");
-    }
-
-    std::vector<Ratio> ratios;
-    if (!lens) ratios.push_back({"compare/(trace+raster)", compare.median() / (trace.median() + raster.median()), 0.10, true});
-    ratios.push_back({"peak-rss/budget", peakMiB / budgetMiB, 1.0, true});
-    if (lens) {
-        ratios.push_back({"rays/trace", rays.median() / depthTrace.median(), 0.10, true});
-        ratios.push_back({"warm-export-seconds", warmExport.median() / 1e3, 0.5, true});
-    }
-    if (isFile) ratios.push_back({"load-MB/s", fileMB / (load.median() / 1e3), 150.0, false});
-    if (!glDraw.ms.empty()) ratios.push_back({"raster/llvmpipe", raster.median() / glDraw.median(), 0.33, true});
-    if (!embreeTrace.ms.empty()) {
-        ratios.push_back({"trace-throughput/embree", embreeTrace.median() / (lens ? depthTrace : trace).median(), lens ? 0.8 : 0.9, false});
-        if (!lens) ratios.push_back({"whole/(load+embree-bvh+embree-trace)",
-                          whole.median() / (load.median() + embreeBuild.median() + embreeTrace.median()), 1.3, true});
-    }
-    // The same targets for the warm repeat (see WholeCheck): like for like with the
-    // yardsticks, which repeat on buffers they have touched before.
-    if (!lens) ratios.push_back({"warm-compare/(trace+raster)", warmCompare.median() / (warmTrace.median() + warmRaster.median()), 0.10, true});
-    if (!glDraw.ms.empty()) ratios.push_back({"warm-raster/llvmpipe", warmRaster.median() / glDraw.median(), 0.33, true});
-    if (!embreeTrace.ms.empty() && !lens)
-        ratios.push_back({"warm-trace-throughput/embree", embreeTrace.median() / warmTrace.median(), 0.9, false});
+    const auto threadLimit = limitThreads(threads);
+    References ref;
+    if (o.reference) ref = measureReferences(o.input.scene, camera, threads, o.repeat, forms.front().form, progress);
+    std::vector<KernelForm> formList;
+    for (const FormPhases& f : forms) formList.push_back(f.form);
 
     if (o.json) {
-        auto phaseJson = [](const Phase& p) { return nlohmann::ordered_json{{"median_ms", p.median()}, {"best_ms", p.best()}, {"ms", p.ms}}; };
         nlohmann::ordered_json out;
         out["scene"] = o.input.scene;
         if (workload) out["workload"] = o.workload;
@@ -454,93 +699,51 @@ int runBenchCommand(const BenchOptions& o)
         out["triangles"] = triangles;
         out["width"] = camera.width(), out["height"] = camera.height();
         out["threads"] = threads, out["repeat"] = o.repeat;
+        out["kernels"] = namesOf(formList);
+        // The first form's keys, as with one form; "consistent" is every form's.
+        const nlohmann::ordered_json first = formJson(forms.front(), s, ref);
+        for (const auto& item : first.items()) out[item.key()] = item.value();
         out["consistent"] = consistent;
-        out["phases"] = {{"load", phaseJson(load)},     {"bvh", phaseJson(bvh)},         {"tiles", phaseJson(tiles)},
-                         {"trace", phaseJson(trace)},
-                         {"raster", phaseJson(raster)}, {"compare", phaseJson(compare)}, {"whole", phaseJson(whole)},
-                         {"warm_trace", phaseJson(warmTrace)}, {"warm_raster", phaseJson(warmRaster)},
-                         {"warm_compare", phaseJson(warmCompare)}};
-        if (lens)
-            out["lens_phases"] = {{"ray_table", phaseJson(rayTable)},         {"rays", phaseJson(rays)},
-                                  {"depth_trace", phaseJson(depthTrace)},
-                                  {"export", phaseJson(exportOneShot)},       {"export_trace", phaseJson(exportTrace)},
-                                  {"export_write", phaseJson(exportWrite)},   {"warm_export", phaseJson(warmExport)}};
-        out["mrays_per_s"] = pixels / trace.median() / 1e3;
-        out["mtris_per_s"] = double(triangles) / raster.median() / 1e3;
-        out["peak_rss_mib"] = peakMiB;
-        out["memory_budget_mib"] = budgetMiB;
-        if (isFile) out["load_mb_per_s"] = fileMB / (load.median() / 1e3);
+        out["memory_budget_mib"] = s.budgetMiB;
         if (o.reference) {
-            auto& ref = out["reference"];
-            ref["embree_bvh"] = phaseJson(embreeBuild);
-            ref["embree_trace"] = phaseJson(embreeTrace);
-            ref["embree_mrays_per_s"] = pixels / embreeTrace.median() / 1e3;
-            ref["embree_agreement"] = embreeAgreement;
-            if (!glDraw.ms.empty()) {
-                ref["llvmpipe_draw"] = phaseJson(glDraw);
-                ref["llvmpipe_renderer"] = glRenderer;
-                ref["llvmpipe_agreement"] = glAgreement;
+            auto& json = out["reference"];
+            json["embree_bvh"] = phaseJson(ref.embreeBuild);
+            json["embree_trace"] = phaseJson(ref.embreeTrace);
+            json["embree_mrays_per_s"] = s.pixels / ref.embreeTrace.median() / 1e3;
+            json["embree_agreement"] = ref.embreeAgreement;
+            if (!ref.glDraw.ms.empty()) {
+                json["llvmpipe_draw"] = phaseJson(ref.glDraw);
+                json["llvmpipe_renderer"] = ref.glRenderer;
+                json["llvmpipe_agreement"] = ref.glAgreement;
             } else {
-                ref["llvmpipe_skipped"] = glSkipped;
+                json["llvmpipe_skipped"] = ref.glSkipped;
             }
         }
-        for (const Ratio& r : ratios)
-            out["ratios"][r.name] = {{"value", r.value}, {"target", r.target}, {"bound", r.atMost ? "at most" : "at least"}, {"met", r.met()}};
+        if (forms.size() > 1)
+            for (const FormPhases& f : forms) out["forms"][nameOf(f.form)] = formJson(f, s, ref);
         std::cout << out.dump(2) << "\n";
         return kExitConsistent;
     }
 
     const std::string depth = lens ? "lens model " + camera.lens()->spec().model + ", distance"
                                    : toString(camera.depth().format) + (camera.depth().reversed ? " reversed-Z" : "");
-    std::printf("zcheck bench: %s%s, %zu triangles, %dx%d, %s, %d threads, %d repeats, %s\n",
+    std::printf("zcheck bench: %s%s, %zu triangles, %dx%d, %s, kernels %s, %d threads, %d repeats, %s\n",
                 workload ? (o.workload + ": ").c_str() : "", o.input.scene.c_str(), triangles, camera.width(), camera.height(),
-                depth.c_str(), threads, o.repeat, consistent ? "consistent" : "INCONSISTENT");
-    printPhase("load", load, isFile ? rate(fileMB / (load.median() / 1e3), "MB/s") : "(built in)");
-    printPhase("bvh build", bvh);
-    if (lens) printPhase("ray table", rayTable, rate(pixels / rayTable.median() / 1e3, "Mrays/s") + " (built once per intrinsics)");
-    printPhase("trace", trace, rate(pixels / trace.median() / 1e3, "Mrays/s") + (lens ? " (the table built; eye points kept)" : ""));
-    if (lens) {
-        printPhase("depth trace", depthTrace, rate(pixels / depthTrace.median() / 1e3, "Mrays/s") + " (the depth alone)");
-        printPhase("rays", rays, rate(pixels / rays.median() / 1e3, "Mrays/s") + " (every pixel's world ray from the table)");
-        std::printf("%-24s does not apply: a lens model has no projection matrix to rasterize through\n", "raster");
-        printPhase("lens check", compare, rate(pixels / compare.median() / 1e3, "Mpixels/s") + " (round trip and forward)");
-    } else {
-        printPhase("raster", raster, rate(double(triangles) / raster.median() / 1e3, "Mtris/s"));
-        printPhase("compare", compare);
+                depth.c_str(), namesOf(formList).c_str(), threads, o.repeat, consistent ? "consistent" : "INCONSISTENT");
+    for (const FormPhases& f : forms) {
+        if (forms.size() > 1) std::printf("kernels %s\n", nameOf(f.form));
+        printPhases(f, s);
     }
-    printPhase("whole check", whole, "as zcheck check: load + bvh + tile by tile");
-    printPhase("tile by tile", tiles, "trace, raster and compare interleaved, nothing kept per pixel");
-    printPhase("warm trace", warmTrace, rate(pixels / warmTrace.median() / 1e3, "Mrays/s (the check repeated)"));
-    if (lens) {
-        printPhase("warm lens check", warmCompare);
-        printPhase("export", exportOneShot, "distance to .npy, one-shot: load + bvh + ray table + trace + write");
-        printPhase("export trace", exportTrace);
-        printPhase("export write", exportWrite);
-        printPhase("warm export", warmExport, "trace + write again, the BVH and the ray table kept");
-    } else {
-        printPhase("warm raster", warmRaster, rate(double(triangles) / warmRaster.median() / 1e3, "Mtris/s"));
-        printPhase("warm compare", warmCompare);
+    if (o.reference) printReferences(ref, s);
+    if (forms.size() > 1) {
+        printRatioTable(forms, s, ref);
+        return kExitConsistent;
     }
-    std::printf("%-24s %.1f MiB   budget %.1f MiB (150 B/triangle + %.0f B/pixel%s)\n", "peak RSS", peakMiB, budgetMiB,
-                bytesPerPixel, lens ? ": 32, 24 for the ray table, 24 for the eye points" : "");
-    if (o.reference) {
-        printPhase("reference embree-bvh", embreeBuild);
-        printPhase("reference embree-trace", embreeTrace,
-                   rate(pixels / embreeTrace.median() / 1e3, "Mrays/s") +
-                       (lens ? " (rtcIntersect16, the rays from a table made before timing), " : " (rtcIntersect16), ") +
-                       rate(100.0 * embreeAgreement, "%") + " pixels hit the ray route's primitive");
-        if (!glDraw.ms.empty())
-            printPhase("reference llvmpipe", glDraw, glRenderer + ", LP_NUM_THREADS=" + std::to_string(threads) + ", " +
-                                                         rate(100.0 * glAgreement, "% pixels as zcheck's raster"));
-        else
-            std::printf("%-24s skipped: %s\n", "reference llvmpipe", glSkipped.c_str());
-    }
-    for (const Ratio& r : ratios)
+    for (const Ratio& r : ratiosOf(forms.front(), s, ref))
         std::printf("ratio %-34s %8.3f   target %s %.2f   %s\n", r.name.c_str(), r.value, r.atMost ? "<=" : ">=", r.target,
                     r.met() ? "met" : "NOT met");
     return kExitConsistent;
 }
-
 }  // namespace
 
 Command addBenchCommand(CLI::App& app)
@@ -557,6 +760,10 @@ Command addBenchCommand(CLI::App& app)
     command->add_option("--threads", o->threads,
                         "worker threads, 1..1024, also llvmpipe's LP_NUM_THREADS (default: all cores)")
         ->check(kThreadRange);
+    command->add_option("--kernels", o->kernels,
+                        "the kernel forms to time: auto (the one ZCHECK_KERNELS or the processor gives), all\n"
+                        "(every form this processor has), or a comma-separated list of baseline, avx2, avx512")
+        ->capture_default_str();
     command->add_flag("--reference", o->reference,
                       "also time Embree's own BVH build and best packet trace (rtcIntersect16, 8x8 tiles) and\n"
                       "a depth-only OpenGL draw on Mesa llvmpipe through EGL, and print the ratios to the targets");
@@ -588,8 +795,14 @@ Command addBenchCommand(CLI::App& app)
         "its trace and llvmpipe's draws repeat in this process (llvmpipe's from the plugin\n"
         "libzcheck_gl_yardstick.so, loaded only here). Lines are\n"
         "'<phase> median <ms> ms best <ms> ms <rate>' and 'ratio <name> <value> target <bound>'.\n"
+        "The header names the kernel forms timed (--kernels; each bit-identical to the baseline's, only\n"
+        "speed differs): every child runs with ZCHECK_KERNELS set to its form. With several forms they\n"
+        "take turns within each repeat (their medians paired on a busy machine), each form's phases\n"
+        "follow a line 'kernels <form>', the references are measured once for all, and the ratios make\n"
+        "a table, a column per form, '*' after a value that misses its target.\n"
         "Examples:\n"
         "  zcheck bench --reference                         terrain-1M-1080p, with both references\n"
+        "  zcheck bench --kernels all --reference           the same, every form this processor has\n"
         "  zcheck bench --scene terrain.obj --camera cam.json --threads 1 --json\n"
         "  zcheck bench --scene 'builtin:terrain?n=1416&size=2' --width 3840 --height 2160");
     return {command, [o] { return runBenchCommand(*o); }};

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # `zcheck bench`: the phases it prints add up, the lines parse, --json carries the same
-# numbers, and --reference runs both yardsticks in the process (llvmpipe only where it was
-# built). A measurement tool, so the numbers are checked for sense, never for speed.
+# numbers, --reference runs both yardsticks in the process (llvmpipe only where it was built),
+# and --kernels times the kernel forms named, each in its own block. A measurement tool, so the
+# numbers are checked for sense, never for speed.
 set -euo pipefail
 source "$(dirname "$0")/lib.sh"
 zcheck=$1
@@ -9,7 +10,7 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 
 "$zcheck" bench --scene "builtin:terrain?n=60" --width 320 --height 180 --repeat 2 --threads 1 > "$tmp/bench.txt"
-grep -qE "^zcheck bench: builtin:terrain\?n=60, 6962 triangles, 320x180, .*1 threads, 2 repeats, consistent$" "$tmp/bench.txt"
+grep -qE "^zcheck bench: builtin:terrain\?n=60, 6962 triangles, 320x180, .*, kernels (baseline|avx2|avx512), 1 threads, 2 repeats, consistent$" "$tmp/bench.txt"
 for phase in load "bvh build" trace raster compare "whole check" "tile by tile" "warm trace" "warm raster" "warm compare"; do
     grep -qE "^$phase +median +[0-9.]+ ms +best +[0-9.]+ ms" "$tmp/bench.txt"
 done
@@ -26,6 +27,7 @@ python3 - "$tmp/bench.json" <<'PY'
 import json, sys
 r = json.load(open(sys.argv[1]))
 assert r["triangles"] == 2 * 59 * 59 and r["width"] == 320 and r["height"] == 180 and r["threads"] == 2, r
+assert r["kernels"] in ("baseline", "avx2", "avx512") and "forms" not in r, r
 p = r["phases"]
 for name in ("load", "bvh", "tiles", "trace", "raster", "compare", "whole", "warm_trace", "warm_raster", "warm_compare"):
     assert len(p[name]["ms"]) == 2 and 0 < p[name]["best_ms"] <= p[name]["median_ms"], (name, p[name])
@@ -71,7 +73,7 @@ cat > "$tmp/fisheye.json" <<'JSON'
   "view": {"eye": [0, 0.2, 0], "target": [0, 0, 0], "up": [0, 0, 1]} }
 JSON
 "$zcheck" bench --scene "builtin:terrain?n=60&size=2" --camera "$tmp/fisheye.json" --repeat 2 --threads 2 > "$tmp/lens.txt"
-grep -qE "^zcheck bench: builtin:terrain\?n=60&size=2, 6962 triangles, 160x120, lens model opencv_fisheye, distance, 2 threads, 2 repeats, consistent$" "$tmp/lens.txt"
+grep -qE "^zcheck bench: builtin:terrain\?n=60&size=2, 6962 triangles, 160x120, lens model opencv_fisheye, distance, kernels (baseline|avx2|avx512), 2 threads, 2 repeats, consistent$" "$tmp/lens.txt"
 for phase in "ray table" trace "depth trace" rays "lens check" export "warm export"; do
     grep -qE "^$phase +median +[0-9.]+ ms +best +[0-9.]+ ms" "$tmp/lens.txt"
 done
@@ -101,6 +103,53 @@ assert not any(name.startswith(("compare", "whole", "warm-compare", "warm-trace"
 PY
 # Embree's yardstick traces the ray route's rays: a pinhole's agree too.
 python3 -c "import json,sys; a=json.load(open(sys.argv[1]))['reference']['embree_agreement']; assert a > 0.99, a" "$tmp/bench.json"
+
+# --kernels: the forms this processor has (as kernel_form.h decides: AVX2 with FMA; AVX-512 F,
+# DQ and VL besides), each timed in a block of its own under a line naming it, the ratios a table
+# with a column per form; one form prints as without the option.
+flags=" $(grep -m1 '^flags' /proc/cpuinfo || true) "
+forms=(baseline)
+if [[ $flags == *" avx2 "* && $flags == *" fma "* ]]; then
+    forms+=(avx2)
+    if [[ $flags == *" avx512f "* && $flags == *" avx512dq "* && $flags == *" avx512vl "* ]]; then forms+=(avx512); fi
+fi
+all=$(IFS=,; echo "${forms[*]}")
+small=(--scene "builtin:terrain?n=60" --width 320 --height 180 --repeat 1 --threads 1)
+"$zcheck" bench "${small[@]}" --kernels baseline > "$tmp/baseline.txt"
+grep -qE "^zcheck bench: .*, kernels baseline, 1 threads, 1 repeats, consistent$" "$tmp/baseline.txt"
+grep -qE "^ratio compare/\(trace\+raster\) +[0-9.]+ +target <= 0.10 +(met|NOT met)$" "$tmp/baseline.txt"
+if grep -qE "^kernels " "$tmp/baseline.txt"; then echo "one form printed a 'kernels <form>' block"; exit 1; fi
+"$zcheck" bench "${small[@]}" --kernels all > "$tmp/all.txt"
+grep -qE "^zcheck bench: .*, kernels $all, 1 threads, 1 repeats, consistent$" "$tmp/all.txt"
+if (( ${#forms[@]} > 1 )); then
+    [[ $(grep -E "^kernels " "$tmp/all.txt") == $(printf 'kernels %s\n' "${forms[@]}") ]]
+    [[ $(grep -cE "^trace +median" "$tmp/all.txt") -eq ${#forms[@]} ]]
+    grep -qE "^ratio +$(printf '%s +' "${forms[@]}")target$" "$tmp/all.txt"
+    for ratio in "compare/\(trace\+raster\)" "peak-rss/budget" "warm-compare/\(trace\+raster\)"; do
+        grep -qE "^$ratio( +[0-9.]+\*?){${#forms[@]}} +<= [0-9.]+$" "$tmp/all.txt"
+    done
+fi
+"$zcheck" bench "${small[@]}" --kernels all --json > "$tmp/all.json"
+python3 - "$tmp/all.json" "$all" <<'PY'
+import json, sys
+r, forms = json.load(open(sys.argv[1])), sys.argv[2].split(",")
+assert r["kernels"] == sys.argv[2] and r["consistent"] is True, r
+if len(forms) == 1:
+    assert "forms" not in r, r
+else:
+    assert list(r["forms"]) == forms, r["forms"].keys()
+    for form in forms:
+        f = r["forms"][form]
+        assert f["consistent"] is True and len(f["phases"]["trace"]["ms"]) == 1, (form, f)
+        assert f["ratios"].keys() == r["ratios"].keys(), (form, f["ratios"])
+    # The top level is the first form's, as with one form.
+    assert r["phases"] == r["forms"][forms[0]]["phases"] and r["ratios"] == r["forms"][forms[0]]["ratios"]
+PY
+expect_error 2 "kernels 'sse9': 'sse9' is not a kernel form.*baseline, avx2 and avx512" bench "${small[@]}" --kernels sse9
+expect_error 2 "kernels 'avx2,avx2' names avx2 twice" bench "${small[@]}" --kernels avx2,avx2
+if [[ $all != *avx512* ]]; then expect_error 2 "cannot run the avx512 form" bench "${small[@]}" --kernels avx512; fi
+ZCHECK_KERNELS=bogus expect_error 2 "^zcheck: error: ZCHECK_KERNELS=bogus: must be auto, baseline, avx2 or avx512$" \
+    bench "${small[@]}"
 
 expect_error 2 "workload 'fisheye'.*terrain-1M-1080p, fisheye-1M-1080p or panorama-1M-1920x960" bench --workload fisheye
 expect_error 2 "workload fisheye-1M-1080p names its own scene and camera" bench --workload fisheye-1M-1080p --scene builtin:default

@@ -1,8 +1,11 @@
 #pragma once
-// For the tests that run a route's AVX-512 form and its baseline form (kernel_choice.h) and
+// For the tests that run a route's forms (zcheck/kernel_form.h: baseline, avx2, avx512) and
 // compare them bit for bit: a scene that exercises them and the switch between them.
 #include "zcheck/camera.h"
+#include "zcheck/kernel_form.h"
 #include "zcheck/scene.h"
+
+#include <catch2/catch.hpp>
 
 #include <cmath>
 #include <cstdint>
@@ -74,6 +77,35 @@ auto withEnvironment(const char* variable, const char* value, Run run)
     if (value) setenv(variable, value, 1);
     else unsetenv(variable);
     return run();
+}
+
+// run() with ZCHECK_KERNELS set to `form` ("baseline", "avx2", "avx512"; nullptr: unset).
+template <class Run>
+auto inForm(const char* form, Run run)
+{
+    return withEnvironment("ZCHECK_KERNELS", form, run);
+}
+
+// The vector forms this processor runs, each to be compared with the baseline form; a WARN
+// names each form it lacks (its bit-identity is then not tested on this machine).
+inline std::vector<const char*> vectorFormsToTest()
+{
+    std::vector<const char*> forms;
+    for (KernelForm form : {KernelForm::Avx2, KernelForm::Avx512}) {
+        if (kernelFormSupported(form))
+            forms.push_back(nameOf(form));
+        else
+            WARN("this processor cannot run the " << nameOf(form) << " form: its bit-identity to the baseline is skipped");
+    }
+    return forms;
+}
+
+// "baseline" and the vector forms this processor runs (vectorFormsToTest).
+inline std::vector<const char*> everyFormToTest()
+{
+    std::vector<const char*> forms{"baseline"};
+    for (const char* form : vectorFormsToTest()) forms.push_back(form);
+    return forms;
 }
 
 }  // namespace zcheck::testing

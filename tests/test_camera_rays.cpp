@@ -155,18 +155,16 @@ TEST_CASE("each hit's depth is its triangle's plane met by the pixel's ray in do
     }
 }
 
-TEST_CASE("the trace compiled for AVX-512 is bit-identical to its baseline form", "[ray][kernel]")
+TEST_CASE("the trace's AVX2 and AVX-512 forms are bit-identical to its baseline form", "[ray][kernel]")
 {
-    // RayRenderer::traceRect is one source compiled twice (kernel_choice.h): rays generated,
+    // RayRenderer::traceRect is one source compiled per form (kernel_choice.h): rays generated,
     // traced, and every hit re-evaluated in double against its triangle's plane. Two soups of
     // triangles (one wholly between the near and far planes, one mostly across them), through
     // the soups' perspective camera in every convention, reversed or not, with a narrowed
     // depth range, and through every example projection model (the raw matrix one takes
     // per-pixel rays, not affine ones) looking at the soup; with no fault and with each of
     // the ray route's faults; window depths, primitive ids and eye points compared bit for bit.
-    const bool avx512 = testing::withEnvironment("ZCHECK_RAY_KERNEL", nullptr,
-                                                 [] { return useAvx512Form("ZCHECK_RAY_KERNEL", "baseline"); });
-    if (!avx512) WARN("this processor has no AVX-512 (F, DQ, VL): both renders below are the baseline form");
+    const std::vector<const char*> forms = testing::vectorFormsToTest();
 
     std::vector<CameraSpec> cameras;
     for (const char* convention : kConventions)
@@ -196,14 +194,15 @@ TEST_CASE("the trace compiled for AVX-512 is bit-identical to its baseline form"
         const Scene soup = testing::triangleSoup(inside, inside ? 31 : 32);
         // The form is chosen when a renderer is made.
         auto rendererIn = [&](const char* form) {
-            return testing::withEnvironment("ZCHECK_RAY_KERNEL", form, [&] { return std::make_unique<RayRenderer>(soup); });
+            return testing::inForm(form, [&] { return std::make_unique<RayRenderer>(soup); });
         };
-        const std::unique_ptr<RayRenderer> baselineForm = rendererIn("baseline"), chosenForm = rendererIn("auto");
+        const std::unique_ptr<RayRenderer> baselineForm = rendererIn("baseline");
+        std::vector<std::unique_ptr<RayRenderer>> vectorForms;
+        for (const char* form : forms) vectorForms.push_back(rendererIn(form));
         for (const CameraSpec& spec : cameras) {
             const Camera camera(spec);
             for (const RayFaults& faults : {RayFaults{}, shifted, rowsFlipped, colsFlipped, distance}) {
                 const RenderResult baseline = baselineForm->render(camera, faults, EyePoints::Keep);
-                const RenderResult chosen = chosenForm->render(camera, faults, EyePoints::Keep);
                 INFO((inside ? "soup inside, " : "soup across, ") << spec.convention.name << " " << spec.width << "x"
                      << spec.height << (spec.depth.reversed ? " reversed" : "") << " fault shift/rows/cols/distance "
                      << faults.shiftPixels.x << "/" << faults.flipRows << "/" << faults.flipCols << "/"
@@ -212,32 +211,35 @@ TEST_CASE("the trace compiled for AVX-512 is bit-identical to its baseline form"
                                                 [](std::uint32_t id) { return id != kNoPrimitive; });
                 REQUIRE(hits > 100);  // not an empty picture
                 misses += std::int64_t(baseline.primitiveId.size()) - hits;
-                REQUIRE(testing::sameBits(chosen.primitiveId, baseline.primitiveId));
-                REQUIRE(testing::sameBits(chosen.windowDepth.value, baseline.windowDepth.value));
-                REQUIRE(testing::sameBits(chosen.pEye, baseline.pEye));
-                // Without eye points, each 64×64 region is traced into a buffer of its own and
-                // copied into the image: the same pixels (regions cut at the image's edges too).
-                const RenderResult staged = chosenForm->render(camera, faults, EyePoints::Omit);
-                REQUIRE(testing::sameBits(staged.primitiveId, chosen.primitiveId));
-                REQUIRE(testing::sameBits(staged.windowDepth.value, chosen.windowDepth.value));
+                for (std::size_t f = 0; f < forms.size(); ++f) {
+                    INFO("the " << forms[f] << " form");
+                    const RenderResult vector = vectorForms[f]->render(camera, faults, EyePoints::Keep);
+                    REQUIRE(testing::sameBits(vector.primitiveId, baseline.primitiveId));
+                    REQUIRE(testing::sameBits(vector.windowDepth.value, baseline.windowDepth.value));
+                    REQUIRE(testing::sameBits(vector.pEye, baseline.pEye));
+                    // Without eye points, each 64×64 region is traced into a buffer of its own and
+                    // copied into the image: the same pixels (regions cut at the image's edges too).
+                    const RenderResult staged = vectorForms[f]->render(camera, faults, EyePoints::Omit);
+                    REQUIRE(testing::sameBits(staged.primitiveId, vector.primitiveId));
+                    REQUIRE(testing::sameBits(staged.windowDepth.value, vector.windowDepth.value));
+                }
             }
         }
     }
     REQUIRE(misses > 10000);
 }
 
-TEST_CASE("ZCHECK_RAY_KERNEL takes auto or baseline and nothing else", "[ray][kernel]")
+TEST_CASE("the trace reads ZCHECK_KERNELS when its renderer is made and refuses a bad value", "[ray][kernel]")
 {
     const Scene soup = testing::triangleSoup(true, 33);
     const Camera camera(testing::kernelCamera("opengl", DepthFormat::Unorm24, false, false));
     auto renderWith = [&](const char* form) {  // read when the renderer is made
-        return testing::withEnvironment("ZCHECK_RAY_KERNEL", form, [&] { return RayRenderer(soup).render(camera); });
+        return testing::inForm(form, [&] { return RayRenderer(soup).render(camera); });
     };
     REQUIRE_NOTHROW(renderWith("auto"));
     REQUIRE_NOTHROW(renderWith(""));
     REQUIRE_NOTHROW(renderWith("baseline"));
-    REQUIRE_THROWS_WITH(renderWith("avx2"),
-                        Catch::Contains("ZCHECK_RAY_KERNEL=avx2") && Catch::Contains("'auto' or 'baseline'"));
+    REQUIRE_THROWS_WITH(renderWith("sse2"), Catch::Equals("ZCHECK_KERNELS=sse2: must be auto, baseline, avx2 or avx512"));
 }
 
 TEST_CASE("regression: a raw matrix whose near plane crosses the eye plane gave Embree a negative tnear", "[rays][regression]")

@@ -369,11 +369,11 @@ TEST_CASE("a judge's slopes are each triangle's own, for its camera, one at a ti
     const std::uint32_t last = std::uint32_t(scene.triangleCount() - 1);
     const std::vector<std::uint32_t> row = {4096, 4096, 0, 1, 1, kNoPrimitive, 4097, 1, 0, 5120, 1024,
                                             last, kUnknownPrimitive, last + 1, last - 64};
-    for (const char* form : {"baseline", "auto"}) {
+    for (const char* form : testing::everyFormToTest()) {
         for (const SlopeSource source : {SlopeSource::TableOfSeen, SlopeSource::EachCall}) {
             const char* sourceName = source == SlopeSource::TableOfSeen ? "table" : "each call";
             auto judge = [&](const Camera& camera) {
-                return testing::withEnvironment("ZCHECK_COMPARE_KERNEL", form, [&] {
+                return testing::inForm(form, [&] {
                     return std::make_unique<PixelJudge>(scene, camera, ToleranceModel{}, source);
                 });
             };
@@ -421,10 +421,10 @@ TEST_CASE("a judge's table of slopes filled from several threads at once holds e
         }
     }
     const tbb::global_control threads(tbb::global_control::max_allowed_parallelism, 4);
-    for (const char* form : {"baseline", "auto"})
+    for (const char* form : testing::everyFormToTest())
         for (int round = 0; round < 20; ++round) {
-            const std::unique_ptr<PixelJudge> judge = testing::withEnvironment(
-                "ZCHECK_COMPARE_KERNEL", form, [&] { return std::make_unique<PixelJudge>(scene, camera); });
+            const std::unique_ptr<PixelJudge> judge = testing::inForm(
+                form, [&] { return std::make_unique<PixelJudge>(scene, camera); });
             std::atomic<std::size_t> wrong{0};
             tbb::parallel_for(std::size_t(0), rows.size(), [&](std::size_t k) {
                 const std::vector<std::uint32_t>& r = rows[(k * 2654435761u + std::size_t(round)) % rows.size()];
@@ -495,7 +495,7 @@ std::string reportWithoutTimings(CheckReport report)
 }
 }  // namespace
 
-TEST_CASE("the comparison's AVX-512 form is bit-identical to its baseline form", "[compare][kernel]")
+TEST_CASE("the comparison's AVX2 and AVX-512 forms are bit-identical to its baseline form", "[compare][kernel]")
 {
     // TileComparison's row loop is one source compiled twice (kernel_choice.h), and the slopes
     // of a row's triangles are computed together, several per instruction. Both forms over
@@ -507,10 +507,8 @@ TEST_CASE("the comparison's AVX-512 form is bit-identical to its baseline form",
     // (every count, maximum, percentile, the worst pixel and the samples) and the per-pixel
     // classes and ratios compared bit for bit; also compareRoutes given the ray's eye points
     // and the raster's own per-pixel quanta (verify's inputs).
-    const bool avx512 = testing::withEnvironment("ZCHECK_COMPARE_KERNEL", nullptr,
-                                                 [] { return useAvx512Form("ZCHECK_COMPARE_KERNEL", "baseline"); });
-    if (!avx512) WARN("this processor has no AVX-512 (F, DQ, VL): both comparisons below are the baseline form");
-    auto inForm = [](const char* form, auto run) { return testing::withEnvironment("ZCHECK_COMPARE_KERNEL", form, run); };
+    const std::vector<const char*> forms = testing::vectorFormsToTest();
+    auto inForm = [](const char* form, auto run) { return testing::inForm(form, run); };
 
     std::vector<CheckOptions> runs(4);
     runs[1].faults.ray.flipRows = true;
@@ -546,10 +544,13 @@ TEST_CASE("the comparison's AVX-512 form is bit-identical to its baseline form",
                           << (spec.depth.reversed ? " reversed" : "") << ", projection " << int(spec.projection.type)
                           << ", run " << k);
                 const CheckResult baseline = inForm("baseline", [&] { return checker.check(camera, runs[k]); });
-                const CheckResult chosen = inForm("auto", [&] { return checker.check(camera, runs[k]); });
-                REQUIRE(reportWithoutTimings(chosen.report) == reportWithoutTimings(baseline.report));
-                REQUIRE(testing::sameBits(chosen.comparison.pixelClass, baseline.comparison.pixelClass));
-                REQUIRE(testing::sameBits(chosen.comparison.errorOverTolerance, baseline.comparison.errorOverTolerance));
+                for (const char* form : forms) {
+                    INFO("the " << form << " form");
+                    const CheckResult chosen = inForm(form, [&] { return checker.check(camera, runs[k]); });
+                    REQUIRE(reportWithoutTimings(chosen.report) == reportWithoutTimings(baseline.report));
+                    REQUIRE(testing::sameBits(chosen.comparison.pixelClass, baseline.comparison.pixelClass));
+                    REQUIRE(testing::sameBits(chosen.comparison.errorOverTolerance, baseline.comparison.errorOverTolerance));
+                }
                 const ComparisonReport& r = baseline.report.comparison;
                 agree += r.agree, unexplained += r.unexplained(), explained += r.coverageExplained + r.edgeSurface;
                 biased += r.depthBias ? 1 : 0;
@@ -569,12 +570,15 @@ TEST_CASE("the comparison's AVX-512 form is bit-identical to its baseline form",
                                                            {ownQuanta, &allowance, true}, {nullptr, &allowance, false}};
             for (const DeclaredMap& declared : declarations) {
                 const Comparison b = inForm("baseline", [&] { return compareRoutes(checker.scene(), camera, ray, raster, {}, declared); });
-                const Comparison c = inForm("auto", [&] { return compareRoutes(checker.scene(), camera, ray, raster, {}, declared); });
-                CheckReport byBaseline, byChosen;
-                byBaseline.comparison = b.report, byChosen.comparison = c.report;
-                REQUIRE(checkReportJson(byChosen) == checkReportJson(byBaseline));
-                REQUIRE(testing::sameBits(c.pixelClass, b.pixelClass));
-                REQUIRE(testing::sameBits(c.errorOverTolerance, b.errorOverTolerance));
+                for (const char* form : forms) {
+                    INFO("the " << form << " form");
+                    const Comparison c = inForm(form, [&] { return compareRoutes(checker.scene(), camera, ray, raster, {}, declared); });
+                    CheckReport byBaseline, byChosen;
+                    byBaseline.comparison = b.report, byChosen.comparison = c.report;
+                    REQUIRE(checkReportJson(byChosen) == checkReportJson(byBaseline));
+                    REQUIRE(testing::sameBits(c.pixelClass, b.pixelClass));
+                    REQUIRE(testing::sameBits(c.errorOverTolerance, b.errorOverTolerance));
+                }
             }
         }
     }
@@ -604,7 +608,7 @@ struct MadeUpRoutes {
     std::vector<double> quantum;
 };
 
-// The routes compared tile by tile in both kernel forms, with the keepers' floors given: the
+// The routes compared tile by tile in every kernel form, with the keepers' floors given: the
 // reports (both there or both not) and the per-pixel results must be the same bit for bit.
 // Returns the baseline form's report.
 std::optional<ComparisonReport> requireFormsAgree(const Scene& scene, const Camera& camera, const MadeUpRoutes& routes,
@@ -613,7 +617,7 @@ std::optional<ComparisonReport> requireFormsAgree(const Scene& scene, const Came
     RoutePixels ray = RoutePixels::of(routes.ray), raster = RoutePixels::of(routes.raster);
     raster.quantum = routes.quantum.data();
     auto compare = [&](const char* form, Comparison& perPixel) {
-        return testing::withEnvironment("ZCHECK_COMPARE_KERNEL", form, [&] {
+        return testing::inForm(form, [&] {
             const PixelJudge judge(scene, camera);
             TileComparison tiles(judge, &perPixel, errorQuantaFloor, relativeEyeZFloor);
             for (int tile = 0; tile < tiles.tiles().count(); ++tile) tiles.compareTile(tile, ray, raster);
@@ -625,20 +629,24 @@ std::optional<ComparisonReport> requireFormsAgree(const Scene& scene, const Came
         report.comparison = comparison;
         return checkReportJson(report);
     };
-    Comparison byBaseline, byChosen;
+    Comparison byBaseline;
     const std::optional<ComparisonReport> baseline = compare("baseline", byBaseline);
-    const std::optional<ComparisonReport> chosen = compare("auto", byChosen);
-    REQUIRE(bool(chosen) == bool(baseline));
-    if (baseline) REQUIRE(json(*chosen) == json(*baseline));
-    REQUIRE(testing::sameBits(byChosen.pixelClass, byBaseline.pixelClass));
-    REQUIRE(testing::sameBits(byChosen.errorOverTolerance, byBaseline.errorOverTolerance));
+    for (const char* form : testing::vectorFormsToTest()) {
+        INFO("the " << form << " form");
+        Comparison byChosen;
+        const std::optional<ComparisonReport> chosen = compare(form, byChosen);
+        REQUIRE(bool(chosen) == bool(baseline));
+        if (baseline) REQUIRE(json(*chosen) == json(*baseline));
+        REQUIRE(testing::sameBits(byChosen.pixelClass, byBaseline.pixelClass));
+        REQUIRE(testing::sameBits(byChosen.errorOverTolerance, byBaseline.errorOverTolerance));
+    }
     return baseline;
 }
 }  // namespace
 
-TEST_CASE("the comparison's AVX-512 form is bit-identical to its baseline form on edge values too", "[compare][kernel]")
+TEST_CASE("the comparison's vector forms are bit-identical to its baseline form on edge values too", "[compare][kernel]")
 {
-    // The AVX-512 form's lane pass is written out by hand (check/src/compare_rows.cpp), so renders alone,
+    // The vector forms' lane pass is written out over lane types (check/src/compare_rows.cpp), so renders alone,
     // which hold few of the values where two ways of computing a lane part, do not pin it.
     // Here the routes' arrays are made up: rows of 5, 67 and 203 pixels (every tile's row ends in a
     // part of eight lanes), hits on one side, on neither and on two triangles, and in the common
@@ -713,7 +721,7 @@ TEST_CASE("the comparison's AVX-512 form is bit-identical to its baseline form o
     REQUIRE(orderMatters > 0);
 }
 
-TEST_CASE("the comparison's AVX-512 form on rows of NaN, a zero bound and the bias rule's edge",
+TEST_CASE("the comparison's vector forms on rows of NaN, a zero bound and the bias rule's edge",
           "[compare][kernel]")
 {
     // Rows of eleven pixels, every one on one triangle in both routes. First: a NaN depth in its
@@ -780,10 +788,10 @@ void requireJudgesRule(const Scene& scene, const Camera& camera, const RenderRes
     const PixelJudge::ToleranceTerms terms = judge.toleranceTerms();
     RoutePixels ray = RoutePixels::of(rayRender), raster = RoutePixels::of(rasterRender);
     raster.quantum = quantum.data(), raster.allowance = allowance.data();
-    for (const char* form : {"baseline", "auto"}) {
+    for (const char* form : testing::everyFormToTest()) {
         INFO(form);
         Comparison perPixel;
-        const std::optional<ComparisonReport> report = testing::withEnvironment("ZCHECK_COMPARE_KERNEL", form, [&] {
+        const std::optional<ComparisonReport> report = testing::inForm(form, [&] {
             const PixelJudge tableJudge(scene, camera);
             TileComparison tiles(tableJudge, &perPixel);
             for (int tile = 0; tile < tiles.tiles().count(); ++tile) tiles.compareTile(tile, ray, raster);
@@ -818,7 +826,7 @@ void requireJudgesRule(const Scene& scene, const Camera& camera, const RenderRes
 }
 }  // namespace
 
-TEST_CASE("the tolerance rule is one: PixelJudge's, the baseline row pass's and the AVX-512 row pass's classes agree on every pixel",
+TEST_CASE("the tolerance rule is one: PixelJudge's, the baseline row pass's and the vector row passes' classes agree on every pixel",
           "[compare][kernel][tolerance]")
 {
     // The tolerance C·q + S·m + E + a and the bias test's rule are written once (compare.h,
@@ -934,17 +942,16 @@ TEST_CASE("a comparison whose sampled floors lie above its percentiles runs agai
     REQUIRE(checkReportJson(fromRoutes) == checkReportJson(fromTiles));
 }
 
-TEST_CASE("ZCHECK_COMPARE_KERNEL takes auto or baseline and nothing else", "[compare][kernel]")
+TEST_CASE("a check refuses a bad ZCHECK_KERNELS in one line", "[compare][kernel]")
 {
     const Checker checker(builtinScene("builtin:default"));
     const Camera camera(smallCamera(checker.scene()));
     auto checkWith = [&](const char* form) {
-        return testing::withEnvironment("ZCHECK_COMPARE_KERNEL", form, [&] { return checker.check(camera); });
+        return testing::inForm(form, [&] { return checker.check(camera); });
     };
     REQUIRE_NOTHROW(checkWith("auto"));
     REQUIRE_NOTHROW(checkWith("baseline"));
-    REQUIRE_THROWS_WITH(checkWith("scalar"),
-                        Catch::Contains("ZCHECK_COMPARE_KERNEL=scalar") && Catch::Contains("'auto' or 'baseline'"));
+    REQUIRE_THROWS_WITH(checkWith("scalar"), Catch::Equals("ZCHECK_KERNELS=scalar: must be auto, baseline, avx2 or avx512"));
 }
 
 TEST_CASE("the comparison writes every pixel's class and ratio, whose arrays are not cleared first", "[compare][allocated]")
@@ -1048,11 +1055,14 @@ TEST_CASE("the worst pixel is the first in scan order with the largest ratio, in
     const RenderResult& ray = quad.ray;
     const std::uint32_t triangle = ray.primitiveId[std::size_t(75) * 200 + 100];
     REQUIRE(triangle != kNoPrimitive);
-    for (const auto& [form, error] : {std::pair{"baseline", 0x1p-12}, {"auto", 0x1p-12}, {"baseline", 0x1p-26}, {"auto", 0x1p-26}}) {
+    std::vector<std::pair<const char*, double>> formsAndErrors;
+    for (const double error : {0x1p-12, 0x1p-26})
+        for (const char* form : testing::everyFormToTest()) formsAndErrors.push_back({form, error});
+    for (const auto& [form, error] : formsAndErrors) {
         // 2^-12 ≈ 4000 q of unorm24, a depth error; 2^-26 ≈ q/4, within the tolerance (agree)
         INFO(form << ", error " << error);
         const PixelClass expectedClass = error > 0x1p-20 ? PixelClass::DepthError : PixelClass::Agree;
-        testing::withEnvironment("ZCHECK_COMPARE_KERNEL", form, [&] {
+        testing::inForm(form, [&] {
             const RenderResult& raster = quad.raster;
             std::vector<std::size_t> onTriangle;  // in scan order
             for (std::size_t i = 0; i < ray.primitiveId.size(); ++i) {
@@ -1113,9 +1123,9 @@ TEST_CASE("a NaN depth is a depth error and never the largest error", "[compare]
         REQUIRE(quad.ray.hit(i));
         REQUIRE(quad.ray.primitiveId[i] == quad.raster.primitiveId[i]);
     }
-    for (const char* form : {"baseline", "auto"}) {
+    for (const char* form : testing::everyFormToTest()) {
         INFO(form);
-        testing::withEnvironment("ZCHECK_COMPARE_KERNEL", form, [&] {
+        testing::inForm(form, [&] {
             RenderResult raster = quad.raster;
             raster.windowDepth.value[a] = NAN;
             raster.windowDepth.value[b] = quad.ray.windowDepth.value[b] + 0x1p-12;

@@ -226,23 +226,18 @@ namespace {
 using testing::kernelCamera;
 using testing::triangleSoup;
 
-// render() with ZCHECK_RASTER_KERNEL set to `kernel` (nullptr: unset, the default choice).
-template <class Render>
-RenderResult withKernel(const char* kernel, Render render)
-{
-    return testing::withEnvironment("ZCHECK_RASTER_KERNEL", kernel, render);
-}
-
-RenderResult renderWithKernel(const RasterRenderer& raster, const Camera& camera, const char* kernel,
+// raster.render() in kernel form `form` (ZCHECK_KERNELS; nullptr: unset, the default choice).
+RenderResult renderWithKernel(const RasterRenderer& raster, const Camera& camera, const char* form,
                               const RasterFaults& faults = {})
 {
-    return withKernel(kernel, [&] { return raster.render(camera, faults); });
+    return testing::inForm(form, [&] { return raster.render(camera, faults); });
 }
 
 }  // namespace
 
 TEST_CASE("the vector kernels are bit-identical to the scalar loops", "[raster][kernel]")
 {
+    const std::vector<const char*> forms = testing::vectorFormsToTest();
     // Two soups of triangles from sub-pixel slivers to ones spanning several 64×64 tiles, with
     // exact duplicates under other ids (equal keys: the first drawn keeps the pixel) and both
     // windings. In the first, every triangle lies between the near and far planes, anywhere in
@@ -273,19 +268,20 @@ TEST_CASE("the vector kernels are bit-identical to the scalar loops", "[raster][
                                                                           << (faults.noNearClip ? " no near clipping" : "")
                                                                           << (faults.viewportMinusOne ? " viewport − 1" : "")
                                                                           << (faults.screenLinearEyeZ ? " eye-z in screen space" : ""));
-                        const RenderResult scalar = renderWithKernel(raster, camera, "scalar", faults);
-                        const RenderResult chosen = renderWithKernel(raster, camera, nullptr, faults);
+                        const RenderResult scalar = renderWithKernel(raster, camera, "baseline", faults);
                         const std::size_t pixels = std::size_t(spec.width) * spec.height;
                         REQUIRE(std::count_if(scalar.primitiveId.begin(), scalar.primitiveId.end(), [](std::uint32_t id) {
                                     return id != kNoPrimitive;
                                 }) > std::ptrdiff_t(pixels / 2));
-                        REQUIRE(std::memcmp(scalar.primitiveId.data(), chosen.primitiveId.data(), pixels * sizeof(std::uint32_t)) == 0);
-                        REQUIRE(std::memcmp(scalar.windowDepth.value.data(), chosen.windowDepth.value.data(),
-                                            pixels * sizeof(double)) == 0);
+                        for (const char* form : forms) {
+                            INFO("the " << form << " form");
+                            const RenderResult vector = renderWithKernel(raster, camera, form, faults);
+                            REQUIRE(std::memcmp(scalar.primitiveId.data(), vector.primitiveId.data(), pixels * sizeof(std::uint32_t)) == 0);
+                            REQUIRE(std::memcmp(scalar.windowDepth.value.data(), vector.windowDepth.value.data(),
+                                                pixels * sizeof(double)) == 0);
+                        }
                     }
     }
-    if (!__builtin_cpu_supports("avx512f") || !__builtin_cpu_supports("avx512dq") || !__builtin_cpu_supports("avx512vl"))
-        WARN("this processor has no AVX-512 (F, DQ, VL): both renders used the scalar loops");
 }
 
 TEST_CASE("the vector draw kernel's depth arithmetic equals the scalar loop's to 2^-52", "[raster][kernel]")
@@ -296,8 +292,9 @@ TEST_CASE("the vector draw kernel's depth arithmetic equals the scalar loop's to
     // the pixels it touches. The soup wholly inside the depth range, every convention,
     // standard and reversed-Z, the full and a narrowed depth range.
     const Scene soup = triangleSoup(true, 52);
-    auto fineKeys = [&](const char* kernel, const Camera& camera) {
-        return withKernel(kernel, [&] { return rasterRenderWithFineKeysForTesting(soup, camera); });
+    const std::vector<const char*> forms = testing::vectorFormsToTest();
+    auto fineKeys = [&](const char* form, const Camera& camera) {
+        return testing::inForm(form, [&] { return rasterRenderWithFineKeysForTesting(soup, camera); });
     };
     std::size_t distinct = 0;
     for (const char* convention : {"opengl", "direct3d", "vulkan", "metal", "opencv"})
@@ -305,11 +302,14 @@ TEST_CASE("the vector draw kernel's depth arithmetic equals the scalar loop's to
             for (bool narrowRange : {false, true}) {
                 const Camera camera(kernelCamera(convention, DepthFormat::Unorm24, reversed, narrowRange));
                 INFO(convention << (reversed ? " reversed" : "") << (narrowRange ? " range [0.25, 0.75]" : ""));
-                const RenderResult scalar = fineKeys("scalar", camera);
-                const RenderResult vector = fineKeys("auto", camera);
+                const RenderResult scalar = fineKeys("baseline", camera);
                 const std::size_t pixels = scalar.windowDepth.value.size();
-                REQUIRE(std::memcmp(scalar.primitiveId.data(), vector.primitiveId.data(), pixels * sizeof(std::uint32_t)) == 0);
-                REQUIRE(std::memcmp(scalar.windowDepth.value.data(), vector.windowDepth.value.data(), pixels * sizeof(double)) == 0);
+                for (const char* form : forms) {
+                    INFO("the " << form << " form");
+                    const RenderResult vector = fineKeys(form, camera);
+                    REQUIRE(std::memcmp(scalar.primitiveId.data(), vector.primitiveId.data(), pixels * sizeof(std::uint32_t)) == 0);
+                    REQUIRE(std::memcmp(scalar.windowDepth.value.data(), vector.windowDepth.value.data(), pixels * sizeof(double)) == 0);
+                }
                 // The fine keys do resolve depth far below unorm24's quantum (the test can see a last bit).
                 for (std::size_t i = 0; i < pixels; ++i)
                     if (scalar.primitiveId[i] != kNoPrimitive &&
@@ -335,6 +335,7 @@ TEST_CASE("the vector vertex stage computes every vertex bit for bit as the scal
     }
     positions[5] = {0, 0, 0};  // the eye itself (w = 0)
     const Scene cloud = sceneOf(positions, {{0, 1, 2}});
+    const std::vector<const char*> forms = testing::vectorFormsToTest();
     int snappedCount = 0;
     for (const char* convention : {"opengl", "direct3d", "vulkan", "metal", "opencv"})
         for (ProjectionType type : {ProjectionType::Perspective, ProjectionType::Orthographic})
@@ -359,15 +360,19 @@ TEST_CASE("the vector vertex stage computes every vertex bit for bit as the scal
                 const Camera camera(spec);
                 INFO(convention << ' ' << toString(type) << " variant " << variant);
                 const std::vector<RasterVertexForTesting> scalar = rasterVertexStageForTesting(cloud, camera, faults, false);
-                const std::vector<RasterVertexForTesting> vector = rasterVertexStageForTesting(cloud, camera, faults, true);
                 REQUIRE(scalar.size() == positions.size());
-                for (std::size_t v = 0; v < scalar.size(); ++v) {
-                    INFO("vertex " << v);
-                    REQUIRE(vector[v].outcode == scalar[v].outcode);
-                    REQUIRE(vector[v].X == scalar[v].X);
-                    REQUIRE(vector[v].Y == scalar[v].Y);
-                    REQUIRE(std::memcmp(&vector[v].z, &scalar[v].z, sizeof(double)) == 0);
-                    snappedCount += scalar[v].X != INT32_MIN;
+                for (std::size_t v = 0; v < scalar.size(); ++v) snappedCount += scalar[v].X != INT32_MIN;
+                for (const char* form : forms) {
+                    INFO("the " << form << " form");
+                    const std::vector<RasterVertexForTesting> vector =
+                        testing::inForm(form, [&] { return rasterVertexStageForTesting(cloud, camera, faults, true); });
+                    for (std::size_t v = 0; v < scalar.size(); ++v) {
+                        INFO("vertex " << v);
+                        REQUIRE(vector[v].outcode == scalar[v].outcode);
+                        REQUIRE(vector[v].X == scalar[v].X);
+                        REQUIRE(vector[v].Y == scalar[v].Y);
+                        REQUIRE(std::memcmp(&vector[v].z, &scalar[v].z, sizeof(double)) == 0);
+                    }
                 }
             }
     REQUIRE(snappedCount > 50 * 2000);  // most cameras see a good part of the cloud
@@ -388,25 +393,47 @@ TEST_CASE("the vector vertex stage computes every vertex bit for bit as the scal
         ties.emplace_back(-64.0f - half, 0.0f, -2.0f);  // window x·256 = −(k + ½)
     }
     const Scene tieCloud = sceneOf(ties, {{0, 1, 2}});
-    for (bool vector : {false, true}) {
-        const std::vector<RasterVertexForTesting> snapped = rasterVertexStageForTesting(tieCloud, Camera(exact), {}, vector);
+    std::vector<const char*> everyForm = forms;
+    everyForm.push_back("baseline");
+    for (const char* form : everyForm) {
+        const std::vector<RasterVertexForTesting> snapped =
+            testing::inForm(form, [&] { return rasterVertexStageForTesting(tieCloud, Camera(exact), {}, true); });
         for (int k = 0; k < 403; ++k) {
-            INFO((vector ? "vector" : "scalar") << ", k = " << k);
+            INFO("the " << form << " form, k = " << k);
             REQUIRE(snapped[2 * k].X == k + 1);
             REQUIRE(snapped[2 * k + 1].X == -(k + 1));
         }
     }
 }
 
-TEST_CASE("ZCHECK_RASTER_KERNEL takes auto or scalar and nothing else", "[raster][kernel]")
+TEST_CASE("ZCHECK_KERNELS takes auto or a form the processor has, and nothing else", "[raster][kernel]")
 {
     const Scene triangle = sceneOf({{0, 0, -1}, {1, 0, -1}, {0, 1, -1}}, {{0, 1, 2}});
     const RasterRenderer raster(triangle);  // keeps a reference to the scene
     const Camera camera(pixelExactCamera(8));
     REQUIRE_NOTHROW(renderWithKernel(raster, camera, "auto"));
-    REQUIRE_NOTHROW(renderWithKernel(raster, camera, "scalar"));
-    REQUIRE_THROWS_WITH(renderWithKernel(raster, camera, "avx2"),
-                        Catch::Contains("ZCHECK_RASTER_KERNEL=avx2") && Catch::Contains("'auto' or 'scalar'"));
+    REQUIRE_NOTHROW(renderWithKernel(raster, camera, "baseline"));
+    for (KernelForm form : {KernelForm::Avx2, KernelForm::Avx512}) {
+        INFO(nameOf(form));
+        if (kernelFormSupported(form)) {
+            REQUIRE_NOTHROW(renderWithKernel(raster, camera, nameOf(form)));
+            REQUIRE(testing::inForm(nameOf(form), [] { return kernelForm(); }) == form);
+        } else {
+            REQUIRE_THROWS_WITH(renderWithKernel(raster, camera, nameOf(form)),
+                                Catch::Contains(std::string("ZCHECK_KERNELS=") + nameOf(form)) &&
+                                    Catch::Contains("this processor cannot run"));
+        }
+    }
+    REQUIRE_THROWS_WITH(renderWithKernel(raster, camera, "scalar"),
+                        Catch::Equals("ZCHECK_KERNELS=scalar: must be auto, baseline, avx2 or avx512"));
+    REQUIRE_THROWS_WITH(renderWithKernel(raster, camera, "AVX2"), Catch::Contains("must be auto, baseline, avx2 or avx512"));
+    // auto takes the widest form the processor has.
+    const KernelForm widest = kernelFormSupported(KernelForm::Avx512) ? KernelForm::Avx512
+                              : kernelFormSupported(KernelForm::Avx2) ? KernelForm::Avx2
+                                                                       : KernelForm::Baseline;
+    REQUIRE(testing::inForm("auto", [] { return kernelForm(); }) == widest);
+    REQUIRE(testing::inForm(nullptr, [] { return kernelForm(); }) == widest);
+    REQUIRE(testing::inForm("", [] { return kernelForm(); }) == widest);
 }
 
 TEST_CASE("both routes write every pixel of a render, whose buffers are not cleared first", "[raster][ray][allocated]")

@@ -290,24 +290,26 @@ struct TileComparison::Impl {
     // Rows [rowBegin, rowEnd) of tiles [tileBegin, tileEnd), consecutive tiles of one band,
     // image row by image row across them (TileComparison::compareTileRows, compareBandRows).
     void compare(int tileBegin, int tileEnd, int rowBegin, int rowEnd, const RoutePixels& ray, const RoutePixels& raster);
-    template <bool kAvx512>
+    template <KernelForm kForm>
     void compareBody(int tileBegin, int tileEnd, int rowBegin, int rowEnd, const RoutePixels& ray,
                      const RoutePixels& raster);
     // compareBody's steps.
-    template <bool kAvx512>
+    template <KernelForm kForm>
     void compareTileRow(TileTally& tally, const PixelRect& rect, int row, const RoutePixels& ray,
                         const RoutePixels& raster, const RowForms& forms, LanePassArrays& arrays,
                         StatisticCounts& counts, RowLanes& lanes);
-    template <bool kAvx512>
+    template <KernelForm kForm>
     RowInputs lanePassInputs(const TileRow& tileRow, const RoutePixels& ray, const RoutePixels& raster,
                              const RowForms& forms, LanePassArrays& arrays) const;
     void judgeOffCommonPixel(const TileRow& tileRow, int j, const RoutePixels& ray, const RoutePixels& raster,
                              ScanOrderVisits& scan);
     void compareBaseline(int tileBegin, int tileEnd, int rowBegin, int rowEnd, const RoutePixels& ray,
                          const RoutePixels& raster);
-#ifdef ZCHECK_X86_AVX512
-    ZCHECK_TARGET_AVX512 void compareAvx512(int tileBegin, int tileEnd, int rowBegin, int rowEnd, const RoutePixels& ray,
-                                            const RoutePixels& raster);
+#ifdef ZCHECK_X86_FORMS
+    ZCHECK_KERNEL_ENTRY_AVX2 void compareAvx2(int tileBegin, int tileEnd, int rowBegin, int rowEnd, const RoutePixels& ray,
+                                              const RoutePixels& raster);
+    ZCHECK_KERNEL_ENTRY_AVX512 void compareAvx512(int tileBegin, int tileEnd, int rowBegin, int rowEnd,
+                                                  const RoutePixels& ray, const RoutePixels& raster);
 #endif
 
     const std::unique_ptr<const PixelJudge> ownJudge;
@@ -321,7 +323,7 @@ struct TileComparison::Impl {
     tbb::enumerable_thread_specific<StatisticCounts> statisticCounts;
 };
 
-// Impl::compare's work, inlined into a baseline and an AVX-512 form (compareBaseline,
+// Impl::compare's work, inlined into one function per form (compareBaseline, compareAvx2,
 // compareAvx512; kernel_choice.h), bit-identical to each other and to the pixel-by-pixel
 // tally they replaced: the same IEEE operations in the same order wherever the order can change
 // a result. Row by row: first the common case's measures for the whole row, lane by lane
@@ -335,7 +337,7 @@ struct TileComparison::Impl {
 // the quantum's and the relative error's forms) is found once per call, not once per 64 pixels.
 // Its steps (compareTileRow and what it calls) are always inlined too, so that each form
 // compiles its own copy of them.
-template <bool kAvx512>
+template <KernelForm kForm>
 ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tileBegin, int tileEnd, int rowBegin,
                                                                    int rowEnd, const RoutePixels& ray,
                                                                    const RoutePixels& raster)
@@ -357,7 +359,7 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tileBegin
             // with misses. (Across a band's tiles a row is one stream.)
             if (tileEnd - tileBegin == 1 && row + kRowsAhead < row1)
                 prefetchRow(ray, raster, rect.col0, row + kRowsAhead, rect.col1 - rect.col0);
-            compareTileRow<kAvx512>(tallies[std::size_t(tile)], rect, row, ray, raster, forms, arrays, counts, lanes);
+            compareTileRow<kForm>(tallies[std::size_t(tile)], rect, row, ray, raster, forms, arrays, counts, lanes);
         }
     }
 }
@@ -365,7 +367,7 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareBody(int tileBegin
 // Row `row` of the tile `rect` whose tally is `tally`, compareBody's step: the row's lane pass
 // (each form's own), the tally of its misses and common lanes, its bias sum, then in scan order
 // the pixels pixelsToVisit picks. `arrays` and `lanes` are the call's, overwritten.
-template <bool kAvx512>
+template <KernelForm kForm>
 ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareTileRow(TileTally& tally, const PixelRect& rect,
                                                                       int row, const RoutePixels& ray,
                                                                       const RoutePixels& raster, const RowForms& forms,
@@ -377,11 +379,12 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareTileRow(TileTally&
     const TileRow tileRow{rect.col0, row, rect.col1 - rect.col0,
                           a0, b0, std::size_t(row) * W + rect.col0,
                           ray.primitive + a0, raster.primitive + b0, ray.windowDepth + a0, raster.windowDepth + b0};
-    const RowInputs in = lanePassInputs<kAvx512>(tileRow, ray, raster, forms, arrays);
-#ifdef ZCHECK_X86_AVX512
-    if constexpr (kAvx512) rowLanesAvx512(in, judge.toleranceTerms(), counts, lanes);
+    const RowInputs in = lanePassInputs<kForm>(tileRow, ray, raster, forms, arrays);
+#ifdef ZCHECK_X86_FORMS
+    if constexpr (kForm == KernelForm::Avx2) rowLanesAvx2(in, judge.toleranceTerms(), counts, lanes);
+    if constexpr (kForm == KernelForm::Avx512) rowLanesAvx512(in, judge.toleranceTerms(), counts, lanes);
 #endif
-    if constexpr (!kAvx512) rowLanesBaseline(in, judge.toleranceTerms(), counts, lanes);
+    if constexpr (kForm == KernelForm::Baseline) rowLanesBaseline(in, judge.toleranceTerms(), counts, lanes);
 
     tallyCommonLanes(tally.report, lanes, tileRow.n);
     sumBiasInScanOrder(tally, lanes, tileRow, forms, arrays);
@@ -396,9 +399,9 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::compareTileRow(TileTally&
 }
 
 // The lane pass's inputs for a tile's row: its pixels, and its slopes, quanta and relative
-// errors put in `arrays`, except those the AVX-512 form computes itself (RowInputs); its surface
-// in `arrays` in both forms.
-template <bool kAvx512>
+// errors put in `arrays`, except those the vector forms compute themselves (RowInputs); its
+// surface in `arrays` in every form.
+template <KernelForm kForm>
 ZCHECK_ALWAYS_INLINE inline RowInputs TileComparison::Impl::lanePassInputs(const TileRow& tileRow,
                                                                           const RoutePixels& ray,
                                                                           const RoutePixels& raster,
@@ -411,17 +414,20 @@ ZCHECK_ALWAYS_INLINE inline RowInputs TileComparison::Impl::lanePassInputs(const
     in.rayDepth = tileRow.rayDepth, in.rasterDepth = tileRow.rasterDepth;
     in.slope = arrays.slope, in.quantum = arrays.quantum, in.relative = arrays.relative, in.n = n;
     in.allowance = raster.allowance ? raster.allowance + tileRow.b0 : kNoAllowance;
-#ifdef ZCHECK_X86_AVX512
-    if constexpr (kAvx512) {
+#ifdef ZCHECK_X86_FORMS
+    if constexpr (kForm != KernelForm::Baseline) {
         const SlopeTable* table = judge.slopeTable();
-        const std::uint64_t blockRuns = surfaceAndBlockRunsAvx512(tileRow.rayPrimitive, tileRow.rasterPrimitive, n,
-                                                                  table ? table->blockCount() : 0, arrays.surface);
+        const std::uint32_t blocks = table ? table->blockCount() : 0;
+        const std::uint64_t blockRuns =
+            kForm == KernelForm::Avx2
+                ? surfaceAndBlockRunsAvx2(tileRow.rayPrimitive, tileRow.rasterPrimitive, n, blocks, arrays.surface)
+                : surfaceAndBlockRunsAvx512(tileRow.rayPrimitive, tileRow.rasterPrimitive, n, blocks, arrays.surface);
         if (table && gatherable(table->none()))
             in.slopeTable = table->tableForRuns(arrays.surface, blockRuns), in.slopeTableNone = table->none();
         in.constantQuantum = forms.constantQuantum, in.relativeForm = forms.relativeForm;
     }
 #endif
-    if constexpr (!kAvx512)
+    if constexpr (kForm == KernelForm::Baseline)
         for (int j = 0; j < n; ++j) {
             const bool common =
                 tileRow.rayPrimitive[j] != kNoPrimitive && tileRow.rayPrimitive[j] == tileRow.rasterPrimitive[j];
@@ -499,22 +505,30 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::judgeOffCommonPixel(const
 void TileComparison::Impl::compareBaseline(int tileBegin, int tileEnd, int rowBegin, int rowEnd, const RoutePixels& ray,
                                            const RoutePixels& raster)
 {
-    compareBody<false>(tileBegin, tileEnd, rowBegin, rowEnd, ray, raster);
+    compareBody<KernelForm::Baseline>(tileBegin, tileEnd, rowBegin, rowEnd, ray, raster);
 }
 
-#ifdef ZCHECK_X86_AVX512
-ZCHECK_TARGET_AVX512 void TileComparison::Impl::compareAvx512(int tileBegin, int tileEnd, int rowBegin, int rowEnd,
-                                                              const RoutePixels& ray, const RoutePixels& raster)
+#ifdef ZCHECK_X86_FORMS
+ZCHECK_KERNEL_ENTRY_AVX2 void TileComparison::Impl::compareAvx2(int tileBegin, int tileEnd, int rowBegin, int rowEnd,
+                                                                const RoutePixels& ray, const RoutePixels& raster)
 {
-    compareBody<true>(tileBegin, tileEnd, rowBegin, rowEnd, ray, raster);
+    compareBody<KernelForm::Avx2>(tileBegin, tileEnd, rowBegin, rowEnd, ray, raster);
+}
+
+ZCHECK_KERNEL_ENTRY_AVX512 void TileComparison::Impl::compareAvx512(int tileBegin, int tileEnd, int rowBegin,
+                                                                    int rowEnd, const RoutePixels& ray,
+                                                                    const RoutePixels& raster)
+{
+    compareBody<KernelForm::Avx512>(tileBegin, tileEnd, rowBegin, rowEnd, ray, raster);
 }
 #endif
 
 void TileComparison::Impl::compare(int tileBegin, int tileEnd, int rowBegin, int rowEnd, const RoutePixels& ray,
                                    const RoutePixels& raster)
 {
-#ifdef ZCHECK_X86_AVX512
-    if (judge.avx512Form()) return compareAvx512(tileBegin, tileEnd, rowBegin, rowEnd, ray, raster);
+#ifdef ZCHECK_X86_FORMS
+    if (judge.form() == KernelForm::Avx2) return compareAvx2(tileBegin, tileEnd, rowBegin, rowEnd, ray, raster);
+    if (judge.form() == KernelForm::Avx512) return compareAvx512(tileBegin, tileEnd, rowBegin, rowEnd, ray, raster);
 #endif
     compareBaseline(tileBegin, tileEnd, rowBegin, rowEnd, ray, raster);
 }

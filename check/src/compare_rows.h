@@ -4,14 +4,13 @@
 // (compare_rows.cpp) and reads back what they found; and what both measure, written once.
 //
 // A row is n ≤ kLanes pixels of one tile, pixel j at entry j of each array of RowInputs. Its
-// lane pass comes in two forms (kernel_choice.h), chosen once per call of the driver
-// (PixelJudge::avx512Form): rowLanesBaseline, lane loops compiled for the build's baseline, and
-// rowLanesAvx512, written out eight lanes at a time with intrinsics (ZCHECK_TARGET_AVX512: call
-// it, and surfaceAndBlockRunsAvx512, only from code of that target, where the processor has
-// AVX-512). Both instantiate the one tolerance rule (PixelJudge::ToleranceTerms) with the same
-// IEEE operations in the same order, so their RowLanes, the row's per-pixel results and the
-// values given to the keepers are the same bits; the driver does everything else (the bias sum
-// and the pixels off the common case, in scan order).
+// lane pass comes in three forms (kernel_choice.h), chosen once per call of the driver
+// (PixelJudge::form): rowLanesBaseline, lane loops compiled for the build's baseline, and
+// rowLanesAvx2 and rowLanesAvx512, one template over a lane type (lanes.h), eight lanes at a
+// time. All instantiate the one tolerance rule (PixelJudge::ToleranceTerms) with the same IEEE
+// operations in the same order, so their RowLanes, the row's per-pixel results and the values
+// given to the keepers are the same bits; the driver does everything else (the bias sum and the
+// pixels off the common case, in scan order).
 //
 // Thread-safety: a lane pass writes only its RowLanes, the row's entries of the per-pixel
 // arrays and the calling thread's StatisticCounts; rows of different tiles may be passed from
@@ -103,7 +102,7 @@ struct PixelMeasures {
     const DepthFormat format;
 };
 
-// A tile's row, as its lane pass (rowLanesBaseline, rowLanesAvx512) reads it: n ≤ kLanes
+// A tile's row, as its lane pass (rowLanesBaseline, rowLanesAvx2, rowLanesAvx512) reads it: n ≤ kLanes
 // pixels, pixel j at entry j of each array.
 constexpr int kLanes = TileComparison::kTileSize;
 struct RowInputs {
@@ -117,7 +116,7 @@ struct RowInputs {
     const double* allowance = nullptr; // a (RoutePixels::allowance; kNoAllowance where it has none)
     const double* relative = nullptr;  // the relative eye-z error
     int n = 0;
-    // rowLanesAvx512 only: where these are given, it computes the three arrays above itself
+    // The vector forms only: where these are given, they compute the three arrays above themselves
     // (which are then not read): the slopes from PixelJudge::slopeTableFor, the quantum one for
     // all, the relative error in closed form.
     const double* slopeTable = nullptr;  // SlopeTable::tableFor (where gatherable())
@@ -129,7 +128,7 @@ struct RowInputs {
 };
 
 // A row's allowances where the raster side declares none. One object for the library (an
-// inline variable): rowLanesAvx512 tells it from the raster's own array by its address.
+// inline variable): the vector forms tell it from the raster's own array by its address.
 alignas(64) inline constexpr double kNoAllowance[kLanes] __attribute__((visibility("hidden"))) = {};
 
 // What a row's lane pass gives the rest of its tally: the common case's measures (both routes
@@ -159,7 +158,7 @@ ZCHECK_ALWAYS_INLINE inline double ratioOf(double error, double bound)
     return boundPositive ? quotient : unbounded;
 }
 
-// Whether rowLanesAvx512 can look up slopes in a table whose largest index (SlopeTable::none())
+// Whether the vector forms can look up slopes in a table whose largest index (SlopeTable::none())
 // is this itself: its gathers take signed 32-bit indices (so not for 2^31 triangles or more,
 // beyond any scene a machine of today holds; the lane loops then look them up).
 inline bool gatherable(std::uint32_t largestIndex) { return largestIndex < (1u << 31); }
@@ -167,20 +166,28 @@ inline bool gatherable(std::uint32_t largestIndex) { return largestIndex < (1u <
 // A row's lane pass, lane by lane: the measures and masks above; each pixel's class and ratio
 // as the common case or a miss has them (the scan-order pass rewrites the others); the common
 // lanes' |Δ|/q and relative errors given to the keepers. Reads the row's slope, quantum and
-// relative arrays (RowInputs), never its AVX-512-only entries.
+// relative arrays (RowInputs), never its vector-only entries.
 __attribute__((visibility("hidden"))) void rowLanesBaseline(const RowInputs& in,
                                                            const PixelJudge::ToleranceTerms& terms,
                                                            StatisticCounts& counts, RowLanes& out);
 
-#ifdef ZCHECK_X86_AVX512
+#ifdef ZCHECK_X86_FORMS
 // A row's surface (the triangle both routes hit, else kNoPrimitive) into `surface` (n entries),
 // and, as bits, the lanes that begin a run in one slope block of the scene's `blocks` blocks:
-// the run starts SlopeTable::tableForRuns takes.
+// the run starts SlopeTable::tableForRuns takes. One function per vector form; call each only
+// from code of its target (kernel_choice.h), where the processor has the form.
+__attribute__((visibility("hidden"))) ZCHECK_TARGET_AVX2 std::uint64_t
+surfaceAndBlockRunsAvx2(const std::uint32_t* rayPrimitive, const std::uint32_t* rasterPrimitive, int n,
+                        std::uint32_t blocks, std::uint32_t* surface);
 __attribute__((visibility("hidden"))) ZCHECK_TARGET_AVX512 std::uint64_t
 surfaceAndBlockRunsAvx512(const std::uint32_t* rayPrimitive, const std::uint32_t* rasterPrimitive, int n,
                           std::uint32_t blocks, std::uint32_t* surface);
 // rowLanesBaseline's results, bit for bit; computes the slopes, the quantum or the relative
-// errors itself where RowInputs gives their AVX-512-only entries.
+// errors itself where RowInputs gives their vector-only entries. One function per vector form,
+// as above.
+__attribute__((visibility("hidden"))) ZCHECK_TARGET_AVX2 void
+rowLanesAvx2(const RowInputs& in, const PixelJudge::ToleranceTerms& termsOfJudge, StatisticCounts& counts,
+             RowLanes& out);
 __attribute__((visibility("hidden"))) ZCHECK_TARGET_AVX512 void
 rowLanesAvx512(const RowInputs& in, const PixelJudge::ToleranceTerms& termsOfJudge, StatisticCounts& counts,
                RowLanes& out);

@@ -92,8 +92,8 @@ double windowDepthSlope(const Camera& camera, const glm::dvec3& a, const glm::dv
 namespace {
 
 // Slopes of up to kSlopeLanes consecutive triangles together: their corners dealt into lane
-// arrays, then slopeOfTriangle lane by lane. Inlined into a baseline and an AVX-512 form
-// (kernel_choice.h), both bit-identical to DepthSlopeFrame::slope of each (the same IEEE
+// arrays, then slopeOfTriangle lane by lane. Inlined into one function per form
+// (kernel_choice.h), each bit-identical to DepthSlopeFrame::slope of each (the same IEEE
 // operations in the same order).
 constexpr std::size_t kSlopeLanes = 64;
 
@@ -138,9 +138,15 @@ void slopesTogetherBaseline(const DepthSlopeFrame& frame, const Scene& scene, st
     slopesTogether(frame, scene, first, n, slope);
 }
 
-#ifdef ZCHECK_X86_AVX512
-ZCHECK_TARGET_AVX512 void slopesTogetherAvx512(const DepthSlopeFrame& frame, const Scene& scene, std::uint32_t first,
-                                               std::size_t n, double* slope)
+#ifdef ZCHECK_X86_FORMS
+ZCHECK_KERNEL_ENTRY_AVX2 void slopesTogetherAvx2(const DepthSlopeFrame& frame, const Scene& scene, std::uint32_t first,
+                                                 std::size_t n, double* slope)
+{
+    slopesTogether(frame, scene, first, n, slope);
+}
+
+ZCHECK_KERNEL_ENTRY_AVX512 void slopesTogetherAvx512(const DepthSlopeFrame& frame, const Scene& scene,
+                                                     std::uint32_t first, std::size_t n, double* slope)
 {
     slopesTogether(frame, scene, first, n, slope);
 }
@@ -154,10 +160,10 @@ PixelJudge::PixelJudge(const Scene& scene, const Camera& camera, const Tolerance
       tolerance_(tolerance),
       terms_{tolerance.constantFor(camera.depth()), tolerance.snapPixels(),
              16 * std::ldexp(1.0, -52) * std::max(std::abs(camera.depth().rangeMin), std::abs(camera.depth().rangeMax))},
-      avx512_(useAvx512Form("ZCHECK_COMPARE_KERNEL", "baseline")),
+      form_(kernelForm()),
       slopeFrame_(camera, tolerance.slopeCredit)
 {
-    if (slopes == SlopeSource::TableOfSeen) table_ = std::make_unique<SlopeTable>(scene_, slopeFrame_, avx512_);
+    if (slopes == SlopeSource::TableOfSeen) table_ = std::make_unique<SlopeTable>(scene_, slopeFrame_, form_);
 }
 
 PixelJudge::~PixelJudge() = default;
@@ -169,8 +175,8 @@ double PixelJudge::slope(std::uint32_t primitive) const
     return computeSlope(primitive);
 }
 
-SlopeTable::SlopeTable(const Scene& scene, const DepthSlopeFrame& frame, bool avx512)
-    : scene_(scene), frame_(frame), avx512_(avx512)
+SlopeTable::SlopeTable(const Scene& scene, const DepthSlopeFrame& frame, KernelForm form)
+    : scene_(scene), frame_(frame), form_(form)
 {
     const std::size_t n = scene.triangles.size();
     none_ = std::uint32_t(n);
@@ -188,8 +194,8 @@ bool SlopeTable::makeBlockReady(std::uint32_t block) const
         return notComputed == kReady;  // false: another thread is computing it
     static_assert(kBlock == kSlopeLanes, "a block's slopes are computed together");
     auto* together = &slopesTogetherBaseline;
-#ifdef ZCHECK_X86_AVX512
-    if (avx512_) together = &slopesTogetherAvx512;
+#ifdef ZCHECK_X86_FORMS
+    together = formOf(form_, together, &slopesTogetherAvx2, &slopesTogetherAvx512);
 #endif
     const std::size_t first = std::size_t(block) * kBlock;
     together(frame_, scene_, std::uint32_t(first), std::min<std::size_t>(kBlock, scene_.triangles.size() - first),

@@ -31,9 +31,9 @@ public:
     // Triangles [b·kBlock, (b+1)·kBlock) are block b.
     static constexpr std::uint32_t kBlock = 64;
 
-    // The slopes of `scene`'s triangles through `frame` (both must outlive the table); `avx512`:
-    // blocks are computed by the AVX-512 form (bit-identical to the baseline's).
-    SlopeTable(const Scene& scene, const DepthSlopeFrame& frame, bool avx512);
+    // The slopes of `scene`'s triangles through `frame` (both must outlive the table); blocks are
+    // computed in form `form` (kernel_form.h; each bit-identical to the baseline's).
+    SlopeTable(const Scene& scene, const DepthSlopeFrame& frame, KernelForm form);
 
     std::uint32_t blockCount() const { return blockCount_; }
     // The table's entry for any primitive not of the scene: 0, and always there.
@@ -98,7 +98,7 @@ private:
 
     const Scene& scene_;
     const DepthSlopeFrame& frame_;
-    bool avx512_;
+    KernelForm form_;
     std::uint32_t none_ = 0, blockCount_ = 0;
     // m of triangle t once its block is ready; one entry more, 0, for any primitive not of the scene.
     mutable LargeVector<double> slopeOfTriangle_;

@@ -12,6 +12,7 @@
 
 #include "zcheck/compare.h"
 #include "zcheck/inverse_projection.h"
+#include "zcheck/kernel_form.h"
 #include "zcheck/large_buffer.h"
 #include "zcheck/mesh_loader.h"
 #include "zcheck/mistakes.h"
@@ -134,6 +135,21 @@ maps pays their page faults once because of them; a long-lived program that is d
 calls this. Safe at any time: buffers in use are not touched.)doc");
     m.def("cached_buffer_bytes", [] { return cachedLargeBufferBytes(); },
           "The bytes zcheck's kept per-frame buffers hold (see release_cached_buffers).");
+    m.def(
+        "kernel_form", [] { return std::string(nameOf(kernelForm())); },
+        R"doc(The form zcheck's kernels (the trace, the raster, the comparison) run in: "baseline",
+"avx2" or "avx512" — the widest this processor has, or the one the environment variable
+ZCHECK_KERNELS names (read when a render or comparison starts; a form the processor lacks, or
+any other value, raises ValueError). Every form's results are bit-identical.)doc");
+    m.def(
+        "kernel_forms_supported",
+        [] {
+            std::vector<std::string> forms;
+            for (KernelForm form : {KernelForm::Baseline, KernelForm::Avx2, KernelForm::Avx512})
+                if (kernelFormSupported(form)) forms.push_back(nameOf(form));
+            return forms;
+        },
+        "The kernel forms this processor can run, narrowest first (see kernel_form).");
 }
 
 }  // namespace

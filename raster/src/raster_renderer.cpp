@@ -13,6 +13,7 @@
 #include "zcheck/large_buffer.h"
 #include "zcheck/inverse_projection.h"
 #include "zcheck/detail/kernel_choice.h"
+#include "zcheck/detail/lanes.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -20,10 +21,6 @@
 #include <algorithm>
 #include <cstddef>
 #include <cmath>
-
-#ifdef ZCHECK_X86_AVX512
-#include <immintrin.h>
-#endif
 
 namespace zcheck {
 
@@ -339,154 +336,130 @@ void drawInTile(const Viewport& vp, const DepthKeys& keys, const TriangleSetup& 
     }
 }
 
-#ifdef ZCHECK_X86_AVX512
-ZCHECK_INTRINSICS_BEGIN
+#ifdef ZCHECK_X86_FORMS
 
-// std::clamp(v, lo, hi) per lane: v < lo ? lo : hi < v ? hi : v, NaN and signed zeros included.
-ZCHECK_TARGET_AVX512 inline __m512d clamp(__m512d v, __m512d lo, __m512d hi)
-{
-    v = _mm512_mask_blend_pd(_mm512_cmp_pd_mask(v, lo, _CMP_LT_OQ), v, lo);
-    return _mm512_mask_blend_pd(_mm512_cmp_pd_mask(hi, v, _CMP_LT_OQ), v, hi);
-}
-
-// Edge function k of t at pixels (col + j, row), j = 0..7, one per lane.
-ZCHECK_TARGET_AVX512 inline __m512i edgeAtLanes(const TriangleSetup& t, int k, int col, int row)
-{
-    const std::int64_t px = col * kSubpixel + kHalfPixel, py = row * kSubpixel + kHalfPixel;
-    return _mm512_add_epi64(_mm512_set1_epi64(t.A[k] * px + t.B[k] * py + t.C[k]),
-                            _mm512_mullo_epi64(_mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0), _mm512_set1_epi64(t.A[k] * kSubpixel)));
-}
+// The vector kernels, written once over a lane type (lanes.h) and compiled per form below.
 
 // drawInTile<false> with eight pixels of a row at a time: the same integer edge functions
 // and the same double operations in the same order per pixel (the build forbids contracting
 // them into fused multiply-adds), so its output is bit-identical to the scalar loop's. A
 // triangle's pixels are distinct within a row, so lanes never depend on each other.
-ZCHECK_TARGET_AVX512 void drawInTileAvx512(const DepthSettings& depth, const DepthKeys& keys, const TriangleSetup& t,
-                                           int tileCol0, int tileRow0, int tileCol1, int tileRow1, TileBuffer& out)
+template <class L>
+ZCHECK_ALWAYS_INLINE inline void drawInTileLanes(const DepthSettings& depth, const DepthKeys& keys, const TriangleSetup& t,
+                                                 int tileCol0, int tileRow0, int tileCol1, int tileRow1, TileBuffer& out)
 {
+    using Real = typename L::Real;
+    using Int64 = typename L::Int64;
+    using Mask = typename L::Mask;
     const int col0 = std::max(t.box.minCol, tileCol0), col1 = std::min(t.box.maxCol, tileCol1);
     const int row0 = std::max(t.box.minRow, tileRow0), row1 = std::min(t.box.maxRow, tileRow1);
     // Edge function k at lane j of a group: its value at the group's first pixel + j·A_k·256;
     // a group eight pixels on adds 8·A_k·256, a row down B_k·256 (exact: what the scalar loop
-    // computes as A_k·px + B_k·py + C_k).
-    __m512i rowE0 = edgeAtLanes(t, 0, col0, row0), rowE1 = edgeAtLanes(t, 1, col0, row0), rowE2 = edgeAtLanes(t, 2, col0, row0);
-    const __m512i down0 = _mm512_set1_epi64(t.B[0] * kSubpixel), across0 = _mm512_set1_epi64(t.A[0] * kSubpixel * 8);
-    const __m512i down1 = _mm512_set1_epi64(t.B[1] * kSubpixel), across1 = _mm512_set1_epi64(t.A[1] * kSubpixel * 8);
-    const __m512i down2 = _mm512_set1_epi64(t.B[2] * kSubpixel), across2 = _mm512_set1_epi64(t.A[2] * kSubpixel * 8);
-    // A lane's pixel centre col + 0.5 (exact in double, as are its steps of 8).
-    const __m512d firstCentres = _mm512_add_pd(_mm512_set1_pd(col0), _mm512_set_pd(7.5, 6.5, 5.5, 4.5, 3.5, 2.5, 1.5, 0.5));
-    const __m512d eight = _mm512_set1_pd(8.0), x0 = _mm512_set1_pd(t.x0), dzdx = _mm512_set1_pd(t.dzdx);
-    const __m512d rangeMin = _mm512_set1_pd(depth.rangeMin), rangeMax = _mm512_set1_pd(depth.rangeMax);
-    const __m512d maxCode = _mm512_set1_pd(keys.maxCode);
-    const __m512d noFractionBits = _mm512_set1_pd(4503599627370496.0);  // nearbyintNonNegative's 2^52
-    const __m256i primitive = _mm256_set1_epi32(int(t.primitive));
+    // computes as A_k·px + B_k·py + C_k, in the same wrapping int64 arithmetic).
+    Int64 rowE[3], down[3], across[3];
+    for (int k = 0; k < 3; ++k) {
+        const std::int64_t px = col0 * kSubpixel + kHalfPixel, py = row0 * kSubpixel + kHalfPixel;
+        rowE[k] = L::steps(t.A[k] * px + t.B[k] * py + t.C[k], t.A[k] * kSubpixel);
+        down[k] = L::set1(std::int64_t(t.B[k] * kSubpixel)), across[k] = L::set1(std::int64_t(t.A[k] * kSubpixel * 8));
+    }
+    // A lane's pixel centre col + 0.5 (exact in double, as are its steps of 8); a lane is in the
+    // box while its centre is left of col1 + 1.
+    alignas(64) static constexpr double kCentres[8] = {0.5, 1.5, 2.5, 3.5, 4.5, 5.5, 6.5, 7.5};
+    const Real firstCentres = L::set1(double(col0)) + L::load(kCentres), boxEnd = L::set1(col1 + 1.0);
+    const Real eight = L::set1(8.0), x0 = L::set1(t.x0), dzdx = L::set1(t.dzdx);
+    const Real rangeMin = L::set1(depth.rangeMin), rangeMax = L::set1(depth.rangeMax);
+    const Real maxCode = L::set1(keys.maxCode);
+    const Real noFractionBits = L::set1(4503599627370496.0);  // nearbyintNonNegative's 2^52
+    const typename L::Int32 primitive = L::set1(std::int32_t(t.primitive));
+    const bool unorm = keys.unorm, reversed = depth.reversed;  // not read again after each store
     // No branch on coverage: a group with no pixel covered stores nothing (its masks are
     // empty), and a branch on it was mispredicted often enough to cost 5 %.
     for (int row = row0; row <= row1; ++row) {
-        const __m512d rowDepth = _mm512_set1_pd(t.z0 + t.dzdy * (row + 0.5 - t.y0));
+        const Real rowDepth = L::set1(t.z0 + t.dzdy * (row + 0.5 - t.y0));
         double* keyRow = out.key + (row - out.row0) * TileBuffer::kSide - out.col0;
         std::uint32_t* primitiveRow = out.primitive + (row - out.row0) * TileBuffer::kSide - out.col0;
-        __m512i e0 = rowE0, e1 = rowE1, e2 = rowE2;
-        __m512d centre = firstCentres;
+        Int64 e0 = rowE[0], e1 = rowE[1], e2 = rowE[2];
+        Real centre = firstCentres;
         for (int col = col0; col <= col1; col += 8) {
-            const __mmask8 inBox = __mmask8((1u << std::min(8, col1 - col + 1)) - 1);
-            const __mmask8 covered = _mm512_mask_cmpge_epi64_mask(
-                inBox, _mm512_or_si512(_mm512_or_si512(e0, e1), e2), _mm512_setzero_si512());
-            const __m512d interpolated = _mm512_add_pd(rowDepth, _mm512_mul_pd(dzdx, _mm512_sub_pd(centre, x0)));
-            const __m512d windowDepth = clamp(interpolated, rangeMin, rangeMax);
+            const Mask covered = (centre < boxEnd) & L::nonNegative(e0 | e1 | e2);
+            const Real interpolated = rowDepth + dzdx * (centre - x0);
+            const Real windowDepth = clampLanes<L>(interpolated, rangeMin, rangeMax);
             // unormCode's own clamp to [0, 1] is left out: the camera holds 0 ≤ rangeMin < rangeMax ≤ 1,
             // so it returns every clamped value unchanged (NaN and −0 included).
-            const __m512d key =
-                keys.unorm ? _mm512_sub_pd(_mm512_add_pd(_mm512_mul_pd(windowDepth, maxCode), noFractionBits), noFractionBits)
-                           : _mm512_cvtps_pd(_mm512_cvtpd_ps(windowDepth));
-            const __m512d stored = _mm512_maskz_loadu_pd(covered, keyRow + col);
-            const __mmask8 nearer = depth.reversed ? _mm512_mask_cmp_pd_mask(covered, stored, key, _CMP_LT_OQ)
-                                                   : _mm512_mask_cmp_pd_mask(covered, key, stored, _CMP_LT_OQ);
-            _mm512_mask_storeu_pd(keyRow + col, nearer, key);
-            _mm256_mask_storeu_epi32(primitiveRow + col, nearer, primitive);
-            e0 = _mm512_add_epi64(e0, across0), e1 = _mm512_add_epi64(e1, across1), e2 = _mm512_add_epi64(e2, across2);
-            centre = _mm512_add_pd(centre, eight);
+            const Real key = unorm ? (windowDepth * maxCode + noFractionBits) - noFractionBits
+                                   : L::toReal(L::toFloat(windowDepth));
+            const Real stored = L::maskedLoad(covered, keyRow + col);
+            const Mask nearer = covered & (reversed ? stored < key : key < stored);
+            L::maskedStore(nearer, keyRow + col, key);
+            L::maskedStore(nearer, primitiveRow + col, primitive);
+            e0 = e0 + across[0], e1 = e1 + across[1], e2 = e2 + across[2];
+            centre = centre + eight;
         }
-        rowE0 = _mm512_add_epi64(rowE0, down0), rowE1 = _mm512_add_epi64(rowE1, down1), rowE2 = _mm512_add_epi64(rowE2, down2);
+        rowE[0] = rowE[0] + down[0], rowE[1] = rowE[1] + down[1], rowE[2] = rowE[2] + down[2];
     }
 }
 
-// Matrix column c, row r of a glm::dmat4 (m[c][r]) in every lane.
-ZCHECK_TARGET_AVX512 inline __m512d broadcast(const glm::dmat4& m, int c, int r) { return _mm512_set1_pd(m[c][r]); }
-
 // Row r of m · (x, y, z, 1) in glm's order: (m0·x + m1·y) + (m2·z + m3·1).
-ZCHECK_TARGET_AVX512 inline __m512d transformRow(const glm::dmat4& m, int r, __m512d x, __m512d y, __m512d z)
+template <class L>
+ZCHECK_ALWAYS_INLINE inline typename L::Real transformRow(const glm::dmat4& m, int r, typename L::Real x,
+                                                          typename L::Real y, typename L::Real z)
 {
-    return _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(broadcast(m, 0, r), x), _mm512_mul_pd(broadcast(m, 1, r), y)),
-                         _mm512_add_pd(_mm512_mul_pd(broadcast(m, 2, r), z), broadcast(m, 3, r)));
+    return (L::set1(m[0][r]) * x + L::set1(m[1][r]) * y) + (L::set1(m[2][r]) * z + L::set1(m[3][r]));
 }
 
-// roundHalfAwayFromZero per lane (|x| < 2^52): the truncation and the fraction are exact.
-ZCHECK_TARGET_AVX512 inline __m512i roundHalfAwayFromZero(__m512d x)
+// roundHalfAwayFromZero per lane, for |x| < 2^31 (the lanes StoredVertex keeps: |x| < 2^29):
+// the truncation and the fraction are exact.
+template <class L>
+ZCHECK_ALWAYS_INLINE inline typename L::Int32 roundHalfAwayFromZero(typename L::Real x)
 {
-    const __m512i t = _mm512_cvttpd_epi64(x);
-    const __m512d fraction = _mm512_sub_pd(x, _mm512_cvtepi64_pd(t));
-    const __mmask8 up = _mm512_cmp_pd_mask(fraction, _mm512_set1_pd(0.5), _CMP_GE_OQ);
-    const __mmask8 down = _mm512_cmp_pd_mask(fraction, _mm512_set1_pd(-0.5), _CMP_LE_OQ);
-    const __m512i one = _mm512_set1_epi64(1);
-    const __m512i roundedUp = _mm512_mask_add_epi64(t, up, t, one);
-    return _mm512_mask_sub_epi64(roundedUp, down, roundedUp, one);
+    const typename L::Int32 t = L::truncateToInt32(x);
+    const typename L::Real fraction = x - L::toReal(t);
+    // t + 1 where the fraction is ≥ 0.5, t − 1 where ≤ −0.5 (a mask's lanes are −1).
+    return (t - L::allOnesWhere(fraction >= L::set1(0.5))) + L::allOnesWhere(fraction <= L::set1(-0.5));
 }
 
 // The vertex stage for vertices v .. v+7 at once: clip space, outcodes and stored vertices
 // exactly as clipOf, Viewport::outcode, snapVertex and StoredVertex compute them one by one
 // (glm's order of operations for a matrix times a vector and for a dot product). Not for the
 // fault that interpolates eye-z (snapVertex's z is then another quantity).
-ZCHECK_TARGET_AVX512 void snapEight(const Viewport& vp, const glm::vec3* positions, std::size_t v, StoredVertex* stored)
+template <class L>
+ZCHECK_ALWAYS_INLINE inline void snapEightLanes(const Viewport& vp, const glm::vec3* positions, std::size_t v,
+                                                StoredVertex* stored)
 {
+    using Real = typename L::Real;
+    using Int64 = typename L::Int64;
+    using Mask = typename L::Mask;
     static_assert(sizeof(glm::vec3) == 12, "positions are three packed floats");
-    const float* xyz = reinterpret_cast<const float*>(positions + v);
-    const __m512 first16 = _mm512_loadu_ps(xyz);
-    const __m512 last8 = _mm512_zextps256_ps512(_mm256_loadu_ps(xyz + 16));
-    __m512d p[3];
-    for (int k = 0; k < 3; ++k) {
-        const __m512i corner = _mm512_add_epi32(_mm512_set_epi32(0, 0, 0, 0, 0, 0, 0, 0, 21, 18, 15, 12, 9, 6, 3, 0),
-                                                _mm512_set1_epi32(k));
-        p[k] = _mm512_cvtps_pd(_mm512_castps512_ps256(_mm512_permutex2var_ps(first16, corner, last8)));
-    }
-    __m512d clip[4];
-    for (int r = 0; r < 4; ++r) clip[r] = transformRow(vp.clipFromWorld, r, p[0], p[1], p[2]);
+    Real p[3];
+    L::loadTriples(reinterpret_cast<const float*>(positions + v), p);
+    Real clip[4];
+    for (int r = 0; r < 4; ++r) clip[r] = transformRow<L>(vp.clipFromWorld, r, p[0], p[1], p[2]);
     // Outcodes: plane · pClip < 0, the dot product as glm's (t.x + t.y) + (t.z + t.w).
-    __m512i code = _mm512_setzero_si512();
+    const Real zero = L::zero();
+    Int64 code = L::set1(std::int64_t(0));
     for (int k = 0; k < vp.planes.size; ++k) {
         const glm::dvec4& plane = vp.planes.plane[k];
-        const __m512d dot = _mm512_add_pd(
-            _mm512_add_pd(_mm512_mul_pd(_mm512_set1_pd(plane.x), clip[0]), _mm512_mul_pd(_mm512_set1_pd(plane.y), clip[1])),
-            _mm512_add_pd(_mm512_mul_pd(_mm512_set1_pd(plane.z), clip[2]), _mm512_mul_pd(_mm512_set1_pd(plane.w), clip[3])));
-        code = _mm512_mask_or_epi64(code, _mm512_cmp_pd_mask(dot, _mm512_setzero_pd(), _CMP_LT_OQ), code,
-                                    _mm512_set1_epi64(std::int64_t(1) << k));
+        const Real dot = (L::set1(plane.x) * clip[0] + L::set1(plane.y) * clip[1]) +
+                         (L::set1(plane.z) * clip[2] + L::set1(plane.w) * clip[3]);
+        code = L::select(dot < zero, code | L::set1(std::int64_t(1) << k), code);
     }
     // Divide, viewport, image rows top-down, snap (snapVertex); lanes outside a plane are
     // computed too and then replaced (StoredVertex::outside).
-    __m512d ndc[3];
-    for (int k = 0; k < 3; ++k) ndc[k] = _mm512_div_pd(clip[k], clip[3]);
-    const __m512d windowX = transformRow(vp.windowFromNdc, 0, ndc[0], ndc[1], ndc[2]);
-    const __m512d windowY = transformRow(vp.windowFromNdc, 1, ndc[0], ndc[1], ndc[2]);
-    const __m512d windowZ = transformRow(vp.windowFromNdc, 2, ndc[0], ndc[1], ndc[2]);
-    const __m512d imageY = vp.camera.convention().windowOriginTop
-                               ? windowY
-                               : _mm512_sub_pd(_mm512_set1_pd(double(vp.camera.height())), windowY);
-    const __m512d limit = _mm512_set1_pd(2 * kMaxImageCoordinate);
-    const __mmask8 inside = _mm512_cmpeq_epi64_mask(code, _mm512_setzero_si512());
-    const __mmask8 valid = inside & _mm512_cmp_pd_mask(_mm512_abs_pd(windowX), limit, _CMP_LT_OQ) &
-                           _mm512_cmp_pd_mask(_mm512_abs_pd(imageY), limit, _CMP_LT_OQ);
-    const __m512d subpixel = _mm512_set1_pd(double(kSubpixel));
-    const __m512i X = roundHalfAwayFromZero(_mm512_mul_pd(windowX, subpixel));
-    const __m512i Y = roundHalfAwayFromZero(_mm512_mul_pd(imageY, subpixel));
+    Real ndc[3];
+    for (int k = 0; k < 3; ++k) ndc[k] = clip[k] / clip[3];
+    const Real windowX = transformRow<L>(vp.windowFromNdc, 0, ndc[0], ndc[1], ndc[2]);
+    const Real windowY = transformRow<L>(vp.windowFromNdc, 1, ndc[0], ndc[1], ndc[2]);
+    const Real windowZ = transformRow<L>(vp.windowFromNdc, 2, ndc[0], ndc[1], ndc[2]);
+    const Real imageY = vp.camera.convention().windowOriginTop ? windowY : L::set1(double(vp.camera.height())) - windowY;
+    const Real limit = L::set1(2 * kMaxImageCoordinate);
+    const Mask valid = L::isZero(code) & (L::abs(windowX) < limit) & (L::abs(imageY) < limit);
+    const Real subpixel = L::set1(double(kSubpixel));
+    const typename L::Int32 X = roundHalfAwayFromZero<L>(windowX * subpixel);
+    const typename L::Int32 Y = roundHalfAwayFromZero<L>(imageY * subpixel);
     // StoredVertex: snapped {z, X, Y}; not snappable {0, INT32_MIN, 0}; outside {0, INT32_MIN, outcode}.
-    const __m512i notSnapped = _mm512_set1_epi64(std::int64_t(std::uint32_t(INT32_MIN)));
-    const __m512i xy = _mm512_mask_or_epi64(_mm512_or_si512(notSnapped, _mm512_slli_epi64(code, 32)), valid,
-                                            _mm512_and_si512(X, _mm512_set1_epi64(0xFFFFFFFF)), _mm512_slli_epi64(Y, 32));
-    const __m512d z = _mm512_maskz_mov_pd(valid, windowZ);
-    const __m512d xyAsDouble = _mm512_castsi512_pd(xy);
-    double* out = reinterpret_cast<double*>(stored + v);
-    _mm512_storeu_pd(out, _mm512_permutex2var_pd(z, _mm512_set_epi64(11, 3, 10, 2, 9, 1, 8, 0), xyAsDouble));
-    _mm512_storeu_pd(out + 8, _mm512_permutex2var_pd(z, _mm512_set_epi64(15, 7, 14, 6, 13, 5, 12, 4), xyAsDouble));
+    const Int64 notSnapped = L::set1(std::int64_t(std::uint32_t(INT32_MIN))) | L::template shiftLeft<32>(code);
+    L::storePairs(reinterpret_cast<double*>(stored + v), L::select(valid, windowZ, zero),
+                  L::select(valid, L::joined(X, Y), notSnapped));
 }
 
 // The prepare stage's loop body for triangles p .. p+7 at once: the bin items of those whose
@@ -498,68 +471,106 @@ ZCHECK_TARGET_AVX512 void snapEight(const Viewport& vp, const glm::vec3* positio
 static_assert(sizeof(glm::uvec3) == 12 && sizeof(StoredVertex) == 16 && offsetof(StoredVertex, X) == 8 &&
                   offsetof(StoredVertex, Y) == 12,
               "the gathers' strides and offsets");
-ZCHECK_TARGET_AVX512 bool binItemsOfEight(const Viewport& vp, const glm::uvec3* triangles, std::uint32_t p,
-                                           const StoredVertex* snapped, std::vector<BinItem>& items)
+template <class L>
+ZCHECK_ALWAYS_INLINE inline bool binItemsOfEightLanes(const Viewport& vp, const glm::uvec3* triangles, std::uint32_t p,
+                                                      const StoredVertex* snapped, std::vector<BinItem>& items)
 {
-    // The eight triangles' 24 vertex indices, loaded as they lie and dealt out by corner.
-    const int* corners = reinterpret_cast<const int*>(triangles + p);
-    const __m512i indices0to15 = _mm512_loadu_si512(corners);
-    const __m512i indices16to23 = _mm512_zextsi256_si512(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(corners + 16)));
+    using Int32 = typename L::Int32;
+    using Int64 = typename L::Int64;
+    using Mask = typename L::Mask;
+    // The eight triangles' 24 vertex indices, dealt out by corner.
+    Int32 vertex[3];
+    L::loadTriples(reinterpret_cast<const std::uint32_t*>(triangles + p), vertex);
     // X and Y of each corner, one 64-bit gather (X in the low half); a vertex not snapped
     // (X = INT32_MIN) holds its outcode in Y (StoredVertex).
     const char* xyBase = reinterpret_cast<const char*>(snapped) + offsetof(StoredVertex, X);
-    const __m256i notSnapped = _mm256_set1_epi32(INT32_MIN);
-    __m256i X[3], Y[3];
-    __m256i orCodes = _mm256_setzero_si256(), andCodes = _mm256_set1_epi32(-1);
-    __mmask8 snappedAll = 0xFF;
+    const Int32 notSnapped = L::set1(std::int32_t(INT32_MIN)), zero = L::set1(std::int32_t(0));
+    Int32 X[3], Y[3];
+    Int32 orCodes = zero, andCodes = L::set1(std::int32_t(-1));
+    Mask snappedAll = L::firstLanes(8);
     for (int k = 0; k < 3; ++k) {
-        const __m512i corner = _mm512_add_epi32(_mm512_set_epi32(0, 0, 0, 0, 0, 0, 0, 0, 21, 18, 15, 12, 9, 6, 3, 0),
-                                                _mm512_set1_epi32(k));
-        const __m256i vertex = _mm512_castsi512_si256(_mm512_permutex2var_epi32(indices0to15, corner, indices16to23));
-        const __m512i xy = _mm512_i64gather_epi64(_mm512_slli_epi64(_mm512_cvtepu32_epi64(vertex), 1), xyBase, 8);
-        X[k] = _mm512_cvtepi64_epi32(xy), Y[k] = _mm512_cvtepi64_epi32(_mm512_srli_epi64(xy, 32));
-        const __mmask8 isSnapped = _mm256_cmpneq_epi32_mask(X[k], notSnapped);
-        const __m256i code = _mm256_maskz_mov_epi32(__mmask8(~isSnapped), Y[k]);
-        orCodes = _mm256_or_si256(orCodes, code), andCodes = _mm256_and_si256(andCodes, code);
-        snappedAll &= isSnapped;
+        const Int64 xy = L::gather(xyBase, L::template shiftLeft<1>(L::widenUnsigned(vertex[k])));
+        X[k] = L::lowHalves(xy), Y[k] = L::highHalves(xy);
+        const Mask isSnapped = L::notEqual(X[k], notSnapped);
+        const Int32 code = L::select(isSnapped, zero, Y[k]);
+        orCodes = orCodes | code, andCodes = andCodes & code;
+        snappedAll = snappedAll & isSnapped;
     }
-    const __mmask8 inside = _mm256_cmpeq_epi32_mask(orCodes, _mm256_setzero_si256());
-    const __mmask8 outsideOne = _mm256_test_epi32_mask(andCodes, andCodes);
-    if (__mmask8(~(inside | outsideOne))) return false;  // one needs clipping
-    __mmask8 keep = inside & snappedAll;
-    // coveredBox's twice signed area, in int64.
-    __m512i wide[3][2];  // [corner][X, Y]
-    for (int k = 0; k < 3; ++k) wide[k][0] = _mm512_cvtepi32_epi64(X[k]), wide[k][1] = _mm512_cvtepi32_epi64(Y[k]);
-    const __m512i area2 = _mm512_sub_epi64(
-        _mm512_mullo_epi64(_mm512_sub_epi64(wide[1][0], wide[0][0]), _mm512_sub_epi64(wide[2][1], wide[0][1])),
-        _mm512_mullo_epi64(_mm512_sub_epi64(wide[1][1], wide[0][1]), _mm512_sub_epi64(wide[2][0], wide[0][0])));
-    keep &= _mm512_test_epi64_mask(area2, area2);
+    const Mask inside = L::equal(orCodes, zero);
+    const Mask outsideOne = L::anyBits(andCodes);
+    if (L::bits(inside | outsideOne) != 0xFF) return false;  // one needs clipping
+    Mask keep = inside & snappedAll;
+    // coveredBox's twice signed area, in int64 (a snapped vertex's |X|, |Y| < 2^29: each
+    // difference fits 32 signed bits, each product 62).
+    Int64 wide[3][2];  // [corner][X, Y]
+    for (int k = 0; k < 3; ++k) wide[k][0] = L::widen(X[k]), wide[k][1] = L::widen(Y[k]);
+    const Int64 area2 = L::multiplySmall(wide[1][0] - wide[0][0], wide[2][1] - wide[0][1]) -
+                        L::multiplySmall(wide[1][1] - wide[0][1], wide[2][0] - wide[0][0]);
+    keep = L::andNot(keep, L::isZero(area2));
     // coveredBox's box: firstCentre (lo + 127) >> 8 and lastCentre (hi − 128) >> 8, inside the image.
-    const __m256i zero = _mm256_setzero_si256();
-    const __m256i firstOffset = _mm256_set1_epi32(int(kSubpixel - 1 - kHalfPixel)), lastOffset = _mm256_set1_epi32(int(kHalfPixel));
+    const Int32 firstOffset = L::set1(std::int32_t(kSubpixel - 1 - kHalfPixel)), lastOffset = L::set1(std::int32_t(kHalfPixel));
     constexpr int kBits = RasterRenderer::kSubpixelBits;
-    const __m256i firstCol = _mm256_max_epi32(zero, _mm256_srai_epi32(_mm256_add_epi32(_mm256_min_epi32(_mm256_min_epi32(X[0], X[1]), X[2]), firstOffset), kBits));
-    const __m256i lastCol = _mm256_min_epi32(_mm256_set1_epi32(vp.width - 1), _mm256_srai_epi32(_mm256_sub_epi32(_mm256_max_epi32(_mm256_max_epi32(X[0], X[1]), X[2]), lastOffset), kBits));
-    const __m256i firstRow = _mm256_max_epi32(zero, _mm256_srai_epi32(_mm256_add_epi32(_mm256_min_epi32(_mm256_min_epi32(Y[0], Y[1]), Y[2]), firstOffset), kBits));
-    const __m256i lastRow = _mm256_min_epi32(_mm256_set1_epi32(vp.height - 1), _mm256_srai_epi32(_mm256_sub_epi32(_mm256_max_epi32(_mm256_max_epi32(Y[0], Y[1]), Y[2]), lastOffset), kBits));
-    alignas(32) int minCol[8], maxCol[8], minRow[8], maxRow[8];
-    _mm256_store_si256(reinterpret_cast<__m256i*>(minCol), firstCol);
-    _mm256_store_si256(reinterpret_cast<__m256i*>(maxCol), lastCol);
-    _mm256_store_si256(reinterpret_cast<__m256i*>(minRow), firstRow);
-    _mm256_store_si256(reinterpret_cast<__m256i*>(maxRow), lastRow);
-    keep &= _mm256_cmple_epi32_mask(firstCol, lastCol) & _mm256_cmple_epi32_mask(firstRow, lastRow);
-    for (unsigned bits = keep; bits; bits &= bits - 1) {
+    auto firstCentre = [&](const Int32 (&c)[3]) ZCHECK_ALWAYS_INLINE {
+        return L::max(zero, L::template shiftRightArithmetic<kBits>(L::min(L::min(c[0], c[1]), c[2]) + firstOffset));
+    };
+    auto lastCentre = [&](const Int32 (&c)[3], int size) ZCHECK_ALWAYS_INLINE {
+        return L::min(L::set1(std::int32_t(size - 1)), L::template shiftRightArithmetic<kBits>(L::max(L::max(c[0], c[1]), c[2]) - lastOffset));
+    };
+    const Int32 firstCol = firstCentre(X), lastCol = lastCentre(X, vp.width);
+    const Int32 firstRow = firstCentre(Y), lastRow = lastCentre(Y, vp.height);
+    alignas(32) std::int32_t minCol[8], maxCol[8], minRow[8], maxRow[8];
+    L::store(minCol, firstCol), L::store(maxCol, lastCol), L::store(minRow, firstRow), L::store(maxRow, lastRow);
+    keep = keep & L::lessOrEqual(firstCol, lastCol) & L::lessOrEqual(firstRow, lastRow);
+    for (unsigned bits = L::bits(keep); bits; bits &= bits - 1) {
         const int k = __builtin_ctz(bits);
         items.push_back({p + std::uint32_t(k), {minCol[k], maxCol[k], minRow[k], maxRow[k]}});
     }
     return true;
 }
-ZCHECK_INTRINSICS_END
+
+#endif  // ZCHECK_X86_FORMS
+
+// The raster's vector kernels in one form; null in the baseline form (the scalar loops run).
+struct RasterKernels {
+    void (*draw)(const DepthSettings&, const DepthKeys&, const TriangleSetup&, int, int, int, int, TileBuffer&) = nullptr;
+    void (*snapEight)(const Viewport&, const glm::vec3*, std::size_t, StoredVertex*) = nullptr;
+    bool (*binItemsOfEight)(const Viewport&, const glm::uvec3*, std::uint32_t, const StoredVertex*,
+                            std::vector<BinItem>&) = nullptr;
+};
+
+#ifdef ZCHECK_X86_FORMS
+// Each kernel's entry function of one form (kernel_choice.h).
+#define ZCHECK_RASTER_FORM(Entry, Form)                                                                                \
+    Entry void drawInTile##Form(const DepthSettings& depth, const DepthKeys& keys, const TriangleSetup& t, int c0, int r0, \
+                                int c1, int r1, TileBuffer& out)                                                       \
+    {                                                                                                                  \
+        drawInTileLanes<Form##Lanes>(depth, keys, t, c0, r0, c1, r1, out);                                             \
+    }                                                                                                                  \
+    Entry void snapEight##Form(const Viewport& vp, const glm::vec3* positions, std::size_t v, StoredVertex* stored)    \
+    {                                                                                                                  \
+        snapEightLanes<Form##Lanes>(vp, positions, v, stored);                                                         \
+    }                                                                                                                  \
+    Entry bool binItemsOfEight##Form(const Viewport& vp, const glm::uvec3* triangles, std::uint32_t p,                 \
+                                     const StoredVertex* snapped, std::vector<BinItem>& items)                         \
+    {                                                                                                                  \
+        return binItemsOfEightLanes<Form##Lanes>(vp, triangles, p, snapped, items);                                    \
+    }
+ZCHECK_RASTER_FORM(ZCHECK_KERNEL_ENTRY_AVX2, Avx2)
+ZCHECK_RASTER_FORM(ZCHECK_KERNEL_ENTRY_AVX512, Avx512)
+#undef ZCHECK_RASTER_FORM
 #endif
 
-// Whether the vector kernels run (the clean chain's pixels eight at a time, the set-up of
-// eight triangles at a time): kernel_choice.h, ZCHECK_RASTER_KERNEL=scalar|auto.
-bool useVectorKernels() { return useAvx512Form("ZCHECK_RASTER_KERNEL", "scalar"); }
+// The vector kernels of kernelForm() (kernel_form.h; read by each frame when it is made).
+RasterKernels rasterKernels()
+{
+    const KernelForm form = kernelForm();
+#ifdef ZCHECK_X86_FORMS
+    if (form == KernelForm::Avx2) return {&drawInTileAvx2, &snapEightAvx2, &binItemsOfEightAvx2};
+    if (form == KernelForm::Avx512) return {&drawInTileAvx512, &snapEightAvx512, &binItemsOfEightAvx512};
+#endif
+    (void)form;
+    return {};
+}
 
 glm::dvec4 clipOf(const Viewport& vp, const glm::vec3& position)
 {
@@ -568,19 +579,16 @@ glm::dvec4 clipOf(const Viewport& vp, const glm::vec3& position)
 
 // The vertex stage: every vertex to clip space in double and its stored vertex (snapped
 // where inside every clip plane, StoredVertex::outside with its outcode where not): eight at
-// a time with `vector` (snapEight; the caller checks its condition), one at a time
-// otherwise. Writes every element of `stored`, which is resized uninitialised.
-void vertexStage(const Viewport& vp, const std::vector<glm::vec3>& positions, bool vector, LargeVector<StoredVertex>& stored)
+// a time with `snapEight` (a form's kernel; the caller checks its condition), one at a time
+// where it is null. Writes every element of `stored`, which is resized uninitialised.
+void vertexStage(const Viewport& vp, const std::vector<glm::vec3>& positions, decltype(RasterKernels::snapEight) snapEight,
+                 LargeVector<StoredVertex>& stored)
 {
     stored.resize(positions.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, positions.size(), 4096), [&](const auto& range) {
         std::size_t v = range.begin();
-#ifdef ZCHECK_X86_AVX512
-        if (vector)
+        if (snapEight)
             for (; v + 8 <= range.end(); v += 8) snapEight(vp, positions.data(), v, stored.data());
-#else
-        (void)vector;
-#endif
         for (; v != range.end(); ++v) {
             const glm::dvec4 pClip = clipOf(vp, positions[v]);
             const unsigned code = vp.outcode(pClip);
@@ -596,7 +604,7 @@ std::vector<RasterVertexForTesting> rasterVertexStageForTesting(const Scene& sce
 {
     const Viewport vp(camera, faults);
     LargeVector<StoredVertex> stored;
-    vertexStage(vp, scene.positions, vector && useVectorKernels() && !faults.screenLinearEyeZ, stored);
+    vertexStage(vp, scene.positions, vector && !faults.screenLinearEyeZ ? rasterKernels().snapEight : nullptr, stored);
     std::vector<RasterVertexForTesting> out(stored.size());
     for (std::size_t v = 0; v < stored.size(); ++v) out[v] = {stored[v].outcode(), stored[v].X, stored[v].Y, stored[v].z};
     return out;
@@ -611,9 +619,10 @@ struct RasterFrame::Impl {
     Impl(const Scene& s, const Camera& c, const RasterFaults& f, double keyCodes = 0)
         : scene(s), camera(c), faults(f), vp(camera, faults),
           keys(keyCodes > 0 ? DepthKeys::withCodes(keyCodes) : DepthKeys(camera.depth().format)),
-          clearKey(keys.keyOfStored(camera.clearDepth())), vectorKernels(useVectorKernels()),
-          vectorDraw(vectorKernels && !vp.pixelFaults)
+          clearKey(keys.keyOfStored(camera.clearDepth())), kernels(rasterKernels())
     {
+        if (vp.pixelFaults) kernels.draw = nullptr;              // the scalar loop computes the faulty depths
+        if (faults.screenLinearEyeZ) kernels.snapEight = nullptr;  // snapEight is for window depth only
     }
 
     glm::dvec4 clipOf(std::uint32_t v) const { return zcheck::clipOf(vp, scene.positions[v]); }
@@ -627,8 +636,7 @@ struct RasterFrame::Impl {
     const Viewport vp;
     const DepthKeys keys;
     const double clearKey;
-    const bool vectorKernels;  // useVectorKernels: binItemsOfEight, and for the clean chain
-    const bool vectorDraw;     // drawInTileAvx512
+    RasterKernels kernels;  // the vector kernels of kernelForm() this frame may run (null: the scalar loops)
     LargeVector<StoredVertex> snapped;  // per vertex: snapped, or its outcode (StoredVertex)
     std::vector<Chunk> chunks;
 };
@@ -637,7 +645,7 @@ void RasterFrame::Impl::prepare()
 {
     // Vertices to clip space in double, their outcodes, and those inside every clip plane
     // snapped once (a vertex outside one is snapped only where clipping made it).
-    vertexStage(vp, scene.positions, vectorKernels && !faults.screenLinearEyeZ, snapped);
+    vertexStage(vp, scene.positions, kernels.snapEight, snapped);
 
     // Set-up and binning, one fixed-size chunk of triangles per task.
     const std::size_t triangleCount = scene.triangles.size();
@@ -671,12 +679,10 @@ void RasterFrame::Impl::prepare()
                 items.push_back({kClippedBit | std::uint32_t(k), chunk.clipped[k].box});
         };
         std::size_t p = first;
-#ifdef ZCHECK_X86_AVX512
-        if (vectorKernels)
+        if (kernels.binItemsOfEight)
             for (; p + 8 <= last; p += 8)
-                if (!binItemsOfEight(vp, scene.triangles.data(), std::uint32_t(p), snapped.data(), items))
+                if (!kernels.binItemsOfEight(vp, scene.triangles.data(), std::uint32_t(p), snapped.data(), items))
                     for (std::size_t q = p; q < p + 8; ++q) setUp(q);
-#endif
         for (; p < last; ++p) setUp(p);
         binChunk(vp, items, chunk);
     });
@@ -695,9 +701,7 @@ void RasterFrame::Impl::drawTile(int tile, double* windowDepth, std::uint32_t* p
     std::fill(std::begin(tileBuffer.key), std::end(tileBuffer.key), clearKey);
     std::fill(std::begin(tileBuffer.primitive), std::end(tileBuffer.primitive), kNoPrimitive);
     auto draw = [&](const TriangleSetup& setup) {
-#ifdef ZCHECK_X86_AVX512
-        if (vectorDraw) return drawInTileAvx512(camera.depth(), keys, setup, col0, row0, col1, row1, tileBuffer);
-#endif
+        if (kernels.draw) return kernels.draw(camera.depth(), keys, setup, col0, row0, col1, row1, tileBuffer);
         vp.pixelFaults ? drawInTile<true>(vp, keys, setup, col0, row0, col1, row1, tileBuffer)
                        : drawInTile<false>(vp, keys, setup, col0, row0, col1, row1, tileBuffer);
     };

@@ -18,15 +18,15 @@ struct RasterVertexForTesting {
     double z;
 };
 
-// The vertex stage for every vertex of `scene`: with `vector`, the AVX-512 kernel where the
-// processor has it and the faults allow it (ZCHECK_RASTER_KERNEL applies), else the scalar loop.
+// The vertex stage for every vertex of `scene`: with `vector`, the vector kernel of
+// kernelForm() (ZCHECK_KERNELS applies) where the faults allow it, else the scalar loop.
 std::vector<RasterVertexForTesting> rasterVertexStageForTesting(const Scene& scene, const Camera& camera,
                                                                 const RasterFaults& faults, bool vector);
 
 // The clean chain's render with depth keys of 2^52 steps instead of the format's: each
 // pixel's clamped window depth to within 2^-52 (the stored value is key / 2^52), so that a
 // last-bit difference between the kernels' depth arithmetic shows in about half the pixels
-// it touches, where the format would hide it. ZCHECK_RASTER_KERNEL applies.
+// it touches, where the format would hide it. ZCHECK_KERNELS applies.
 RenderResult rasterRenderWithFineKeysForTesting(const Scene& scene, const Camera& camera);
 
 }  // namespace zcheck

@@ -143,7 +143,7 @@ struct RayRenderer::Embree {
 };
 
 RayRenderer::RayRenderer(const Scene& scene)
-    : embree_(std::make_unique<Embree>()), scene_(scene), avx512_(useAvx512Form("ZCHECK_RAY_KERNEL", "baseline"))
+    : embree_(std::make_unique<Embree>()), scene_(scene), form_(kernelForm())
 {
     validateScene(scene);
     const auto start = Clock::now();
@@ -240,13 +240,13 @@ RenderResult RayRenderer::render(const Camera& camera, const RayFaults& fault, E
 
 namespace {
 
-#ifdef ZCHECK_X86_AVX512
-// The AVX-512 form's reading of a packet's planes (the baseline form reads them lane by lane):
+#ifdef ZCHECK_X86_FORMS
+// The vector forms' reading of a packet's planes (the baseline form reads them lane by lane):
 // four entries at a time, each as one 32-byte load (the normal and the vertex's x and y) and
 // one of 8 bytes (its z), transposed into the lanes. The same values: only the loads differ.
 // (Lane by lane, GCC made 96 scalar loads and as many inserts per packet.)
 ZCHECK_INTRINSICS_BEGIN
-ZCHECK_TARGET_AVX512 inline void planesInLanesAvx512(const HitPlane* planes, const std::uint32_t* triangle,
+ZCHECK_TARGET_AVX2 inline void planesInLanes(const HitPlane* planes, const std::uint32_t* triangle,
                                                      double (*plane)[kPacketRays])
 {
     static_assert(kPacketRays % 4 == 0 && offsetof(HitPlane, vertex) == 24, "four entries at a time, as laid out");
@@ -273,11 +273,11 @@ ZCHECK_TARGET_AVX512 inline void planesInLanesAvx512(const HitPlane* planes, con
 ZCHECK_INTRINSICS_END
 #endif
 
-// RayRenderer::traceRect's work, inlined into two functions: one compiled for the build's
-// baseline and one for AVX-512 (kernel_choice.h). Its per-packet steps below, and the lambdas
-// of traceRectBody that call them, must be inlined too, or they would stay baseline code. The
-// arrays that finish's steps share are declared in its lambda and passed by reference, as
-// arrays: so both forms compile to the code the uncut body did (declared inside the steps, as
+// RayRenderer::traceRect's work, inlined into one function per form (kernel_choice.h). Its
+// per-packet steps below, and the lambdas of traceRectBody that call them, are inlined too (the
+// entry functions flatten them), or they would stay baseline code. The arrays that finish's
+// steps share are declared in its lambda and passed by reference, as arrays: so every form
+// compiles to the code the uncut body did (declared inside the steps, as
 // triangle and tEmbree were, or passed as pointers, GCC laid out and scheduled the loop anew).
 
 // A rectangle as the per-packet steps read it, made once: its pixels [col0, col1) × [row0, row1)
@@ -409,7 +409,7 @@ ZCHECK_ALWAYS_INLINE inline void intersectPacket(PacketInFlight& p, RTCScene rtc
 }
 
 // Each lane's triangle (a miss: 0) and that triangle's plane: plane[0..2] a vertex, plane[3..5] the normal.
-template <bool kAvx512>
+template <KernelForm kForm>
 ZCHECK_ALWAYS_INLINE inline void hitPlanesOfPacket(const PacketInFlight& p, const HitPlane* planes,
                                                    std::uint32_t (&triangle)[kPacketRays],
                                                    double (&plane)[6][kPacketRays])
@@ -419,10 +419,10 @@ ZCHECK_ALWAYS_INLINE inline void hitPlanesOfPacket(const PacketInFlight& p, cons
     // mispredicted branches than the arithmetic it saved.) A miss takes triangle 0's plane
     // (a scene has one, RayRenderer checked), and its result is not used.
     for (int k = 0; k < kPacketRays; ++k) triangle[k] = p.hit(k) ? p.packet.hit.primID[k] : 0;
-#ifdef ZCHECK_X86_AVX512
-    if constexpr (kAvx512) planesInLanesAvx512(planes, triangle, plane);
+#ifdef ZCHECK_X86_FORMS
+    if constexpr (kForm != KernelForm::Baseline) planesInLanes(planes, triangle, plane);
 #endif
-    if constexpr (!kAvx512)
+    if constexpr (kForm == KernelForm::Baseline)
         for (int k = 0; k < kPacketRays; ++k) {
             const HitPlane& h = planes[triangle[k]];
             for (int axis = 0; axis < 3; ++axis)
@@ -491,8 +491,8 @@ ZCHECK_ALWAYS_INLINE inline void writePacketPixels(const PacketInFlight& p, cons
     }
 }
 
-// traceRect for one rectangle, packet by packet through the steps above. kAvx512: the AVX-512 form's own steps.
-template <bool kAvx512>
+// traceRect for one rectangle, packet by packet through the steps above, in form kForm.
+template <KernelForm kForm>
 ZCHECK_ALWAYS_INLINE inline void traceRectBody(RTCScene rtcScene, const glm::dvec3& frameOrigin, const HitPlane* planes,
                                         const Camera& camera, const PixelRect& rect, double* windowDepth,
                                         std::uint32_t* primitiveId, std::size_t stride, const RayFaults& fault,
@@ -524,7 +524,7 @@ ZCHECK_ALWAYS_INLINE inline void traceRectBody(RTCScene rtcScene, const glm::dve
     auto finish = [&](const PacketInFlight& p) ZCHECK_ALWAYS_INLINE {
         std::uint32_t triangle[kPacketRays];
         alignas(64) double plane[6][kPacketRays];
-        hitPlanesOfPacket<kAvx512>(p, planes, triangle, plane);
+        hitPlanesOfPacket<kForm>(p, planes, triangle, plane);
         alignas(64) double tEmbree[kPacketRays], t[kPacketRays], eyeZ[kPacketRays];
         hitsInDouble(p, plane, cameraRays, fault, tEmbree, t, eyeZ);
         writePacketPixels(p, t, eyeZ, cameraRays, setUp);
@@ -550,17 +550,22 @@ void traceRectBaseline(RTCScene rtcScene, const glm::dvec3& frameOrigin, const H
                        const PixelRect& rect, double* windowDepth, std::uint32_t* primitiveId, std::size_t stride,
                        const RayFaults& fault, glm::dvec3* pEye)
 {
-    traceRectBody<false>(rtcScene, frameOrigin, planes, camera, rect, windowDepth, primitiveId, stride, fault, pEye);
+    traceRectBody<KernelForm::Baseline>(rtcScene, frameOrigin, planes, camera, rect, windowDepth, primitiveId, stride,
+                                        fault, pEye);
 }
 
-#ifdef ZCHECK_X86_AVX512
-ZCHECK_TARGET_AVX512 void traceRectAvx512(RTCScene rtcScene, const glm::dvec3& frameOrigin, const HitPlane* planes,
-                                          const Camera& camera, const PixelRect& rect, double* windowDepth,
-                                          std::uint32_t* primitiveId, std::size_t stride, const RayFaults& fault,
-                                          glm::dvec3* pEye)
-{
-    traceRectBody<true>(rtcScene, frameOrigin, planes, camera, rect, windowDepth, primitiveId, stride, fault, pEye);
-}
+#ifdef ZCHECK_X86_FORMS
+#define ZCHECK_TRACE_FORM(Entry, Form)                                                                                \
+    Entry void traceRect##Form(RTCScene rtcScene, const glm::dvec3& frameOrigin, const HitPlane* planes,                \
+                               const Camera& camera, const PixelRect& rect, double* windowDepth,                       \
+                               std::uint32_t* primitiveId, std::size_t stride, const RayFaults& fault, glm::dvec3* pEye) \
+    {                                                                                                                 \
+        traceRectBody<KernelForm::Form>(rtcScene, frameOrigin, planes, camera, rect, windowDepth, primitiveId, stride, \
+                                        fault, pEye);                                                                 \
+    }
+ZCHECK_TRACE_FORM(ZCHECK_KERNEL_ENTRY_AVX2, Avx2)
+ZCHECK_TRACE_FORM(ZCHECK_KERNEL_ENTRY_AVX512, Avx512)
+#undef ZCHECK_TRACE_FORM
 #endif
 
 }  // namespace
@@ -569,8 +574,8 @@ void RayRenderer::traceRect(const Camera& camera, const PixelRect& rect, double*
                             std::size_t stride, const RayFaults& fault, glm::dvec3* pEye) const
 {
     auto* form = &traceRectBaseline;
-#ifdef ZCHECK_X86_AVX512
-    if (avx512_) form = &traceRectAvx512;
+#ifdef ZCHECK_X86_FORMS
+    form = formOf(form_, form, &traceRectAvx2, &traceRectAvx512);
 #endif
     form(embree_->scene.get(), embree_->frameOrigin, embree_->planes.data(), camera, rect, windowDepth, primitiveId,
          stride, fault, pEye);

@@ -167,3 +167,29 @@ def test_release_cached_buffers_gives_the_kept_frames_back(default_scene, defaul
     assert zcheck.cached_buffer_bytes() == 0
     # The next check of that size maps fresh buffers and gives the same answer.
     assert default_checker.check(camera).consistent
+
+
+def test_the_kernel_form_is_the_widest_supported_or_the_one_zcheck_kernels_names(monkeypatch):
+    supported = zcheck.kernel_forms_supported()
+    assert supported[0] == "baseline" and set(supported) <= {"baseline", "avx2", "avx512"}
+    monkeypatch.delenv("ZCHECK_KERNELS", raising=False)
+    assert zcheck.kernel_form() == supported[-1]
+    scene = zcheck.Scene.from_file("builtin:default")
+    checker = zcheck.Checker(scene)
+    camera = scene.default_camera.replace(width=64, height=48)
+    renders = {}
+    for form in supported:
+        monkeypatch.setenv("ZCHECK_KERNELS", form)
+        assert zcheck.kernel_form() == form
+        renders[form] = checker.render(camera, "window", route="raster").tobytes()
+    assert len(set(renders.values())) == 1  # bit-identical in every form
+    for bad in ["sse2", "AVX2", "avx1024"]:
+        monkeypatch.setenv("ZCHECK_KERNELS", bad)
+        with pytest.raises(zcheck.Error, match=f"ZCHECK_KERNELS={bad}: must be auto, baseline, avx2 or avx512"):
+            zcheck.kernel_form()
+        with pytest.raises(zcheck.Error, match=f"ZCHECK_KERNELS={bad}"):
+            checker.render(camera, "window", route="raster")
+    for form in {"avx2", "avx512"} - set(supported):
+        monkeypatch.setenv("ZCHECK_KERNELS", form)
+        with pytest.raises(zcheck.Error, match="this processor cannot run"):
+            zcheck.kernel_form()

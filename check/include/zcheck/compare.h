@@ -35,6 +35,7 @@
 //
 // Verdict: consistent ⇔ no unexplained coverage mismatch, no depth error and no bias.
 #include "zcheck/camera.h"
+#include "zcheck/kernel_form.h"
 #include "zcheck/large_buffer.h"
 #include "zcheck/render.h"
 #include "zcheck/scene.h"
@@ -200,8 +201,8 @@ class SlopeTable;
 
 class PixelJudge {
 public:
-    // Reads ZCHECK_COMPARE_KERNEL (auto or baseline: the AVX-512 forms or not) and throws Error for a value but
-    // `baseline`, `auto` or empty; so do compareRoutes and TileComparison, which make one.
+    // Reads ZCHECK_KERNELS (zcheck/kernel_form.h: the form its comparisons run in) and throws Error
+    // for a value it refuses; so do compareRoutes and TileComparison, which make one.
     PixelJudge(const Scene& scene, const Camera& camera, const ToleranceModel& tolerance = {},
                SlopeSource slopes = SlopeSource::TableOfSeen);
     ~PixelJudge();
@@ -264,9 +265,8 @@ public:
     // TableOfSeen: the table the comparison's kernels read slopes from (check/src/slope_table.h,
     // private to zcheck_check); null for EachCall.
     const SlopeTable* slopeTable() const { return table_.get(); }
-    // Whether the comparison's AVX-512 forms run (ZCHECK_COMPARE_KERNEL, read when the judge
-    // was made).
-    bool avx512Form() const { return avx512_; }
+    // The form the comparison's kernels run in (ZCHECK_KERNELS, read when the judge was made).
+    KernelForm form() const { return form_; }
     double snapPixels() const { return terms_.S; }
     // What it was made for.
     const Scene& scene() const { return scene_; }
@@ -282,7 +282,7 @@ private:
     const Camera& camera_;
     ToleranceModel tolerance_;
     ToleranceTerms terms_;
-    bool avx512_;  // ZCHECK_COMPARE_KERNEL: the AVX-512 forms (avx512Form())
+    KernelForm form_;  // form()
     DepthSlopeFrame slopeFrame_;
     std::unique_ptr<SlopeTable> table_;  // TableOfSeen's; null for EachCall
 };

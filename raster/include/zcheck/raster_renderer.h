@@ -19,11 +19,11 @@
 // order; tiles are then drawn in parallel, each walking the chunks in order. The result is
 // bit-identical for any number of threads.
 //
-// Where the processor has AVX-512 (F, DQ, VL), the vertex stage, the set-up and the clean
-// chain's pixels run eight at a time, with the same integer and double operations in the same
-// order as the scalar loops (no FMA contraction), so the result is bit-identical to theirs;
-// the environment variable ZCHECK_RASTER_KERNEL=scalar forces the scalar loops, "auto" (or
-// unset) picks, and any other value makes render() and prepare() throw Error.
+// In the AVX2 and AVX-512 forms (zcheck/kernel_form.h), the vertex stage, the set-up and the
+// clean chain's pixels run eight at a time, with the same integer and double operations in the
+// same order as the scalar loops (no FMA contraction), so the result is bit-identical to
+// theirs; the baseline form runs the scalar loops. ZCHECK_KERNELS chooses the form, read by
+// render() and prepare(), which throw Error for a value it refuses.
 //
 //   const zcheck::RasterRenderer raster(scene);
 //   const zcheck::RenderResult drawn = raster.render(camera);   // drawn.windowDepth: stored values

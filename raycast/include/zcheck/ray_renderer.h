@@ -21,6 +21,7 @@
 // Embree lifetimes: the device outlives the scene; geometry is committed before the scene
 // is, and the scene is committed before any ray is traced. An error Embree reports through
 // its callback becomes an Error.
+#include "zcheck/kernel_form.h"
 #include "zcheck/render.h"
 #include "zcheck/scene.h"
 #include "zcheck/tile_grid.h"
@@ -47,10 +48,9 @@ enum class EyePoints { Omit, Keep };
 class RayRenderer {
 public:
     // Builds the BVH and the triangles' planes (timed together); throws Error. `scene` must
-    // outlive it: Embree reads its index buffer in place. Where the processor has AVX-512 (F,
-    // DQ, VL) the trace runs a form of itself compiled for it, bit-identical to the baseline
-    // form (chosen at run time); the environment variable ZCHECK_RAY_KERNEL=baseline, read here,
-    // forces the baseline form, and any value but that, `auto` or empty throws Error.
+    // outlive it: Embree reads its index buffer in place. The trace's steps around Embree run in
+    // the form kernelForm() gives when this is made (zcheck/kernel_form.h: ZCHECK_KERNELS,
+    // read here; a value it refuses throws Error), each form bit-identical to the baseline.
     explicit RayRenderer(const Scene& scene);
     ~RayRenderer();
     RayRenderer(const RayRenderer&) = delete;
@@ -78,7 +78,7 @@ private:
     struct Embree;
     std::unique_ptr<Embree> embree_;
     const Scene& scene_;
-    bool avx512_;  // the trace's AVX-512 form (ZCHECK_RAY_KERNEL, read when this was made)
+    KernelForm form_;  // the trace's form (ZCHECK_KERNELS, read when this was made)
     double buildMilliseconds_ = 0;
 };
 

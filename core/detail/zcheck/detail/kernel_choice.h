@@ -1,42 +1,45 @@
 #pragma once
 // Internal to zcheck (core/detail, never installed).
-// The choice, at run time, between a routine's AVX-512 form and its baseline form.
+// How a kernel comes in its three forms (zcheck/kernel_form.h: baseline, AVX2 + FMA, AVX-512)
+// and how one is chosen at run time.
 //
-// The raster's vector kernels and the comparison's row pass (hand-written, eight lanes at a
-// time), the trace and the rest of the comparison (the same source compiled twice, once for
-// AVX-512) run their AVX-512 forms where the processor has AVX-512 F, DQ and VL, and their
-// baseline forms elsewhere. The two forms do the same IEEE operations in the same order (the
-// build has -ffp-contract=off, so no multiply and add are fused into one rounding), so their
-// outputs are bit-identical; the tests run both and compare them bit for bit. An environment
-// variable per stage forces the baseline form:
+// A kernel is written once. Its vector steps are a template over a lane type (lanes.h:
+// Avx2Lanes, Avx512Lanes — eight lanes of each, the same operations); its scalar steps are
+// plain code the compiler vectorises for each target. One entry function per form compiles the
+// one body for that form's instructions:
 //
-//   ZCHECK_RASTER_KERNEL=scalar     the raster's scalar loops
-//   ZCHECK_RAY_KERNEL=baseline      the trace compiled for the build's baseline (x86-64: SSE2)
-//   ZCHECK_COMPARE_KERNEL=baseline  the comparison's row pass (its lane loops) and slopes, likewise
-//
-// A variable unset, empty or `auto` lets the processor decide.
-//
-//   ZCHECK_ALWAYS_INLINE inline void drawBody(...) { ... }       // one source ...
-//   void drawBaseline(...) { drawBody(...); }
-//   #ifdef ZCHECK_X86_AVX512
-//   ZCHECK_TARGET_AVX512 void drawAvx512(...) { drawBody(...); } // ... compiled twice
+//   template <class Lanes> ZCHECK_ALWAYS_INLINE inline void drawBody(...) { ... }  // one source ...
+//   void drawBaseline(...) { drawScalar(...); }
+//   #ifdef ZCHECK_X86_FORMS
+//   ZCHECK_KERNEL_ENTRY_AVX2 void drawAvx2(...) { drawBody<Avx2Lanes>(...); }       // ... compiled
+//   ZCHECK_KERNEL_ENTRY_AVX512 void drawAvx512(...) { drawBody<Avx512Lanes>(...); } // per form
 //   #endif
-//   auto* draw = &drawBaseline;
-//   #ifdef ZCHECK_X86_AVX512
-//   if (useAvx512Form("ZCHECK_RAY_KERNEL", "baseline")) draw = &drawAvx512;
-//   #endif
+//   auto* draw = formOf<decltype(&drawBaseline)>(kernelForm(), drawBaseline, drawAvx2, drawAvx512);
 //
-// Read the choice once per render or frame, on the calling thread (not per tile on the
-// workers: a program may change its environment meanwhile).
+// An entry function is `flatten`: everything it calls that can be inlined is, recursively, so
+// that no step of its body (nor a lane operation, nor a lambda) stays a call into code compiled
+// for another target. The forms do the same IEEE operations in the same order (the build has
+// -ffp-contract=off, so no multiply and add are fused into one rounding), so their outputs
+// are bit-identical; the tests run each form the processor has and compare them bit for bit.
+//
+// Read the choice once per render, frame or comparison, on the calling thread (not per tile on
+// the workers: a program may change its environment meanwhile).
+#include "zcheck/kernel_form.h"
 
 // A function inlined wherever it is called, also into a function compiled for other
-// instructions (a body shared by two forms, and the lambdas inside it, must be).
+// instructions (a body shared by the forms, and the lambdas inside it).
 #define ZCHECK_ALWAYS_INLINE __attribute__((always_inline))
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-#define ZCHECK_X86_AVX512 1
-// A function compiled for AVX-512 F, DQ and VL; its callers check useAvx512Form first.
-#define ZCHECK_TARGET_AVX512 __attribute__((target("avx512f,avx512dq,avx512vl")))
+#define ZCHECK_X86_FORMS 1
+// x86-64-v3's vector and bit instructions (AVX2, FMA, BMI1/2, LZCNT, MOVBE, F16C); the AVX-512
+// target includes them all, so that an AVX2 helper inlines into an AVX-512 function too.
+#define ZCHECK_TARGET_AVX2 __attribute__((target("avx,avx2,fma,bmi,bmi2,lzcnt,movbe,f16c,popcnt")))
+#define ZCHECK_TARGET_AVX512 \
+    __attribute__((target("avx,avx2,fma,bmi,bmi2,lzcnt,movbe,f16c,popcnt,avx512f,avx512dq,avx512vl")))
+// A form's entry function: its target, and everything it calls inlined into it (above).
+#define ZCHECK_KERNEL_ENTRY_AVX2 ZCHECK_TARGET_AVX2 __attribute__((flatten))
+#define ZCHECK_KERNEL_ENTRY_AVX512 ZCHECK_TARGET_AVX512 __attribute__((flatten))
 #endif
 
 // Around hand-written intrinsics: GCC 12's intrinsics headers start many conversions from an
@@ -54,10 +57,17 @@
 
 namespace zcheck {
 
-// Whether the AVX-512 form runs: the processor has AVX-512 F, DQ and VL (and the build
-// targets x86-64), and the environment variable `variable` is unset, empty or "auto", not
-// `baselineValue`. Any other value throws Error naming the variable, the value and the two
-// allowed. Reads the environment on every call (cheap next to a render).
-bool useAvx512Form(const char* variable, const char* baselineValue);
+// The function of `form` among a kernel's three entry functions (the vector ones exist where
+// ZCHECK_X86_FORMS is defined; elsewhere kernelForm() is always Baseline).
+template <class Function>
+Function formOf(KernelForm form, Function baseline, [[maybe_unused]] Function avx2, [[maybe_unused]] Function avx512)
+{
+    switch (form) {
+    case KernelForm::Avx2: return avx2;
+    case KernelForm::Avx512: return avx512;
+    case KernelForm::Baseline: break;
+    }
+    return baseline;
+}
 
 }  // namespace zcheck
