@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 #include <sys/resource.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -38,8 +39,10 @@ namespace zcheck::cli {
 
 namespace {
 
-// The named workloads (docs/speed.md): one million-triangle terrain, three cameras.
+// The named workloads (docs/speed.md): a million-triangle terrain through three cameras, and a
+// ten-million-triangle one at 4K.
 const char* const kWorkloadScene = "builtin:terrain?n=709&size=2";
+const char* const kHugeWorkloadScene = "builtin:terrain?n=2237&size=2";
 
 // terrain-1M-1080p: seen from above at 1080p through a pinhole, every pixel covered.
 CameraSpec terrainCamera()
@@ -49,6 +52,15 @@ CameraSpec terrainCamera()
     spec.projection = Projection::perspective(60.0, 0.01, 10.0);
     spec.view = View::lookAt({0.0, 0.6, -0.15}, {0.0, 0.0, 0.0}, {0.0, 1.0, 0.0});
     spec.depth.format = DepthFormat::Unorm24;
+    return spec;
+}
+
+// terrain-10M-4K: the same view of a terrain ten times as fine (9,999,392 triangles) at
+// 3840x2160: 0.83 rays per triangle, a check whose BVH build is most of it.
+CameraSpec hugeTerrainCamera()
+{
+    CameraSpec spec = terrainCamera();
+    spec.width = 3840, spec.height = 2160;
     return spec;
 }
 
@@ -83,12 +95,14 @@ CameraSpec panoramaCamera()
 
 struct Workload {
     const char* name;
+    const char* scene;
     CameraSpec (*camera)();
 };
 const Workload kWorkloads[] = {
-    {"terrain-1M-1080p", terrainCamera},
-    {"fisheye-1M-1080p", fisheyeCamera},
-    {"panorama-1M-1920x960", panoramaCamera},
+    {"terrain-1M-1080p", kWorkloadScene, terrainCamera},
+    {"fisheye-1M-1080p", kWorkloadScene, fisheyeCamera},
+    {"panorama-1M-1920x960", kWorkloadScene, panoramaCamera},
+    {"terrain-10M-4K", kHugeWorkloadScene, hugeTerrainCamera},
 };
 
 struct Phase {
@@ -111,6 +125,16 @@ int threadsOfThisProcess()
     for (std::string line; std::getline(status, line);)
         if (line.rfind("Threads:", 0) == 0) return std::atoi(line.c_str() + 8);
     return 0;
+}
+
+// loadScene on the calling thread alone: TBB starts no worker (as a parallel loop, or a
+// global_control, would), so that this process can still fork the measuring children (inChild).
+Scene loadSceneOnThisThread(const std::string& name)
+{
+    Scene scene;
+    tbb::task_arena callingThreadOnly(1);
+    callingThreadOnly.execute([&] { scene = loadScene(name); });
+    return scene;
 }
 
 // Runs `measure` in a child process of its own (fresh memory and page tables, nothing
@@ -153,13 +177,15 @@ std::pair<Result, double> inChild(int threads, const char* what, Measure measure
     return {result, maxResidentMiB(usage)};
 }
 
-// One whole check as `zcheck check` runs it (tile by tile, keeping no per-pixel result; cold:
-// as in a fresh `zcheck check` process), then, with the same Checker, a check that keeps
-// both routes' full-frame renders (the phases the speed targets time: each route's whole
-// image, its buffers new), and that one again (warm: the memory the one before freed is
-// reused, as in a program that checks many cameras or maps, and as the yardsticks' repeated
-// draws and traces run).
+// One whole check as `zcheck check` runs it (its BVH built for one frame's rays, bvhBuildFor;
+// tile by tile, keeping no per-pixel result; cold: as in a fresh `zcheck check` process),
+// then, over a BVH built for many frames (the same one where that was the one-frame choice too),
+// a check that keeps both routes' full-frame renders (the phases the speed targets time: each
+// route's whole image, its buffers new), and that one again (warm: the memory the one before
+// freed is reused, as in a program that checks many cameras or maps, and as the yardsticks'
+// repeated draws and traces run, over Embree's own thorough build).
 struct WholeCheck {
+    BvhBuild build;                          // the whole check's
     double loadMs, bvhMs, tilesMs, wholeMs;  // tilesMs: the tile-by-tile pass of the whole check
     double traceMs, rasterMs, compareMs;     // the full-frame check's phases
     double warmTraceMs, warmRasterMs, warmCompareMs;
@@ -175,11 +201,12 @@ WholeCheck wholeCheckInChild(const std::string& sceneName, const Camera& camera,
         const auto start = Clock::now();
         Scene scene = loadScene(sceneName);
         w.loadMs = millisecondsSince(start);
-        const Checker checker(std::move(scene));
+        w.build = bvhBuildFor(double(camera.width()) * camera.height(), scene.triangleCount());
+        auto checker = std::make_unique<const Checker>(std::move(scene), w.build);
         {
             CheckOptions asTheCommand;
             asTheCommand.keepPixels = false;
-            const CheckResult run = checker.check(camera, asTheCommand);
+            const CheckResult run = checker->check(camera, asTheCommand);
             w.wholeMs = millisecondsSince(start);
             w.bvhMs = run.report.timings.bvhBuildMs;
             w.tilesMs = run.report.timings.traceMs + run.report.timings.rasterMs + run.report.timings.compareMs;
@@ -188,17 +215,22 @@ WholeCheck wholeCheckInChild(const std::string& sceneName, const Camera& camera,
         rusage usage{};
         getrusage(RUSAGE_SELF, &usage);
         w.peakMiB = maxResidentMiB(usage);
+        if (w.build != BvhBuild::Thorough) {  // the phases over the many-frame BVH
+            Scene again = checker->scene();
+            checker.reset();
+            checker = std::make_unique<const Checker>(std::move(again), BvhBuild::Thorough);
+        }
         {
             releaseCachedLargeBuffers();  // the full-frame check's buffers new, as in a fresh process
-            const CheckResult fullFrame = checker.check(camera);
+            const CheckResult fullFrame = checker->check(camera);
             w.traceMs = fullFrame.report.timings.traceMs, w.rasterMs = fullFrame.report.timings.rasterMs;
             w.compareMs = fullFrame.report.timings.compareMs;
             w.consistent = w.consistent && fullFrame.report.comparison.consistent();
         }
-        const CheckResult again = checker.check(camera);
+        const CheckResult again = checker->check(camera);
         w.warmTraceMs = again.report.timings.traceMs, w.warmRasterMs = again.report.timings.rasterMs;
         w.warmCompareMs = again.report.timings.compareMs;
-        w.triangles = checker.scene().triangleCount();
+        w.triangles = checker->scene().triangleCount();
         return w;
     }).first;
 }
@@ -209,7 +241,8 @@ WholeCheck wholeCheckInChild(const std::string& sceneName, const Camera& camera,
 // traces, and what a pinhole check's trace does; a lens check's trace also keeps every hit's
 // eye point for its forward check), and a one-shot
 // export of its distance map as `zcheck export` runs it (load, BVH, table, trace, the .npy
-// written), then the same export warm (BVH and table kept: the second frame of a dataset).
+// written; its BVH built for one frame's rays, bvhBuildFor), then the same export warm (the
+// table kept, the BVH built for many frames: the second frame of a dataset).
 struct LensCosts {
     double tableMs, raysMs, depthTraceMs;
     double exportMs, exportTraceMs, exportWriteMs, warmExportMs;
@@ -230,12 +263,21 @@ LensCosts lensCostsInChild(const std::string& sceneName, const Camera& camera, i
             writeMs = millisecondsSince(start);
         };
         const auto start = Clock::now();
-        const Checker checker(loadScene(sceneName));
+        auto checker = [&] {  // as `zcheck export` builds it: for one frame's rays
+            Scene scene = loadScene(sceneName);
+            const BvhBuild build = bvhBuildFor(double(camera.width()) * camera.height(), scene.triangleCount());
+            return std::make_unique<const Checker>(std::move(scene), build);
+        }();
         const auto tableStart = Clock::now();
         camera.lens()->directionAtPixel(0, 0);  // builds the table
         c.tableMs = millisecondsSince(tableStart);
-        exportOnce(checker, c.exportTraceMs, c.exportWriteMs);
+        exportOnce(*checker, c.exportTraceMs, c.exportWriteMs);
         c.exportMs = millisecondsSince(start);
+        if (checker->rayRenderer().bvhBuild() != BvhBuild::Thorough) {  // the rest over the many-frame BVH
+            Scene again = checker->scene();
+            checker.reset();
+            checker = std::make_unique<const Checker>(std::move(again), BvhBuild::Thorough);
+        }
 
         const CameraRays cameraRays(camera);
         const int W = camera.width(), H = camera.height();
@@ -251,11 +293,11 @@ LensCosts lensCostsInChild(const std::string& sceneName, const Camera& camera, i
         c.raysMs = millisecondsSince(raysStart);
         if (std::isnan(std::accumulate(sums.begin(), sums.end(), 0.0))) c.raysMs = NAN;
 
-        c.depthTraceMs = checker.renderRay(camera).renderMilliseconds;
+        c.depthTraceMs = checker->renderRay(camera).renderMilliseconds;
 
         const auto warmStart = Clock::now();
         double traceMs = 0, writeMs = 0;
-        exportOnce(checker, traceMs, writeMs);
+        exportOnce(*checker, traceMs, writeMs);
         c.warmExportMs = millisecondsSince(warmStart);
         std::filesystem::remove(output);
         return c;
@@ -366,12 +408,14 @@ struct BenchSetting {
     double fileMB;
     double pixels;
     double bytesPerPixel, budgetMiB;
+    bool huge = false;  // terrain-10M-4K: its own targets, the whole check's seconds and memory
 };
 
 // One kernel form's measurements: every repeat's whole check (WholeCheck) and, for a lens
 // camera, its own costs (LensCosts), each in a child that ran in this form.
 struct FormPhases {
     KernelForm form = KernelForm::Baseline;
+    BvhBuild build = BvhBuild::Thorough;  // the whole check's (WholeCheck)
     Phase load, bvh, tiles, trace, raster, compare, whole, warmTrace, warmRaster, warmCompare;
     Phase rayTable, rays, depthTrace, exportOneShot, exportTrace, exportWrite, warmExport;
     std::size_t triangles = 0;
@@ -386,6 +430,7 @@ void addWholeCheck(FormPhases& f, const std::string& sceneName, const Camera& ca
         const KernelsEnvironment inForm(f.form);
         return wholeCheckInChild(sceneName, camera, threads);
     }();
+    f.build = w.build;
     f.load.ms.push_back(w.loadMs), f.bvh.ms.push_back(w.bvhMs), f.tiles.ms.push_back(w.tilesMs), f.trace.ms.push_back(w.traceMs);
     f.raster.ms.push_back(w.rasterMs), f.compare.ms.push_back(w.compareMs), f.whole.ms.push_back(w.wholeMs);
     f.warmTrace.ms.push_back(w.warmTraceMs), f.warmRaster.ms.push_back(w.warmRasterMs);
@@ -425,7 +470,7 @@ References measureReferences(const std::string& sceneName, const Camera& camera,
     References ref;
     const KernelsEnvironment inForm(form);  // before TBB starts here
     const bool lens = camera.lens() != nullptr;
-    const Scene scene = loadScene(sceneName);
+    const Scene scene = loadSceneOnThisThread(sceneName);  // Embree's builds below fork
     if (progress) std::fprintf(stderr, "\rbench: Embree reference%20s", ""), std::fflush(stderr);
     // Embree's build, like the check's, in a fresh process each time: in this process
     // its repeats ran on memory earlier builds had faulted in (and varied 142-274 ms).
@@ -509,6 +554,10 @@ std::vector<Ratio> ratiosOf(const FormPhases& f, const BenchSetting& s, const Re
         ratios.push_back({"warm-export-seconds", f.warmExport.median() / 1e3, 0.5, true});
     }
     if (s.isFile) ratios.push_back({"load-MB/s", s.fileMB / (f.load.median() / 1e3), 150.0, false});
+    if (s.huge) {  // the one-shot huge mesh: its BVH built quickly
+        ratios.push_back({"whole-check-seconds", f.whole.median() / 1e3, 2.0, true});
+        ratios.push_back({"peak-rss-GB", f.peakMiB * 1024.0 * 1024.0 / 1e9, 1.4, true});
+    }
     if (!ref.glDraw.ms.empty()) ratios.push_back({"raster/llvmpipe", f.raster.median() / ref.glDraw.median(), 0.33, true});
     if (!ref.embreeTrace.ms.empty()) {
         ratios.push_back({"trace-throughput/embree", ref.embreeTrace.median() / (lens ? f.depthTrace : f.trace).median(),
@@ -539,6 +588,7 @@ nlohmann::ordered_json formJson(const FormPhases& f, const BenchSetting& s, cons
 {
     nlohmann::ordered_json out;
     out["consistent"] = f.consistent;
+    out["bvh_build"] = nameOf(f.build);  // the whole check's; the other phases' is thorough
     out["phases"] = {{"load", phaseJson(f.load)},     {"bvh", phaseJson(f.bvh)},         {"tiles", phaseJson(f.tiles)},
                      {"trace", phaseJson(f.trace)},
                      {"raster", phaseJson(f.raster)}, {"compare", phaseJson(f.compare)}, {"whole", phaseJson(f.whole)},
@@ -565,7 +615,10 @@ void printPhases(const FormPhases& f, const BenchSetting& s)
     const bool lens = s.lens;
     const double pixels = s.pixels;
     printPhase("load", f.load, s.isFile ? rate(s.fileMB / (f.load.median() / 1e3), "MB/s") : "(built in)");
-    printPhase("bvh build", f.bvh);
+    char perTriangle[32];
+    std::snprintf(perTriangle, sizeof perTriangle, "%.2f", pixels / double(f.triangles));
+    printPhase("bvh build", f.bvh,
+               std::string(nameOf(f.build)) + " (" + perTriangle + " rays per triangle; the phases below: thorough)");
     if (lens) printPhase("ray table", f.rayTable, rate(pixels / f.rayTable.median() / 1e3, "Mrays/s") + " (built once per intrinsics)");
     printPhase("trace", f.trace, rate(pixels / f.trace.median() / 1e3, "Mrays/s") + (lens ? " (the table built; eye points kept)" : ""));
     if (lens) {
@@ -637,9 +690,10 @@ int runBenchCommand(const BenchOptions& o)
     const Workload* named = nullptr;
     for (const Workload& w : kWorkloads)
         if (o.workload == w.name) named = &w;
-    if (!named) throw Error("--workload '" + o.workload + "' is not a named workload: terrain-1M-1080p, fisheye-1M-1080p or panorama-1M-1920x960");
+    if (!named) throw Error("--workload '" + o.workload + "' is not a named workload: terrain-1M-1080p, fisheye-1M-1080p, panorama-1M-1920x960 or terrain-10M-4K");
     if (o.workload != kWorkloads[0].name && !workload)
         throw Error("--workload " + o.workload + " names its own scene and camera: give it without --scene and --camera");
+    const std::string sceneName = workload ? named->scene : o.input.scene;
     std::vector<FormPhases> forms;
     for (KernelForm form : kernelFormsOf(o.kernels)) forms.emplace_back().form = form;
 
@@ -647,15 +701,15 @@ int runBenchCommand(const BenchOptions& o)
     // effects are not what this measures). TBB is not started before the children fork.
     CameraSpec spec;
     {
-        Scene scene = loadScene(o.input.scene);
+        Scene scene = loadSceneOnThisThread(sceneName);
         if (workload) scene.defaultCamera = named->camera();
         spec = cameraSpecFor(scene, o.input);
     }
     o.imageSize.apply(spec);
     const Camera camera(spec);
     const bool lens = camera.lens() != nullptr;
-    const bool isFile = !isBuiltinSceneName(o.input.scene);
-    const double fileMB = isFile ? double(std::filesystem::file_size(o.input.scene)) / 1e6 : 0.0;
+    const bool isFile = !isBuiltinSceneName(sceneName);
+    const double fileMB = isFile ? double(std::filesystem::file_size(sceneName)) / 1e6 : 0.0;
 
     // The whole check, N times per form, each in a process of its own; the forms in turn within
     // each repeat, so that a slower spell of a shared machine falls on every form alike.
@@ -666,7 +720,7 @@ int runBenchCommand(const BenchOptions& o)
         for (FormPhases& f : forms) {
             if (progress)
                 std::fprintf(stderr, "\rbench: whole check %d/%d%s ", r + 1, o.repeat, formSuffix(f).c_str()), std::fflush(stderr);
-            addWholeCheck(f, o.input.scene, camera, threads);
+            addWholeCheck(f, sceneName, camera, threads);
         }
     // A lens camera's own costs, as many times, likewise.
     for (int r = 0; lens && r < o.repeat; ++r)
@@ -674,12 +728,13 @@ int runBenchCommand(const BenchOptions& o)
             if (progress)
                 std::fprintf(stderr, "\rbench: lens rays and export %d/%d%s ", r + 1, o.repeat, formSuffix(f).c_str()),
                     std::fflush(stderr);
-            addLensCosts(f, o.input.scene, camera, threads);
+            addLensCosts(f, sceneName, camera, threads);
         }
     if (progress) std::fprintf(stderr, "\r%50s\r", "");
     const std::size_t triangles = forms.front().triangles;
     const bool consistent = std::all_of(forms.begin(), forms.end(), [](const FormPhases& f) { return f.consistent; });
     BenchSetting s{threads, lens, isFile, fileMB, double(camera.width()) * camera.height(), 0, 0};
+    s.huge = workload && named->scene == kHugeWorkloadScene;
     // A lens camera's check holds two arrays more, 24 bytes a pixel each: the ray table (lens.h)
     // and the trace's eye points, which its forward check projects.
     s.bytesPerPixel = lens ? 32.0 + 24.0 + 24.0 : 32.0;
@@ -687,13 +742,13 @@ int runBenchCommand(const BenchOptions& o)
 
     const auto threadLimit = limitThreads(threads);
     References ref;
-    if (o.reference) ref = measureReferences(o.input.scene, camera, threads, o.repeat, forms.front().form, progress);
+    if (o.reference) ref = measureReferences(sceneName, camera, threads, o.repeat, forms.front().form, progress);
     std::vector<KernelForm> formList;
     for (const FormPhases& f : forms) formList.push_back(f.form);
 
     if (o.json) {
         nlohmann::ordered_json out;
-        out["scene"] = o.input.scene;
+        out["scene"] = sceneName;
         if (workload) out["workload"] = o.workload;
         if (lens) out["lens"] = camera.lens()->spec().model;
         out["triangles"] = triangles;
@@ -728,7 +783,7 @@ int runBenchCommand(const BenchOptions& o)
     const std::string depth = lens ? "lens model " + camera.lens()->spec().model + ", distance"
                                    : toString(camera.depth().format) + (camera.depth().reversed ? " reversed-Z" : "");
     std::printf("zcheck bench: %s%s, %zu triangles, %dx%d, %s, kernels %s, %d threads, %d repeats, %s\n",
-                workload ? (o.workload + ": ").c_str() : "", o.input.scene.c_str(), triangles, camera.width(), camera.height(),
+                workload ? (o.workload + ": ").c_str() : "", sceneName.c_str(), triangles, camera.width(), camera.height(),
                 depth.c_str(), namesOf(formList).c_str(), threads, o.repeat, consistent ? "consistent" : "INCONSISTENT");
     for (const FormPhases& f : forms) {
         if (forms.size() > 1) std::printf("kernels %s\n", nameOf(f.form));
@@ -770,7 +825,7 @@ Command addBenchCommand(CLI::App& app)
     command->add_flag("--json", o->json, "print the measurements as JSON");
     command->add_option("--workload", o->workload,
                         "a named workload, without --scene and --camera: terrain-1M-1080p, fisheye-1M-1080p,\n"
-                        "panorama-1M-1920x960")
+                        "panorama-1M-1920x960, terrain-10M-4K")
         ->capture_default_str();
     command->footer(
         "Without --scene and --camera the workload is terrain-1M-1080p: builtin:terrain?n=709&size=2\n"
@@ -779,7 +834,9 @@ Command addBenchCommand(CLI::App& app)
         "the same terrain through an OpenCV fisheye (opencv_fisheye fx = fy = 340, k1..k4 0.021,\n"
         "-0.004, 0.0007, -0.0001) at 1920x1080 from (0, 0.2, 0) looking straight down, its 180° circle as\n"
         "high as the image; panorama-1M-1920x960: a whole-sphere equirectangular panorama at\n"
-        "1920x960 from (0, 0.2, 0), the sky half missing. For a lens camera there is no raster route:\n"
+        "1920x960 from (0, 0.2, 0), the sky half missing; terrain-10M-4K: builtin:terrain?n=2237&size=2\n"
+        "(9,999,392 triangles) seen as terrain-1M-1080p at 3840x2160, 0.83 rays per triangle (targets:\n"
+        "whole check <= 2 s, peak RSS <= 1.4 GB). For a lens camera there is no raster route:\n"
         "'compare' is the lens check (every pixel's round trip, every hit projected forward), and\n"
         "bench also times the ray table's build, every pixel's world ray made from it (rays: what\n"
         "each frame pays, target <= 10 % of the depth trace), the trace of the depth alone (the\n"
@@ -787,8 +844,10 @@ Command addBenchCommand(CLI::App& app)
         "distance map to .npy, one-shot and warm (target <= 0.5 s); --reference times Embree on the\n"
         "same rays (target: the depth trace >= 0.8x its throughput).\n"
         "Each repeat is a whole check in a child process of its own, as `zcheck check` runs it: the\n"
-        "scene is loaded, the BVH built, both routes drawn and compared tile by tile ('whole check').\n"
-        "The child then checks again with the same BVH keeping both routes' full-frame renders, whose\n"
+        "scene is loaded, the BVH built for one frame's rays (quick below 10 rays per triangle,\n"
+        "else thorough), both routes drawn and compared tile by tile ('whole check').\n"
+        "The child then checks again over a thorough BVH (as for many frames; Embree's reference is\n"
+        "built so too) keeping both routes' full-frame renders, whose\n"
         "trace, raster and compare are the phases timed (their buffers new), and once more ('warm':\n"
         "memory the check before freed is reused, as when a program checks many cameras). Peak RSS\n"
         "is the largest child's, after the first check. Embree's reference builds run in children too;\n"

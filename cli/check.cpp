@@ -36,7 +36,9 @@ int runCheckCommand(const CheckCommandOptions& o)
     if (o.reversedZ) spec.depth.reversed = true;
     const Camera camera(spec);  // validated before the BVH is built
 
-    const Checker checker(std::move(scene));
+    // One frame's rays: a huge mesh is checked soonest over a BVH built quickly (ray_renderer.h).
+    const BvhBuild build = bvhBuildFor(double(camera.width()) * camera.height(), scene.triangleCount());
+    const Checker checker(std::move(scene), build);
     CheckOptions options;
     options.keepPixels = !o.outDir.empty();  // pictures and maps need them; the report does not
     const CheckResult run = checker.check(camera, options);

@@ -41,7 +41,10 @@ int runExportCommand(const ExportOptions& o)
     Scene loaded = loadScene(o.input.scene);
     const CameraSpec spec = cameraSpecFor(loaded, o.input);
     const Camera camera(spec);
-    const Checker checker(std::move(loaded));
+    // One frame's rays (none from the raster): the BVH built for them (ray_renderer.h).
+    const double rays = o.backend == "ray" ? double(camera.width()) * camera.height() : 0.0;
+    const BvhBuild build = bvhBuildFor(rays, loaded.triangleCount());
+    const Checker checker(std::move(loaded), build);
     const Scene& scene = checker.scene();
     Departure sampling;
     if (!o.sampleOffset.empty()) {

@@ -119,7 +119,9 @@ int runRemapCommand(const RemapOptions& o)
                               {"misses", remapped.misses}};
     if (sampling == RemapSampling::Plane) summary["nearest_at_edges"] = remapped.nearestAtEdges;
     if (!o.scene.empty()) {
-        const Checker checker(loadScene(o.scene));
+        Scene scene = loadScene(o.scene);
+        const BvhBuild build = bvhBuildFor(double(to.width()) * to.height(), scene.triangleCount());  // one render
+        const Checker checker(std::move(scene), build);
         summary["against_render"] = comparisonWithRender(remapped.values, checker.render(to, image.quantity, Route::Ray), o.scene);
     }
     nlohmann::json sidecar = depthFileSidecar(o.output, format, to, {image}, o.scale);

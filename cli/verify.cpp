@@ -44,7 +44,10 @@ int runVerifyCommand(const VerifyOptions& o)
     const Camera camera(made.spec);
     DepthMapFile& file = made.map;
     const DepthMap map = DepthMap::of(file, quantity, reading);
-    const Checker checker(std::move(scene));
+    // One frame's rays, or (--diagnose) one per hypothesis tried: the BVH built for them (ray_renderer.h).
+    const BvhBuild build = o.diagnose ? BvhBuild::Thorough
+                                      : bvhBuildFor(double(camera.width()) * camera.height(), scene.triangleCount());
+    const Checker checker(std::move(scene), build);
     const MapVerifier verifier(checker);
     const DepthMapSource source{o.depthMap, quantityName, file.channel, reading};
     const VerifiedMap verified = verifyMap(verifier, camera, map, o.diagnose, source.name());

@@ -17,6 +17,10 @@ done
 grep -qE "^trace .* [0-9.]+ Mrays/s$" "$tmp/bench.txt"
 grep -qE "^raster .* [0-9.]+ Mtris/s$" "$tmp/bench.txt"
 grep -qE "^peak RSS +[0-9.]+ MiB +budget [0-9.]+ MiB" "$tmp/bench.txt"
+# 57600 rays over 6962 triangles (8.27 a triangle): the one-frame check builds its BVH quickly.
+grep -qE "^bvh build .* quick \(8\.27 rays per triangle; the phases below: thorough\)$" "$tmp/bench.txt"
+"$zcheck" bench --scene "builtin:terrain?n=30" --width 320 --height 180 --repeat 1 --threads 1 > "$tmp/small.txt"
+grep -qE "^bvh build .* thorough \(34\.24 rays per triangle; the phases below: thorough\)$" "$tmp/small.txt"
 
 # Mesa's driver, loaded and unloaded by the llvmpipe yardstick, leaks a few hundred bytes the
 # leak checker cannot even name (the code is unloaded by then): under the sanitizers this one
@@ -151,7 +155,7 @@ if [[ $all != *avx512* ]]; then expect_error 2 "cannot run the avx512 form" benc
 ZCHECK_KERNELS=bogus expect_error 2 "^zcheck: error: ZCHECK_KERNELS=bogus: must be auto, baseline, avx2 or avx512$" \
     bench "${small[@]}"
 
-expect_error 2 "workload 'fisheye'.*terrain-1M-1080p, fisheye-1M-1080p or panorama-1M-1920x960" bench --workload fisheye
+expect_error 2 "workload 'fisheye'.*terrain-1M-1080p, fisheye-1M-1080p, panorama-1M-1920x960 or terrain-10M-4K" bench --workload fisheye
 expect_error 2 "workload fisheye-1M-1080p names its own scene and camera" bench --workload fisheye-1M-1080p --scene builtin:default
 expect_error 2 "repeat" bench --repeat 0
 expect_error 2 "width" bench --width 0

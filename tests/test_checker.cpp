@@ -6,6 +6,7 @@
 #include "zcheck/inverse_projection.h"
 #include "zcheck/detail/kernel_choice.h"
 #include "zcheck/map_verifier.h"
+#include "zcheck/mesh_loader.h"
 #include "zcheck/mistakes.h"
 #include "zcheck/report.h"
 #include "zcheck/verify.h"
@@ -1296,4 +1297,64 @@ TEST_CASE("regression: 'about 0 unexplained pixels' stood beside 'none makes the
     INFO(biased);
     REQUIRE(biased.find("explains every pixel but leaves a systematic bias or values out of range") != std::string::npos);
     REQUIRE(biased.find("about 0") == std::string::npos);
+}
+
+TEST_CASE("the BVH is built quickly for few rays per triangle, thoroughly for many", "[checker][bvh]")
+{
+    // bvhBuildFor: quick below kQuickBuildRaysPerTriangle rays per triangle.
+    REQUIRE(kQuickBuildRaysPerTriangle == 10.0);
+    REQUIRE(bvhBuildFor(0.0, 1) == BvhBuild::Quick);
+    REQUIRE(bvhBuildFor(1920.0 * 1080, 1002528) == BvhBuild::Quick);      // one 1080p frame of a 1 M mesh
+    REQUIRE(bvhBuildFor(3840.0 * 2160, 9999392) == BvhBuild::Quick);      // one 4K frame of a 10 M mesh
+    REQUIRE(bvhBuildFor(9999999.0, 1000000) == BvhBuild::Quick);
+    REQUIRE(bvhBuildFor(10000000.0, 1000000) == BvhBuild::Thorough);
+    REQUIRE(bvhBuildFor(640.0 * 480, 3332) == BvhBuild::Thorough);          // the default scene's frame
+    REQUIRE(bvhBuildFor(INFINITY, 1) == BvhBuild::Thorough);               // unknown: many
+    REQUIRE(std::string(nameOf(BvhBuild::Quick)) == "quick");
+    REQUIRE(std::string(nameOf(BvhBuild::Thorough)) == "thorough");
+}
+
+TEST_CASE("a check over a quick BVH reports what a check over a thorough one does", "[checker][bvh]")
+{
+    // The trace keeps the closest hit and recomputes its depth in double against the hit
+    // triangle's plane, so the BVH's build cannot change a depth; it could change only which of
+    // two triangles hit at exactly the same distance is kept. Meshes without such ties (a
+    // terrain, the default scene, a scanned mesh) give the same renders bit for bit and the same
+    // report; the soup's exact duplicates under other ids may differ in id, never in depth.
+    int compared = 0;
+    for (const std::string name : {std::string("builtin:terrain?n=300"), std::string("builtin:default"),
+                                   std::string(ZCHECK_MODELS_DIR) + "/stanford-bunny.obj", std::string("soup")}) {
+        INFO(name);
+        const bool soup = name == "soup";
+        const Scene scene = soup ? testing::triangleSoup(true, 46) : loadScene(name);
+        const Checker quick(scene, BvhBuild::Quick), thorough(scene, BvhBuild::Thorough);
+        REQUIRE(quick.rayRenderer().bvhBuild() == BvhBuild::Quick);
+        REQUIRE(thorough.rayRenderer().bvhBuild() == BvhBuild::Thorough);
+        CameraSpec spec = soup ? testing::kernelCamera("opengl", DepthFormat::Unorm24, false, false) : scene.defaultCamera;
+        spec.width = 331, spec.height = 197;
+        for (const char* convention : {"opengl", "direct3d"}) {
+            spec.convention = Convention::preset(convention);
+            const Camera camera(spec);
+            const RenderResult a = quick.renderRay(camera, {}, EyePoints::Keep), b = thorough.renderRay(camera, {}, EyePoints::Keep);
+            REQUIRE(testing::sameBits(a.windowDepth.value, b.windowDepth.value));
+            std::size_t hits = 0, otherId = 0;
+            for (std::size_t i = 0; i < a.primitiveId.size(); ++i) {
+                hits += b.hit(i);
+                otherId += a.primitiveId[i] != b.primitiveId[i];
+            }
+            REQUIRE(hits > 1000);
+            if (soup) {
+                REQUIRE(otherId < hits / 100);
+                continue;
+            }
+            REQUIRE(otherId == 0);
+            REQUIRE(testing::sameBits(a.pEye, b.pEye));
+            CheckOptions tileByTile;
+            tileByTile.keepPixels = false;
+            REQUIRE(reportWithoutTimings(quick.check(camera, tileByTile).report) ==
+                    reportWithoutTimings(thorough.check(camera, tileByTile).report));
+            ++compared;
+        }
+    }
+    REQUIRE(compared == 6);
 }

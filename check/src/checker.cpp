@@ -33,7 +33,7 @@ void requireSomethingCompared(const ComparisonReport& report, const std::string&
                     "' through this camera (is it pointing away, or are near/far wrong?)");
 }
 
-Checker::Checker(Scene scene) : scene_(std::move(scene)), rays_(scene_), raster_(scene_) {}
+Checker::Checker(Scene scene, BvhBuild build) : scene_(std::move(scene)), rays_(scene_, build), raster_(scene_) {}
 
 namespace {
 

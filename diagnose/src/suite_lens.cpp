@@ -156,7 +156,7 @@ bool mapsDifferVisibly(const Camera& camera, const DepthMap& clean, const DepthM
             }
             if (!a) continue;
             double slope = 0;
-            for (const auto [dx, dy] : {std::pair{1, 0}, std::pair{0, 1}}) {
+            for (const auto& [dx, dy] : {std::pair{1, 0}, std::pair{0, 1}}) {
                 double steepest = 0;
                 for (const int sign : {-1, 1})
                     if (const std::optional<double> n = depth(clean, col + sign * dx, row + sign * dy))

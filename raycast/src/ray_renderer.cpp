@@ -103,25 +103,38 @@ struct HitPlane {
 };
 static_assert(sizeof(HitPlane) == 40, "5 entries in 200 bytes: half of them span two cache lines");
 
+// Triangle t's HitPlane, from its corners.
+ZCHECK_ALWAYS_INLINE inline HitPlane hitPlaneOf(const Scene& scene, std::uint32_t t)
+{
+    const glm::uvec3& corners = scene.triangles[t];
+    const glm::vec3& a = scene.positions[corners[0]];
+    const glm::dvec3 b(scene.positions[corners[1]]), c(scene.positions[corners[2]]);
+    const glm::dvec3 normal = glm::cross(b - glm::dvec3(a), c - glm::dvec3(a));
+    HitPlane plane;
+    for (int axis = 0; axis < 3; ++axis) plane.normal[axis] = normal[axis], plane.vertex[axis] = a[axis];
+    plane.unused = 0;
+    return plane;
+}
+
 LargeVector<HitPlane> hitPlanesOf(const Scene& scene)
 {
     LargeVector<HitPlane> planes;  // on huge pages (40 MB for a million triangles)
     planes.resize(scene.triangles.size());  // uninitialised: each entry written below
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, scene.triangles.size(), 4096),
                       [&](const tbb::blocked_range<std::size_t>& range) {
-                          for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                              const glm::uvec3& corners = scene.triangles[i];
-                              const glm::vec3& a = scene.positions[corners[0]];
-                              const glm::dvec3 b(scene.positions[corners[1]]), c(scene.positions[corners[2]]);
-                              const glm::dvec3 normal = glm::cross(b - glm::dvec3(a), c - glm::dvec3(a));
-                              HitPlane& plane = planes[i];
-                              for (int axis = 0; axis < 3; ++axis)
-                                  plane.normal[axis] = normal[axis], plane.vertex[axis] = a[axis];
-                              plane.unused = 0;
-                          }
+                          for (std::size_t i = range.begin(); i != range.end(); ++i)
+                              planes[i] = hitPlaneOf(scene, std::uint32_t(i));
                       });
     return planes;
 }
+
+// Where a hit's plane comes from: the table (a thorough build's, made with the BVH), or, without
+// one (a quick build's: its 40 bytes a triangle are more to fault in than a one-frame check
+// reads back), the hit triangle's corners, computed as the table is (the same bits).
+struct PlaneSource {
+    const HitPlane* table;  // by primitive id, or null
+    const Scene& scene;
+};
 
 }  // namespace
 
@@ -133,7 +146,7 @@ struct RayRenderer::Embree {
     ErrorLog errors;
     DeviceHandle device;
     SceneHandle scene;
-    LargeVector<HitPlane> planes;  // by primitive id (hitPlanesOf)
+    LargeVector<HitPlane> planes;  // by primitive id (hitPlanesOf); empty for a quick build (PlaneSource)
 
     void check(const char* step)
     {
@@ -142,8 +155,15 @@ struct RayRenderer::Embree {
     }
 };
 
-RayRenderer::RayRenderer(const Scene& scene)
-    : embree_(std::make_unique<Embree>()), scene_(scene), form_(kernelForm())
+BvhBuild bvhBuildFor(double expectedRays, std::size_t triangles)
+{
+    return expectedRays < kQuickBuildRaysPerTriangle * double(triangles) ? BvhBuild::Quick : BvhBuild::Thorough;
+}
+
+const char* nameOf(BvhBuild build) { return build == BvhBuild::Quick ? "quick" : "thorough"; }
+
+RayRenderer::RayRenderer(const Scene& scene, BvhBuild build)
+    : embree_(std::make_unique<Embree>()), scene_(scene), form_(kernelForm()), build_(build)
 {
     validateScene(scene);
     const auto start = Clock::now();
@@ -153,8 +173,10 @@ RayRenderer::RayRenderer(const Scene& scene)
     rtcSetDeviceErrorFunction(embree_->device.get(), recordError, &embree_->errors);
 
     embree_->scene.reset(rtcNewScene(embree_->device.get()));
-    rtcSetSceneFlags(embree_->scene.get(), RTC_SCENE_FLAG_ROBUST);
-    rtcSetSceneBuildQuality(embree_->scene.get(), RTC_BUILD_QUALITY_MEDIUM);
+    const bool quick = build == BvhBuild::Quick;
+    rtcSetSceneFlags(embree_->scene.get(),
+                     quick ? RTCSceneFlags(RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_COMPACT) : RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(embree_->scene.get(), quick ? RTC_BUILD_QUALITY_LOW : RTC_BUILD_QUALITY_MEDIUM);
 
     // Released when this scope ends, after the scene has taken its own reference (or on a throw).
     const GeometryHandle geometry(rtcNewGeometry(embree_->device.get(), RTC_GEOMETRY_TYPE_TRIANGLE));
@@ -174,11 +196,15 @@ RayRenderer::RayRenderer(const Scene& scene)
     for (std::size_t v = 0; v < scene.positions.size(); ++v)
         for (int k = 0; k < 3; ++k)
             vertices[3 * v + k] = float(double(scene.positions[v][k]) - embree_->frameOrigin[k]);
+    // The mesh's own BVH: the scene's quality sets only the level above it (Embree builds the
+    // mesh's at MEDIUM unless told; only this made the quick build quick: 10 M triangles ~0.7 s
+    // against ~3 s).
+    rtcSetGeometryBuildQuality(geometry.get(), quick ? RTC_BUILD_QUALITY_LOW : RTC_BUILD_QUALITY_MEDIUM);
     rtcCommitGeometry(geometry.get());  // commit before attaching, or no intersections
     rtcAttachGeometryByID(embree_->scene.get(), geometry.get(), 0);
     rtcCommitScene(embree_->scene.get());
     embree_->check("building the BVH");
-    embree_->planes = hitPlanesOf(scene);
+    if (!quick) embree_->planes = hitPlanesOf(scene);  // a quick build's trace reads the corners (PlaneSource)
     buildMilliseconds_ = millisecondsSince(start);
 }
 
@@ -396,21 +422,22 @@ ZCHECK_ALWAYS_INLINE inline void embreeLanesOfPacket(PacketInFlight& p, const gl
 
 // Traces the packet (Embree's hits in p.packet, then p.hits) and asks for the hit planes its finish reads.
 ZCHECK_ALWAYS_INLINE inline void intersectPacket(PacketInFlight& p, RTCScene rtcScene, RTCIntersectContext& context,
-                                                 const HitPlane* planes)
+                                                 const PlaneSource& planes)
 {
     rtcIntersect16(p.valid, rtcScene, &context, &p.packet);
     p.noteHits();
-    for (int k = 0; k < kPacketRays; ++k)  // the hit planes asked for: both ends of each entry
+    for (int k = 0; k < kPacketRays; ++k)  // the hit planes asked for: both ends of each entry (or the index triple)
         if (p.hit(k)) {
-            const char* entry = reinterpret_cast<const char*>(planes + p.packet.hit.primID[k]);
+            const char* entry = planes.table ? reinterpret_cast<const char*>(planes.table + p.packet.hit.primID[k])
+                                             : reinterpret_cast<const char*>(&planes.scene.triangles[p.packet.hit.primID[k]]);
             __builtin_prefetch(entry);
-            __builtin_prefetch(entry + sizeof(HitPlane) - 1);
+            __builtin_prefetch(entry + (planes.table ? sizeof(HitPlane) : sizeof(glm::uvec3)) - 1);
         }
 }
 
 // Each lane's triangle (a miss: 0) and that triangle's plane: plane[0..2] a vertex, plane[3..5] the normal.
 template <KernelForm kForm>
-ZCHECK_ALWAYS_INLINE inline void hitPlanesOfPacket(const PacketInFlight& p, const HitPlane* planes,
+ZCHECK_ALWAYS_INLINE inline void hitPlanesOfPacket(const PacketInFlight& p, const PlaneSource& planes,
                                                    std::uint32_t (&triangle)[kPacketRays],
                                                    double (&plane)[6][kPacketRays])
 {
@@ -419,12 +446,20 @@ ZCHECK_ALWAYS_INLINE inline void hitPlanesOfPacket(const PacketInFlight& p, cons
     // mispredicted branches than the arithmetic it saved.) A miss takes triangle 0's plane
     // (a scene has one, RayRenderer checked), and its result is not used.
     for (int k = 0; k < kPacketRays; ++k) triangle[k] = p.hit(k) ? p.packet.hit.primID[k] : 0;
+    if (!planes.table) {  // from the corners (PlaneSource)
+        for (int k = 0; k < kPacketRays; ++k) {
+            const HitPlane h = hitPlaneOf(planes.scene, triangle[k]);
+            for (int axis = 0; axis < 3; ++axis)
+                plane[axis][k] = double(h.vertex[axis]), plane[3 + axis][k] = h.normal[axis];
+        }
+        return;
+    }
 #ifdef ZCHECK_X86_FORMS
-    if constexpr (kForm != KernelForm::Baseline) planesInLanes(planes, triangle, plane);
+    if constexpr (kForm != KernelForm::Baseline) planesInLanes(planes.table, triangle, plane);
 #endif
     if constexpr (kForm == KernelForm::Baseline)
         for (int k = 0; k < kPacketRays; ++k) {
-            const HitPlane& h = planes[triangle[k]];
+            const HitPlane& h = planes.table[triangle[k]];
             for (int axis = 0; axis < 3; ++axis)
                 plane[axis][k] = double(h.vertex[axis]), plane[3 + axis][k] = h.normal[axis];
         }
@@ -493,7 +528,7 @@ ZCHECK_ALWAYS_INLINE inline void writePacketPixels(const PacketInFlight& p, cons
 
 // traceRect for one rectangle, packet by packet through the steps above, in form kForm.
 template <KernelForm kForm>
-ZCHECK_ALWAYS_INLINE inline void traceRectBody(RTCScene rtcScene, const glm::dvec3& frameOrigin, const HitPlane* planes,
+ZCHECK_ALWAYS_INLINE inline void traceRectBody(RTCScene rtcScene, const glm::dvec3& frameOrigin, const PlaneSource& planes,
                                         const Camera& camera, const PixelRect& rect, double* windowDepth,
                                         std::uint32_t* primitiveId, std::size_t stride, const RayFaults& fault,
                                         glm::dvec3* pEye)
@@ -546,7 +581,7 @@ ZCHECK_ALWAYS_INLINE inline void traceRectBody(RTCScene rtcScene, const glm::dve
 }
 
 
-void traceRectBaseline(RTCScene rtcScene, const glm::dvec3& frameOrigin, const HitPlane* planes, const Camera& camera,
+void traceRectBaseline(RTCScene rtcScene, const glm::dvec3& frameOrigin, const PlaneSource& planes, const Camera& camera,
                        const PixelRect& rect, double* windowDepth, std::uint32_t* primitiveId, std::size_t stride,
                        const RayFaults& fault, glm::dvec3* pEye)
 {
@@ -556,7 +591,7 @@ void traceRectBaseline(RTCScene rtcScene, const glm::dvec3& frameOrigin, const H
 
 #ifdef ZCHECK_X86_FORMS
 #define ZCHECK_TRACE_FORM(Entry, Form)                                                                                \
-    Entry void traceRect##Form(RTCScene rtcScene, const glm::dvec3& frameOrigin, const HitPlane* planes,                \
+    Entry void traceRect##Form(RTCScene rtcScene, const glm::dvec3& frameOrigin, const PlaneSource& planes,            \
                                const Camera& camera, const PixelRect& rect, double* windowDepth,                       \
                                std::uint32_t* primitiveId, std::size_t stride, const RayFaults& fault, glm::dvec3* pEye) \
     {                                                                                                                 \
@@ -577,7 +612,8 @@ void RayRenderer::traceRect(const Camera& camera, const PixelRect& rect, double*
 #ifdef ZCHECK_X86_FORMS
     form = formOf(form_, form, &traceRectAvx2, &traceRectAvx512);
 #endif
-    form(embree_->scene.get(), embree_->frameOrigin, embree_->planes.data(), camera, rect, windowDepth, primitiveId,
+    const PlaneSource planes{embree_->planes.empty() ? nullptr : embree_->planes.data(), scene_};
+    form(embree_->scene.get(), embree_->frameOrigin, planes, camera, rect, windowDepth, primitiveId,
          stride, fault, pEye);
 }
 

@@ -2,6 +2,10 @@
 
 #include "zcheck/error.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -72,11 +76,41 @@ std::string PolygonPlanarity::warning(const std::string& mesh) const
            "their depth depends on the split: triangulate the mesh before rendering it";
 }
 
+namespace {
+
+// Whether any vertex or index breaks validateScene's rules: each thread a part of the arrays
+// (a ten-million-triangle scene is checked by every renderer made for it).
+bool anyInvalid(const Scene& scene)
+{
+    auto badVertex = [](const glm::vec3& p) {
+        for (int i = 0; i < 3; ++i)
+            if (!(std::abs(p[i]) <= Camera::kMaxWorldCoordinate)) return true;  // NaN too
+        return false;
+    };
+    const std::size_t vertices = scene.positions.size();
+    auto badIndices = [vertices](const glm::uvec3& t) { return t[0] >= vertices || t[1] >= vertices || t[2] >= vertices; };
+    auto any = [](std::size_t n, auto bad) {
+        return tbb::parallel_reduce(
+            tbb::blocked_range<std::size_t>(0, n, 1 << 16), false,
+            [&](const tbb::blocked_range<std::size_t>& r, bool found) {
+                for (std::size_t i = r.begin(); i != r.end() && !found; ++i) found = bad(i);
+                return found;
+            },
+            [](bool a, bool b) { return a || b; });
+    };
+    return any(scene.positions.size(), [&](std::size_t i) { return badVertex(scene.positions[i]); }) ||
+           any(scene.triangles.size(), [&](std::size_t i) { return badIndices(scene.triangles[i]); });
+}
+
+}  // namespace
+
 void validateScene(const Scene& scene)
 {
     if (scene.triangles.empty()) throw Error("scene '" + scene.name + "' has no triangles");
     if (scene.triangles.size() >= 0xFFFFFFFFu)
         throw Error("scene '" + scene.name + "' has more triangles than 32-bit primitive ids can name");
+    if (!anyInvalid(scene)) return;
+    // The first offending element, in order, for the message.
     for (const auto& p : scene.positions)
         for (int i = 0; i < 3; ++i) {
             if (!std::isfinite(p[i])) throw Error("scene '" + scene.name + "' has a vertex that is not finite");
@@ -115,14 +149,15 @@ std::shared_ptr<const TriangleChunks> triangleChunksOf(const Scene& scene)
     const std::size_t count = (scene.triangles.size() + TriangleChunks::kSize - 1) / TriangleChunks::kSize;
     chunks->lo.assign(count, glm::vec3(INFINITY));
     chunks->hi.assign(count, glm::vec3(-INFINITY));
-    for (std::size_t t = 0; t < scene.triangles.size(); ++t) {
-        glm::vec3& lo = chunks->lo[t / TriangleChunks::kSize];
-        glm::vec3& hi = chunks->hi[t / TriangleChunks::kSize];
-        for (int k = 0; k < 3; ++k) {
-            const glm::vec3& p = scene.positions[scene.triangles[t][k]];
-            lo = glm::min(lo, p), hi = glm::max(hi, p);
-        }
-    }
+    tbb::parallel_for(std::size_t(0), count, [&](std::size_t c) {  // chunk by chunk, each thread its own
+        glm::vec3 &lo = chunks->lo[c], &hi = chunks->hi[c];
+        const std::size_t end = std::min(scene.triangles.size(), (c + 1) * TriangleChunks::kSize);
+        for (std::size_t t = c * TriangleChunks::kSize; t < end; ++t)
+            for (int k = 0; k < 3; ++k) {
+                const glm::vec3& p = scene.positions[scene.triangles[t][k]];
+                lo = glm::min(lo, p), hi = glm::max(hi, p);
+            }
+    });
     return chunks;
 }
 

@@ -138,8 +138,10 @@ void requireSomethingCompared(const ComparisonReport& report, const std::string&
 class Checker {
 public:
     // Validates the scene (throws Error: no triangles, an index out of range) and builds both
-    // routes: Embree's BVH (timed, Timings::bvhBuildMs) and the rasterizer.
-    explicit Checker(Scene scene);
+    // routes: Embree's BVH (timed, Timings::bvhBuildMs; `build`: for a few rays per triangle, a
+    // one-frame check, bvhBuildFor; the thorough default for many frames or unknown use) and
+    // the rasterizer.
+    explicit Checker(Scene scene, BvhBuild build = BvhBuild::Thorough);
     Checker(const Checker&) = delete;
     Checker& operator=(const Checker&) = delete;
 

@@ -45,13 +45,38 @@ struct RayFaults {
 // positions read it; a check does not).
 enum class EyePoints { Omit, Keep };
 
+// How Embree builds the BVH. Its build is most of a one-frame check of a large mesh (10 M
+// triangles at 4K: ~3 s of ~5), its trace most of a check of many frames; the trace's results
+// are the same whichever was built (the closest hit, its depth recomputed in double).
+enum class BvhBuild {
+    // Embree's RTC_BUILD_QUALITY_LOW for the mesh (Morton codes) with RTC_SCENE_FLAG_COMPACT:
+    // built ~4× as fast in ~25 % less memory, traced ~1.3–1.5× as slowly.
+    Quick,
+    // RTC_BUILD_QUALITY_MEDIUM (binned SAH): the fastest trace. The default, for a dataset's
+    // frames, a program's loop over cameras, or a use not known beforehand.
+    Thorough,
+};
+
+// Measured on the development machine (docs/speed.md): the quick build saves ~180–230 ns a
+// triangle and costs ~13–19 ns a ray, so it pays below ~12 rays per triangle. Below this many
+// expected rays per triangle bvhBuildFor chooses it.
+constexpr double kQuickBuildRaysPerTriangle = 10.0;
+
+// The build that costs least in all where `expectedRays` rays (every trace this BVH will serve,
+// together) meet `triangles` triangles: Quick below kQuickBuildRaysPerTriangle rays per
+// triangle, else Thorough. An unknown count is infinity (Thorough).
+BvhBuild bvhBuildFor(double expectedRays, std::size_t triangles);
+// "quick", "thorough".
+const char* nameOf(BvhBuild build);
+
 class RayRenderer {
 public:
-    // Builds the BVH and the triangles' planes (timed together); throws Error. `scene` must
-    // outlive it: Embree reads its index buffer in place. The trace's steps around Embree run in
-    // the form kernelForm() gives when this is made (zcheck/kernel_form.h: ZCHECK_KERNELS,
-    // read here; a value it refuses throws Error), each form bit-identical to the baseline.
-    explicit RayRenderer(const Scene& scene);
+    // Builds the BVH (as `build` says) and the triangles' planes, timed together; throws Error.
+    // `scene` must outlive it: Embree reads its index buffer in place. The trace's steps around
+    // Embree run in the form kernelForm() gives when this is made (zcheck/kernel_form.h:
+    // ZCHECK_KERNELS, read here; a value it refuses throws Error), each form bit-identical to
+    // the baseline.
+    explicit RayRenderer(const Scene& scene, BvhBuild build = BvhBuild::Thorough);
     ~RayRenderer();
     RayRenderer(const RayRenderer&) = delete;
     RayRenderer& operator=(const RayRenderer&) = delete;
@@ -73,12 +98,14 @@ public:
     std::uint32_t primitiveAt(const Camera& camera, const glm::dvec2& pWindow) const;
 
     double buildMilliseconds() const { return buildMilliseconds_; }
+    BvhBuild bvhBuild() const { return build_; }
 
 private:
     struct Embree;
     std::unique_ptr<Embree> embree_;
     const Scene& scene_;
     KernelForm form_;  // the trace's form (ZCHECK_KERNELS, read when this was made)
+    BvhBuild build_;
     double buildMilliseconds_ = 0;
 };
 
