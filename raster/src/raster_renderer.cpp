@@ -340,7 +340,7 @@ void drawInTile(const Viewport& vp, const DepthKeys& keys, const TriangleSetup& 
 
 // The vector kernels, written once over a lane type (lanes.h) and compiled per form below.
 
-// drawInTile<false> with eight pixels of a row at a time: the same integer edge functions
+// drawInTile<false> with L::kLanes pixels of a row at a time: the same integer edge functions
 // and the same double operations in the same order per pixel (the build forbids contracting
 // them into fused multiply-adds), so its output is bit-identical to the scalar loop's. A
 // triangle's pixels are distinct within a row, so lanes never depend on each other.
@@ -356,17 +356,18 @@ ZCHECK_ALWAYS_INLINE inline void drawInTileLanes(const DepthSettings& depth, con
     // Edge function k at lane j of a group: its value at the group's first pixel + j·A_k·256;
     // a group eight pixels on adds 8·A_k·256, a row down B_k·256 (exact: what the scalar loop
     // computes as A_k·px + B_k·py + C_k, in the same wrapping int64 arithmetic).
+    constexpr int kLanes = L::kLanes;  // pixels per group
     Int64 rowE[3], down[3], across[3];
     for (int k = 0; k < 3; ++k) {
         const std::int64_t px = col0 * kSubpixel + kHalfPixel, py = row0 * kSubpixel + kHalfPixel;
         rowE[k] = L::steps(t.A[k] * px + t.B[k] * py + t.C[k], t.A[k] * kSubpixel);
-        down[k] = L::set1(std::int64_t(t.B[k] * kSubpixel)), across[k] = L::set1(std::int64_t(t.A[k] * kSubpixel * 8));
+        down[k] = L::set1(std::int64_t(t.B[k] * kSubpixel)), across[k] = L::set1(std::int64_t(t.A[k] * kSubpixel * kLanes));
     }
-    // A lane's pixel centre col + 0.5 (exact in double, as are its steps of 8); a lane is in the
-    // box while its centre is left of col1 + 1.
+    // A lane's pixel centre col + 0.5 (exact in double, as are its steps of kLanes); a lane is in
+    // the box while its centre is left of col1 + 1.
     alignas(64) static constexpr double kCentres[8] = {0.5, 1.5, 2.5, 3.5, 4.5, 5.5, 6.5, 7.5};
     const Real firstCentres = L::set1(double(col0)) + L::load(kCentres), boxEnd = L::set1(col1 + 1.0);
-    const Real eight = L::set1(8.0), x0 = L::set1(t.x0), dzdx = L::set1(t.dzdx);
+    const Real groupStep = L::set1(double(kLanes)), x0 = L::set1(t.x0), dzdx = L::set1(t.dzdx);
     const Real rangeMin = L::set1(depth.rangeMin), rangeMax = L::set1(depth.rangeMax);
     const Real maxCode = L::set1(keys.maxCode);
     const Real noFractionBits = L::set1(4503599627370496.0);  // nearbyintNonNegative's 2^52
@@ -380,7 +381,7 @@ ZCHECK_ALWAYS_INLINE inline void drawInTileLanes(const DepthSettings& depth, con
         std::uint32_t* primitiveRow = out.primitive + (row - out.row0) * TileBuffer::kSide - out.col0;
         Int64 e0 = rowE[0], e1 = rowE[1], e2 = rowE[2];
         Real centre = firstCentres;
-        for (int col = col0; col <= col1; col += 8) {
+        for (int col = col0; col <= col1; col += kLanes) {
             const Mask covered = (centre < boxEnd) & L::nonNegative(e0 | e1 | e2);
             const Real interpolated = rowDepth + dzdx * (centre - x0);
             const Real windowDepth = clampLanes<L>(interpolated, rangeMin, rangeMax);
@@ -393,7 +394,7 @@ ZCHECK_ALWAYS_INLINE inline void drawInTileLanes(const DepthSettings& depth, con
             L::maskedStore(nearer, keyRow + col, key);
             L::maskedStore(nearer, primitiveRow + col, primitive);
             e0 = e0 + across[0], e1 = e1 + across[1], e2 = e2 + across[2];
-            centre = centre + eight;
+            centre = centre + groupStep;
         }
         rowE[0] = rowE[0] + down[0], rowE[1] = rowE[1] + down[1], rowE[2] = rowE[2] + down[2];
     }
@@ -540,11 +541,11 @@ struct RasterKernels {
 
 #ifdef ZCHECK_X86_FORMS
 // Each kernel's entry function of one form (kernel_choice.h).
-#define ZCHECK_RASTER_FORM(Entry, Form)                                                                                \
+#define ZCHECK_RASTER_FORM(Entry, Form, DrawLanes)                                                                     \
     Entry void drawInTile##Form(const DepthSettings& depth, const DepthKeys& keys, const TriangleSetup& t, int c0, int r0, \
                                 int c1, int r1, TileBuffer& out)                                                       \
     {                                                                                                                  \
-        drawInTileLanes<Form##Lanes>(depth, keys, t, c0, r0, c1, r1, out);                                             \
+        drawInTileLanes<DrawLanes>(depth, keys, t, c0, r0, c1, r1, out);                                               \
     }                                                                                                                  \
     Entry void snapEight##Form(const Viewport& vp, const glm::vec3* positions, std::size_t v, StoredVertex* stored)    \
     {                                                                                                                  \
@@ -555,8 +556,8 @@ struct RasterKernels {
     {                                                                                                                  \
         return binItemsOfEightLanes<Form##Lanes>(vp, triangles, p, snapped, items);                                    \
     }
-ZCHECK_RASTER_FORM(ZCHECK_KERNEL_ENTRY_AVX2, Avx2)
-ZCHECK_RASTER_FORM(ZCHECK_KERNEL_ENTRY_AVX512, Avx512)
+ZCHECK_RASTER_FORM(ZCHECK_KERNEL_ENTRY_AVX2, Avx2, Avx2Lanes4)  // four pixels a group: see Avx2Lanes4
+ZCHECK_RASTER_FORM(ZCHECK_KERNEL_ENTRY_AVX512, Avx512, Avx512Lanes)
 #undef ZCHECK_RASTER_FORM
 #endif
 

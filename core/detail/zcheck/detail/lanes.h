@@ -7,7 +7,9 @@
 //   Avx512Lanes  one 512-bit register per eight doubles or 64-bit integers, masks in mask registers
 //   Avx2Lanes    two 256-bit registers per eight doubles or 64-bit integers, masks as vectors
 //                whose lanes are all ones or all zeros
+//   Avx2Lanes4   four lanes in one 256-bit register, for the raster's pixel loop in the AVX2 form
 //
+// (L::kLanes says how many lanes.)
 // Each lane type L has
 //   L::Real   eight doubles: + − × ÷ (IEEE, lane by lane), < <= > >= (a Mask), select, min, max, abs
 //   L::Int64  eight 64-bit integers: + − | & <<, steps, select, max, reduceMax
@@ -36,6 +38,7 @@ ZCHECK_INTRINSICS_BEGIN
 // AVX2 + FMA: lanes 0–3 in `lo`, 4–7 in `hi`.
 struct Avx2Lanes {
 #define ZCHECK_LANE ZCHECK_TARGET_AVX2 inline
+    static constexpr int kLanes = 8;
     struct Mask {
         __m256i lo, hi;  // per 64-bit lane: all ones (true) or zeros
         friend ZCHECK_LANE Mask operator&(Mask a, Mask b) { return {_mm256_and_si256(a.lo, b.lo), _mm256_and_si256(a.hi, b.hi)}; }
@@ -301,6 +304,7 @@ struct Avx2Lanes {
 // AVX-512 F, DQ, VL: eight lanes per 512-bit register (Real, Int64) or 256-bit one (Int32, Float).
 struct Avx512Lanes {
 #define ZCHECK_LANE ZCHECK_TARGET_AVX512 inline
+    static constexpr int kLanes = 8;
     struct Mask {
         __mmask8 k;
         friend ZCHECK_LANE Mask operator&(Mask a, Mask b) { return {__mmask8(a.k & b.k)}; }
@@ -440,6 +444,60 @@ struct Avx512Lanes {
         }
     }
     static ZCHECK_LANE Int32 shiftedIn(Int32 a, Int32 before) { return {_mm256_alignr_epi32(a.v, before.v, 7)}; }
+#undef ZCHECK_LANE
+};
+
+// ---------------------------------------------------------------------------------------------
+// AVX2 + FMA, four lanes in one 256-bit register: the members the raster's pixel loop needs
+// (drawInTileLanes), for the AVX2 form, where a row of a small triangle's pixels (the common
+// case of a large mesh) fits one group of four and eight lanes in two registers did twice the work.
+struct Avx2Lanes4 {
+#define ZCHECK_LANE ZCHECK_TARGET_AVX2 inline
+    static constexpr int kLanes = 4;
+    struct Mask {
+        __m256i v;  // per 64-bit lane: all ones or zeros
+        friend ZCHECK_LANE Mask operator&(Mask a, Mask b) { return {_mm256_and_si256(a.v, b.v)}; }
+        friend ZCHECK_LANE Mask operator|(Mask a, Mask b) { return {_mm256_or_si256(a.v, b.v)}; }
+    };
+    struct Real {
+        __m256d v;
+        friend ZCHECK_LANE Real operator+(Real a, Real b) { return {_mm256_add_pd(a.v, b.v)}; }
+        friend ZCHECK_LANE Real operator-(Real a, Real b) { return {_mm256_sub_pd(a.v, b.v)}; }
+        friend ZCHECK_LANE Real operator*(Real a, Real b) { return {_mm256_mul_pd(a.v, b.v)}; }
+        friend ZCHECK_LANE Mask operator<(Real a, Real b) { return {_mm256_castpd_si256(_mm256_cmp_pd(a.v, b.v, _CMP_LT_OQ))}; }
+    };
+    struct Int64 {
+        __m256i v;
+        friend ZCHECK_LANE Int64 operator+(Int64 a, Int64 b) { return {_mm256_add_epi64(a.v, b.v)}; }
+        friend ZCHECK_LANE Int64 operator|(Int64 a, Int64 b) { return {_mm256_or_si256(a.v, b.v)}; }
+    };
+    struct Int32 {
+        __m128i v;
+    };
+    struct Float {
+        __m128 v;
+    };
+    static ZCHECK_LANE Real set1(double x) { return {_mm256_set1_pd(x)}; }
+    static ZCHECK_LANE Real load(const double* p) { return {_mm256_loadu_pd(p)}; }
+    static ZCHECK_LANE Real maskedLoad(Mask m, const double* p) { return {_mm256_maskload_pd(p, m.v)}; }
+    static ZCHECK_LANE void maskedStore(Mask m, double* p, Real a) { _mm256_maskstore_pd(p, m.v, a.v); }
+    static ZCHECK_LANE Real max(Real a, Real b) { return {_mm256_max_pd(a.v, b.v)}; }
+    static ZCHECK_LANE Real min(Real a, Real b) { return {_mm256_min_pd(a.v, b.v)}; }
+    static ZCHECK_LANE Float toFloat(Real a) { return {_mm256_cvtpd_ps(a.v)}; }
+    static ZCHECK_LANE Real toReal(Float a) { return {_mm256_cvtps_pd(a.v)}; }
+    static ZCHECK_LANE Int64 set1(std::int64_t x) { return {_mm256_set1_epi64x(x)}; }
+    static ZCHECK_LANE Int64 steps(std::int64_t first, std::int64_t step)  // lane j: first + j·step, wrapping
+    {
+        const std::uint64_t f = std::uint64_t(first), s = std::uint64_t(step);
+        return {_mm256_set_epi64x(std::int64_t(f + 3 * s), std::int64_t(f + 2 * s), std::int64_t(f + s), first)};
+    }
+    static ZCHECK_LANE Mask nonNegative(Int64 a) { return {_mm256_cmpgt_epi64(a.v, _mm256_set1_epi64x(-1))}; }
+    static ZCHECK_LANE Int32 set1(std::int32_t x) { return {_mm_set1_epi32(x)}; }
+    static ZCHECK_LANE void maskedStore(Mask m, std::uint32_t* p, Int32 a)
+    {
+        const __m128i m32 = _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(m.v, _mm256_setr_epi32(0, 2, 4, 6, 0, 0, 0, 0)));
+        _mm_maskstore_epi32(reinterpret_cast<int*>(p), m32, a.v);
+    }
 #undef ZCHECK_LANE
 };
 
