@@ -35,10 +35,49 @@ namespace zcheck {
 ZCHECK_INTRINSICS_BEGIN
 
 // ---------------------------------------------------------------------------------------------
+// Eight 32-bit lanes in one 256-bit register, with the operations both eight-lane forms do alike
+// (AVX2 instructions: an AVX-512 function inlines them too); each form derives from it.
+struct Lanes32 {
+#define ZCHECK_LANE ZCHECK_TARGET_AVX2 inline
+    struct Int32 {
+        __m256i v;
+        friend ZCHECK_LANE Int32 operator+(Int32 a, Int32 b) { return {_mm256_add_epi32(a.v, b.v)}; }
+        friend ZCHECK_LANE Int32 operator-(Int32 a, Int32 b) { return {_mm256_sub_epi32(a.v, b.v)}; }
+        friend ZCHECK_LANE Int32 operator|(Int32 a, Int32 b) { return {_mm256_or_si256(a.v, b.v)}; }
+        friend ZCHECK_LANE Int32 operator&(Int32 a, Int32 b) { return {_mm256_and_si256(a.v, b.v)}; }
+    };
+    struct Float {
+        __m256 v;
+    };
+    static ZCHECK_LANE Int32 set1(std::int32_t x) { return {_mm256_set1_epi32(x)}; }
+    static ZCHECK_LANE Int32 load(const std::uint32_t* p) { return {_mm256_loadu_si256(reinterpret_cast<const __m256i*>(p))}; }
+    static ZCHECK_LANE void store(float* p, Float a) { _mm256_storeu_ps(p, a.v); }
+    static ZCHECK_LANE Int32 minUnsigned(Int32 a, Int32 b) { return {_mm256_min_epu32(a.v, b.v)}; }
+    static ZCHECK_LANE Int32 min(Int32 a, Int32 b) { return {_mm256_min_epi32(a.v, b.v)}; }
+    static ZCHECK_LANE Int32 max(Int32 a, Int32 b) { return {_mm256_max_epi32(a.v, b.v)}; }
+    template <int kShift>
+    static ZCHECK_LANE Int32 shiftRightArithmetic(Int32 a) { return {_mm256_srai_epi32(a.v, kShift)}; }
+    template <int kShift>
+    static ZCHECK_LANE Int32 shiftRightLogical(Int32 a) { return {_mm256_srli_epi32(a.v, kShift)}; }
+    static ZCHECK_LANE void store(std::int32_t* p, Int32 a) { _mm256_storeu_si256(reinterpret_cast<__m256i*>(p), a.v); }
+    static ZCHECK_LANE Int32 bitsOf(Float a) { return {_mm256_castps_si256(a.v)}; }
+#undef ZCHECK_LANE
+};
+// The base's overloads of the names a form also defines (set1, load, store, min, max, bitsOf).
+#define ZCHECK_LANES32_NAMES                                                                      \
+    using Lanes32::set1;                                                                          \
+    using Lanes32::load;                                                                          \
+    using Lanes32::store;                                                                         \
+    using Lanes32::min;                                                                           \
+    using Lanes32::max;                                                                           \
+    using Lanes32::bitsOf
+
+// ---------------------------------------------------------------------------------------------
 // AVX2 + FMA: lanes 0–3 in `lo`, 4–7 in `hi`.
-struct Avx2Lanes {
+struct Avx2Lanes : Lanes32 {
 #define ZCHECK_LANE ZCHECK_TARGET_AVX2 inline
     static constexpr int kLanes = 8;
+    ZCHECK_LANES32_NAMES;
     struct Mask {
         __m256i lo, hi;  // per 64-bit lane: all ones (true) or zeros
         friend ZCHECK_LANE Mask operator&(Mask a, Mask b) { return {_mm256_and_si256(a.lo, b.lo), _mm256_and_si256(a.hi, b.hi)}; }
@@ -64,16 +103,6 @@ struct Avx2Lanes {
         friend ZCHECK_LANE Int64 operator-(Int64 a, Int64 b) { return {_mm256_sub_epi64(a.lo, b.lo), _mm256_sub_epi64(a.hi, b.hi)}; }
         friend ZCHECK_LANE Int64 operator|(Int64 a, Int64 b) { return {_mm256_or_si256(a.lo, b.lo), _mm256_or_si256(a.hi, b.hi)}; }
         friend ZCHECK_LANE Int64 operator&(Int64 a, Int64 b) { return {_mm256_and_si256(a.lo, b.lo), _mm256_and_si256(a.hi, b.hi)}; }
-    };
-    struct Int32 {
-        __m256i v;
-        friend ZCHECK_LANE Int32 operator+(Int32 a, Int32 b) { return {_mm256_add_epi32(a.v, b.v)}; }
-        friend ZCHECK_LANE Int32 operator-(Int32 a, Int32 b) { return {_mm256_sub_epi32(a.v, b.v)}; }
-        friend ZCHECK_LANE Int32 operator|(Int32 a, Int32 b) { return {_mm256_or_si256(a.v, b.v)}; }
-        friend ZCHECK_LANE Int32 operator&(Int32 a, Int32 b) { return {_mm256_and_si256(a.v, b.v)}; }
-    };
-    struct Float {
-        __m256 v;
     };
 
     // Masks.
@@ -242,15 +271,12 @@ struct Avx2Lanes {
     }
 
     // 32-bit integers.
-    static ZCHECK_LANE Int32 set1(std::int32_t x) { return {_mm256_set1_epi32(x)}; }
-    static ZCHECK_LANE Int32 load(const std::uint32_t* p) { return {_mm256_loadu_si256(reinterpret_cast<const __m256i*>(p))}; }
     static ZCHECK_LANE Int32 maskedLoad(Mask m, const std::uint32_t* p)  // 0 outside m
     {
         return {_mm256_maskload_epi32(reinterpret_cast<const int*>(p), narrow(m))};
     }
     static ZCHECK_LANE void maskedStore(Mask m, std::uint32_t* p, Int32 a) { _mm256_maskstore_epi32(reinterpret_cast<int*>(p), narrow(m), a.v); }
     static ZCHECK_LANE void maskedStore(Mask m, float* p, Float a) { _mm256_maskstore_ps(p, narrow(m), a.v); }
-    static ZCHECK_LANE void store(float* p, Float a) { _mm256_storeu_ps(p, a.v); }
     // The low byte of each lane to p[k] where m holds.
     static ZCHECK_LANE void maskedStoreBytes(Mask m, std::uint8_t* p, Int32 a)
     {
@@ -272,17 +298,8 @@ struct Avx2Lanes {
     static ZCHECK_LANE Mask lessOrEqual(Int32 a, Int32 b) { return widen(_mm256_xor_si256(_mm256_cmpgt_epi32(a.v, b.v), _mm256_set1_epi32(-1))); }
     static ZCHECK_LANE Mask atLeastUnsigned(Int32 a, Int32 b) { return widen(_mm256_cmpeq_epi32(_mm256_max_epu32(a.v, b.v), a.v)); }
     static ZCHECK_LANE Mask anyBits(Int32 a) { return widen(_mm256_xor_si256(_mm256_cmpeq_epi32(a.v, _mm256_setzero_si256()), _mm256_set1_epi32(-1))); }
-    static ZCHECK_LANE Int32 minUnsigned(Int32 a, Int32 b) { return {_mm256_min_epu32(a.v, b.v)}; }
-    static ZCHECK_LANE Int32 min(Int32 a, Int32 b) { return {_mm256_min_epi32(a.v, b.v)}; }
-    static ZCHECK_LANE Int32 max(Int32 a, Int32 b) { return {_mm256_max_epi32(a.v, b.v)}; }
     static ZCHECK_LANE Int32 select(Mask m, Int32 ifTrue, Int32 ifFalse) { return {_mm256_blendv_epi8(ifFalse.v, ifTrue.v, narrow(m))}; }
     static ZCHECK_LANE Int32 allOnesWhere(Mask m) { return {narrow(m)}; }  // −1 where m holds, 0 elsewhere
-    template <int kShift>
-    static ZCHECK_LANE Int32 shiftRightArithmetic(Int32 a) { return {_mm256_srai_epi32(a.v, kShift)}; }
-    template <int kShift>
-    static ZCHECK_LANE Int32 shiftRightLogical(Int32 a) { return {_mm256_srli_epi32(a.v, kShift)}; }
-    static ZCHECK_LANE void store(std::int32_t* p, Int32 a) { _mm256_storeu_si256(reinterpret_cast<__m256i*>(p), a.v); }
-    static ZCHECK_LANE Int32 bitsOf(Float a) { return {_mm256_castps_si256(a.v)}; }
     static ZCHECK_LANE Float zeroWhereNot(Mask m, Float a) { return {_mm256_and_ps(a.v, _mm256_castsi256_ps(narrow(m)))}; }
     // Eight packed int32 triples (24 ints from p) as three lanes: corner 0, 1, 2.
     static ZCHECK_LANE void loadTriples(const std::uint32_t* p, Int32 (&corner)[3])
@@ -302,9 +319,10 @@ struct Avx2Lanes {
 
 // ---------------------------------------------------------------------------------------------
 // AVX-512 F, DQ, VL: eight lanes per 512-bit register (Real, Int64) or 256-bit one (Int32, Float).
-struct Avx512Lanes {
+struct Avx512Lanes : Lanes32 {
 #define ZCHECK_LANE ZCHECK_TARGET_AVX512 inline
     static constexpr int kLanes = 8;
+    ZCHECK_LANES32_NAMES;
     struct Mask {
         __mmask8 k;
         friend ZCHECK_LANE Mask operator&(Mask a, Mask b) { return {__mmask8(a.k & b.k)}; }
@@ -330,16 +348,6 @@ struct Avx512Lanes {
         friend ZCHECK_LANE Int64 operator-(Int64 a, Int64 b) { return {_mm512_sub_epi64(a.v, b.v)}; }
         friend ZCHECK_LANE Int64 operator|(Int64 a, Int64 b) { return {_mm512_or_si512(a.v, b.v)}; }
         friend ZCHECK_LANE Int64 operator&(Int64 a, Int64 b) { return {_mm512_and_si512(a.v, b.v)}; }
-    };
-    struct Int32 {
-        __m256i v;
-        friend ZCHECK_LANE Int32 operator+(Int32 a, Int32 b) { return {_mm256_add_epi32(a.v, b.v)}; }
-        friend ZCHECK_LANE Int32 operator-(Int32 a, Int32 b) { return {_mm256_sub_epi32(a.v, b.v)}; }
-        friend ZCHECK_LANE Int32 operator|(Int32 a, Int32 b) { return {_mm256_or_si256(a.v, b.v)}; }
-        friend ZCHECK_LANE Int32 operator&(Int32 a, Int32 b) { return {_mm256_and_si256(a.v, b.v)}; }
-    };
-    struct Float {
-        __m256 v;
     };
 
     // Masks.
@@ -410,29 +418,17 @@ struct Avx512Lanes {
     }
 
     // 32-bit integers.
-    static ZCHECK_LANE Int32 set1(std::int32_t x) { return {_mm256_set1_epi32(x)}; }
-    static ZCHECK_LANE Int32 load(const std::uint32_t* p) { return {_mm256_loadu_si256(reinterpret_cast<const __m256i*>(p))}; }
     static ZCHECK_LANE Int32 maskedLoad(Mask m, const std::uint32_t* p) { return {_mm256_maskz_loadu_epi32(m.k, p)}; }
     static ZCHECK_LANE void maskedStore(Mask m, std::uint32_t* p, Int32 a) { _mm256_mask_storeu_epi32(p, m.k, a.v); }
     static ZCHECK_LANE void maskedStore(Mask m, float* p, Float a) { _mm256_mask_storeu_ps(p, m.k, a.v); }
-    static ZCHECK_LANE void store(float* p, Float a) { _mm256_storeu_ps(p, a.v); }
     static ZCHECK_LANE void maskedStoreBytes(Mask m, std::uint8_t* p, Int32 a) { _mm256_mask_cvtepi32_storeu_epi8(p, m.k, a.v); }
     static ZCHECK_LANE Mask equal(Int32 a, Int32 b) { return {_mm256_cmpeq_epi32_mask(a.v, b.v)}; }
     static ZCHECK_LANE Mask notEqual(Int32 a, Int32 b) { return {_mm256_cmpneq_epi32_mask(a.v, b.v)}; }
     static ZCHECK_LANE Mask lessOrEqual(Int32 a, Int32 b) { return {_mm256_cmple_epi32_mask(a.v, b.v)}; }
     static ZCHECK_LANE Mask atLeastUnsigned(Int32 a, Int32 b) { return {_mm256_cmpge_epu32_mask(a.v, b.v)}; }
     static ZCHECK_LANE Mask anyBits(Int32 a) { return {_mm256_test_epi32_mask(a.v, a.v)}; }
-    static ZCHECK_LANE Int32 minUnsigned(Int32 a, Int32 b) { return {_mm256_min_epu32(a.v, b.v)}; }
-    static ZCHECK_LANE Int32 min(Int32 a, Int32 b) { return {_mm256_min_epi32(a.v, b.v)}; }
-    static ZCHECK_LANE Int32 max(Int32 a, Int32 b) { return {_mm256_max_epi32(a.v, b.v)}; }
     static ZCHECK_LANE Int32 select(Mask m, Int32 ifTrue, Int32 ifFalse) { return {_mm256_mask_blend_epi32(m.k, ifFalse.v, ifTrue.v)}; }
     static ZCHECK_LANE Int32 allOnesWhere(Mask m) { return {_mm256_movm_epi32(m.k)}; }
-    template <int kShift>
-    static ZCHECK_LANE Int32 shiftRightArithmetic(Int32 a) { return {_mm256_srai_epi32(a.v, kShift)}; }
-    template <int kShift>
-    static ZCHECK_LANE Int32 shiftRightLogical(Int32 a) { return {_mm256_srli_epi32(a.v, kShift)}; }
-    static ZCHECK_LANE void store(std::int32_t* p, Int32 a) { _mm256_storeu_si256(reinterpret_cast<__m256i*>(p), a.v); }
-    static ZCHECK_LANE Int32 bitsOf(Float a) { return {_mm256_castps_si256(a.v)}; }
     static ZCHECK_LANE Float zeroWhereNot(Mask m, Float a) { return {_mm256_maskz_mov_ps(m.k, a.v)}; }
     static ZCHECK_LANE void loadTriples(const std::uint32_t* p, Int32 (&corner)[3])
     {
@@ -509,6 +505,7 @@ ZCHECK_ALWAYS_INLINE inline typename L::Real clampLanes(typename L::Real v, type
     return L::min(hi, L::max(lo, v));
 }
 
+#undef ZCHECK_LANES32_NAMES
 ZCHECK_INTRINSICS_END
 
 }  // namespace zcheck
