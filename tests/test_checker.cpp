@@ -1322,7 +1322,7 @@ TEST_CASE("a check over a quick BVH reports what a check over a thorough one doe
     // terrain, the default scene, a scanned mesh) give the same renders bit for bit and the same
     // report; the soup's exact duplicates under other ids may differ in id, never in depth.
     int compared = 0;
-    for (const std::string name : {std::string("builtin:terrain?n=300"), std::string("builtin:default"),
+    for (const std::string& name : {std::string("builtin:terrain?n=300"), std::string("builtin:default"),
                                    std::string(ZCHECK_MODELS_DIR) + "/stanford-bunny.obj", std::string("soup")}) {
         INFO(name);
         const bool soup = name == "soup";

@@ -111,7 +111,7 @@ py::array_t<T> image(const std::vector<T, Allocator>& values, int width, int hei
 // zcheck.Checker: a Checker and, beside it, the MapVerifier that its verify, verify_file and
 // diagnose share (map_verifier.h: the neighbour index is built once per Checker, not per map).
 struct PyChecker {
-    explicit PyChecker(Scene scene) : checker(std::move(scene)), verifier(checker) {}
+    explicit PyChecker(Scene scene, BvhBuild build = BvhBuild::Thorough) : checker(std::move(scene), build), verifier(checker) {}
     const Checker checker;
     const MapVerifier verifier;
 };

@@ -5,6 +5,9 @@
 
 #include <pybind11/stl.h>
 
+#include <optional>
+#include <string>
+
 namespace zcheck::python {
 
 namespace {
@@ -164,12 +167,23 @@ void bindChecker(py::module_& m)
 question zcheck answers about it. Immutable and thread-safe: its methods release the GIL and may be
 called from several Python threads at once.)doc");
     checker
-        .def(py::init([](const Scene& scene) {
+        .def(py::init([](const Scene& scene, std::optional<double> expectedRays) {
+                 if (expectedRays && !(*expectedRays >= 0))
+                     throw Error("expected_rays " + std::to_string(*expectedRays) + " must be a count of rays, >= 0");
+                 const BvhBuild build = expectedRays ? bvhBuildFor(*expectedRays, scene.triangleCount()) : BvhBuild::Thorough;
                  Scene copy = scene;
                  py::gil_scoped_release release;
-                 return std::make_unique<PyChecker>(std::move(copy));
+                 return std::make_unique<PyChecker>(std::move(copy), build);
              }),
-             py::arg("scene"), "Validates the scene and builds both routes (the scene is copied).")
+             py::arg("scene"), py::kw_only(), py::arg("expected_rays") = py::none(),
+             R"doc(Validates the scene and builds both routes (the scene is copied). expected_rays: how many rays
+all the checks and renders of this Checker will trace together (e.g. width * height for one
+frame); below 10 per triangle the BVH is built quickly (Embree's LOW quality, compact: ~4x faster
+to build, ~1.3-1.5x slower to trace), else, and by default (None: many frames), thoroughly.
+Results are the same either way.)doc")
+        .def_property_readonly(
+            "bvh_build", [](const PyChecker& self) { return std::string(nameOf(self.checker.rayRenderer().bvhBuild())); },
+            "\"quick\" or \"thorough\": how the BVH was built (see expected_rays).")
         .def_property_readonly(
             "scene", [](const PyChecker& self) -> const Scene& { return self.checker.scene(); },
             py::return_value_policy::reference_internal)

@@ -1,5 +1,6 @@
 #include "zcheck/scene.h"
 
+#include "zcheck/detail/streaming_stores.h"
 #include "zcheck/error.h"
 
 #include <tbb/blocked_range.h>
@@ -74,6 +75,25 @@ std::string PolygonPlanarity::warning(const std::string& mesh) const
            " polygons of more than 3 corners are not planar (corners up to " + worstText +
            " % of the polygon's size off its plane); renderers split such polygons along different diagonals, so "
            "their depth depends on the split: triangulate the mesh before rendering it";
+}
+
+Scene::Scene(const Scene& other)
+    : name(other.name),
+      defaultCamera(other.defaultCamera),
+      planarity(other.planarity),
+      cameras(other.cameras),
+      chunks(other.chunks)
+{
+    reserveLarge(positions, other.positions.size());
+    positions.assign(other.positions.begin(), other.positions.end());
+    reserveLarge(triangles, other.triangles.size());
+    triangles.assign(other.triangles.begin(), other.triangles.end());
+}
+
+Scene& Scene::operator=(const Scene& other)
+{
+    if (this != &other) *this = Scene(other);
+    return *this;
 }
 
 namespace {

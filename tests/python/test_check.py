@@ -167,3 +167,19 @@ def test_gil_is_released_during_check():
     worker.join()
     assert iterations > 100
     assert longest < duration / 2, f"this thread stalled {longest:.3f} s of a {duration:.3f} s check"
+
+
+def test_a_checker_built_for_one_frame_builds_its_bvh_quickly_and_reports_the_same():
+    scene = zcheck.Scene.from_file("builtin:terrain?n=300")  # 178,802 triangles
+    camera = scene.default_camera.replace(width=320, height=240)
+    thorough = zcheck.Checker(scene)
+    quick = zcheck.Checker(scene, expected_rays=320 * 240)  # 0.43 rays per triangle
+    assert thorough.bvh_build == "thorough" and quick.bvh_build == "quick"
+    assert zcheck.Checker(scene, expected_rays=10 * scene.triangle_count).bvh_build == "thorough"
+    a, b = quick.check(camera), thorough.check(camera)
+    assert a.consistent and b.consistent
+    assert without_timings(a.to_dict()) == without_timings(b.to_dict())
+    assert np.array_equal(quick.render(camera, "window", route="ray"), thorough.render(camera, "window", route="ray"))
+    for bad in [-1.0, float("nan")]:
+        with pytest.raises(zcheck.Error, match="expected_rays .* must be a count of rays"):
+            zcheck.Checker(scene, expected_rays=bad)

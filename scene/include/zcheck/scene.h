@@ -44,6 +44,14 @@ struct TriangleChunks {
 };
 
 struct Scene {
+    Scene() = default;
+    // A copy's positions and triangles lie on huge pages, as a loaded scene's do (a copy on small
+    // pages made the comparison's slope lookups, which read them all over, ~1.8× as long).
+    Scene(const Scene& other);
+    Scene& operator=(const Scene& other);
+    Scene(Scene&&) = default;
+    Scene& operator=(Scene&&) = default;
+
     std::string name;                     // as addressed: "builtin:default", a file path
     std::vector<glm::vec3> positions;     // world space
     std::vector<glm::uvec3> triangles;    // indices into positions; the index is the primitive id
