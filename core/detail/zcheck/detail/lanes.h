@@ -8,9 +8,9 @@
 //   Avx2Lanes    two 256-bit registers per eight doubles or 64-bit integers, masks as vectors
 //                whose lanes are all ones or all zeros
 //   Avx2Lanes4   four lanes in one 256-bit register, for the raster's pixel loop in the AVX2 form
+//                (only the members that loop uses)
 //
-// (L::kLanes says how many lanes.)
-// Each lane type L has
+// L::kLanes says how many lanes. Each eight-lane type L has
 //   L::Real   eight doubles: + − × ÷ (IEEE, lane by lane), < <= > >= (a Mask), select, min, max, abs
 //   L::Int64  eight 64-bit integers: + − | & <<, steps, select, max, reduceMax
 //   L::Int32  eight 32-bit integers: + −, == !=, min/max (unsigned), select
