@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <cfenv>
+#include <cfloat>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -354,6 +355,22 @@ TEST_CASE("storage quanta and quantization follow the formats' definitions", "[c
     REQUIRE(storageQuantum(DepthFormat::Unorm24, 0.3) == 1.0 / 16777215);
     REQUIRE(storageQuantum(DepthFormat::Float32, 1.0) == std::ldexp(1.0, -23));
     REQUIRE(storageQuantum(DepthFormat::Float32, 0.75) == std::ldexp(1.0, -24));
+    // float32's ulp above |value| is std::nextafter's step (the inline form adds one to the bits):
+    // at zero, a subnormal, the largest normal's neighbours, negative and random values.
+    const auto ulpAbove = [](double value) {
+        const float magnitude = std::fabs(float(value));
+        return double(std::nextafter(magnitude, INFINITY)) - double(magnitude);
+    };
+    std::mt19937_64 random(11);
+    std::vector<double> values = {0.0, -0.0, 1e-45, -3e-39, 1.1754942e-38, 3.4028233e38, double(FLT_MAX), -0.3, 1e30};
+    for (int k = 0; k < 100000; ++k) values.push_back(std::ldexp(double(random() % 100000 + 1), int(random() % 200) - 140));
+    for (const double value : values) {
+        INFO(value);
+        REQUIRE(storageQuantum(DepthFormat::Float32, value) == ulpAbove(value));
+    }
+    REQUIRE(storageQuantum(DepthFormat::Float32, double(FLT_MAX)) == INFINITY);
+    REQUIRE(std::isnan(storageQuantum(DepthFormat::Float32, INFINITY)));
+    REQUIRE(std::isnan(storageQuantum(DepthFormat::Float32, NAN)));
     REQUIRE(quantizeDepth(DepthFormat::Unorm16, 0.5) == 32768.0 / 65535);  // round(0.5·65535) = 32768
     REQUIRE(quantizeDepth(DepthFormat::Unorm16, 1.2) == 1.0);
     REQUIRE(quantizeDepth(DepthFormat::Float32, 0.1) == double(0.1f));

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <type_traits>
 
 namespace zcheck {
 
@@ -92,7 +93,8 @@ void rowLanesBaseline(const RowInputs& in, const PixelJudge::ToleranceTerms& ter
 // lanes at a time, and, as bits, the lanes that begin a run in one slope block of the scene's
 // (SlopeTable::tableForRuns): found from the lanes in registers, each one's left
 // neighbour's block shifted in, where reading the stored surface back one lane off waited on
-// the stores (~10 % of the row pass's samples).
+// the stores (~10 % of the row pass's samples). All in 32-bit lanes' masks (Mask32): in the
+// AVX2 form, widening each to the Mask of doubles' lanes made this pass 2.7× as long.
 static_assert(kLanes <= 64, "a row's run starts fit one word");
 template <class L>
 ZCHECK_ALWAYS_INLINE inline std::uint64_t surfaceAndBlockRunsLanes(const std::uint32_t* rayPrimitive,
@@ -100,38 +102,68 @@ ZCHECK_ALWAYS_INLINE inline std::uint64_t surfaceAndBlockRunsLanes(const std::ui
                                                                    std::uint32_t blocks, std::uint32_t* surface)
 {
     using Int32 = typename L::Int32;
-    using Mask = typename L::Mask;
+    using Mask32 = typename L::Mask32;
     static_assert(SlopeTable::kBlock == 64, "a block is a shift by 6");
     const Int32 none = L::set1(std::int32_t(kNoPrimitive)), blockCount = L::set1(std::int32_t(blocks));
     Int32 previousBlocks = L::set1(std::int32_t(-1));  // lane 7: the block left of lane 0, none of the scene's
     std::uint64_t runStarts = 0;
-    for (int j = 0; j < n; j += 8) {
-        const Mask lanes = L::firstLanes(std::min(8, n - j));
-        const Int32 ray = L::maskedLoad(lanes, rayPrimitive + j), raster = L::maskedLoad(lanes, rasterPrimitive + j);
-        const Mask common = lanes & L::notEqual(ray, none) & L::equal(ray, raster);
-        const Int32 row = L::select(common, ray, none);
-        L::maskedStore(lanes, surface + j, row);
+    // Eight lanes from j (kFull: plain loads and stores), or the row's last n − j (masked).
+    auto group = [&](int j, auto full) ZCHECK_ALWAYS_INLINE {
+        constexpr bool kFull = decltype(full)::value;
+        const Mask32 lanes = L::firstLanes32(kFull ? 8 : n - j);
+        const Int32 ray = kFull ? L::load(rayPrimitive + j) : L::maskedLoad32(lanes, rayPrimitive + j);
+        const Int32 raster = kFull ? L::load(rasterPrimitive + j) : L::maskedLoad32(lanes, rasterPrimitive + j);
+        const Mask32 common = L::andNot32(L::equal32(ray, raster), L::equal32(ray, none)) & lanes;
+        const Int32 row = L::select32(common, ray, none);
+        if constexpr (kFull)
+            L::store(surface + j, row);
+        else
+            L::maskedStore32(lanes, surface + j, row);
         const Int32 block = L::template shiftRightLogical<6>(row);
         const Int32 leftBlock = L::shiftedIn(block, previousBlocks);  // lane k: block of lane k − 1
-        const Mask starts = L::andNot(lanes, L::atLeastUnsigned(block, blockCount)) & L::notEqual(block, leftBlock);
-        runStarts |= std::uint64_t(L::bits(starts)) << j;
+        const Mask32 starts = L::andNot32(L::andNot32(lanes, L::atLeastUnsigned32(block, blockCount)), L::equal32(block, leftBlock));
+        runStarts |= std::uint64_t(L::bits32(starts)) << j;
         previousBlocks = block;
-    }
+    };
+    int j = 0;
+    for (; j + 8 <= n; j += 8) group(j, std::true_type{});
+    if (j < n) group(j, std::false_type{});
     return runStarts;
 }
+
+// RowLanes::largest of lanes each ≥ +0 or −1 (none): the largest value's bits, or −1.
+template <class L>
+ZCHECK_ALWAYS_INLINE inline std::int64_t largestBits(typename L::Real lanes)
+{
+    alignas(64) double lane[L::kLanes];
+    L::store(lane, lanes);
+    double largest = lane[0];
+    for (int k = 1; k < L::kLanes; ++k) largest = lane[k] > largest ? lane[k] : largest;
+    std::int64_t bits;
+    __builtin_memcpy(&bits, &largest, sizeof bits);
+    return largest < 0 ? -1 : bits;
+}
+
+// Which of a row's inputs rowLanesOf reads from arrays, fixed per instantiation where they are
+// the common case's, so that its loop carries no branch and no value merged from two (which
+// spilled): ClosedForm and ClosedFormParallel have a slope table, one quantum for all, the
+// relative error in closed form (the view's z axis along each ray or parallel to it) and no
+// allowance; General reads RowInputs to find out.
+enum class RowCase { General, ClosedForm, ClosedFormParallel };
 
 // rowLanesBaseline's results, eight lanes at a time: the same IEEE operations lane for lane
 // (bit-identical), its masks as masks and the keepers' candidates found among them, a row in
 // one pass. (The lane loops above compiled for AVX-512, each through arrays of bytes, made the
-// whole comparison ~1.3× as long; bench/speed-log.md.)
-template <class L>
+// whole comparison ~1.3× as long; bench/speed-log.md.) The masks of 32-bit lanes (the
+// primitives', the keepers') stay Mask32; only the common lanes' is widened, once.
+template <class L, RowCase kCase>
 ZCHECK_ALWAYS_INLINE inline void rowLanesOf(const RowInputs& in, const PixelJudge::ToleranceTerms& termsOfJudge,
                                             StatisticCounts& counts, RowLanes& out)
 {
     using Real = typename L::Real;
     using Int32 = typename L::Int32;
-    using Int64 = typename L::Int64;
     using Mask = typename L::Mask;
+    using Mask32 = typename L::Mask32;
     using Float = typename L::Float;
     const PixelJudge::ToleranceTerms terms = termsOfJudge;  // its C, S and E in registers for the row
     alignas(64) float errorQuantaOfLane[kLanes], relativeOfLane[kLanes];
@@ -139,7 +171,8 @@ ZCHECK_ALWAYS_INLINE inline void rowLanesOf(const RowInputs& in, const PixelJudg
     const Real zero = L::zero(), infinity = L::set1(double(INFINITY));
     // A keeper's candidates: the common lanes at or above its leastKeepable() (none at 2^32).
     const std::uint64_t leastQ = counts.errorQuanta.leastKeepable(), leastE = counts.relativeEyeZ.leastKeepable();
-    const Mask keepsQ = L::firstLanes(leastQ >> 32 ? 0 : 8), keepsE = L::firstLanes(leastE >> 32 ? 0 : 8);
+    constexpr int kGroup = L::kLanes;
+    const Mask32 keepsQ = L::firstLanes32(leastQ >> 32 ? 0 : kGroup), keepsE = L::firstLanes32(leastE >> 32 ? 0 : kGroup);
     const Int32 leastQBits = L::set1(std::int32_t(std::uint32_t(leastQ)));
     const Int32 leastEBits = L::set1(std::int32_t(std::uint32_t(leastE)));
     const Int32 slopeTableNone = L::set1(std::int32_t(in.slopeTableNone));
@@ -147,40 +180,53 @@ ZCHECK_ALWAYS_INLINE inline void rowLanesOf(const RowInputs& in, const PixelJudg
     const Int32 bothMissClass = L::set1(std::int32_t(PixelClass::BothMiss));
     const Real constantQuantum = L::set1(in.constantQuantum.value_or(0.0));
     const Real relativeA = L::set1(in.relativeForm ? in.relativeForm->A : 0.0);
-    const bool parallel = in.relativeForm && in.relativeForm->parallel;
-    Int64 largestQ = L::set1(std::int64_t(-1)), largestE = largestQ, largestR = largestQ;
+    constexpr bool kClosedForm = kCase != RowCase::General;
+    const bool parallel = kClosedForm ? kCase == RowCase::ClosedFormParallel : in.relativeForm && in.relativeForm->parallel;
+    // The three maxima as doubles, −1 where no lane counts: each lane's value where common, −1
+    // elsewhere, through x86's max(candidate, largest) (which keeps `largest` where the
+    // candidate is NaN). The values are ≥ +0 or NaN, so the largest is the one std::max's.
+    const Real noLargest = L::set1(-1.0);
+    Real largestQ = noLargest, largestE = noLargest, largestR = noLargest;
     std::uint64_t common = 0, agree = 0, hit = 0, bias = 0, candidateQ = 0, candidateE = 0;
     // The inputs in locals: the stores below may alias `in`, which would be read again each group.
     const int n = in.n;
     const std::uint32_t *rayPrimitives = in.rayPrimitive, *rasterPrimitives = in.rasterPrimitive;
     const double *rayDepths = in.rayDepth, *rasterDepths = in.rasterDepth, *slopeTable = in.slopeTable;
     const double *slopes = in.slope, *quanta = in.quantum, *relatives = in.relative;
-    const double* allowances = in.allowance == kNoAllowance ? nullptr : in.allowance;
-    const bool quantumConstant = bool(in.constantQuantum), relativeInClosedForm = bool(in.relativeForm);
+    const double* allowances = kClosedForm || in.allowance == kNoAllowance ? nullptr : in.allowance;
+    const bool quantumConstant = kClosedForm || in.constantQuantum, relativeInClosedForm = kClosedForm || in.relativeForm;
     std::uint8_t* pixelClasses = reinterpret_cast<std::uint8_t*>(in.pixelClass);
     float* errorOverTolerance = in.errorOverTolerance;
-    for (int j = 0; j < n; j += 8) {
-        const Mask lanes = L::firstLanes(std::min(8, n - j));
-        const Int32 rayPrimitive = L::maskedLoad(lanes, rayPrimitives + j);
-        const Int32 rasterPrimitive = L::maskedLoad(lanes, rasterPrimitives + j);
-        const Mask rayHit = lanes & L::notEqual(rayPrimitive, none);
-        const Mask c = rayHit & L::equal(rayPrimitive, rasterPrimitive);
-        const Mask h = rayHit | (lanes & L::notEqual(rasterPrimitive, none));
-        const Real rayDepth = L::maskedLoad(lanes, rayDepths + j);
-        const Real rasterDepth = L::maskedLoad(lanes, rasterDepths + j);
+    // A group of lanes from j: all kGroup of them (kFull: plain loads and stores), or the row's
+    // last n − j (masked: nothing read or written past the row).
+    auto group = [&](int j, auto full) ZCHECK_ALWAYS_INLINE {
+        constexpr bool kFull = decltype(full)::value;
+        const Mask lanes = L::firstLanes(kFull ? kGroup : n - j);
+        const Mask32 lanes32 = L::firstLanes32(kFull ? kGroup : n - j);
+        const auto within = [&](Mask m) ZCHECK_ALWAYS_INLINE { return kFull ? m : lanes & m; };
+        const auto load = [&](const auto* p) ZCHECK_ALWAYS_INLINE {
+            if constexpr (kFull) return L::load(p + j);
+            else return L::maskedLoad(lanes, p + j);
+        };
+        const Int32 rayPrimitive = load(rayPrimitives), rasterPrimitive = load(rasterPrimitives);
+        // Either route hit where the smaller id is one; both hit one triangle where the ids
+        // are equal too. (As 32-bit lanes' masks: c is widened once, h never.)
+        const Mask32 h = L::andNot32(lanes32, L::equal32(L::minUnsigned(rayPrimitive, rasterPrimitive), none));
+        const Mask32 c32 = h & L::equal32(rayPrimitive, rasterPrimitive);
+        const Mask c = L::toMask(c32);
+        const Real rayDepth = load(rayDepths), rasterDepth = load(rasterDepths);
         // The slope of a common lane's triangle (0 elsewhere, as table[slopeTableNone] is).
-        const Real m = slopeTable ? L::gather(c, slopeTable, L::minUnsigned(rayPrimitive, slopeTableNone))
-                                  : L::maskedLoad(lanes, slopes + j);
-        const Real q = quantumConstant ? constantQuantum : L::maskedLoad(lanes, quanta + j);
+        const Real m = kClosedForm || slopeTable ? L::gather(c, slopeTable, L::minUnsigned(rayPrimitive, slopeTableNone)) : load(slopes);
+        const Real q = quantumConstant ? constantQuantum : load(quanta);
         // CameraRays::relativeEyeZDifferences (reference: the ray's depth, other: the raster's).
         Real relative;
         if (!relativeInClosedForm)
-            relative = L::maskedLoad(lanes, relatives + j);
+            relative = load(relatives);
         else if (parallel)
             relative = L::abs((rasterDepth - rayDepth) / (rayDepth - relativeA));
         else
             relative = L::abs((rayDepth - rasterDepth) / (rasterDepth - relativeA));
-        const Real allowance = allowances ? L::maskedLoad(lanes, allowances + j) : zero;
+        const Real allowance = allowances ? load(allowances) : zero;
         // The tolerance model's rules, as the baseline form and PixelJudge apply them (compare.h).
         Real bound;
         terms.bound(m, q, allowance, bound);
@@ -191,7 +237,7 @@ ZCHECK_ALWAYS_INLINE inline void rowLanesOf(const RowInputs& in, const PixelJudg
         // ratioOf(error, bound).
         const Real unbounded = L::select(error > zero, infinity, zero);
         const Real ratio = L::select(bound > zero, error / bound, unbounded);
-        const Mask a = lanes & (error <= bound);
+        const Mask a = within(error <= bound);
         Mask dominates;
         terms.quantizationDominates(m, q, allowance, dominates);
         const Mask b = c & dominates;
@@ -201,25 +247,34 @@ ZCHECK_ALWAYS_INLINE inline void rowLanesOf(const RowInputs& in, const PixelJudg
         L::store(out.ratio + j, ratio);
         const Float errorQuantaOfLanes = L::toFloat(errorQuanta), relativeOfLanes = L::toFloat(relative);
         if (pixelClasses) {
-            const Int32 pixelClass = L::select(c & a, agreeClass, L::select(L::andNot(c, a), errorClass, bothMissClass));
-            L::maskedStoreBytes(lanes, pixelClasses + j, pixelClass);
-            L::maskedStore(lanes, errorOverTolerance + j, L::zeroWhereNot(c, L::toFloat(ratio)));
+            const Int32 pixelClass = L::select32(c32, L::select(a, agreeClass, errorClass), bothMissClass);
+            const Float ratioOfCommon = L::zeroWhereNot32(c32, L::toFloat(ratio));
+            if constexpr (kFull) {
+                L::storeBytes(pixelClasses + j, pixelClass);
+                L::store(errorOverTolerance + j, ratioOfCommon);
+            } else {
+                L::maskedStoreBytes(lanes, pixelClasses + j, pixelClass);
+                L::maskedStore(lanes, errorOverTolerance + j, ratioOfCommon);
+            }
         }
-        largestQ = L::select(c & L::ordered(errorQuanta), L::max(largestQ, L::bitsOf(errorQuanta)), largestQ);
-        largestE = L::select(c & L::ordered(relative), L::max(largestE, L::bitsOf(relative)), largestE);
-        largestR = L::select(c & L::ordered(ratio), L::max(largestR, L::bitsOf(ratio)), largestR);
+        largestQ = L::max(L::select(c, errorQuanta, noLargest), largestQ);
+        largestE = L::max(L::select(c, relative, noLargest), largestE);
+        largestR = L::max(L::select(c, ratio, noLargest), largestR);
         L::store(errorQuantaOfLane + j, errorQuantaOfLanes);
         L::store(relativeOfLane + j, relativeOfLanes);
-        const Mask keptQ = c & keepsQ & L::atLeastUnsigned(L::bitsOf(errorQuantaOfLanes), leastQBits);
-        const Mask keptE = c & keepsE & L::atLeastUnsigned(L::bitsOf(relativeOfLanes), leastEBits);
-        common |= std::uint64_t(L::bits(c)) << j, agree |= std::uint64_t(L::bits(a)) << j;
-        hit |= std::uint64_t(L::bits(h)) << j, bias |= std::uint64_t(L::bits(b)) << j;
-        candidateQ |= std::uint64_t(L::bits(keptQ)) << j, candidateE |= std::uint64_t(L::bits(keptE)) << j;
-    }
+        const Mask32 keptQ = c32 & keepsQ & L::atLeastUnsigned32(L::bitsOf(errorQuantaOfLanes), leastQBits);
+        const Mask32 keptE = c32 & keepsE & L::atLeastUnsigned32(L::bitsOf(relativeOfLanes), leastEBits);
+        common |= std::uint64_t(L::bits32(c32)) << j, agree |= std::uint64_t(L::bits(a)) << j;
+        hit |= std::uint64_t(L::bits32(h)) << j, bias |= std::uint64_t(L::bits(b)) << j;
+        candidateQ |= std::uint64_t(L::bits32(keptQ)) << j, candidateE |= std::uint64_t(L::bits32(keptE)) << j;
+    };
+    int j = 0;
+    for (; j + kGroup <= n; j += kGroup) group(j, std::true_type{});
+    if (j < n) group(j, std::false_type{});
     out.common = common, out.agree = agree, out.hit = hit, out.bias = bias;
-    out.largest[0] = L::reduceMax(largestQ);
-    out.largest[1] = L::reduceMax(largestE);
-    out.largest[2] = L::reduceMax(largestR);
+    out.largest[0] = largestBits<L>(largestQ);
+    out.largest[1] = largestBits<L>(largestE);
+    out.largest[2] = largestBits<L>(largestR);
     const std::size_t commons = std::size_t(__builtin_popcountll(common));
     counts.errorQuanta.addCandidates(errorQuantaOfLane, candidateQ, commons);
     counts.relativeEyeZ.addCandidates(relativeOfLane, candidateE, commons);
@@ -236,7 +291,12 @@ ZCHECK_ALWAYS_INLINE inline void rowLanesOf(const RowInputs& in, const PixelJudg
     Entry void rowLanes##Form(const RowInputs& in, const PixelJudge::ToleranceTerms& terms, StatisticCounts& counts, \
                               RowLanes& out)                                                                      \
     {                                                                                                             \
-        rowLanesOf<Form##Lanes>(in, terms, counts, out);                                                          \
+        if (!in.slopeTable || !in.constantQuantum || !in.relativeForm || in.allowance != kNoAllowance)           \
+            rowLanesOf<Form##Lanes, RowCase::General>(in, terms, counts, out);                                    \
+        else if (in.relativeForm->parallel)                                                                       \
+            rowLanesOf<Form##Lanes, RowCase::ClosedFormParallel>(in, terms, counts, out);                         \
+        else                                                                                                      \
+            rowLanesOf<Form##Lanes, RowCase::ClosedForm>(in, terms, counts, out);                                 \
     }
 ZCHECK_ROWS_FORM(ZCHECK_KERNEL_ENTRY_AVX2, Avx2)
 ZCHECK_ROWS_FORM(ZCHECK_KERNEL_ENTRY_AVX512, Avx512)

@@ -1,12 +1,13 @@
 // The per-pixel rule (compare.h): PixelJudge, the tolerance model's constants, the pixel
 // classes, and the slope m of a triangle's plane, one at a time (DepthSlopeFrame) or a block of
-// 64 at a time for the judge's table (slope_table.h), in a baseline and an AVX-512 form. The
+// 64 at a time for the judge's table (slope_table.h), in each kernel form. The
 // comparison's row pass (compare_rows.cpp) and its tile driver (compare.cpp) apply this rule.
 #include "zcheck/compare.h"
 
 #include "zcheck/drawn_polygon.h"
 #include "zcheck/inverse_projection.h"
 #include "zcheck/detail/kernel_choice.h"
+#include "zcheck/detail/lanes.h"
 #include "slope_table.h"
 
 #include <algorithm>
@@ -56,25 +57,47 @@ DepthSlopeFrame::DepthSlopeFrame(const Camera& camera, SlopeCredit credit)
 
 namespace {
 
-// DepthSlopeFrame::slope's arithmetic, inlined where it is called: one triangle at a time, and
-// over lane arrays in PixelJudge::slopes (several triangles per instruction there, so no
-// branch: a plane seen edge-on selects +inf after the division by its zero).
-ZCHECK_ALWAYS_INLINE inline double slopeOfTriangle(const DepthSlopeFrame& frame, const glm::dvec3& a,
-                                                             const glm::dvec3& b, const glm::dvec3& c)
+// DepthSlopeFrame::slope's arithmetic, written once for one triangle (Real: double, Ops:
+// ScalarOps) and for a lane type's eight (Real: L::Real, Ops: L), inlined where it is called;
+// each form's lanes compute the bits the scalar form does (the same IEEE operations in the same
+// order). Corners a, b and c as x, y, z. No branch: a plane seen edge-on selects +inf after the
+// division by its zero.
+struct ScalarOps {
+    static double abs(double x) { return std::abs(x); }
+    static double max(double a, double b) { return a > b ? a : b; }  // as the lane types' max
+    static double select(bool m, double ifTrue, double ifFalse) { return m ? ifTrue : ifFalse; }
+    static double set1(double x) { return x; }
+};
+
+template <class Ops, class Real>
+ZCHECK_ALWAYS_INLINE inline Real slopeOfCorners(const DepthSlopeFrame& frame, const Real (&a)[3], const Real (&b)[3],
+                                                const Real (&c)[3])
 {
-    const glm::dvec3 normal = glm::cross(b - a, c - a);
-    const glm::dvec4 plane(normal, -glm::dot(normal, a));
-    // The clip-space plane's x, y and z (its w is not needed): rows 0-2 of the product.
+    // The plane (normal, −normal·a): glm::cross(b − a, c − a) and glm::dot's order.
+    const Real e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const Real normal[3] = {e1[1] * e2[2] - e2[1] * e1[2], e1[2] * e2[0] - e2[2] * e1[0], e1[0] * e2[1] - e2[0] * e1[1]};
+    const Real offset = normal[0] * a[0] + normal[1] * a[1] + normal[2] * a[2];  // the plane's w is −offset
+    // The clip-space plane's x, y and z (its w is not needed): rows 0-2 of the product, its last
+    // term m·(−offset) as − m·offset (the same bits).
     const glm::dmat4& m = frame.clipPlaneFromWorldPlane;
-    const double x = m[0][0] * plane.x + m[1][0] * plane.y + m[2][0] * plane.z + m[3][0] * plane.w;
-    const double y = m[0][1] * plane.x + m[1][1] * plane.y + m[2][1] * plane.z + m[3][1] * plane.w;
-    const double z = m[0][2] * plane.x + m[1][2] * plane.y + m[2][2] * plane.z + m[3][2] * plane.w;
-    const double dx = std::abs(x) * frame.ndcPerPixelX, dy = std::abs(y) * frame.ndcPerPixelY;
+    const auto row = [&](int r) ZCHECK_ALWAYS_INLINE {
+        return m[0][r] * normal[0] + m[1][r] * normal[1] + m[2][r] * normal[2] - m[3][r] * offset;
+    };
+    const Real x = row(0), y = row(1), z = row(2);
+    const Real dx = frame.ndcPerPixelX * Ops::abs(x), dy = frame.ndcPerPixelY * Ops::abs(y);
     // A sample up to S off in x and in y moves depth by up to S·(|∂d/∂x| + |∂d/∂y|); vertices
-    // snapped by up to S/2 per axis by no more than S·max (compare.h).
-    const double slope =
-        frame.zWindowPerZNdc * (frame.credit == SlopeCredit::SampleOffset ? dx + dy : std::max(dx, dy)) / std::abs(z);
-    return z == 0 ? INFINITY : slope;
+    // snapped by up to S/2 per axis by no more than S·max (compare.h). (std::max(dx, dy) is
+    // max(dy, dx) here: dx where either is NaN or they are equal.)
+    const Real perPixel = frame.credit == SlopeCredit::SampleOffset ? dx + dy : Ops::max(dy, dx);
+    const Real absZ = Ops::abs(z);
+    return Ops::select(absZ <= Ops::set1(0.0), Ops::set1(INFINITY), frame.zWindowPerZNdc * perPixel / absZ);
+}
+
+ZCHECK_ALWAYS_INLINE inline double slopeOfTriangle(const DepthSlopeFrame& frame, const glm::dvec3& a,
+                                                   const glm::dvec3& b, const glm::dvec3& c)
+{
+    const double corners[3][3] = {{a.x, a.y, a.z}, {b.x, b.y, b.z}, {c.x, c.y, c.z}};
+    return slopeOfCorners<ScalarOps>(frame, corners[0], corners[1], corners[2]);
 }
 
 }  // namespace
@@ -92,9 +115,9 @@ double windowDepthSlope(const Camera& camera, const glm::dvec3& a, const glm::dv
 namespace {
 
 // Slopes of up to kSlopeLanes consecutive triangles together: their corners dealt into lane
-// arrays, then slopeOfTriangle lane by lane. Inlined into one function per form
-// (kernel_choice.h), each bit-identical to DepthSlopeFrame::slope of each (the same IEEE
-// operations in the same order).
+// arrays, then slopeOfCorners over them, one triangle at a time in the baseline form (which the
+// compiler vectorises as it can) and eight at a time over a lane type in the vector forms (which
+// GCC left scalar for AVX2). Inlined into one function per form (kernel_choice.h).
 constexpr std::size_t kSlopeLanes = 64;
 
 // The corners of `n` ≤ Lanes triangles dealt into lane arrays in double, for kernels that then
@@ -112,8 +135,9 @@ ZCHECK_ALWAYS_INLINE inline void cornersInLanes(const Scene& scene, const std::u
     }
 }
 
-ZCHECK_ALWAYS_INLINE inline void slopesTogether(const DepthSlopeFrame& frame, const Scene& scene, std::uint32_t first,
-                                                std::size_t n, double* slope)
+// The corners of triangles first.. first + n − 1 in lane arrays, their positions asked for first.
+ZCHECK_ALWAYS_INLINE inline void cornersOfBlock(const Scene& scene, std::uint32_t first, std::size_t n,
+                                                double (&corner)[3][3][kSlopeLanes])
 {
     std::uint32_t triangle[kSlopeLanes];
     for (std::size_t k = 0; k < n; ++k) triangle[k] = first + std::uint32_t(k);
@@ -121,34 +145,58 @@ ZCHECK_ALWAYS_INLINE inline void slopesTogether(const DepthSlopeFrame& frame, co
     // them in order waited on each few in turn), and the next block's index triples too: the
     // comparison often asks for blocks in order (the comparison ~5 % faster in process).
     for (std::size_t k = 0; k < n; ++k)
-        for (int corner = 0; corner < 3; ++corner) __builtin_prefetch(&scene.positions[scene.triangles[first + k][corner]]);
+        for (int v = 0; v < 3; ++v) __builtin_prefetch(&scene.positions[scene.triangles[first + k][v]]);
     const std::size_t nextBlock = first + n, nextBlockEnd = std::min(scene.triangles.size(), nextBlock + kSlopeLanes);
     for (std::size_t k = nextBlock; k < nextBlockEnd; k += 64 / sizeof(glm::uvec3)) __builtin_prefetch(&scene.triangles[k]);
-    alignas(64) double corner[3][3][kSlopeLanes];  // corner, axis, lane
     cornersInLanes(scene, triangle, n, corner);
-    for (std::size_t k = 0; k < n; ++k)
-        slope[k] = slopeOfTriangle(frame, glm::dvec3(corner[0][0][k], corner[0][1][k], corner[0][2][k]),
-                                   glm::dvec3(corner[1][0][k], corner[1][1][k], corner[1][2][k]),
-                                   glm::dvec3(corner[2][0][k], corner[2][1][k], corner[2][2][k]));
 }
 
 void slopesTogetherBaseline(const DepthSlopeFrame& frame, const Scene& scene, std::uint32_t first, std::size_t n,
                             double* slope)
 {
-    slopesTogether(frame, scene, first, n, slope);
+    alignas(64) double corner[3][3][kSlopeLanes];  // corner, axis, lane
+    cornersOfBlock(scene, first, n, corner);
+    for (std::size_t k = 0; k < n; ++k) {
+        const double a[3] = {corner[0][0][k], corner[0][1][k], corner[0][2][k]};
+        const double b[3] = {corner[1][0][k], corner[1][1][k], corner[1][2][k]};
+        const double c[3] = {corner[2][0][k], corner[2][1][k], corner[2][2][k]};
+        slope[k] = slopeOfCorners<ScalarOps>(frame, a, b, c);
+    }
 }
 
 #ifdef ZCHECK_X86_FORMS
+template <class L>
+ZCHECK_ALWAYS_INLINE inline void slopesTogetherLanes(const DepthSlopeFrame& frame, const Scene& scene,
+                                                     std::uint32_t first, std::size_t n, double* slope)
+{
+    using Real = typename L::Real;
+    alignas(64) double corner[3][3][kSlopeLanes];  // corner, axis, lane
+    cornersOfBlock(scene, first, n, corner);
+    for (std::size_t k = n; k % L::kLanes != 0; ++k)  // the last group's lanes past n: zeros, not stored
+        for (int v = 0; v < 3; ++v)
+            for (int axis = 0; axis < 3; ++axis) corner[v][axis][k] = 0.0;
+    for (std::size_t k = 0; k < n; k += L::kLanes) {
+        Real c[3][3];
+        for (int v = 0; v < 3; ++v)
+            for (int axis = 0; axis < 3; ++axis) c[v][axis] = L::load(&corner[v][axis][k]);
+        const Real slopes = slopeOfCorners<L>(frame, c[0], c[1], c[2]);
+        if (k + L::kLanes <= n)
+            L::store(slope + k, slopes);
+        else
+            L::maskedStore(L::firstLanes(int(n - k)), slope + k, slopes);
+    }
+}
+
 ZCHECK_KERNEL_ENTRY_AVX2 void slopesTogetherAvx2(const DepthSlopeFrame& frame, const Scene& scene, std::uint32_t first,
                                                  std::size_t n, double* slope)
 {
-    slopesTogether(frame, scene, first, n, slope);
+    slopesTogetherLanes<Avx2Lanes>(frame, scene, first, n, slope);
 }
 
 ZCHECK_KERNEL_ENTRY_AVX512 void slopesTogetherAvx512(const DepthSlopeFrame& frame, const Scene& scene,
                                                      std::uint32_t first, std::size_t n, double* slope)
 {
-    slopesTogether(frame, scene, first, n, slope);
+    slopesTogetherLanes<Avx512Lanes>(frame, scene, first, n, slope);
 }
 #endif
 

@@ -16,6 +16,8 @@
 // storage format of the depth buffer.
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -81,12 +83,20 @@ inline double quantizeDepth(DepthFormat format, double windowDepth)
 }
 
 // The storage quantum q at a stored value: 1 LSB = 1/(2^N − 1) for unorm-N, the spacing of
-// binary32 numbers above |value| (1 ulp) for float32.
+// binary32 numbers above |value| (1 ulp) for float32: the next binary32 up, whose bits are
+// |value|'s plus one (what std::nextafter(|value|, +inf) gives for every finite value; +inf
+// and NaN give NaN either way), less |value|. No library call, so a loop of these is
+// vectorised (the comparison takes one per pixel of a float32 map).
 inline double storageQuantum(DepthFormat format, double windowDepth)
 {
     if (format != DepthFormat::Float32) return 1.0 / unormMax(format);
     const float magnitude = std::fabs(static_cast<float>(windowDepth));
-    return static_cast<double>(std::nextafter(magnitude, INFINITY)) - static_cast<double>(magnitude);
+    std::uint32_t bits;
+    std::memcpy(&bits, &magnitude, sizeof bits);
+    ++bits;
+    float next;
+    std::memcpy(&next, &bits, sizeof next);
+    return static_cast<double>(next) - static_cast<double>(magnitude);
 }
 
 struct DepthSettings {

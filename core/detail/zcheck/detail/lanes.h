@@ -16,6 +16,8 @@
 //   L::Int32  eight 32-bit integers: + −, == !=, min/max (unsigned), select
 //   L::Float  eight floats: the rounded doubles the keepers and the heatmap take
 //   L::Mask   eight lanes' truth: & | ^ andNot, bits() (lane j: bit j)
+//   L::Mask32 eight 32-bit lanes' truth, in the form's cheapest shape for 32-bit work: & andNot32,
+//             bits32, and toMask (to a Mask, where doubles' lanes need it)
 // and the loads, stores, gathers and conversions the kernels need, each named for what it does.
 // A masked load reads no memory of a lane outside its mask, a masked store writes none (so a
 // group of eight may run past the end of its row). Every operation on doubles is the one IEEE
@@ -61,6 +63,37 @@ struct Lanes32 {
     static ZCHECK_LANE Int32 shiftRightLogical(Int32 a) { return {_mm256_srli_epi32(a.v, kShift)}; }
     static ZCHECK_LANE void store(std::int32_t* p, Int32 a) { _mm256_storeu_si256(reinterpret_cast<__m256i*>(p), a.v); }
     static ZCHECK_LANE Int32 bitsOf(Float a) { return {_mm256_castps_si256(a.v)}; }
+    // Lane k: a's lane k − 1, lane 0: `before`'s lane 7 (the lanes moved one up, the previous group's last shifted in).
+    static ZCHECK_LANE Int32 shiftedIn(Int32 a, Int32 before)
+    {
+        const __m256i up = _mm256_permutevar8x32_epi32(a.v, _mm256_setr_epi32(7, 0, 1, 2, 3, 4, 5, 6));
+        const __m256i last = _mm256_permutevar8x32_epi32(before.v, _mm256_set1_epi32(7));
+        return {_mm256_blend_epi32(up, last, 0x01)};
+    }
+
+    // The truth of eight 32-bit lanes, for work on 32-bit lanes alone, which then needs no
+    // widening to the form's Mask (toMask widens it where a Real's lanes need it): here lanes of
+    // all ones or zeros, the AVX2 form's; the AVX-512 form's is its Mask (a mask register).
+    struct Mask32 {
+        __m256i v;
+        friend ZCHECK_LANE Mask32 operator&(Mask32 a, Mask32 b) { return {_mm256_and_si256(a.v, b.v)}; }
+    };
+    static ZCHECK_LANE Mask32 firstLanes32(int n)  // lanes [0, n), n in [0, 8]
+    {
+        return {_mm256_cmpgt_epi32(_mm256_set1_epi32(n), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7))};
+    }
+    static ZCHECK_LANE Mask32 andNot32(Mask32 a, Mask32 b) { return {_mm256_andnot_si256(b.v, a.v)}; }  // a & ~b
+    static ZCHECK_LANE unsigned bits32(Mask32 m) { return unsigned(_mm256_movemask_ps(_mm256_castsi256_ps(m.v))); }
+    static ZCHECK_LANE Mask32 equal32(Int32 a, Int32 b) { return {_mm256_cmpeq_epi32(a.v, b.v)}; }
+    static ZCHECK_LANE Mask32 atLeastUnsigned32(Int32 a, Int32 b) { return {_mm256_cmpeq_epi32(_mm256_max_epu32(a.v, b.v), a.v)}; }
+    static ZCHECK_LANE Int32 select32(Mask32 m, Int32 ifTrue, Int32 ifFalse) { return {_mm256_blendv_epi8(ifFalse.v, ifTrue.v, m.v)}; }
+    static ZCHECK_LANE Int32 maskedLoad32(Mask32 m, const std::uint32_t* p)  // 0 outside m
+    {
+        return {_mm256_maskload_epi32(reinterpret_cast<const int*>(p), m.v)};
+    }
+    static ZCHECK_LANE void maskedStore32(Mask32 m, std::uint32_t* p, Int32 a) { _mm256_maskstore_epi32(reinterpret_cast<int*>(p), m.v, a.v); }
+    static ZCHECK_LANE Float zeroWhereNot32(Mask32 m, Float a) { return {_mm256_and_ps(a.v, _mm256_castsi256_ps(m.v))}; }
+    static ZCHECK_LANE void store(std::uint32_t* p, Int32 a) { _mm256_storeu_si256(reinterpret_cast<__m256i*>(p), a.v); }
 #undef ZCHECK_LANE
 };
 // The base's overloads of the names a form also defines (set1, load, store, min, max, bitsOf).
@@ -127,6 +160,7 @@ struct Avx2Lanes : Lanes32 {
     {
         return {_mm256_cvtepi32_epi64(_mm256_castsi256_si128(m32)), _mm256_cvtepi32_epi64(_mm256_extracti128_si256(m32, 1))};
     }
+    static ZCHECK_LANE Mask toMask(Mask32 m) { return widen(m.v); }
 
     // Reals.
     static ZCHECK_LANE Real set1(double x) { return {_mm256_set1_pd(x), _mm256_set1_pd(x)}; }
@@ -278,18 +312,19 @@ struct Avx2Lanes : Lanes32 {
     static ZCHECK_LANE void maskedStore(Mask m, std::uint32_t* p, Int32 a) { _mm256_maskstore_epi32(reinterpret_cast<int*>(p), narrow(m), a.v); }
     static ZCHECK_LANE void maskedStore(Mask m, float* p, Float a) { _mm256_maskstore_ps(p, narrow(m), a.v); }
     // The low byte of each lane to p[k] where m holds.
-    static ZCHECK_LANE void maskedStoreBytes(Mask m, std::uint8_t* p, Int32 a)
+    static ZCHECK_LANE void storeBytes(std::uint8_t* p, Int32 a)  // the low byte of each lane to p[k]
+    {
+        const __m256i bytes = _mm256_shuffle_epi8(a.v, _mm256_setr_epi8(0, 4, 8, 12, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1,
+                                                                        0, 4, 8, 12, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1));
+        const __m256i together = _mm256_permutevar8x32_epi32(bytes, _mm256_setr_epi32(0, 4, 0, 0, 0, 0, 0, 0));
+        _mm_storel_epi64(reinterpret_cast<__m128i*>(p), _mm256_castsi256_si128(together));
+    }
+    static ZCHECK_LANE void maskedStoreBytes(Mask m, std::uint8_t* p, Int32 a)  // the same where m holds
     {
         const unsigned lanes = bits(m);
+        if (lanes == 0xFF) return storeBytes(p, a);
         alignas(32) std::int32_t lane[8];
         _mm256_store_si256(reinterpret_cast<__m256i*>(lane), a.v);
-        if (lanes == 0xFF) {
-            const __m256i bytes = _mm256_shuffle_epi8(a.v, _mm256_setr_epi8(0, 4, 8, 12, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1,
-                                                                            0, 4, 8, 12, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1));
-            const std::uint32_t first = std::uint32_t(_mm256_extract_epi32(bytes, 0)), second = std::uint32_t(_mm256_extract_epi32(bytes, 4));
-            __builtin_memcpy(p, &first, 4), __builtin_memcpy(p + 4, &second, 4);
-            return;
-        }
         for (int k = 0; k < 8; ++k)
             if (lanes >> k & 1) p[k] = std::uint8_t(lane[k]);
     }
@@ -306,13 +341,6 @@ struct Avx2Lanes : Lanes32 {
     {
         const __m256i stride = _mm256_setr_epi32(0, 3, 6, 9, 12, 15, 18, 21);
         for (int k = 0; k < 3; ++k) corner[k] = {_mm256_i32gather_epi32(reinterpret_cast<const int*>(p + k), stride, 4)};
-    }
-    // Lane k: a's lane k − 1, lane 0: `before`'s lane 7 (the lanes moved one up, the previous group's last shifted in).
-    static ZCHECK_LANE Int32 shiftedIn(Int32 a, Int32 before)
-    {
-        const __m256i up = _mm256_permutevar8x32_epi32(a.v, _mm256_setr_epi32(7, 0, 1, 2, 3, 4, 5, 6));
-        const __m256i last = _mm256_permutevar8x32_epi32(before.v, _mm256_set1_epi32(7));
-        return {_mm256_blend_epi32(up, last, 0x01)};
     }
 #undef ZCHECK_LANE
 };
@@ -421,6 +449,7 @@ struct Avx512Lanes : Lanes32 {
     static ZCHECK_LANE Int32 maskedLoad(Mask m, const std::uint32_t* p) { return {_mm256_maskz_loadu_epi32(m.k, p)}; }
     static ZCHECK_LANE void maskedStore(Mask m, std::uint32_t* p, Int32 a) { _mm256_mask_storeu_epi32(p, m.k, a.v); }
     static ZCHECK_LANE void maskedStore(Mask m, float* p, Float a) { _mm256_mask_storeu_ps(p, m.k, a.v); }
+    static ZCHECK_LANE void storeBytes(std::uint8_t* p, Int32 a) { _mm_storel_epi64(reinterpret_cast<__m128i*>(p), _mm256_cvtepi32_epi8(a.v)); }
     static ZCHECK_LANE void maskedStoreBytes(Mask m, std::uint8_t* p, Int32 a) { _mm256_mask_cvtepi32_storeu_epi8(p, m.k, a.v); }
     static ZCHECK_LANE Mask equal(Int32 a, Int32 b) { return {_mm256_cmpeq_epi32_mask(a.v, b.v)}; }
     static ZCHECK_LANE Mask notEqual(Int32 a, Int32 b) { return {_mm256_cmpneq_epi32_mask(a.v, b.v)}; }
@@ -440,6 +469,18 @@ struct Avx512Lanes : Lanes32 {
         }
     }
     static ZCHECK_LANE Int32 shiftedIn(Int32 a, Int32 before) { return {_mm256_alignr_epi32(a.v, before.v, 7)}; }
+    // Mask32: the mask registers themselves.
+    using Mask32 = Mask;
+    static ZCHECK_LANE Mask toMask(Mask32 m) { return m; }
+    static ZCHECK_LANE Mask32 firstLanes32(int n) { return firstLanes(n); }
+    static ZCHECK_LANE Mask32 andNot32(Mask32 a, Mask32 b) { return andNot(a, b); }
+    static ZCHECK_LANE unsigned bits32(Mask32 m) { return m.k; }
+    static ZCHECK_LANE Mask32 equal32(Int32 a, Int32 b) { return equal(a, b); }
+    static ZCHECK_LANE Mask32 atLeastUnsigned32(Int32 a, Int32 b) { return atLeastUnsigned(a, b); }
+    static ZCHECK_LANE Int32 select32(Mask32 m, Int32 ifTrue, Int32 ifFalse) { return select(m, ifTrue, ifFalse); }
+    static ZCHECK_LANE Int32 maskedLoad32(Mask32 m, const std::uint32_t* p) { return maskedLoad(m, p); }
+    static ZCHECK_LANE void maskedStore32(Mask32 m, std::uint32_t* p, Int32 a) { maskedStore(m, p, a); }
+    static ZCHECK_LANE Float zeroWhereNot32(Mask32 m, Float a) { return zeroWhereNot(m, a); }
 #undef ZCHECK_LANE
 };
 
