@@ -194,6 +194,17 @@ struct WholeCheck {
     double peakMiB;  // the child's maximum resident set, after the cold check
 };
 
+// `checker` as a program checking many frames builds it (BvhBuild::Thorough): itself where it
+// was, else one over a copy of its scene. (A copy's arrays lie on huge pages, as a loaded
+// scene's: on small pages the comparison's slopes, which read them all over, ran ~1.8× as long.)
+void buildThorough(std::unique_ptr<const Checker>& checker)
+{
+    if (checker->rayRenderer().bvhBuild() == BvhBuild::Thorough) return;
+    Scene scene = checker->scene();
+    checker.reset();
+    checker = std::make_unique<const Checker>(std::move(scene), BvhBuild::Thorough);
+}
+
 WholeCheck wholeCheckInChild(const std::string& sceneName, const Camera& camera, int threads)
 {
     return inChild<WholeCheck>(threads, "the check (run `zcheck check` with the same scene and camera)", [&] {
@@ -215,12 +226,7 @@ WholeCheck wholeCheckInChild(const std::string& sceneName, const Camera& camera,
         rusage usage{};
         getrusage(RUSAGE_SELF, &usage);
         w.peakMiB = maxResidentMiB(usage);
-        if (w.build != BvhBuild::Thorough) {  // the phases over the many-frame BVH
-            // The scene loaded again, not copied: a copy's arrays lie on small pages, and the
-            // comparison's slopes, which read them all over, ran ~1.8× as long.
-            checker.reset();
-            checker = std::make_unique<const Checker>(loadScene(sceneName), BvhBuild::Thorough);
-        }
+        buildThorough(checker);  // the phases over the many-frame BVH
         {
             releaseCachedLargeBuffers();  // the full-frame check's buffers new, as in a fresh process
             const CheckResult fullFrame = checker->check(camera);
@@ -274,10 +280,7 @@ LensCosts lensCostsInChild(const std::string& sceneName, const Camera& camera, i
         c.tableMs = millisecondsSince(tableStart);
         exportOnce(*checker, c.exportTraceMs, c.exportWriteMs);
         c.exportMs = millisecondsSince(start);
-        if (checker->rayRenderer().bvhBuild() != BvhBuild::Thorough) {  // the rest over the many-frame BVH
-            checker.reset();
-            checker = std::make_unique<const Checker>(loadScene(sceneName), BvhBuild::Thorough);  // not copied: see above
-        }
+        buildThorough(checker);  // the rest over the many-frame BVH
 
         const CameraRays cameraRays(camera);
         const int W = camera.width(), H = camera.height();

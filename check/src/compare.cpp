@@ -526,11 +526,11 @@ ZCHECK_KERNEL_ENTRY_AVX512 void TileComparison::Impl::compareAvx512(int tileBegi
 void TileComparison::Impl::compare(int tileBegin, int tileEnd, int rowBegin, int rowEnd, const RoutePixels& ray,
                                    const RoutePixels& raster)
 {
+    auto body = &Impl::compareBaseline;
 #ifdef ZCHECK_X86_FORMS
-    if (judge.form() == KernelForm::Avx2) return compareAvx2(tileBegin, tileEnd, rowBegin, rowEnd, ray, raster);
-    if (judge.form() == KernelForm::Avx512) return compareAvx512(tileBegin, tileEnd, rowBegin, rowEnd, ray, raster);
+    body = formOf(judge.form(), body, &Impl::compareAvx2, &Impl::compareAvx512);
 #endif
-    compareBaseline(tileBegin, tileEnd, rowBegin, rowEnd, ray, raster);
+    (this->*body)(tileBegin, tileEnd, rowBegin, rowEnd, ray, raster);
 }
 
 TileComparison::TileComparison(const Scene& scene, const Camera& camera, const ToleranceModel& tolerance,

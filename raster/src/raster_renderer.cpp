@@ -564,13 +564,12 @@ ZCHECK_RASTER_FORM(ZCHECK_KERNEL_ENTRY_AVX512, Avx512, Avx512Lanes)
 // The vector kernels of kernelForm() (kernel_form.h; read by each frame when it is made).
 RasterKernels rasterKernels()
 {
-    const KernelForm form = kernelForm();
+    RasterKernels kernels;  // the baseline form: none (the scalar code)
 #ifdef ZCHECK_X86_FORMS
-    if (form == KernelForm::Avx2) return {&drawInTileAvx2, &snapEightAvx2, &binItemsOfEightAvx2};
-    if (form == KernelForm::Avx512) return {&drawInTileAvx512, &snapEightAvx512, &binItemsOfEightAvx512};
+    kernels = formOf(kernelForm(), kernels, RasterKernels{&drawInTileAvx2, &snapEightAvx2, &binItemsOfEightAvx2},
+                     RasterKernels{&drawInTileAvx512, &snapEightAvx512, &binItemsOfEightAvx512});
 #endif
-    (void)form;
-    return {};
+    return kernels;
 }
 
 glm::dvec4 clipOf(const Viewport& vp, const glm::vec3& position)

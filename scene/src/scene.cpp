@@ -98,52 +98,53 @@ Scene& Scene::operator=(const Scene& other)
 
 namespace {
 
-// Whether any vertex or index breaks validateScene's rules: each thread a part of the arrays
-// (a ten-million-triangle scene is checked by every renderer made for it).
-bool anyInvalid(const Scene& scene)
+// The first i < n, in order, for which bad(i), or n if none: each thread a part of the range (a
+// ten-million-triangle scene is checked by every renderer made for it).
+template <class Bad>
+std::size_t firstWhere(std::size_t n, Bad bad)
 {
-    auto badVertex = [](const glm::vec3& p) {
-        for (int i = 0; i < 3; ++i)
-            if (!(std::abs(p[i]) <= Camera::kMaxWorldCoordinate)) return true;  // NaN too
-        return false;
-    };
-    const std::size_t vertices = scene.positions.size();
-    auto badIndices = [vertices](const glm::uvec3& t) { return t[0] >= vertices || t[1] >= vertices || t[2] >= vertices; };
-    auto any = [](std::size_t n, auto bad) {
-        return tbb::parallel_reduce(
-            tbb::blocked_range<std::size_t>(0, n, 1 << 16), false,
-            [&](const tbb::blocked_range<std::size_t>& r, bool found) {
-                for (std::size_t i = r.begin(); i != r.end() && !found; ++i) found = bad(i);
-                return found;
-            },
-            [](bool a, bool b) { return a || b; });
-    };
-    return any(scene.positions.size(), [&](std::size_t i) { return badVertex(scene.positions[i]); }) ||
-           any(scene.triangles.size(), [&](std::size_t i) { return badIndices(scene.triangles[i]); });
+    return tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, n, 1 << 16), n,
+        [&](const tbb::blocked_range<std::size_t>& r, std::size_t first) {
+            for (std::size_t i = r.begin(); i != r.end() && i < first; ++i)
+                if (bad(i)) return i;
+            return first;
+        },
+        [](std::size_t a, std::size_t b) { return std::min(a, b); });
 }
+
+// validateScene's rule for a vertex coordinate: finite and within ±Camera::kMaxWorldCoordinate
+// (binary32 ray tracing needs headroom: Embree fails beyond ~1e19; the camera's bound too).
+bool coordinateValid(float x) { return std::abs(x) <= Camera::kMaxWorldCoordinate; }  // false for NaN
 
 }  // namespace
 
 void validateScene(const Scene& scene)
 {
-    if (scene.triangles.empty()) throw Error("scene '" + scene.name + "' has no triangles");
-    if (scene.triangles.size() >= 0xFFFFFFFFu)
-        throw Error("scene '" + scene.name + "' has more triangles than 32-bit primitive ids can name");
-    if (!anyInvalid(scene)) return;
-    // The first offending element, in order, for the message.
-    for (const auto& p : scene.positions)
-        for (int i = 0; i < 3; ++i) {
-            if (!std::isfinite(p[i])) throw Error("scene '" + scene.name + "' has a vertex that is not finite");
-            // binary32 ray tracing needs headroom (Embree fails beyond ~1e19); the same bound
-            // as the camera's (Camera::kMaxWorldCoordinate).
-            if (std::abs(p[i]) > Camera::kMaxWorldCoordinate)
-                throw Error("scene '" + scene.name + "' has a vertex coordinate " + formatNumber(p[i]) +
-                            ", beyond the ±1e15 that the ray tracer can represent");
+    const std::string what = "scene '" + scene.name + "'";
+    if (scene.triangles.empty()) throw Error(what + " has no triangles");
+    if (scene.triangles.size() >= 0xFFFFFFFFu) throw Error(what + " has more triangles than 32-bit primitive ids can name");
+    const std::size_t vertices = scene.positions.size();
+    const std::size_t badVertex = firstWhere(vertices, [&](std::size_t i) {
+        const glm::vec3& p = scene.positions[i];
+        return !(coordinateValid(p.x) && coordinateValid(p.y) && coordinateValid(p.z));
+    });
+    if (badVertex < vertices)
+        for (int axis = 0; axis < 3; ++axis) {
+            const float x = scene.positions[badVertex][axis];
+            if (coordinateValid(x)) continue;
+            if (!std::isfinite(x)) throw Error(what + " has a vertex that is not finite");
+            throw Error(what + " has a vertex coordinate " + formatNumber(x) +
+                        ", beyond the ±1e15 that the ray tracer can represent");
         }
-    for (const auto& t : scene.triangles)
-        for (int i = 0; i < 3; ++i)
-            if (t[i] >= scene.positions.size())
-                throw Error("scene '" + scene.name + "' has a vertex index out of range (" + std::to_string(t[i]) + ")");
+    const std::size_t badTriangle = firstWhere(scene.triangles.size(), [&](std::size_t i) {
+        const glm::uvec3& t = scene.triangles[i];
+        return t[0] >= vertices || t[1] >= vertices || t[2] >= vertices;
+    });
+    if (badTriangle < scene.triangles.size())
+        for (int corner = 0; corner < 3; ++corner)
+            if (const std::uint32_t index = scene.triangles[badTriangle][corner]; index >= vertices)
+                throw Error(what + " has a vertex index out of range (" + std::to_string(index) + ")");
 }
 
 Scene frameScene(Scene scene, const std::string& what)
