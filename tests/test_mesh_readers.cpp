@@ -4,9 +4,11 @@
 #include "zcheck/error.h"
 #include "zcheck/mesh_formats.h"
 #include "zcheck/mesh_loader.h"
+#include "zcheck/scene.h"
 
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <unistd.h>
@@ -237,4 +239,37 @@ TEST_CASE("polygons of more than 3 corners: non-planar ones are counted and meas
     REQUIRE(flat.planarity.polygons == 1);
     REQUIRE(flat.planarity.nonPlanar == 0);
     REQUIRE(flat.planarity.warning("f.obj").empty());
+}
+
+TEST_CASE("validateScene names the first offending vertex or index in order, however large the scene", "[mesh][scene]")
+{
+    // 300,000 vertices and triangles: the search runs in parallel parts (65,536 elements each), and
+    // the message must still be the first offender's, in order, not whichever part finished first.
+    Scene scene;
+    scene.name = "big";
+    const std::size_t n = 300000;
+    for (std::size_t i = 0; i < n; ++i) scene.positions.push_back(glm::vec3(float(i % 1000), float(i / 1000), 0.0f));
+    for (std::size_t i = 0; i + 2 < n; ++i)
+        scene.triangles.push_back(glm::uvec3(std::uint32_t(i), std::uint32_t(i + 1), std::uint32_t(i + 2)));
+    REQUIRE_NOTHROW(validateScene(scene));
+
+    Scene vertices = scene;
+    vertices.positions[250000].y = 1e16f;              // later
+    vertices.positions[70000].z = std::nanf("");       // first
+    REQUIRE_THROWS_WITH(validateScene(vertices), "scene 'big' has a vertex that is not finite");
+    vertices.positions[70000].z = 0.0f;
+    vertices.positions[250000].x = INFINITY;           // the same vertex's first bad coordinate: x
+    REQUIRE_THROWS_WITH(validateScene(vertices), "scene 'big' has a vertex that is not finite");
+    vertices.positions[250000].x = 0.0f;
+    REQUIRE_THROWS_WITH(validateScene(vertices),
+                        Catch::StartsWith("scene 'big' has a vertex coordinate 1") && Catch::Contains("beyond the ±1e15"));
+    vertices.positions[250000].y = -1e15f;             // at the bound: allowed
+    REQUIRE_NOTHROW(validateScene(vertices));
+
+    Scene indices = scene;
+    indices.triangles[280000][0] = 400000;             // later
+    indices.triangles[131072][2] = 300000;             // first: the first element of a part
+    REQUIRE_THROWS_WITH(validateScene(indices), "scene 'big' has a vertex index out of range (300000)");
+    indices.triangles[131072][2] = 131074;
+    REQUIRE_THROWS_WITH(validateScene(indices), "scene 'big' has a vertex index out of range (400000)");
 }
