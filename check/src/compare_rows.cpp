@@ -121,7 +121,8 @@ ZCHECK_ALWAYS_INLINE inline std::uint64_t surfaceAndBlockRunsLanes(const std::ui
             L::maskedStore32(lanes, surface + j, row);
         const Int32 block = L::template shiftRightLogical<6>(row);
         const Int32 leftBlock = L::shiftedIn(block, previousBlocks);  // lane k: block of lane k − 1
-        const Mask32 starts = L::andNot32(L::andNot32(lanes, L::atLeastUnsigned32(block, blockCount)), L::equal32(block, leftBlock));
+        const Mask32 inTable = L::andNot32(lanes, L::atLeastUnsigned32(block, blockCount));
+        const Mask32 starts = L::andNot32(inTable, L::equal32(block, leftBlock));
         runStarts |= std::uint64_t(L::bits32(starts)) << j;
         previousBlocks = block;
     };
@@ -216,7 +217,9 @@ ZCHECK_ALWAYS_INLINE inline void rowLanesOf(const RowInputs& in, const PixelJudg
         const Mask c = L::toMask(c32);
         const Real rayDepth = load(rayDepths), rasterDepth = load(rasterDepths);
         // The slope of a common lane's triangle (0 elsewhere, as table[slopeTableNone] is).
-        const Real m = kClosedForm || slopeTable ? L::gather(c, slopeTable, L::minUnsigned(rayPrimitive, slopeTableNone)) : load(slopes);
+        const Real m = kClosedForm || slopeTable
+                           ? L::gather(c, slopeTable, L::minUnsigned(rayPrimitive, slopeTableNone))
+                           : load(slopes);
         const Real q = quantumConstant ? constantQuantum : load(quanta);
         // CameraRays::relativeEyeZDifferences (reference: the ray's depth, other: the raster's).
         Real relative;
