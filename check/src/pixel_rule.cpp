@@ -93,18 +93,12 @@ ZCHECK_ALWAYS_INLINE inline Real slopeOfCorners(const DepthSlopeFrame& frame, co
     return Ops::select(absZ <= Ops::set1(0.0), Ops::set1(INFINITY), frame.zWindowPerZNdc * perPixel / absZ);
 }
 
-ZCHECK_ALWAYS_INLINE inline double slopeOfTriangle(const DepthSlopeFrame& frame, const glm::dvec3& a,
-                                                   const glm::dvec3& b, const glm::dvec3& c)
-{
-    const double corners[3][3] = {{a.x, a.y, a.z}, {b.x, b.y, b.z}, {c.x, c.y, c.z}};
-    return slopeOfCorners<ScalarOps>(frame, corners[0], corners[1], corners[2]);
-}
-
 }  // namespace
 
 double DepthSlopeFrame::slope(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) const
 {
-    return slopeOfTriangle(*this, a, b, c);
+    const double corners[3][3] = {{a.x, a.y, a.z}, {b.x, b.y, b.z}, {c.x, c.y, c.z}};
+    return slopeOfCorners<ScalarOps>(*this, corners[0], corners[1], corners[2]);
 }
 
 double windowDepthSlope(const Camera& camera, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c)
@@ -120,27 +114,13 @@ namespace {
 // GCC left scalar for AVX2). Inlined into one function per form (kernel_choice.h).
 constexpr std::size_t kSlopeLanes = 64;
 
-// The corners of `n` ≤ Lanes triangles dealt into lane arrays in double, for kernels that then
-// work on several triangles per instruction: corner[v][axis][k] is corner v of triangle
-// `triangle[k]`. The indices must be in range (validateScene). Always inlined, so that each
-// form of a kernel compiles its own copy.
-template <std::size_t Lanes>
-ZCHECK_ALWAYS_INLINE inline void cornersInLanes(const Scene& scene, const std::uint32_t* triangle, std::size_t n,
-                                                double (&corner)[3][3][Lanes])
-{
-    for (std::size_t k = 0; k < n; ++k) {
-        const glm::uvec3& t = scene.triangles[triangle[k]];
-        for (int v = 0; v < 3; ++v)
-            for (int axis = 0; axis < 3; ++axis) corner[v][axis][k] = double(scene.positions[t[v]][axis]);
-    }
-}
-
-// The corners of triangles first.. first + n − 1 in lane arrays, their positions asked for first.
+// The corners of triangles first .. first + n − 1 (n ≤ kSlopeLanes) dealt into lane arrays in
+// double, for kernels that then work on several triangles per instruction: corner[v][axis][k] is
+// corner v of triangle first + k. The indices must be in range (validateScene). Always inlined,
+// so that each form of a kernel compiles its own copy.
 ZCHECK_ALWAYS_INLINE inline void cornersOfBlock(const Scene& scene, std::uint32_t first, std::size_t n,
                                                 double (&corner)[3][3][kSlopeLanes])
 {
-    std::uint32_t triangle[kSlopeLanes];
-    for (std::size_t k = 0; k < n; ++k) triangle[k] = first + std::uint32_t(k);
     // Every corner asked for before the first is read (the loads then overlap, where reading
     // them in order waited on each few in turn), and the next block's index triples too: the
     // comparison often asks for blocks in order (the comparison ~5 % faster in process).
@@ -148,7 +128,11 @@ ZCHECK_ALWAYS_INLINE inline void cornersOfBlock(const Scene& scene, std::uint32_
         for (int v = 0; v < 3; ++v) __builtin_prefetch(&scene.positions[scene.triangles[first + k][v]]);
     const std::size_t nextBlock = first + n, nextBlockEnd = std::min(scene.triangles.size(), nextBlock + kSlopeLanes);
     for (std::size_t k = nextBlock; k < nextBlockEnd; k += 64 / sizeof(glm::uvec3)) __builtin_prefetch(&scene.triangles[k]);
-    cornersInLanes(scene, triangle, n, corner);
+    for (std::size_t k = 0; k < n; ++k) {
+        const glm::uvec3& t = scene.triangles[first + k];
+        for (int v = 0; v < 3; ++v)
+            for (int axis = 0; axis < 3; ++axis) corner[v][axis][k] = double(scene.positions[t[v]][axis]);
+    }
 }
 
 void slopesTogetherBaseline(const DepthSlopeFrame& frame, const Scene& scene, std::uint32_t first, std::size_t n,

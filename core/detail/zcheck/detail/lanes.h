@@ -12,7 +12,7 @@
 //
 // L::kLanes says how many lanes. Each eight-lane type L has
 //   L::Real   eight doubles: + − × ÷ (IEEE, lane by lane), < <= > >= (a Mask), select, min, max, abs
-//   L::Int64  eight 64-bit integers: + − | & <<, steps, select, max, reduceMax
+//   L::Int64  eight 64-bit integers: + − | & <<, steps, select
 //   L::Int32  eight 32-bit integers: + −, == !=, min/max (unsigned), select
 //   L::Float  eight floats: the rounded doubles the keepers and the heatmap take
 //   L::Mask   eight lanes' truth: & | ^ andNot, bits() (lane j: bit j)
@@ -177,7 +177,6 @@ struct Avx2Lanes : Lanes32 {
     {
         return {_mm256_castpd_si256(_mm256_cmp_pd(a.lo, b.lo, kPredicate)), _mm256_castpd_si256(_mm256_cmp_pd(a.hi, b.hi, kPredicate))};
     }
-    static ZCHECK_LANE Mask ordered(Real a) { return compare<_CMP_ORD_Q>(a, a); }  // not NaN
     static ZCHECK_LANE Real select(Mask m, Real ifTrue, Real ifFalse)
     {
         return {_mm256_blendv_pd(ifFalse.lo, ifTrue.lo, _mm256_castsi256_pd(m.lo)),
@@ -251,18 +250,6 @@ struct Avx2Lanes : Lanes32 {
     {
         return {_mm256_blendv_epi8(ifFalse.lo, ifTrue.lo, m.lo), _mm256_blendv_epi8(ifFalse.hi, ifTrue.hi, m.hi)};
     }
-    static ZCHECK_LANE Int64 max(Int64 a, Int64 b)  // signed
-    {
-        return {_mm256_blendv_epi8(a.lo, b.lo, _mm256_cmpgt_epi64(b.lo, a.lo)), _mm256_blendv_epi8(a.hi, b.hi, _mm256_cmpgt_epi64(b.hi, a.hi))};
-    }
-    static ZCHECK_LANE std::int64_t reduceMax(Int64 a)
-    {
-        alignas(32) std::int64_t lane[8];
-        _mm256_store_si256(reinterpret_cast<__m256i*>(lane), a.lo), _mm256_store_si256(reinterpret_cast<__m256i*>(lane + 4), a.hi);
-        std::int64_t largest = lane[0];
-        for (int k = 1; k < 8; ++k) largest = lane[k] > largest ? lane[k] : largest;
-        return largest;
-    }
     // Lane k: lo[k] in its low 32 bits, hi[k] in its high 32.
     static ZCHECK_LANE Int64 joined(Int32 lo, Int32 hi)
     {
@@ -309,7 +296,6 @@ struct Avx2Lanes : Lanes32 {
     {
         return {_mm256_maskload_epi32(reinterpret_cast<const int*>(p), narrow(m))};
     }
-    static ZCHECK_LANE void maskedStore(Mask m, std::uint32_t* p, Int32 a) { _mm256_maskstore_epi32(reinterpret_cast<int*>(p), narrow(m), a.v); }
     static ZCHECK_LANE void maskedStore(Mask m, float* p, Float a) { _mm256_maskstore_ps(p, narrow(m), a.v); }
     // The low byte of each lane to p[k] where m holds.
     static ZCHECK_LANE void storeBytes(std::uint8_t* p, Int32 a)  // the low byte of each lane to p[k]
@@ -331,11 +317,9 @@ struct Avx2Lanes : Lanes32 {
     static ZCHECK_LANE Mask equal(Int32 a, Int32 b) { return widen(_mm256_cmpeq_epi32(a.v, b.v)); }
     static ZCHECK_LANE Mask notEqual(Int32 a, Int32 b) { return widen(_mm256_xor_si256(_mm256_cmpeq_epi32(a.v, b.v), _mm256_set1_epi32(-1))); }
     static ZCHECK_LANE Mask lessOrEqual(Int32 a, Int32 b) { return widen(_mm256_xor_si256(_mm256_cmpgt_epi32(a.v, b.v), _mm256_set1_epi32(-1))); }
-    static ZCHECK_LANE Mask atLeastUnsigned(Int32 a, Int32 b) { return widen(_mm256_cmpeq_epi32(_mm256_max_epu32(a.v, b.v), a.v)); }
     static ZCHECK_LANE Mask anyBits(Int32 a) { return widen(_mm256_xor_si256(_mm256_cmpeq_epi32(a.v, _mm256_setzero_si256()), _mm256_set1_epi32(-1))); }
     static ZCHECK_LANE Int32 select(Mask m, Int32 ifTrue, Int32 ifFalse) { return {_mm256_blendv_epi8(ifFalse.v, ifTrue.v, narrow(m))}; }
     static ZCHECK_LANE Int32 allOnesWhere(Mask m) { return {narrow(m)}; }  // −1 where m holds, 0 elsewhere
-    static ZCHECK_LANE Float zeroWhereNot(Mask m, Float a) { return {_mm256_and_ps(a.v, _mm256_castsi256_ps(narrow(m)))}; }
     // Eight packed int32 triples (24 ints from p) as three lanes: corner 0, 1, 2.
     static ZCHECK_LANE void loadTriples(const std::uint32_t* p, Int32 (&corner)[3])
     {
@@ -390,7 +374,6 @@ struct Avx512Lanes : Lanes32 {
     static ZCHECK_LANE void store(double* p, Real a) { _mm512_storeu_pd(p, a.v); }
     static ZCHECK_LANE Real maskedLoad(Mask m, const double* p) { return {_mm512_maskz_loadu_pd(m.k, p)}; }
     static ZCHECK_LANE void maskedStore(Mask m, double* p, Real a) { _mm512_mask_storeu_pd(p, m.k, a.v); }
-    static ZCHECK_LANE Mask ordered(Real a) { return {_mm512_cmp_pd_mask(a.v, a.v, _CMP_ORD_Q)}; }
     static ZCHECK_LANE Real select(Mask m, Real ifTrue, Real ifFalse) { return {_mm512_mask_blend_pd(m.k, ifFalse.v, ifTrue.v)}; }
     static ZCHECK_LANE Real max(Real a, Real b) { return {_mm512_max_pd(a.v, b.v)}; }
     static ZCHECK_LANE Real min(Real a, Real b) { return {_mm512_min_pd(a.v, b.v)}; }
@@ -426,8 +409,6 @@ struct Avx512Lanes : Lanes32 {
     static ZCHECK_LANE Mask nonNegative(Int64 a) { return {_mm512_cmpge_epi64_mask(a.v, _mm512_setzero_si512())}; }
     static ZCHECK_LANE Mask isZero(Int64 a) { return {_mm512_cmpeq_epi64_mask(a.v, _mm512_setzero_si512())}; }
     static ZCHECK_LANE Int64 select(Mask m, Int64 ifTrue, Int64 ifFalse) { return {_mm512_mask_blend_epi64(m.k, ifFalse.v, ifTrue.v)}; }
-    static ZCHECK_LANE Int64 max(Int64 a, Int64 b) { return {_mm512_max_epi64(a.v, b.v)}; }
-    static ZCHECK_LANE std::int64_t reduceMax(Int64 a) { return _mm512_reduce_max_epi64(a.v); }
     static ZCHECK_LANE Int64 joined(Int32 lo, Int32 hi)
     {
         return {_mm512_or_si512(_mm512_cvtepu32_epi64(lo.v), _mm512_slli_epi64(_mm512_cvtepu32_epi64(hi.v), 32))};
@@ -454,11 +435,9 @@ struct Avx512Lanes : Lanes32 {
     static ZCHECK_LANE Mask equal(Int32 a, Int32 b) { return {_mm256_cmpeq_epi32_mask(a.v, b.v)}; }
     static ZCHECK_LANE Mask notEqual(Int32 a, Int32 b) { return {_mm256_cmpneq_epi32_mask(a.v, b.v)}; }
     static ZCHECK_LANE Mask lessOrEqual(Int32 a, Int32 b) { return {_mm256_cmple_epi32_mask(a.v, b.v)}; }
-    static ZCHECK_LANE Mask atLeastUnsigned(Int32 a, Int32 b) { return {_mm256_cmpge_epu32_mask(a.v, b.v)}; }
     static ZCHECK_LANE Mask anyBits(Int32 a) { return {_mm256_test_epi32_mask(a.v, a.v)}; }
     static ZCHECK_LANE Int32 select(Mask m, Int32 ifTrue, Int32 ifFalse) { return {_mm256_mask_blend_epi32(m.k, ifFalse.v, ifTrue.v)}; }
     static ZCHECK_LANE Int32 allOnesWhere(Mask m) { return {_mm256_movm_epi32(m.k)}; }
-    static ZCHECK_LANE Float zeroWhereNot(Mask m, Float a) { return {_mm256_maskz_mov_ps(m.k, a.v)}; }
     static ZCHECK_LANE void loadTriples(const std::uint32_t* p, Int32 (&corner)[3])
     {
         const __m512i first16 = _mm512_loadu_si512(p);
@@ -476,11 +455,11 @@ struct Avx512Lanes : Lanes32 {
     static ZCHECK_LANE Mask32 andNot32(Mask32 a, Mask32 b) { return andNot(a, b); }
     static ZCHECK_LANE unsigned bits32(Mask32 m) { return m.k; }
     static ZCHECK_LANE Mask32 equal32(Int32 a, Int32 b) { return equal(a, b); }
-    static ZCHECK_LANE Mask32 atLeastUnsigned32(Int32 a, Int32 b) { return atLeastUnsigned(a, b); }
+    static ZCHECK_LANE Mask32 atLeastUnsigned32(Int32 a, Int32 b) { return {_mm256_cmpge_epu32_mask(a.v, b.v)}; }
     static ZCHECK_LANE Int32 select32(Mask32 m, Int32 ifTrue, Int32 ifFalse) { return select(m, ifTrue, ifFalse); }
     static ZCHECK_LANE Int32 maskedLoad32(Mask32 m, const std::uint32_t* p) { return maskedLoad(m, p); }
     static ZCHECK_LANE void maskedStore32(Mask32 m, std::uint32_t* p, Int32 a) { maskedStore(m, p, a); }
-    static ZCHECK_LANE Float zeroWhereNot32(Mask32 m, Float a) { return zeroWhereNot(m, a); }
+    static ZCHECK_LANE Float zeroWhereNot32(Mask32 m, Float a) { return {_mm256_maskz_mov_ps(m.k, a.v)}; }
 #undef ZCHECK_LANE
 };
 
