@@ -12,7 +12,8 @@
 #include "zcheck/verify.h"
 
 #include "diagnosis_helpers.h"
-#include "percentile.h"   // check/src: the comparison's private parts, tested white-box
+#include "compare_rows.h"  // check/src: the comparison's private parts, tested white-box
+#include "percentile.h"
 #include "slope_table.h"
 #include "kernel_testing.h"
 
@@ -23,6 +24,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <functional>
 #include <limits>
 #include <map>
@@ -720,6 +722,96 @@ TEST_CASE("the comparison's vector forms are bit-identical to its baseline form 
     }
     REQUIRE(ties > 500);
     REQUIRE(orderMatters > 0);
+}
+
+TEST_CASE("the row pass's maxima leave out NaN and the lanes not in common, in every form", "[compare][kernel]")
+{
+    // RowLanes::largest: the largest |Δ|/q, relative error and ratio of a row's common lanes,
+    // -1 where none counts (NaN left out). Rows of exact agreement (+0), of NaN only, of misses
+    // only, and their mixtures are where a form that masks lanes or finds the maxima another
+    // way could part from the baseline (a +0 taken for "none", or a NaN or a miss's value for
+    // a maximum); each form's RowLanes is compared with the baseline's, and the maxima with
+    // the values expected.
+    const Scene scene = builtinScene("builtin:terrain?n=8");
+    const Camera camera(smallCamera(scene));
+    const PixelJudge::ToleranceTerms terms = PixelJudge(scene, camera).toleranceTerms();
+    const double nan = std::numeric_limits<double>::quiet_NaN(), q = std::ldexp(1.0, -24);
+    enum Lane { Miss, Exact, NaNDepth, Error };
+    struct Row {
+        const char* name;
+        std::vector<Lane> lanes;
+        double expected;  // each maximum: -1 (none counts), 0, or the one Error lane's values (> 0)
+    };
+    auto row = [](int n, std::function<Lane(int)> lane) {
+        std::vector<Lane> lanes(n);
+        for (int j = 0; j < n; ++j) lanes[j] = lane(j);
+        return lanes;
+    };
+    std::vector<Row> rows;
+    for (const int n : {64, 13, 8, 1}) {
+        rows.push_back({"misses only", row(n, [](int) { return Miss; }), -1});
+        rows.push_back({"exact only", row(n, [](int) { return Exact; }), 0});
+        rows.push_back({"NaN only", row(n, [](int) { return NaNDepth; }), -1});
+        rows.push_back({"NaN and misses", row(n, [](int j) { return j % 3 ? NaNDepth : Miss; }), -1});
+        rows.push_back({"exact, NaN and misses", row(n, [n](int j) { return j == n - 1 ? Exact : j % 2 ? NaNDepth : Miss; }), 0});
+        rows.push_back({"one error among NaN and misses", row(n, [n](int j) { return j == n / 2 ? Error : j % 2 ? NaNDepth : Miss; }), 1});
+    }
+    for (const Row& r : rows) {
+        const int n = int(r.lanes.size());
+        INFO(r.name << ", " << n << " lanes");
+        alignas(64) std::uint32_t rayPrimitive[kLanes], rasterPrimitive[kLanes], surface[kLanes];
+        alignas(64) double rayDepth[kLanes], rasterDepth[kLanes], slope[kLanes], quantum[kLanes], relative[kLanes];
+        for (int j = 0; j < kLanes; ++j) {
+            const Lane lane = j < n ? r.lanes[std::size_t(j)] : Miss;
+            rayPrimitive[j] = 3, rasterPrimitive[j] = lane == Miss ? kNoPrimitive : 3;
+            surface[j] = lane == Miss ? kNoPrimitive : 3;
+            rayDepth[j] = lane == NaNDepth ? nan : 0.5;
+            rasterDepth[j] = lane == Error ? 0.5 + 1024 * q : 0.5;
+            slope[j] = 0.25, quantum[j] = q;
+            relative[j] = lane == NaNDepth ? nan : lane == Error ? 0.125 : lane == Exact ? 0.0 : 0.75;  // a miss's is never read
+        }
+        RowInputs in;
+        in.rayPrimitive = rayPrimitive, in.rasterPrimitive = rasterPrimitive, in.surface = surface;
+        in.rayDepth = rayDepth, in.rasterDepth = rasterDepth, in.slope = slope, in.quantum = quantum;
+        in.allowance = kNoAllowance, in.relative = relative, in.n = n;
+        auto pass = [&](void (*rowLanes)(const RowInputs&, const PixelJudge::ToleranceTerms&, StatisticCounts&, RowLanes&)) {
+            StatisticCounts counts{LargestValues(64), LargestValues(64)};
+            RowLanes out{};
+            rowLanes(in, terms, counts, out);
+            return out;
+        };
+        const RowLanes baseline = pass(rowLanesBaseline);
+        auto value = [](std::int64_t bits) {
+            double x;
+            std::memcpy(&x, &bits, sizeof x);
+            return bits < 0 ? -1.0 : x;
+        };
+        const double bound = terms.of(0.25, q);
+        const double expected[3] = {r.expected > 0 ? 1024.0 : r.expected, r.expected > 0 ? 0.125 : r.expected,
+                                    r.expected > 0 ? ((0.5 + 1024 * q) - 0.5) / bound : r.expected};
+        for (int k = 0; k < 3; ++k) {
+            INFO("maximum " << k);
+            REQUIRE(value(baseline.largest[k]) == expected[k]);
+            if (expected[k] < 0) REQUIRE(baseline.largest[k] == -1);
+        }
+#ifdef ZCHECK_X86_FORMS
+        std::vector<std::pair<const char*, RowLanes>> byForm;
+        if (kernelFormSupported(KernelForm::Avx2)) byForm.emplace_back("avx2", pass(rowLanesAvx2));
+        if (kernelFormSupported(KernelForm::Avx512)) byForm.emplace_back("avx512", pass(rowLanesAvx512));
+        for (const auto& [form, lanes] : byForm) {
+            INFO("the " << form << " form");
+            for (int k = 0; k < 3; ++k) REQUIRE(lanes.largest[k] == baseline.largest[k]);
+            REQUIRE(lanes.common == baseline.common);
+            REQUIRE(lanes.agree == baseline.agree);
+            REQUIRE(lanes.hit == baseline.hit);
+            REQUIRE(lanes.bias == baseline.bias);
+            const std::size_t bytes = std::size_t(n) * sizeof(double);
+            REQUIRE(std::memcmp(lanes.ratio, baseline.ratio, bytes) == 0);
+            REQUIRE(std::memcmp(lanes.errorQuanta, baseline.errorQuanta, bytes) == 0);
+            REQUIRE(std::memcmp(lanes.bound, baseline.bound, bytes) == 0);
+        }
+#endif
+    }
 }
 
 TEST_CASE("the comparison's vector forms on rows of NaN, a zero bound and the bias rule's edge",
