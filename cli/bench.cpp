@@ -15,6 +15,7 @@
 #include "zcheck/kernel_form.h"
 #include "zcheck/large_buffer.h"
 #include "zcheck/mesh_loader.h"
+#include "zcheck/ray_renderer.h"
 
 #include <nlohmann/json.hpp>
 #include <sys/resource.h>
@@ -699,6 +700,8 @@ int runBenchCommand(const BenchOptions& o)
     const std::string sceneName = workload ? named->scene : o.input.scene;
     std::vector<FormPhases> forms;
     for (KernelForm form : kernelFormsOf(o.kernels)) forms.emplace_back().form = form;
+    // Embree's set (ZCHECK_EMBREE_ISA), for the header: a bad value refused before any child runs.
+    const std::string embreeSet = embreeIsa();
 
     // The camera comes from a first load (a file is read once before timing: cold-cache
     // effects are not what this measures). TBB is not started before the children fork.
@@ -758,6 +761,7 @@ int runBenchCommand(const BenchOptions& o)
         out["width"] = camera.width(), out["height"] = camera.height();
         out["threads"] = threads, out["repeat"] = o.repeat;
         out["kernels"] = namesOf(formList);
+        out["embree_isa"] = embreeSet;
         // The first form's keys, as with one form; "consistent" is every form's.
         const nlohmann::ordered_json first = formJson(forms.front(), s, ref);
         for (const auto& item : first.items()) out[item.key()] = item.value();
@@ -785,9 +789,10 @@ int runBenchCommand(const BenchOptions& o)
 
     const std::string depth = lens ? "lens model " + camera.lens()->spec().model + ", distance"
                                    : toString(camera.depth().format) + (camera.depth().reversed ? " reversed-Z" : "");
-    std::printf("zcheck bench: %s%s, %zu triangles, %dx%d, %s, kernels %s, %d threads, %d repeats, %s\n",
+    std::printf("zcheck bench: %s%s, %zu triangles, %dx%d, %s, kernels %s, embree %s, %d threads, %d repeats, %s\n",
                 workload ? (o.workload + ": ").c_str() : "", sceneName.c_str(), triangles, camera.width(), camera.height(),
-                depth.c_str(), namesOf(formList).c_str(), threads, o.repeat, consistent ? "consistent" : "INCONSISTENT");
+                depth.c_str(), namesOf(formList).c_str(), embreeSet.c_str(), threads, o.repeat,
+                consistent ? "consistent" : "INCONSISTENT");
     for (const FormPhases& f : forms) {
         if (forms.size() > 1) std::printf("kernels %s\n", nameOf(f.form));
         printPhases(f, s);
@@ -861,10 +866,14 @@ Command addBenchCommand(CLI::App& app)
         "speed differs): every child runs with ZCHECK_KERNELS set to its form. With several forms they\n"
         "take turns within each repeat (their medians paired on a busy machine), each form's phases\n"
         "follow a line 'kernels <form>', the references are measured once for all, and the ratios make\n"
-        "a table, a column per form, '*' after a value that misses its target.\n"
+        "a table, a column per form, '*' after a value that misses its target. 'embree' names the\n"
+        "instruction set of Embree's own kernels, in the check's trace and the yardstick alike: auto (the\n"
+        "widest the processor has) unless ZCHECK_EMBREE_ISA forces one; ZCHECK_EMBREE_ISA=avx2 with\n"
+        "--kernels avx2 measures on an AVX-512 machine what an AVX2-only one runs.\n"
         "Examples:\n"
         "  zcheck bench --reference                         terrain-1M-1080p, with both references\n"
         "  zcheck bench --kernels all --reference           the same, every form this processor has\n"
+        "  ZCHECK_EMBREE_ISA=avx2 zcheck bench --kernels avx2 --reference   as on an AVX2-only processor\n"
         "  zcheck bench --scene terrain.obj --camera cam.json --threads 1 --json\n"
         "  zcheck bench --scene 'builtin:terrain?n=1416&size=2' --width 3840 --height 2160");
     return {command, [o] { return runBenchCommand(*o); }};

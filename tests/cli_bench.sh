@@ -10,7 +10,7 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 
 "$zcheck" bench --scene "builtin:terrain?n=60" --width 320 --height 180 --repeat 2 --threads 1 > "$tmp/bench.txt"
-grep -qE "^zcheck bench: builtin:terrain\?n=60, 6962 triangles, 320x180, .*, kernels (baseline|avx2|avx512), 1 threads, 2 repeats, consistent$" "$tmp/bench.txt"
+grep -qE "^zcheck bench: builtin:terrain\?n=60, 6962 triangles, 320x180, .*, kernels (baseline|avx2|avx512), embree auto, 1 threads, 2 repeats, consistent$" "$tmp/bench.txt"
 for phase in load "bvh build" trace raster compare "whole check" "tile by tile" "warm trace" "warm raster" "warm compare"; do
     grep -qE "^$phase +median +[0-9.]+ ms +best +[0-9.]+ ms" "$tmp/bench.txt"
 done
@@ -77,7 +77,7 @@ cat > "$tmp/fisheye.json" <<'JSON'
   "view": {"eye": [0, 0.2, 0], "target": [0, 0, 0], "up": [0, 0, 1]} }
 JSON
 "$zcheck" bench --scene "builtin:terrain?n=60&size=2" --camera "$tmp/fisheye.json" --repeat 2 --threads 2 > "$tmp/lens.txt"
-grep -qE "^zcheck bench: builtin:terrain\?n=60&size=2, 6962 triangles, 160x120, lens model opencv_fisheye, distance, kernels (baseline|avx2|avx512), 2 threads, 2 repeats, consistent$" "$tmp/lens.txt"
+grep -qE "^zcheck bench: builtin:terrain\?n=60&size=2, 6962 triangles, 160x120, lens model opencv_fisheye, distance, kernels (baseline|avx2|avx512), embree auto, 2 threads, 2 repeats, consistent$" "$tmp/lens.txt"
 for phase in "ray table" trace "depth trace" rays "lens check" export "warm export"; do
     grep -qE "^$phase +median +[0-9.]+ ms +best +[0-9.]+ ms" "$tmp/lens.txt"
 done
@@ -120,11 +120,11 @@ fi
 all=$(IFS=,; echo "${forms[*]}")
 small=(--scene "builtin:terrain?n=60" --width 320 --height 180 --repeat 1 --threads 1)
 "$zcheck" bench "${small[@]}" --kernels baseline > "$tmp/baseline.txt"
-grep -qE "^zcheck bench: .*, kernels baseline, 1 threads, 1 repeats, consistent$" "$tmp/baseline.txt"
+grep -qE "^zcheck bench: .*, kernels baseline, embree auto, 1 threads, 1 repeats, consistent$" "$tmp/baseline.txt"
 grep -qE "^ratio compare/\(trace\+raster\) +[0-9.]+ +target <= 0.10 +(met|NOT met)$" "$tmp/baseline.txt"
 if grep -qE "^kernels " "$tmp/baseline.txt"; then echo "one form printed a 'kernels <form>' block"; exit 1; fi
 "$zcheck" bench "${small[@]}" --kernels all > "$tmp/all.txt"
-grep -qE "^zcheck bench: .*, kernels $all, 1 threads, 1 repeats, consistent$" "$tmp/all.txt"
+grep -qE "^zcheck bench: .*, kernels $all, embree auto, 1 threads, 1 repeats, consistent$" "$tmp/all.txt"
 if (( ${#forms[@]} > 1 )); then
     [[ $(grep -E "^kernels " "$tmp/all.txt") == $(printf 'kernels %s\n' "${forms[@]}") ]]
     [[ $(grep -cE "^trace +median" "$tmp/all.txt") -eq ${#forms[@]} ]]
@@ -153,6 +153,20 @@ expect_error 2 "kernels 'sse9': 'sse9' is not a kernel form.*baseline, avx2 and 
 expect_error 2 "kernels 'avx2,avx2' names avx2 twice" bench "${small[@]}" --kernels avx2,avx2
 if [[ $all != *avx512* ]]; then expect_error 2 "cannot run the avx512 form" bench "${small[@]}" --kernels avx512; fi
 ZCHECK_KERNELS=bogus expect_error 2 "^zcheck: error: ZCHECK_KERNELS=bogus: must be auto, baseline, avx2 or avx512$" \
+    bench "${small[@]}"
+
+# ZCHECK_EMBREE_ISA: Embree's own set, named in the header and the JSON, taken by the check's
+# trace and the yardstick alike (both then agree on every pixel); a bad value refused first.
+ZCHECK_EMBREE_ISA=sse2 "$zcheck" bench "${small[@]}" --kernels baseline --reference --json > "$tmp/sse2.json"
+python3 - "$tmp/sse2.json" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1]))
+assert r["embree_isa"] == "sse2" and r["kernels"] == "baseline" and r["consistent"] is True, r
+assert r["reference"]["embree_agreement"] > 0.99, r["reference"]
+PY
+ZCHECK_EMBREE_ISA=sse2 "$zcheck" bench "${small[@]}" --kernels baseline > "$tmp/sse2.txt"
+grep -qE "^zcheck bench: .*, kernels baseline, embree sse2, 1 threads, 1 repeats, consistent$" "$tmp/sse2.txt"
+ZCHECK_EMBREE_ISA=avx3 expect_error 2 "^zcheck: error: ZCHECK_EMBREE_ISA=avx3: must be auto, sse2, sse4.2, avx, avx2 or avx512$" \
     bench "${small[@]}"
 
 expect_error 2 "workload 'fisheye'.*terrain-1M-1080p, fisheye-1M-1080p, panorama-1M-1920x960 or terrain-10M-4K" bench --workload fisheye

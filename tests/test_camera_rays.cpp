@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstring>
 #include <memory>
 #include <string>
 #include <vector>
@@ -240,6 +241,70 @@ TEST_CASE("the trace reads ZCHECK_KERNELS when its renderer is made and refuses 
     REQUIRE_NOTHROW(renderWith(""));
     REQUIRE_NOTHROW(renderWith("baseline"));
     REQUIRE_THROWS_WITH(renderWith("sse2"), Catch::Equals("ZCHECK_KERNELS=sse2: must be auto, baseline, avx2 or avx512"));
+}
+
+TEST_CASE("ZCHECK_EMBREE_ISA has Embree run one instruction set's kernels, finding the same hits, and refuses a bad value",
+          "[ray][kernel]")
+{
+    // Embree's native packet width tells which set it runs: 4 (SSE), 8 (AVX, AVX2), 16 (AVX-512).
+    // Every set it runs finds the same closest hits; zcheck recomputes each hit's depth from the
+    // triangle's plane, so a pixel with the same triangle has the same bits. Only a tie (two
+    // triangles at exactly one distance: a ray through an edge they share) may go either way.
+    const Scene scene = builtinScene("builtin:default");
+    CameraSpec spec = scene.defaultCamera;
+    spec.width = 160, spec.height = 120;
+    const Camera camera(spec);
+    const auto isa = [](const char* value) { return testing::withEnvironment("ZCHECK_EMBREE_ISA", value, [] { return embreeIsa(); }); };
+    REQUIRE(isa(nullptr) == "auto");
+    REQUIRE(isa("") == "auto");
+    REQUIRE(isa("auto") == "auto");
+    REQUIRE(testing::withEnvironment("ZCHECK_EMBREE_ISA", "auto", [] { return embreeDeviceConfig(); }).empty());
+    for (const char* bad : {"AVX2", "sse4", "avx512f", "bogus", "isa=avx2"})
+        REQUIRE_THROWS_WITH(testing::withEnvironment("ZCHECK_EMBREE_ISA", bad, [&] { return RayRenderer(scene); }),
+                            Catch::Equals(std::string("ZCHECK_EMBREE_ISA=") + bad +
+                                          ": must be auto, sse2, sse4.2, avx, avx2 or avx512"));
+    const RenderResult byDefault = RayRenderer(scene).render(camera);
+    const std::size_t hits = std::size_t(std::count_if(byDefault.primitiveId.begin(), byDefault.primitiveId.end(),
+                                                       [](std::uint32_t id) { return id != kNoPrimitive; }));
+    REQUIRE(hits > byDefault.primitiveId.size() / 4);
+    struct Set {
+        const char* name;
+        bool has;
+        int packet;
+    };
+#ifdef ZCHECK_X86_FORMS
+    const bool avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("bmi") &&
+                      __builtin_cpu_supports("bmi2") && __builtin_cpu_supports("abm");
+    const bool avx512 = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512cd") &&
+                        __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw") &&
+                        __builtin_cpu_supports("avx512vl");
+    const Set sets[] = {{"sse2", true, 4}, {"sse4.2", bool(__builtin_cpu_supports("sse4.2")), 4},
+                        {"avx", bool(__builtin_cpu_supports("avx")), 8}, {"avx2", avx2, 8}, {"avx512", avx512, 16}};
+#else
+    const Set sets[] = {{"sse2", false, 4}, {"avx2", false, 8}};
+#endif
+    for (const Set& set : sets) {
+        INFO("ZCHECK_EMBREE_ISA=" << set.name);
+        if (!set.has) {
+            REQUIRE_THROWS_WITH(testing::withEnvironment("ZCHECK_EMBREE_ISA", set.name, [&] { return RayRenderer(scene); }),
+                                Catch::StartsWith(std::string("ZCHECK_EMBREE_ISA=") + set.name +
+                                                  ": this processor cannot run Embree's " + set.name + " kernels"));
+            WARN("this processor lacks Embree's " << set.name << " kernels: only their refusal is tested");
+            continue;
+        }
+        REQUIRE(isa(set.name) == set.name);
+        const auto rays = testing::withEnvironment("ZCHECK_EMBREE_ISA", set.name, [&] { return std::make_unique<RayRenderer>(scene); });
+        REQUIRE(rays->embreeNativePacket() == set.packet);
+        const RenderResult render = rays->render(camera);
+        std::size_t sameTriangle = 0, otherDepth = 0;
+        for (std::size_t i = 0; i < render.primitiveId.size(); ++i) {
+            if (render.primitiveId[i] != byDefault.primitiveId[i]) continue;
+            ++sameTriangle;
+            otherDepth += std::memcmp(&render.windowDepth.value[i], &byDefault.windowDepth.value[i], sizeof(double)) != 0;
+        }
+        REQUIRE(otherDepth == 0);
+        REQUIRE(sameTriangle >= render.primitiveId.size() - render.primitiveId.size() / 1000);
+    }
 }
 
 TEST_CASE("regression: a raw matrix whose near plane crosses the eye plane gave Embree a negative tnear", "[rays][regression]")

@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <limits>
 #include <mutex>
@@ -162,12 +163,70 @@ BvhBuild bvhBuildFor(double expectedRays, std::size_t triangles)
 
 const char* nameOf(BvhBuild build) { return build == BvhBuild::Quick ? "quick" : "thorough"; }
 
+namespace {
+
+// Embree's instruction sets by its names, each with what the processor must have for it
+// (Embree's own requirements: its AVX2 kernels use FMA, BMI1/2 and LZCNT, its AVX-512 ones
+// SKX's F, CD, DQ, BW and VL).
+struct EmbreeSet {
+    const char* name;
+    const char* needs;
+    bool (*supported)();
+};
+#ifdef ZCHECK_X86_FORMS
+constexpr EmbreeSet kEmbreeSets[] = {
+    {"sse2", "SSE2", [] { return true; }},
+    {"sse4.2", "SSE4.2", [] { return bool(__builtin_cpu_supports("sse4.2")); }},
+    {"avx", "AVX", [] { return bool(__builtin_cpu_supports("avx")); }},
+    {"avx2", "AVX2, FMA, BMI1, BMI2 and LZCNT",
+     [] {
+         return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("bmi") &&
+                __builtin_cpu_supports("bmi2") && __builtin_cpu_supports("abm");
+     }},
+    {"avx512", "AVX-512 F, CD, DQ, BW and VL",
+     [] {
+         return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512cd") &&
+                __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw") &&
+                __builtin_cpu_supports("avx512vl");
+     }},
+};
+#else
+constexpr EmbreeSet kEmbreeSets[] = {{"sse2", "an x86-64 processor", [] { return false; }},
+                                     {"sse4.2", "an x86-64 processor", [] { return false; }},
+                                     {"avx", "an x86-64 processor", [] { return false; }},
+                                     {"avx2", "an x86-64 processor", [] { return false; }},
+                                     {"avx512", "an x86-64 processor", [] { return false; }}};
+#endif
+
+}  // namespace
+
+std::string embreeIsa()
+{
+    const char* requested = std::getenv("ZCHECK_EMBREE_ISA");
+    if (!requested || !*requested || std::strcmp(requested, "auto") == 0) return "auto";
+    for (const EmbreeSet& set : kEmbreeSets) {
+        if (std::strcmp(requested, set.name) != 0) continue;
+        if (!set.supported())
+            throw Error(std::string("ZCHECK_EMBREE_ISA=") + requested + ": this processor cannot run Embree's " +
+                        requested + " kernels (they need " + set.needs + "); use auto, or a set it has");
+        return set.name;
+    }
+    throw Error(std::string("ZCHECK_EMBREE_ISA=") + requested + ": must be auto, sse2, sse4.2, avx, avx2 or avx512");
+}
+
+std::string embreeDeviceConfig()
+{
+    const std::string isa = embreeIsa();
+    return isa == "auto" ? std::string() : "isa=" + isa;
+}
+
 RayRenderer::RayRenderer(const Scene& scene, BvhBuild build)
     : embree_(std::make_unique<Embree>()), scene_(scene), form_(kernelForm()), build_(build)
 {
     validateScene(scene);
     const auto start = Clock::now();
-    embree_->device.reset(rtcNewDevice(nullptr));
+    const std::string config = embreeDeviceConfig();
+    embree_->device.reset(rtcNewDevice(config.empty() ? nullptr : config.c_str()));
     if (!embree_->device) throw Error("cannot create an Embree device (error " + std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
     // Install the error callback first, so every later failure is seen.
     rtcSetDeviceErrorFunction(embree_->device.get(), recordError, &embree_->errors);
@@ -209,6 +268,14 @@ RayRenderer::RayRenderer(const Scene& scene, BvhBuild build)
 }
 
 RayRenderer::~RayRenderer() = default;
+
+int RayRenderer::embreeNativePacket() const
+{
+    RTCDevice device = embree_->device.get();
+    if (rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED)) return 16;
+    if (rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED)) return 8;
+    return 4;
+}
 
 std::uint32_t RayRenderer::primitiveAt(const Camera& camera, const glm::dvec2& pWindow) const
 {

@@ -3,6 +3,7 @@
 #include "zcheck/camera_rays.h"
 #include "zcheck/detail/clock.h"
 #include "zcheck/error.h"
+#include "zcheck/ray_renderer.h"
 
 #include <embree3/rtcore.h>
 #include <tbb/blocked_range.h>
@@ -12,6 +13,7 @@
 #include <chrono>
 #include <cmath>
 #include <optional>
+#include <string>
 #include <vector>
 
 namespace zcheck::reference {
@@ -56,7 +58,8 @@ struct EmbreeReference::Embree {
 EmbreeReference::EmbreeReference(const Scene& scene) : embree_(std::make_unique<Embree>())
 {
     const auto start = Clock::now();
-    embree_->device = rtcNewDevice(nullptr);
+    const std::string config = embreeDeviceConfig();  // ZCHECK_EMBREE_ISA, as the check's trace takes it
+    embree_->device = rtcNewDevice(config.empty() ? nullptr : config.c_str());
     if (!embree_->device) throw Error("reference: cannot create an Embree device");
     embree_->scene = rtcNewScene(embree_->device);
     rtcSetSceneFlags(embree_->scene, RTC_SCENE_FLAG_ROBUST);

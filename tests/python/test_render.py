@@ -169,6 +169,22 @@ def test_release_cached_buffers_gives_the_kept_frames_back(default_scene, defaul
     assert default_checker.check(camera).consistent
 
 
+def test_zcheck_embree_isa_is_read_when_a_checker_is_made_and_a_bad_value_raises(monkeypatch):
+    scene = zcheck.Scene.from_file("builtin:default")
+    camera = scene.default_camera.replace(width=64, height=48)
+    monkeypatch.delenv("ZCHECK_EMBREE_ISA", raising=False)
+    by_default = zcheck.Checker(scene).render(camera, "window", route="ray")
+    # SSE2 is every x86-64 processor's: Embree's SSE2 kernels find the same hits.
+    monkeypatch.setenv("ZCHECK_EMBREE_ISA", "sse2")
+    checker = zcheck.Checker(scene)
+    assert checker.check(camera).consistent
+    assert checker.render(camera, "window", route="ray").tobytes() == by_default.tobytes()
+    for bad in ["SSE2", "avx-512", "isa=avx2"]:
+        monkeypatch.setenv("ZCHECK_EMBREE_ISA", bad)
+        with pytest.raises(zcheck.Error, match=f"ZCHECK_EMBREE_ISA={bad}: must be auto, sse2, sse4.2, avx, avx2 or avx512"):
+            zcheck.Checker(scene)
+
+
 def test_the_kernel_form_is_the_widest_supported_or_the_one_zcheck_kernels_names(monkeypatch):
     supported = zcheck.kernel_forms_supported()
     assert supported[0] == "baseline" and set(supported) <= {"baseline", "avx2", "avx512"}

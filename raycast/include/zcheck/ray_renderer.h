@@ -27,6 +27,7 @@
 #include "zcheck/tile_grid.h"
 
 #include <memory>
+#include <string>
 
 namespace zcheck {
 
@@ -69,6 +70,23 @@ BvhBuild bvhBuildFor(double expectedRays, std::size_t triangles);
 // "quick", "thorough".
 const char* nameOf(BvhBuild build);
 
+// Embree's own kernels (its BVH build and traversal) come in instruction sets as zcheck's do,
+// and Embree runs the widest the processor has. ZCHECK_EMBREE_ISA, read when a RayRenderer (or
+// `zcheck bench`'s Embree yardstick) is made, forces one: unset, empty or `auto` leaves the
+// choice to Embree; sse2, sse4.2, avx, avx2 or avx512 has Embree run that set's kernels, as on
+// a processor with none wider. With ZCHECK_KERNELS=avx2 too, an AVX-512 machine then runs what
+// an AVX2-only one runs (docs/speed.md measures it so). A value that is none of these, or a set
+// the processor lacks, is refused (Error, one line; Embree itself would take an unknown name
+// for SSE2 silently). Every set finds each ray's closest hit; where two triangles are hit at
+// exactly the same distance (an edge they share), which one it reports may differ from set to
+// set, so zcheck's kernel forms are bit-identical to each other under one Embree set at a time.
+//
+//   setenv("ZCHECK_EMBREE_ISA", "avx2", 1);
+//   zcheck::embreeIsa();           // "avx2" (throws Error for a bad value)
+//   zcheck::embreeDeviceConfig();  // "isa=avx2", rtcNewDevice's configuration ("" for auto)
+std::string embreeIsa();
+std::string embreeDeviceConfig();
+
 class RayRenderer {
 public:
     // Builds the BVH (as `build` says) and the triangles' planes, timed together; throws Error.
@@ -99,6 +117,9 @@ public:
 
     double buildMilliseconds() const { return buildMilliseconds_; }
     BvhBuild bvhBuild() const { return build_; }
+    // The widest ray packet Embree traces natively with the instruction set it runs (above):
+    // 4 (SSE), 8 (AVX, AVX2) or 16 (AVX-512).
+    int embreeNativePacket() const;
 
 private:
     struct Embree;
