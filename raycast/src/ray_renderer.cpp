@@ -171,32 +171,30 @@ namespace {
 struct EmbreeSet {
     const char* name;
     const char* needs;
-    bool (*supported)();
 };
+constexpr EmbreeSet kEmbreeSets[] = {{"sse2", "SSE2"},
+                                     {"sse4.2", "SSE4.2"},
+                                     {"avx", "AVX"},
+                                     {"avx2", "AVX2, FMA, BMI1, BMI2 and LZCNT"},
+                                     {"avx512", "AVX-512 F, CD, DQ, BW and VL"}};
+
+bool supported(const EmbreeSet& set)
+{
 #ifdef ZCHECK_X86_FORMS
-constexpr EmbreeSet kEmbreeSets[] = {
-    {"sse2", "SSE2", [] { return true; }},
-    {"sse4.2", "SSE4.2", [] { return bool(__builtin_cpu_supports("sse4.2")); }},
-    {"avx", "AVX", [] { return bool(__builtin_cpu_supports("avx")); }},
-    {"avx2", "AVX2, FMA, BMI1, BMI2 and LZCNT",
-     [] {
-         return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("bmi") &&
-                __builtin_cpu_supports("bmi2") && __builtin_cpu_supports("abm");
-     }},
-    {"avx512", "AVX-512 F, CD, DQ, BW and VL",
-     [] {
-         return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512cd") &&
-                __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw") &&
-                __builtin_cpu_supports("avx512vl");
-     }},
-};
+    const std::string name = set.name;
+    if (name == "sse2") return true;
+    if (name == "sse4.2") return __builtin_cpu_supports("sse4.2");
+    if (name == "avx") return __builtin_cpu_supports("avx");
+    if (name == "avx2")
+        return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("bmi") &&
+               __builtin_cpu_supports("bmi2") && __builtin_cpu_supports("abm");  // abm: LZCNT
+    return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512cd") &&
+           __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl");
 #else
-constexpr EmbreeSet kEmbreeSets[] = {{"sse2", "an x86-64 processor", [] { return false; }},
-                                     {"sse4.2", "an x86-64 processor", [] { return false; }},
-                                     {"avx", "an x86-64 processor", [] { return false; }},
-                                     {"avx2", "an x86-64 processor", [] { return false; }},
-                                     {"avx512", "an x86-64 processor", [] { return false; }}};
+    (void)set;
+    return false;  // Embree's x86 sets on another processor
 #endif
+}
 
 }  // namespace
 
@@ -206,7 +204,7 @@ std::string embreeIsa()
     if (!requested || !*requested || std::strcmp(requested, "auto") == 0) return "auto";
     for (const EmbreeSet& set : kEmbreeSets) {
         if (std::strcmp(requested, set.name) != 0) continue;
-        if (!set.supported())
+        if (!supported(set))
             throw Error(std::string("ZCHECK_EMBREE_ISA=") + requested + ": this processor cannot run Embree's " +
                         requested + " kernels (they need " + set.needs + "); use auto, or a set it has");
         return set.name;
