@@ -16,6 +16,9 @@
 #include <cstdint>
 #include <cstring>
 #include <memory>
+#include <sstream>
+#include <set>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -273,13 +276,27 @@ TEST_CASE("ZCHECK_EMBREE_ISA has Embree run one instruction set's kernels, findi
         int packet;
     };
 #ifdef ZCHECK_X86_FORMS
-    const bool avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("bmi") &&
-                      __builtin_cpu_supports("bmi2") && __builtin_cpu_supports("abm");
-    const bool avx512 = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512cd") &&
-                        __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw") &&
-                        __builtin_cpu_supports("avx512vl");
-    const Set sets[] = {{"sse2", true, 4}, {"sse4.2", bool(__builtin_cpu_supports("sse4.2")), 4},
-                        {"avx", bool(__builtin_cpu_supports("avx")), 8}, {"avx2", avx2, 8}, {"avx512", avx512, 16}};
+    // What the processor has, as Linux lists it (/proc/cpuinfo's flags, "abm" for LZCNT):
+    // another source than the compiler's __builtin_cpu_supports, which zcheck asks. Each set
+    // needs the ones before it, as Embree's do.
+    std::set<std::string> flags;
+    {
+        std::ifstream cpuinfo("/proc/cpuinfo");
+        std::string line;
+        while (std::getline(cpuinfo, line) && flags.empty())
+            if (line.rfind("flags", 0) == 0) {
+                std::istringstream words(line.substr(line.find(':') + 1));
+                for (std::string word; words >> word;) flags.insert(word);
+            }
+    }
+    REQUIRE(flags.count("sse2"));
+    const auto has = [&](std::initializer_list<const char*> names) {
+        return std::all_of(names.begin(), names.end(), [&](const char* name) { return flags.count(name) > 0; });
+    };
+    const bool sse42 = has({"sse4_2", "popcnt"}), avx = sse42 && has({"avx"});
+    const bool avx2 = avx && has({"avx2", "fma", "f16c", "bmi1", "bmi2", "abm"});
+    const bool avx512 = avx2 && has({"avx512f", "avx512cd", "avx512dq", "avx512bw", "avx512vl"});
+    const Set sets[] = {{"sse2", true, 4}, {"sse4.2", sse42, 4}, {"avx", avx, 8}, {"avx2", avx2, 8}, {"avx512", avx512, 16}};
 #else
     const Set sets[] = {{"sse2", false, 4}, {"avx2", false, 8}};
 #endif

@@ -730,8 +730,9 @@ TEST_CASE("the row pass's maxima leave out NaN and the lanes not in common, in e
     // -1 where none counts (NaN left out). Rows of exact agreement (+0), of NaN only, of misses
     // only, and their mixtures are where a form that masks lanes or finds the maxima another
     // way could part from the baseline (a +0 taken for "none", or a NaN or a miss's value for
-    // a maximum); each form's RowLanes is compared with the baseline's, and the maxima with
-    // the values expected.
+    // a maximum); each form's RowLanes (its masks, maxima and per-lane measures) is compared
+    // with the baseline's, and the maxima with the values expected. (No per-pixel outputs are
+    // kept here: the comparison tests compare those.)
     const Scene scene = builtinScene("builtin:terrain?n=8");
     const Camera camera(smallCamera(scene));
     const PixelJudge::ToleranceTerms terms = PixelJudge(scene, camera).toleranceTerms();
@@ -809,6 +810,7 @@ TEST_CASE("the row pass's maxima leave out NaN and the lanes not in common, in e
             REQUIRE(std::memcmp(lanes.ratio, baseline.ratio, bytes) == 0);
             REQUIRE(std::memcmp(lanes.errorQuanta, baseline.errorQuanta, bytes) == 0);
             REQUIRE(std::memcmp(lanes.bound, baseline.bound, bytes) == 0);
+            REQUIRE(std::memcmp(lanes.signedErrorQuanta, baseline.signedErrorQuanta, bytes) == 0);
         }
 #endif
     }

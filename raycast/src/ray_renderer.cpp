@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <iterator>
 #include <limits>
 #include <mutex>
 
@@ -165,35 +166,49 @@ const char* nameOf(BvhBuild build) { return build == BvhBuild::Quick ? "quick" :
 
 namespace {
 
-// Embree's instruction sets by its names, each with what the processor must have for it
-// (Embree's own requirements: its AVX2 kernels use FMA, BMI1/2 and LZCNT, its AVX-512 ones
-// SKX's F, CD, DQ, BW and VL).
+// Embree's instruction sets by its names, each with what the processor must have for it: as
+// Embree's own, each set needs the one before it too (its AVX2 kernels are AVX with F16C, AVX2,
+// FMA, BMI1, BMI2 and LZCNT; its AVX-512 ones SKX's F, CD, DQ, BW and VL besides).
 struct EmbreeSet {
     const char* name;
     const char* needs;
 };
 constexpr EmbreeSet kEmbreeSets[] = {{"sse2", "SSE2"},
-                                     {"sse4.2", "SSE4.2"},
-                                     {"avx", "AVX"},
-                                     {"avx2", "AVX2, FMA, BMI1, BMI2 and LZCNT"},
-                                     {"avx512", "AVX-512 F, CD, DQ, BW and VL"}};
+                                     {"sse4.2", "SSE4.2 and POPCNT"},
+                                     {"avx", "AVX, SSE4.2 and POPCNT"},
+                                     {"avx2", "AVX2, FMA, F16C, BMI1, BMI2 and LZCNT besides AVX"},
+                                     {"avx512", "AVX-512 F, CD, DQ, BW and VL besides AVX2's"}};
 
-bool supported(const EmbreeSet& set)
+// Whether this processor runs Embree's `set` (x86-64 only: elsewhere every set is refused and
+// only auto is taken).
+bool processorRuns(const EmbreeSet& set)
 {
 #ifdef ZCHECK_X86_FORMS
     const std::string name = set.name;
-    if (name == "sse2") return true;
-    if (name == "sse4.2") return __builtin_cpu_supports("sse4.2");
-    if (name == "avx") return __builtin_cpu_supports("avx");
-    if (name == "avx2")
-        return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("bmi") &&
-               __builtin_cpu_supports("bmi2") && __builtin_cpu_supports("abm");  // abm: LZCNT
+    if (name == "sse2") return true;  // every x86-64 processor
+    if (!(__builtin_cpu_supports("sse4.2") && __builtin_cpu_supports("popcnt"))) return false;
+    if (name == "sse4.2") return true;
+    if (!__builtin_cpu_supports("avx")) return false;
+    if (name == "avx") return true;
+    if (!(__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("f16c") &&
+          __builtin_cpu_supports("bmi") && __builtin_cpu_supports("bmi2") && __builtin_cpu_supports("lzcnt")))
+        return false;
+    if (name == "avx2") return true;
     return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512cd") &&
            __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl");
 #else
     (void)set;
-    return false;  // Embree's x86 sets on another processor
+    return false;
 #endif
+}
+
+// "auto, sse2, sse4.2, avx, avx2 or avx512".
+std::string embreeSetNames()
+{
+    std::string names = "auto";
+    const std::size_t n = std::size(kEmbreeSets);
+    for (std::size_t k = 0; k < n; ++k) names += std::string(k + 1 < n ? ", " : " or ") + kEmbreeSets[k].name;
+    return names;
 }
 
 }  // namespace
@@ -204,12 +219,12 @@ std::string embreeIsa()
     if (!requested || !*requested || std::strcmp(requested, "auto") == 0) return "auto";
     for (const EmbreeSet& set : kEmbreeSets) {
         if (std::strcmp(requested, set.name) != 0) continue;
-        if (!supported(set))
+        if (!processorRuns(set))
             throw Error(std::string("ZCHECK_EMBREE_ISA=") + requested + ": this processor cannot run Embree's " +
                         requested + " kernels (they need " + set.needs + "); use auto, or a set it has");
         return set.name;
     }
-    throw Error(std::string("ZCHECK_EMBREE_ISA=") + requested + ": must be auto, sse2, sse4.2, avx, avx2 or avx512");
+    throw Error(std::string("ZCHECK_EMBREE_ISA=") + requested + ": must be " + embreeSetNames());
 }
 
 std::string embreeDeviceConfig()

@@ -174,11 +174,15 @@ def test_zcheck_embree_isa_is_read_when_a_checker_is_made_and_a_bad_value_raises
     camera = scene.default_camera.replace(width=64, height=48)
     monkeypatch.delenv("ZCHECK_EMBREE_ISA", raising=False)
     by_default = zcheck.Checker(scene).render(camera, "window", route="ray")
-    # SSE2 is every x86-64 processor's: Embree's SSE2 kernels find the same hits.
+    # SSE2 is every x86-64 processor's: Embree's SSE2 kernels find the same hits, so the same
+    # depths (a ray through an edge two triangles share may report the other one: 1 in 1,000
+    # pixels allowed, none seen on the development machine).
     monkeypatch.setenv("ZCHECK_EMBREE_ISA", "sse2")
     checker = zcheck.Checker(scene)
     assert checker.check(camera).consistent
-    assert checker.render(camera, "window", route="ray").tobytes() == by_default.tobytes()
+    by_sse2 = checker.render(camera, "window", route="ray")
+    same = (by_sse2 == by_default) | (np.isnan(by_sse2) & np.isnan(by_default))
+    assert same.mean() >= 0.999, same.mean()
     for bad in ["SSE2", "avx-512", "isa=avx2"]:
         monkeypatch.setenv("ZCHECK_EMBREE_ISA", bad)
         with pytest.raises(zcheck.Error, match=f"ZCHECK_EMBREE_ISA={bad}: must be auto, sse2, sse4.2, avx, avx2 or avx512"):

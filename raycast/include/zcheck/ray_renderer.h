@@ -76,10 +76,12 @@ const char* nameOf(BvhBuild build);
 // choice to Embree; sse2, sse4.2, avx, avx2 or avx512 has Embree run that set's kernels, as on
 // a processor with none wider. With ZCHECK_KERNELS=avx2 too, an AVX-512 machine then runs what
 // an AVX2-only one runs (docs/speed.md measures it so). A value that is none of these, or a set
-// the processor lacks, is refused (Error, one line; Embree itself would take an unknown name
-// for SSE2 silently). Every set finds each ray's closest hit; where two triangles are hit at
-// exactly the same distance (an edge they share), which one it reports may differ from set to
-// set, so zcheck's kernel forms are bit-identical to each other under one Embree set at a time.
+// the processor lacks (each set needs the ones below it, as Embree's do), is refused (Error,
+// one line; Embree itself would take an unknown name for SSE2 silently). On a processor other
+// than x86-64 only auto is taken. Every set finds each ray's closest hit; where two triangles
+// are hit at exactly the same distance (an edge they share), which one it reports may differ
+// from set to set, so zcheck's kernel forms are bit-identical to each other under one Embree
+// set at a time.
 //
 //   setenv("ZCHECK_EMBREE_ISA", "avx2", 1);
 //   zcheck::embreeIsa();           // "avx2" (throws Error for a bad value)
@@ -93,7 +95,8 @@ public:
     // `scene` must outlive it: Embree reads its index buffer in place. The trace's steps around
     // Embree run in the form kernelForm() gives when this is made (zcheck/kernel_form.h:
     // ZCHECK_KERNELS, read here; a value it refuses throws Error), each form bit-identical to
-    // the baseline.
+    // the baseline. Embree runs the instruction set embreeIsa() gives (ZCHECK_EMBREE_ISA, read
+    // here too, with the same refusals).
     explicit RayRenderer(const Scene& scene, BvhBuild build = BvhBuild::Thorough);
     ~RayRenderer();
     RayRenderer(const RayRenderer&) = delete;
