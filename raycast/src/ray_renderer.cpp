@@ -166,40 +166,44 @@ const char* nameOf(BvhBuild build) { return build == BvhBuild::Quick ? "quick" :
 
 namespace {
 
-// Embree's instruction sets by its names, each with what the processor must have for it: as
-// Embree's own, each set needs the one before it too (its AVX2 kernels are AVX with F16C, AVX2,
-// FMA, BMI1, BMI2 and LZCNT; its AVX-512 ones SKX's F, CD, DQ, BW and VL besides).
+// Embree's instruction sets by its names, each with what it adds to the one before it (as
+// Embree's own, each set needs the ones before it too: its AVX2 kernels are AVX with F16C, AVX2,
+// FMA, BMI1, BMI2 and LZCNT; its AVX-512 ones SKX's F, CD, DQ, BW and VL besides). `adds` says
+// whether this processor has those (x86-64 only: elsewhere every set is refused and only auto
+// is taken).
 struct EmbreeSet {
     const char* name;
     const char* needs;
+    bool (*adds)();
 };
-constexpr EmbreeSet kEmbreeSets[] = {{"sse2", "SSE2"},
-                                     {"sse4.2", "SSE4.2 and POPCNT"},
-                                     {"avx", "AVX, SSE4.2 and POPCNT"},
-                                     {"avx2", "AVX2, FMA, F16C, BMI1, BMI2 and LZCNT besides AVX"},
-                                     {"avx512", "AVX-512 F, CD, DQ, BW and VL besides AVX2's"}};
-
-// Whether this processor runs Embree's `set` (x86-64 only: elsewhere every set is refused and
-// only auto is taken).
-bool processorRuns(const EmbreeSet& set)
-{
 #ifdef ZCHECK_X86_FORMS
-    const std::string name = set.name;
-    if (name == "sse2") return true;  // every x86-64 processor
-    if (!(__builtin_cpu_supports("sse4.2") && __builtin_cpu_supports("popcnt"))) return false;
-    if (name == "sse4.2") return true;
-    if (!__builtin_cpu_supports("avx")) return false;
-    if (name == "avx") return true;
-    if (!(__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("f16c") &&
-          __builtin_cpu_supports("bmi") && __builtin_cpu_supports("bmi2") && __builtin_cpu_supports("lzcnt")))
-        return false;
-    if (name == "avx2") return true;
-    return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512cd") &&
-           __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl");
+#define ZCHECK_HAS(feature) __builtin_cpu_supports(feature)
 #else
-    (void)set;
-    return false;
+#define ZCHECK_HAS(feature) false
 #endif
+constexpr EmbreeSet kEmbreeSets[] = {
+    {"sse2", "SSE2", []() -> bool { return ZCHECK_HAS("sse2"); }},
+    {"sse4.2", "SSE4.2 and POPCNT", []() -> bool { return ZCHECK_HAS("sse4.2") && ZCHECK_HAS("popcnt"); }},
+    {"avx", "AVX, SSE4.2 and POPCNT", []() -> bool { return ZCHECK_HAS("avx"); }},
+    {"avx2", "AVX2, FMA, F16C, BMI1, BMI2 and LZCNT besides AVX",
+     []() -> bool {
+         return ZCHECK_HAS("avx2") && ZCHECK_HAS("fma") && ZCHECK_HAS("f16c") && ZCHECK_HAS("bmi") && ZCHECK_HAS("bmi2") &&
+                ZCHECK_HAS("lzcnt");
+     }},
+    {"avx512", "AVX-512 F, CD, DQ, BW and VL besides AVX2's",
+     []() -> bool {
+         return ZCHECK_HAS("avx512f") && ZCHECK_HAS("avx512cd") && ZCHECK_HAS("avx512dq") && ZCHECK_HAS("avx512bw") &&
+                ZCHECK_HAS("avx512vl");
+     }},
+};
+#undef ZCHECK_HAS
+
+// Whether this processor runs Embree's set k: it has what each set up to k adds.
+bool processorRuns(std::size_t k)
+{
+    for (std::size_t j = 0; j <= k; ++j)
+        if (!kEmbreeSets[j].adds()) return false;
+    return true;
 }
 
 // "auto, sse2, sse4.2, avx, avx2 or avx512".
@@ -217,9 +221,10 @@ std::string embreeIsa()
 {
     const char* requested = std::getenv("ZCHECK_EMBREE_ISA");
     if (!requested || !*requested || std::strcmp(requested, "auto") == 0) return "auto";
-    for (const EmbreeSet& set : kEmbreeSets) {
+    for (std::size_t k = 0; k < std::size(kEmbreeSets); ++k) {
+        const EmbreeSet& set = kEmbreeSets[k];
         if (std::strcmp(requested, set.name) != 0) continue;
-        if (!processorRuns(set))
+        if (!processorRuns(k))
             throw Error(std::string("ZCHECK_EMBREE_ISA=") + requested + ": this processor cannot run Embree's " +
                         requested + " kernels (they need " + set.needs + "); use auto, or a set it has");
         return set.name;
