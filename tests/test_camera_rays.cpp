@@ -300,6 +300,12 @@ TEST_CASE("ZCHECK_EMBREE_ISA has Embree run one instruction set's kernels, findi
 #else
     const Set sets[] = {{"sse2", false, 4}, {"avx2", false, 8}};
 #endif
+    // auto runs the widest set the processor has: its packet width is that set's.
+    const Set* widest = nullptr;
+    for (const Set& set : sets)
+        if (set.has) widest = &set;
+    REQUIRE(embreeAutoIsa() == (widest ? widest->name : ""));
+    if (widest) REQUIRE(RayRenderer(scene).embreeNativePacket() == widest->packet);
     for (const Set& set : sets) {
         INFO("ZCHECK_EMBREE_ISA=" << set.name);
         if (!set.has) {

@@ -51,11 +51,9 @@ CameraSpec glCameraSpec(const Scene& scene, GlDepth setup, int width, int height
     return spec;
 }
 
-// Mesa's depth buffer for the scene drawn with the camera's matrices in the OpenGL depth
-// set-up `setup`, as a window-depth map; with `samples` > 1 multisampled and resolved by a
-// blit, the sample positions GL reports in `samplePositions`.
-DepthMap glDepthMap(const Scene& scene, const Camera& camera, GlDepth setup, int samples = 0,
-                    std::vector<std::array<float, 2>>* samplePositions = nullptr)
+// Mesa's draw of the scene with the camera's matrices in the OpenGL depth set-up `setup`
+// (timeGlDepthDraw with `repeats`); with `samples` > 1 multisampled and resolved by a blit.
+reference::GlDepthTiming glDraw(const Scene& scene, const Camera& camera, GlDepth setup, int samples, int repeats)
 {
     std::vector<float> positions;
     for (const glm::vec3& p : scene.positions) positions.insert(positions.end(), {p.x, p.y, p.z});
@@ -71,7 +69,15 @@ DepthMap glDepthMap(const Scene& scene, const Camera& camera, GlDepth setup, int
     input.zeroToOne = setup != GlDepth::MinusOneToOne;
     input.threads = 2;
     input.samples = samples;
-    const reference::GlDepthTiming drawn = reference::timeGlDepthDraw(input, 0);
+    return reference::timeGlDepthDraw(input, repeats);
+}
+
+// Mesa's depth buffer (glDraw, no timed repeats) as a window-depth map; the sample positions
+// GL reports in `samplePositions`.
+DepthMap glDepthMap(const Scene& scene, const Camera& camera, GlDepth setup, int samples = 0,
+                    std::vector<std::array<float, 2>>* samplePositions = nullptr)
+{
+    const reference::GlDepthTiming drawn = glDraw(scene, camera, setup, samples, 0);
     if (samplePositions) *samplePositions = drawn.samplePositions;
     INFO("OpenGL renderer: " << drawn.renderer);
     REQUIRE(drawn.depth.size() == std::size_t(camera.width()) * camera.height());
@@ -110,6 +116,28 @@ TEST_CASE("OpenGL depth buffers drawn by Mesa's llvmpipe verify as consistent", 
             const Camera camera(glCameraSpec(scene, setup, 320, 240));
             requireConsistent(verifier, camera, glDepthMap(scene, camera, setup));
         }
+    }
+}
+
+TEST_CASE("the llvmpipe yardstick times each repeat warm and into a new depth buffer, and reads back the first buffer",
+          "[real-renderer]")
+{
+    // bench's cold yardstick: a depth buffer made per draw; the one read back is the buffer the
+    // warm draws drew into, the same picture as with no repeats at all.
+    const Scene scene = loadScene("builtin:terrain?n=48");
+    for (GlDepth setup : {GlDepth::MinusOneToOne, GlDepth::Reversed}) {
+        INFO(nameOf(setup));
+        const Camera camera(glCameraSpec(scene, setup, 160, 120));
+        const reference::GlDepthTiming once = glDraw(scene, camera, setup, 0, 0);
+        const reference::GlDepthTiming timed = glDraw(scene, camera, setup, 0, 3);
+        CHECK(once.drawMs.empty());
+        CHECK(once.coldDrawMs.empty());
+        REQUIRE(timed.drawMs.size() == 3);
+        REQUIRE(timed.coldDrawMs.size() == 3);
+        for (double ms : timed.coldDrawMs) CHECK(ms > 0);
+        CHECK(timed.depth == once.depth);
+        const float cleared = setup == GlDepth::Reversed ? 0.0f : 1.0f;
+        CHECK(std::count(timed.depth.begin(), timed.depth.end(), cleared) < std::ptrdiff_t(timed.depth.size() / 2));
     }
 }
 

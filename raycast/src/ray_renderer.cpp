@@ -232,6 +232,13 @@ std::string embreeIsa()
     throw Error(std::string("ZCHECK_EMBREE_ISA=") + requested + ": must be " + embreeSetNames());
 }
 
+std::string embreeAutoIsa()
+{
+    std::string widest;  // none off x86-64
+    for (std::size_t k = 0; k < std::size(kEmbreeSets) && processorRuns(k); ++k) widest = kEmbreeSets[k].name;
+    return widest;
+}
+
 std::string embreeDeviceConfig()
 {
     const std::string isa = embreeIsa();

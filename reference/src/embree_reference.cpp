@@ -89,8 +89,13 @@ EmbreeReference::~EmbreeReference() = default;
 
 double EmbreeReference::trace(const Camera& camera, std::vector<std::uint32_t>& primitiveId) const
 {
+    primitiveId.resize(std::size_t(camera.width()) * camera.height());
+    return trace(camera, primitiveId.data());
+}
+
+double EmbreeReference::trace(const Camera& camera, std::uint32_t* primitiveId) const
+{
     const int W = camera.width(), H = camera.height();
-    primitiveId.resize(std::size_t(W) * H);
     // The rays (set up outside the timing) in binary32 and the scene-centred frame: affine in the
     // pixel, or a lens model's from a table of every pixel's direction (NaN outside its field).
     const bool lens = camera.lens() != nullptr;

@@ -3,6 +3,7 @@
 // Only libEGL is linked: every GL entry point comes from eglGetProcAddress, so the types
 // and constants are taken from the Khronos header without its prototypes.
 #include <EGL/egl.h>
+#include <malloc.h>
 #include <EGL/eglext.h>
 #include <GL/glcorearb.h>
 
@@ -410,11 +411,13 @@ void createDepthTarget(const Gl& gl, const GlDepthInput& input, GLenum depthForm
         fail(std::string(what) + ": framebuffer incomplete (status " + hex(status) + ")");
 }
 
+// The depth buffer's format. Reversed-Z keeps its precision only with a float buffer.
+GLenum depthFormatOf(const GlDepthInput& input) { return input.reversedZ ? GL_DEPTH_COMPONENT32F : GL_DEPTH_COMPONENT24; }
+
 // The framebuffer drawn into, left bound, and with multisampling first the single-sample one it is resolved into.
 void createDepthTargets(const Gl& gl, GlObjects& objects, const GlDepthInput& input)
 {
-    // Depth-only render target. Reversed-Z keeps its precision only with a float buffer.
-    const GLenum depthFormat = input.reversedZ ? GL_DEPTH_COMPONENT32F : GL_DEPTH_COMPONENT24;
+    const GLenum depthFormat = depthFormatOf(input);
     if (input.samples > 1)
         createDepthTarget(gl, input, depthFormat, 1, objects.resolvedRenderbuffer, objects.resolvedFramebuffer,
                           "creating the resolved depth framebuffer");
@@ -474,6 +477,34 @@ std::vector<double> timeDraws(const Gl& gl, const GlDepthInput& input, int repea
     return drawMs;
 }
 
+// `repeats` timed draws, each into a depth buffer of its own made for it (GlDepthTiming::coldDrawMs),
+// after the warm ones: the framebuffer drawn before is bound again at the end.
+std::vector<double> timeColdDraws(const Gl& gl, const GlObjects& objects, const GlDepthInput& input, int repeats)
+{
+    const auto indexCount = static_cast<GLsizei>(3 * input.triangleCount);
+    std::vector<double> drawMs;
+    drawMs.reserve(static_cast<std::size_t>(repeats));
+    for (int repeat = 0; repeat < repeats; ++repeat) {
+#ifdef __GLIBC__
+        malloc_trim(0);  // memory the C library kept from freed buffers given back: the new one is untouched
+#endif
+        GLuint renderbuffer = 0, framebuffer = 0;
+        const auto start = std::chrono::steady_clock::now();
+        createDepthTarget(gl, input, depthFormatOf(input), input.samples, renderbuffer, framebuffer,
+                          "creating a new depth framebuffer");
+        gl.Clear(GL_DEPTH_BUFFER_BIT);
+        gl.DrawElements(GL_TRIANGLES, indexCount, GL_UNSIGNED_INT, nullptr);
+        gl.Finish();
+        const auto end = std::chrono::steady_clock::now();
+        drawMs.push_back(std::chrono::duration<double, std::milli>(end - start).count());
+        gl.BindFramebuffer(GL_FRAMEBUFFER, objects.framebuffer);
+        gl.DeleteFramebuffers(1, &framebuffer);
+        gl.DeleteRenderbuffers(1, &renderbuffer);
+        gl.check("timed draws into new depth buffers");
+    }
+    return drawMs;
+}
+
 // The multisampled depth blitted into the single-sample framebuffer, which is left bound for reading.
 void resolveMultisampledDepth(const Gl& gl, const GlObjects& objects, const GlDepthInput& input)
 {
@@ -528,6 +559,7 @@ GlDepthTiming timeGlDepthDraw(const GlDepthInput& input, int repeats)
     if (input.samples > 1) timing.samplePositions = samplePositionsOf(gl);
     setDepthState(gl, input, zeroToOne);
     timing.drawMs = timeDraws(gl, input, repeats);
+    timing.coldDrawMs = timeColdDraws(gl, objects, input, repeats);
     if (input.samples > 1) resolveMultisampledDepth(gl, objects, input);
     timing.depth = readBackDepth(gl, input);
     return timing;

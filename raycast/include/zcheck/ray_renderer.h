@@ -86,8 +86,11 @@ const char* nameOf(BvhBuild build);
 //   setenv("ZCHECK_EMBREE_ISA", "avx2", 1);
 //   zcheck::embreeIsa();           // "avx2" (throws Error for a bad value)
 //   zcheck::embreeDeviceConfig();  // "isa=avx2", rtcNewDevice's configuration ("" for auto)
+//   zcheck::embreeAutoIsa();       // "avx512": the set auto runs, the widest the processor has
+//                                  // (Debian's Embree is built with all five; "" off x86-64)
 std::string embreeIsa();
 std::string embreeDeviceConfig();
+std::string embreeAutoIsa();
 
 class RayRenderer {
 public:

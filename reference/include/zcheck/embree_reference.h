@@ -34,6 +34,9 @@ public:
     // Traces one frame; returns its wall time in milliseconds. primitiveId: width·height
     // entries (resized once), the hit primitive or 0xFFFFFFFF, rows top-down.
     double trace(const Camera& camera, std::vector<std::uint32_t>& primitiveId) const;
+    // The same into width·height entries at `primitiveId` that the caller allocated: memory
+    // never touched before makes a cold frame's trace (the time then includes its page faults).
+    double trace(const Camera& camera, std::uint32_t* primitiveId) const;
 
 private:
     struct Embree;

@@ -7,6 +7,11 @@
 //
 // What is timed, per repeat (wall time, std::chrono::steady_clock):
 //   glClear(GL_DEPTH_BUFFER_BIT); glDrawElements(all triangles); glFinish();
+// into the one depth buffer every repeat draws into (warm: its memory touched before), and
+// then, as many times again, the same into a depth buffer made for that draw, its making
+// (glRenderbufferStorage, the framebuffer) timed too, with the C library's free memory given
+// back before it (malloc_trim, untimed): a first frame's buffer, memory the process has not
+// touched, as a cold check's buffers are (the shaders and the mesh stay as they were).
 // What is not timed: creating the EGL display and context, compiling and linking the
 // shaders, uploading the mesh (done once, before any draw), one warm-up draw (llvmpipe
 // compiles its shader variants with LLVM on the first draw), and reading the depth back.
@@ -61,10 +66,11 @@ struct GlDepthInput {
 };
 
 struct GlDepthTiming {
-    std::vector<double> drawMs;  // one per repeat: glClear + glDrawElements + glFinish
-    std::string renderer;        // GL_RENDERER, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
-    // The last draw's depth buffer, width*height values in [0, 1], row 0 = top row of the
-    // image (glReadPixels' bottom-up order flipped).
+    std::vector<double> drawMs;      // one per repeat: glClear + glDrawElements + glFinish (warm)
+    std::vector<double> coldDrawMs;  // one per repeat: the same into a new depth buffer, its making timed
+    std::string renderer;            // GL_RENDERER, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
+    // The depth buffer the warm draws drew into, width*height values in [0, 1], row 0 = top row
+    // of the image (glReadPixels' bottom-up order flipped).
     std::vector<float> depth;
     // Multisampling: each sample's position in the pixel as GL reports it (glGetMultisamplefv,
     // GL_SAMPLE_POSITION): x right and y up from the pixel's lower-left corner, in [0, 1].
@@ -72,11 +78,12 @@ struct GlDepthTiming {
 };
 
 // True when this module was compiled in; the build compiles it only when EGL is found.
-// Draws the mesh once untimed, then `repeats` (≥ 0) timed times, and reads back the last
-// draw's depth. Throws std::invalid_argument for bad input, and std::runtime_error with a
-// one-line message naming the failing EGL/GL step (e.g. "no EGL display (surfaceless)",
-// "EGL_MESA_platform_surfaceless missing", "glClipControl unsupported (needs GL 4.5 or
-// GL_ARB_clip_control)"). Every EGL/GL resource is released on both paths.
+// Draws the mesh once untimed, then `repeats` (≥ 0) timed times into the same depth buffer and
+// as many into new ones, and reads back the first buffer's depth. Throws std::invalid_argument
+// for bad input, and std::runtime_error with a one-line message naming the failing EGL/GL step
+// (e.g. "no EGL display (surfaceless)", "EGL_MESA_platform_surfaceless missing",
+// "glClipControl unsupported (needs GL 4.5 or GL_ARB_clip_control)"). Every EGL/GL resource is
+// released on both paths.
 GlDepthTiming timeGlDepthDraw(const GlDepthInput& input, int repeats);
 
 // What the plugin libzcheck_gl_yardstick.so offers `zcheck bench --reference`, which loads it
