@@ -463,6 +463,41 @@ ZCHECK_ALWAYS_INLINE inline void snapEightLanes(const Viewport& vp, const glm::v
                   L::select(valid, L::joined(X, Y), notSnapped));
 }
 
+// coveredBox's twice signed area for eight triangles' snapped corners, in int64 (a snapped
+// vertex's |X|, |Y| < 2^29: each difference fits 32 signed bits, each product 62).
+template <class L>
+ZCHECK_ALWAYS_INLINE inline typename L::Int64 twiceAreaLanes(const typename L::Int32 (&X)[3], const typename L::Int32 (&Y)[3])
+{
+    typename L::Int64 wide[3][2];  // [corner][X, Y]
+    for (int k = 0; k < 3; ++k) wide[k][0] = L::widen(X[k]), wide[k][1] = L::widen(Y[k]);
+    return L::multiplySmall(wide[1][0] - wide[0][0], wide[2][1] - wide[0][1]) -
+           L::multiplySmall(wide[1][1] - wide[0][1], wide[2][0] - wide[0][0]);
+}
+
+// coveredBox's box for eight triangles' snapped corners: firstCentre (lo + 127) >> 8 and
+// lastCentre (hi − 128) >> 8, inside the image (empty where first > last), in int32.
+template <class L>
+struct BoxLanes {
+    typename L::Int32 minCol, maxCol, minRow, maxRow;
+    typename L::Mask nonEmpty() const { return L::lessOrEqual(minCol, maxCol) & L::lessOrEqual(minRow, maxRow); }
+};
+template <class L>
+ZCHECK_ALWAYS_INLINE inline BoxLanes<L> coveredBoxLanes(const Viewport& vp, const typename L::Int32 (&X)[3],
+                                                        const typename L::Int32 (&Y)[3])
+{
+    using Int32 = typename L::Int32;
+    const Int32 zero = L::set1(std::int32_t(0));
+    const Int32 firstOffset = L::set1(std::int32_t(kSubpixel - 1 - kHalfPixel)), lastOffset = L::set1(std::int32_t(kHalfPixel));
+    constexpr int kBits = RasterRenderer::kSubpixelBits;
+    auto firstCentre = [&](const Int32 (&c)[3]) ZCHECK_ALWAYS_INLINE {
+        return L::max(zero, L::template shiftRightArithmetic<kBits>(L::min(L::min(c[0], c[1]), c[2]) + firstOffset));
+    };
+    auto lastCentre = [&](const Int32 (&c)[3], int size) ZCHECK_ALWAYS_INLINE {
+        return L::min(L::set1(std::int32_t(size - 1)), L::template shiftRightArithmetic<kBits>(L::max(L::max(c[0], c[1]), c[2]) - lastOffset));
+    };
+    return {firstCentre(X), lastCentre(X, vp.width), firstCentre(Y), lastCentre(Y, vp.height)};
+}
+
 // The prepare stage's loop body for triangles p .. p+7 at once: the bin items of those whose
 // vertices all lie inside every clip plane, appended in submission order with the boxes
 // coveredBox gives (the same int64 area, the same int32 box arithmetic); those wholly outside
@@ -500,28 +535,10 @@ ZCHECK_ALWAYS_INLINE inline bool binItemsOfEightLanes(const Viewport& vp, const 
     const Mask inside = L::equal(orCodes, zero);
     const Mask outsideOne = L::anyBits(andCodes);
     if (L::bits(inside | outsideOne) != 0xFF) return false;  // one needs clipping
-    Mask keep = inside & snappedAll;
-    // coveredBox's twice signed area, in int64 (a snapped vertex's |X|, |Y| < 2^29: each
-    // difference fits 32 signed bits, each product 62).
-    Int64 wide[3][2];  // [corner][X, Y]
-    for (int k = 0; k < 3; ++k) wide[k][0] = L::widen(X[k]), wide[k][1] = L::widen(Y[k]);
-    const Int64 area2 = L::multiplySmall(wide[1][0] - wide[0][0], wide[2][1] - wide[0][1]) -
-                        L::multiplySmall(wide[1][1] - wide[0][1], wide[2][0] - wide[0][0]);
-    keep = L::andNot(keep, L::isZero(area2));
-    // coveredBox's box: firstCentre (lo + 127) >> 8 and lastCentre (hi − 128) >> 8, inside the image.
-    const Int32 firstOffset = L::set1(std::int32_t(kSubpixel - 1 - kHalfPixel)), lastOffset = L::set1(std::int32_t(kHalfPixel));
-    constexpr int kBits = RasterRenderer::kSubpixelBits;
-    auto firstCentre = [&](const Int32 (&c)[3]) ZCHECK_ALWAYS_INLINE {
-        return L::max(zero, L::template shiftRightArithmetic<kBits>(L::min(L::min(c[0], c[1]), c[2]) + firstOffset));
-    };
-    auto lastCentre = [&](const Int32 (&c)[3], int size) ZCHECK_ALWAYS_INLINE {
-        return L::min(L::set1(std::int32_t(size - 1)), L::template shiftRightArithmetic<kBits>(L::max(L::max(c[0], c[1]), c[2]) - lastOffset));
-    };
-    const Int32 firstCol = firstCentre(X), lastCol = lastCentre(X, vp.width);
-    const Int32 firstRow = firstCentre(Y), lastRow = lastCentre(Y, vp.height);
+    const BoxLanes<L> box = coveredBoxLanes<L>(vp, X, Y);
+    const Mask keep = L::andNot(inside & snappedAll, L::isZero(twiceAreaLanes<L>(X, Y))) & box.nonEmpty();
     alignas(32) std::int32_t minCol[8], maxCol[8], minRow[8], maxRow[8];
-    L::store(minCol, firstCol), L::store(maxCol, lastCol), L::store(minRow, firstRow), L::store(maxRow, lastRow);
-    keep = keep & L::lessOrEqual(firstCol, lastCol) & L::lessOrEqual(firstRow, lastRow);
+    L::store(minCol, box.minCol), L::store(maxCol, box.maxCol), L::store(minRow, box.minRow), L::store(maxRow, box.maxRow);
     // The kept ones appended together (a push_back each stayed a call in the AVX2 form).
     BinItem kept[8];
     int count = 0;
@@ -533,6 +550,82 @@ ZCHECK_ALWAYS_INLINE inline bool binItemsOfEightLanes(const Viewport& vp, const 
     return true;
 }
 
+// setupFromSnapped for the eight bin entries entry[0..7] at once, each naming a triangle whose
+// corners needed no clipping: out[j] is entry j's set-up where bit j of the result is set, and
+// where it is not, setupFromSnapped returns false (a corner not snapped, or no pixel centre
+// covered). Each lane computes what the scalar code does, in the same order: the int64 area,
+// edges and biases (each product one of two 32-bit values: |X|, |Y| < 2^29), the int32 box, and
+// the plane's double operations, the same IEEE operations (no contraction), so the bits agree.
+template <class L>
+ZCHECK_ALWAYS_INLINE inline unsigned setUpEightLanes(const Viewport& vp, const glm::uvec3* triangles, const std::uint32_t* entry,
+                                                     const StoredVertex* snapped, TriangleSetup* out)
+{
+    using Real = typename L::Real;
+    using Int32 = typename L::Int32;
+    using Int64 = typename L::Int64;
+    using Mask = typename L::Mask;
+    alignas(32) std::uint32_t corner[3][8];  // the eight triangles' vertex indices, by corner
+    for (int j = 0; j < 8; ++j) {
+        const glm::uvec3& tri = triangles[entry[j]];
+        corner[0][j] = tri[0], corner[1][j] = tri[1], corner[2][j] = tri[2];
+    }
+    const Int32 zero = L::set1(std::int32_t(0));
+    const Mask all = L::firstLanes(8);
+    Int32 X[3], Y[3];
+    Real z[3];
+    Mask valid = all;
+    for (int k = 0; k < 3; ++k) {
+        const Int64 record = L::template shiftLeft<1>(L::widenUnsigned(L::load(corner[k])));  // in 8-byte words
+        const Int64 xy = L::gather(reinterpret_cast<const char*>(snapped) + offsetof(StoredVertex, X), record);
+        X[k] = L::lowHalves(xy), Y[k] = L::highHalves(xy);
+        z[k] = L::realOfBits(L::gather(snapped, record));
+        valid = valid & L::notEqual(X[k], L::set1(std::int32_t(INT32_MIN)));
+    }
+    const Int64 area2 = twiceAreaLanes<L>(X, Y);
+    const BoxLanes<L> box = coveredBoxLanes<L>(vp, X, Y);
+    const unsigned drawn = L::bits(L::andNot(valid, L::isZero(area2)) & box.nonEmpty());
+    if (!drawn) return 0;
+    // Both windings drawn, normalised to area2 > 0: corners 1 and 2 swapped where it is negative.
+    const Mask negative = L::andNot(all, L::nonNegative(area2));
+    const Int32 X1 = X[1], Y1 = Y[1];
+    const Real z1 = z[1];
+    X[1] = L::select(negative, X[2], X1), X[2] = L::select(negative, X1, X[2]);
+    Y[1] = L::select(negative, Y[2], Y1), Y[2] = L::select(negative, Y1, Y[2]);
+    z[1] = L::select(negative, z[2], z1), z[2] = L::select(negative, z1, z[2]);
+
+    alignas(64) std::int64_t A[3][8], B[3][8], C[3][8];
+    for (int e = 0; e < 3; ++e) {
+        const int a = e, b = (e + 1) % 3;
+        const Int32 dx = X[b] - X[a], dy = Y[b] - Y[a];
+        // The top-left rule: dy < 0, or dy == 0 and dx > 0.
+        const Mask topLeft = L::andNot(all, L::lessOrEqual(zero, dy)) | (L::equal(dy, zero) & L::andNot(all, L::lessOrEqual(dx, zero)));
+        const Int64 wideDy = L::widen(dy), wideDx = L::widen(dx);
+        const Int64 c = L::multiplySmall(wideDy, L::widen(X[a])) - L::multiplySmall(wideDx, L::widen(Y[a]));
+        L::store(A[e], L::widen(zero - dy));
+        L::store(B[e], wideDx);
+        L::store(C[e], L::select(topLeft, c, c - L::set1(std::int64_t(1))));
+    }
+    const Real subpixel = L::set1(double(kSubpixel));
+    const Real dx1 = L::toReal(X[1] - X[0]) / subpixel, dy1 = L::toReal(Y[1] - Y[0]) / subpixel;
+    const Real dx2 = L::toReal(X[2] - X[0]) / subpixel, dy2 = L::toReal(Y[2] - Y[0]) / subpixel;
+    const Real dz1 = z[1] - z[0], dz2 = z[2] - z[0];
+    const Real det = dx1 * dy2 - dx2 * dy1;
+    alignas(64) double x0[8], y0[8], z0[8], dzdx[8], dzdy[8];
+    L::store(x0, L::toReal(X[0]) / subpixel), L::store(y0, L::toReal(Y[0]) / subpixel), L::store(z0, z[0]);
+    L::store(dzdx, (dz1 * dy2 - dz2 * dy1) / det), L::store(dzdy, (dx1 * dz2 - dx2 * dz1) / det);
+    alignas(32) std::int32_t minCol[8], maxCol[8], minRow[8], maxRow[8];
+    L::store(minCol, box.minCol), L::store(maxCol, box.maxCol), L::store(minRow, box.minRow), L::store(maxRow, box.maxRow);
+    for (unsigned bits = drawn; bits; bits &= bits - 1) {
+        const int j = __builtin_ctz(bits);
+        TriangleSetup& t = out[j];
+        for (int e = 0; e < 3; ++e) t.A[e] = A[e][j], t.B[e] = B[e][j], t.C[e] = C[e][j];
+        t.x0 = x0[j], t.y0 = y0[j], t.z0 = z0[j], t.dzdx = dzdx[j], t.dzdy = dzdy[j];
+        t.box = {minCol[j], maxCol[j], minRow[j], maxRow[j]};
+        t.primitive = entry[j];
+    }
+    return drawn;
+}
+
 #endif  // ZCHECK_X86_FORMS
 
 // The raster's vector kernels in one form; null in the baseline form (the scalar loops run).
@@ -541,6 +634,7 @@ struct RasterKernels {
     void (*snapEight)(const Viewport&, const glm::vec3*, std::size_t, StoredVertex*) = nullptr;
     bool (*binItemsOfEight)(const Viewport&, const glm::uvec3*, std::uint32_t, const StoredVertex*,
                             std::vector<BinItem>&) = nullptr;
+    unsigned (*setUpEight)(const Viewport&, const glm::uvec3*, const std::uint32_t*, const StoredVertex*, TriangleSetup*) = nullptr;
 };
 
 #ifdef ZCHECK_X86_FORMS
@@ -559,6 +653,11 @@ struct RasterKernels {
                                      const StoredVertex* snapped, std::vector<BinItem>& items)                         \
     {                                                                                                                  \
         return binItemsOfEightLanes<Form##Lanes>(vp, triangles, p, snapped, items);                                    \
+    }                                                                                                                  \
+    Entry unsigned setUpEight##Form(const Viewport& vp, const glm::uvec3* triangles, const std::uint32_t* entry,       \
+                                    const StoredVertex* snapped, TriangleSetup* out)                                   \
+    {                                                                                                                  \
+        return setUpEightLanes<Form##Lanes>(vp, triangles, entry, snapped, out);                                       \
     }
 ZCHECK_RASTER_FORM(ZCHECK_KERNEL_ENTRY_AVX2, Avx2, Avx2Lanes4)  // four pixels a group: see Avx2Lanes4
 ZCHECK_RASTER_FORM(ZCHECK_KERNEL_ENTRY_AVX512, Avx512, Avx512Lanes)
@@ -570,8 +669,8 @@ RasterKernels rasterKernels()
 {
     RasterKernels kernels;  // the baseline form: none (the scalar code)
 #ifdef ZCHECK_X86_FORMS
-    kernels = formOf(kernelForm(), kernels, RasterKernels{&drawInTileAvx2, &snapEightAvx2, &binItemsOfEightAvx2},
-                     RasterKernels{&drawInTileAvx512, &snapEightAvx512, &binItemsOfEightAvx512});
+    kernels = formOf(kernelForm(), kernels, RasterKernels{&drawInTileAvx2, &snapEightAvx2, &binItemsOfEightAvx2, &setUpEightAvx2},
+                     RasterKernels{&drawInTileAvx512, &snapEightAvx512, &binItemsOfEightAvx512, &setUpEightAvx512});
 #endif
     return kernels;
 }
@@ -713,15 +812,33 @@ void RasterFrame::Impl::drawTile(int tile, double* windowDepth, std::uint32_t* p
     // ahead: each is a load that misses as often as not (a tile's entries come from a few runs
     // of the mesh, in submission order), and the loop waited on them (the raster ~4 % faster).
     constexpr std::uint32_t kIndicesAhead = 16, kVerticesAhead = 8;
-    for (const Chunk& chunk : chunks)
-        for (std::uint32_t k = chunk.tileStart[tile], end = chunk.tileStart[tile + 1]; k < end; ++k) {
-            if (k + kIndicesAhead < end && !(chunk.binned[k + kIndicesAhead] & kClippedBit))
-                __builtin_prefetch(&scene.triangles[chunk.binned[k + kIndicesAhead]]);
-            if (k + kVerticesAhead < end && !(chunk.binned[k + kVerticesAhead] & kClippedBit)) {
-                const glm::uvec3& ahead = scene.triangles[chunk.binned[k + kVerticesAhead]];
+    TriangleSetup eight[8];
+    for (const Chunk& chunk : chunks) {
+        const std::uint32_t* binned = chunk.binned.data();
+        const std::uint32_t end = chunk.tileStart[tile + 1];
+        auto askAhead = [&](std::uint32_t k) {
+            if (k + kIndicesAhead < end && !(binned[k + kIndicesAhead] & kClippedBit))
+                __builtin_prefetch(&scene.triangles[binned[k + kIndicesAhead]]);
+            if (k + kVerticesAhead < end && !(binned[k + kVerticesAhead] & kClippedBit)) {
+                const glm::uvec3& ahead = scene.triangles[binned[k + kVerticesAhead]];
                 for (int corner = 0; corner < 3; ++corner) __builtin_prefetch(&snapped[ahead[corner]]);
             }
-            const std::uint32_t entry = chunk.binned[k];
+        };
+        for (std::uint32_t k = chunk.tileStart[tile]; k < end;) {
+            // Eight entries that needed no clipping set up at once (a form's kernel), then drawn
+            // in their order; the same set-ups as one at a time below.
+            if (kernels.setUpEight && k + 8 <= end &&
+                !((binned[k] | binned[k + 1] | binned[k + 2] | binned[k + 3] | binned[k + 4] | binned[k + 5] |
+                   binned[k + 6] | binned[k + 7]) & kClippedBit)) {
+                for (std::uint32_t j = 0; j < 8; ++j) askAhead(k + j);
+                for (unsigned bits = kernels.setUpEight(vp, scene.triangles.data(), binned + k, snapped.data(), eight); bits;
+                     bits &= bits - 1)
+                    draw(eight[__builtin_ctz(bits)]);
+                k += 8;
+                continue;
+            }
+            askAhead(k);
+            const std::uint32_t entry = binned[k++];
             if (entry & kClippedBit) {
                 draw(chunk.clipped[entry & ~kClippedBit]);
             } else {
@@ -732,6 +849,7 @@ void RasterFrame::Impl::drawTile(int tile, double* windowDepth, std::uint32_t* p
                     draw(t);
             }
         }
+    }
     for (int row = row0; row <= row1; ++row) {
         const int from = (row - row0) * TileBuffer::kSide, count = col1 - col0 + 1;
         double* depthTo = windowDepth + std::size_t(row - row0) * stride;

@@ -12,7 +12,8 @@
 //
 // L::kLanes says how many lanes. Each eight-lane type L has
 //   L::Real   eight doubles: + − × ÷ (IEEE, lane by lane), < <= > >= (a Mask), select, min, max, abs
-//   L::Int64  eight 64-bit integers: + − | & <<, steps, select
+//   L::Int64  eight 64-bit integers: + − | & <<, steps, select, load, store, and realOfBits
+//             (bitsOf's inverse)
 //   L::Int32  eight 32-bit integers: + −, == !=, min/max (unsigned), select
 //   L::Float  eight floats: the rounded doubles the keepers and the heatmap take
 //   L::Mask   eight lanes' truth: & | ^ andNot, bits() (lane j: bit j)
@@ -234,6 +235,11 @@ struct Avx2Lanes : Lanes32 {
         return {lo, _mm256_add_epi64(lo, _mm256_set1_epi64x(std::int64_t(4 * s)))};
     }
     static ZCHECK_LANE Int64 bitsOf(Real a) { return {_mm256_castpd_si256(a.lo), _mm256_castpd_si256(a.hi)}; }
+    static ZCHECK_LANE Real realOfBits(Int64 a) { return {_mm256_castsi256_pd(a.lo), _mm256_castsi256_pd(a.hi)}; }
+    static ZCHECK_LANE void store(std::int64_t* p, Int64 a)
+    {
+        _mm256_storeu_si256(reinterpret_cast<__m256i*>(p), a.lo), _mm256_storeu_si256(reinterpret_cast<__m256i*>(p + 4), a.hi);
+    }
     template <int kShift>
     static ZCHECK_LANE Int64 shiftLeft(Int64 a) { return {_mm256_slli_epi64(a.lo, kShift), _mm256_slli_epi64(a.hi, kShift)}; }
     static ZCHECK_LANE Mask nonNegative(Int64 a)
@@ -404,6 +410,8 @@ struct Avx512Lanes : Lanes32 {
         return {_mm512_add_epi64(_mm512_set1_epi64(first), _mm512_mullo_epi64(_mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0), _mm512_set1_epi64(step)))};
     }
     static ZCHECK_LANE Int64 bitsOf(Real a) { return {_mm512_castpd_si512(a.v)}; }
+    static ZCHECK_LANE Real realOfBits(Int64 a) { return {_mm512_castsi512_pd(a.v)}; }
+    static ZCHECK_LANE void store(std::int64_t* p, Int64 a) { _mm512_storeu_si512(p, a.v); }
     template <int kShift>
     static ZCHECK_LANE Int64 shiftLeft(Int64 a) { return {_mm512_slli_epi64(a.v, kShift)}; }
     static ZCHECK_LANE Mask nonNegative(Int64 a) { return {_mm512_cmpge_epi64_mask(a.v, _mm512_setzero_si512())}; }
