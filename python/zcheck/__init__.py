@@ -48,6 +48,7 @@ from ._zcheck import (  # noqa: F401
     pixel_classes,
     quantities,
     release_cached_buffers,
+    retain_freed_heap_memory,
     routes,
     unproject,
 )
@@ -71,6 +72,7 @@ __all__ = [
     "quantities",
     "read_depth_map",
     "release_cached_buffers",
+    "retain_freed_heap_memory",
     "routes",
     "unproject",
 ]
