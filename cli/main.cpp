@@ -6,7 +6,6 @@
 #include "image_plugin.h"
 
 #include "zcheck/error.h"
-#include "zcheck/large_buffer.h"
 #include "zcheck/version.h"
 
 #include <iostream>
@@ -15,7 +14,6 @@ int main(int argc, char** argv)
 {
     using namespace zcheck::cli;
     using zcheck::Error;
-    zcheck::retainFreedHeapMemory();  // frame after frame, the scratch of one is the next one's (large_buffer.h)
     loadImageFormatsWhenNeeded();
     CLI::App app{"zcheck proves a graphics transform chain correct by computing every pixel's depth twice —\n"
                  "by ray casting through the camera's definition (Embree) and by rasterizing forward through\n"

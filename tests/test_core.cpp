@@ -21,9 +21,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
-#ifdef __GLIBC__
-#include <malloc.h>
-#endif
 #include <cstring>
 #include <random>
 #include <vector>
@@ -740,28 +737,6 @@ TEST_CASE("a 1080p byte-per-pixel buffer gets a huge page of its own and is kept
 // comparison in `zcheck bench` (which releases the cache first to time fresh buffers) then
 // often took no page fault at all. Memory given back must be the system's again: the next
 // large buffers are fresh, zero-filled memory.
-// retainFreedHeapMemory: 24 MiB malloc'd and freed stays the heap's (glibc mapped a block that
-// large afresh, its mmap threshold rising at most to 32 MiB and only as large blocks are freed,
-// and gave back free memory at the top of a heap past 128 KiB at once).
-TEST_CASE("with retainFreedHeapMemory a freed block stays in the heap for the next frame", "[core][large_buffer]")
-{
-#if !defined(__GLIBC__) || defined(__SANITIZE_ADDRESS__)
-    WARN("glibc's allocator only (not under AddressSanitizer)");
-#else
-    retainFreedHeapMemory();
-    constexpr std::size_t kBytes = std::size_t(24) << 20;
-    const struct mallinfo2 before = mallinfo2();
-    void* block = std::malloc(kBytes);
-    REQUIRE(block != nullptr);
-    std::memset(block, 1, kBytes);
-    const struct mallinfo2 held = mallinfo2();
-    REQUIRE(held.hblkhd == before.hblkhd);  // from the heap, not a mapping of its own
-    std::free(block);
-    const struct mallinfo2 after = mallinfo2();
-    REQUIRE(after.fordblks >= kBytes);  // free in the heap, not given back
-#endif
-}
-
 TEST_CASE("large buffers given back are the system's again: the next ones are fresh memory", "[core][large_buffer]")
 {
 #if defined(__SANITIZE_ADDRESS__)
@@ -770,7 +745,6 @@ TEST_CASE("large buffers given back are the system's again: the next ones are fr
     WARN("not under AddressSanitizer");
 #else
     constexpr std::size_t kValues = std::size_t(8) << 20 >> 3;  // 8 MiB of double
-    retainFreedHeapMemory();  // as zcheck's command runs: released blocks stay in the heap until given back
     for (int round = 0; round < 4; ++round) {
         releaseCachedLargeBuffers();
         std::vector<LargeVector<double>> buffers;

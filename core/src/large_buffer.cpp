@@ -154,12 +154,4 @@ void releaseCachedLargeBuffers() noexcept
 
 std::size_t cachedLargeBufferBytes() noexcept { return blockCache().held(); }
 
-void retainFreedHeapMemory() noexcept
-{
-#ifdef __GLIBC__
-    mallopt(M_MMAP_THRESHOLD, 32 << 20);
-    mallopt(M_TRIM_THRESHOLD, 64 << 20);
-#endif
-}
-
 }  // namespace zcheck

@@ -133,13 +133,6 @@ size (renders and comparisons of 1 MiB and more, up to 1 GiB in all; see cached_
 and has the C library give back the free memory its heap holds. A loop over many cameras or
 maps pays their page faults once because of them; a long-lived program that is done checking
 calls this. Safe at any time: buffers in use are not touched.)doc");
-    m.def(
-        "retain_freed_heap_memory", [] { retainFreedHeapMemory(); },
-        R"doc(Has the C library (glibc) keep the heap memory freed after one frame for the next, in the
-whole process: M_MMAP_THRESHOLD 32 MiB and M_TRIM_THRESHOLD 64 MiB (mallopt), as the zcheck
-command sets them at its start. A loop over many frames then no longer faults in each frame's
-scratch again (~8 % of a warm 1080p comparison). For a program of your own, not a library:
-malloc changes for everything in the process. release_cached_buffers still gives it back.)doc");
     m.def("cached_buffer_bytes", [] { return cachedLargeBufferBytes(); },
           "The bytes zcheck's kept per-frame buffers hold (see release_cached_buffers).");
     m.def(

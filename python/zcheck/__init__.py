@@ -48,7 +48,6 @@ from ._zcheck import (  # noqa: F401
     pixel_classes,
     quantities,
     release_cached_buffers,
-    retain_freed_heap_memory,
     routes,
     unproject,
 )
@@ -72,7 +71,6 @@ __all__ = [
     "quantities",
     "read_depth_map",
     "release_cached_buffers",
-    "retain_freed_heap_memory",
     "routes",
     "unproject",
 ]

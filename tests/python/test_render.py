@@ -169,38 +169,6 @@ def test_release_cached_buffers_gives_the_kept_frames_back(default_scene, defaul
     assert default_checker.check(camera).consistent
 
 
-def test_retain_freed_heap_memory_keeps_a_freed_block_in_the_heap():
-    # glibc maps a 24 MiB block of its own (its mmap threshold reaches 32 MiB at most, and only
-    # as large blocks are freed); once retained, such a block comes from the heap and stays
-    # there when freed. mallinfo2 (glibc 2.33 and later) says where the bytes are.
-    import ctypes
-    import sys
-
-    if not sys.platform.startswith("linux"):
-        pytest.skip("glibc's allocator only")
-
-    class MallInfo2(ctypes.Structure):
-        _fields_ = [(name, ctypes.c_size_t) for name in
-                    ("arena", "ordblks", "smblks", "hblks", "hblkhd", "usmblks", "fsmblks", "uordblks", "fordblks",
-                     "keepcost")]
-
-    libc = ctypes.CDLL(None)
-    if not hasattr(libc, "mallinfo2"):
-        pytest.skip("no mallinfo2: not glibc 2.33 or later")
-    libc.mallinfo2.restype = MallInfo2
-    zcheck.retain_freed_heap_memory()
-    mapped = libc.mallinfo2().hblkhd
-    libc.malloc.restype = ctypes.c_void_p
-    libc.malloc.argtypes = [ctypes.c_size_t]
-    libc.free.argtypes = [ctypes.c_void_p]
-    block = libc.malloc(24 << 20)
-    assert block
-    ctypes.memset(block, 1, 24 << 20)
-    assert libc.mallinfo2().hblkhd == mapped  # from the heap, not a mapping of its own
-    libc.free(block)
-    assert libc.mallinfo2().fordblks >= 24 << 20  # free in the heap, not given back
-
-
 def test_zcheck_embree_isa_is_read_when_a_checker_is_made_and_a_bad_value_raises(monkeypatch):
     scene = zcheck.Scene.from_file("builtin:default")
     camera = scene.default_camera.replace(width=64, height=48)

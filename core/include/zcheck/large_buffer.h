@@ -55,15 +55,6 @@ void releaseLarge(void* data, std::size_t bytes) noexcept;
 void releaseCachedLargeBuffers() noexcept;
 // The bytes the kept blocks hold.
 std::size_t cachedLargeBufferBytes() noexcept;
-// Has the C library keep the heap memory freed between frames for the next ones, process-wide:
-// glibc gives back the free memory at the top of a heap as soon as it passes 128 KiB, and the
-// next frame's scratch (a comparison's keepers and tallies, the raster's bins: hundreds of KiB
-// a frame) is then faulted in again (~300 page faults, 8 % of a warm 1080p comparison). Sets
-// M_MMAP_THRESHOLD to 32 MiB (what glibc's own adjustment reaches at most) and M_TRIM_THRESHOLD
-// to 64 MiB with mallopt; elsewhere than glibc it does nothing. For a program's start (zcheck's
-// command calls it first thing), not for a library's: it changes malloc for the whole process.
-// releaseCachedLargeBuffers still gives all of it back.
-void retainFreedHeapMemory() noexcept;
 
 // std::allocator's contract, with memory from allocateLarge and elements made with no value
 // default-initialised (an int or a double is then left as it was, not zeroed).
