@@ -51,6 +51,8 @@ ratios = r["ratios"]
 # warm phases against their warm repeats.
 assert abs(ratios["trace-throughput/embree"]["value"] - ref["embree_cold_trace"]["median_ms"] / p["trace"]["median_ms"]) < 1e-9
 assert abs(ratios["warm-trace-throughput/embree"]["value"] - ref["embree_trace"]["median_ms"] / p["warm_trace"]["median_ms"]) < 1e-9
+whole = p["whole"]["median_ms"] / (p["load"]["median_ms"] + ref["embree_bvh"]["median_ms"] + ref["embree_cold_trace"]["median_ms"])
+assert abs(ratios["whole/(load+embree-bvh+embree-trace)"]["value"] - whole) < 1e-9
 if "llvmpipe_draw" in ref:
     assert "llvmpipe" in ref["llvmpipe_renderer"], ref
     # The same depth buffer drawn by Mesa: coverage and depth agree almost everywhere.
