@@ -3,9 +3,10 @@
 // Only libEGL is linked: every GL entry point comes from eglGetProcAddress, so the types
 // and constants are taken from the Khronos header without its prototypes.
 #include <EGL/egl.h>
-#include <malloc.h>
 #include <EGL/eglext.h>
 #include <GL/glcorearb.h>
+
+#include <malloc.h>
 
 #include <chrono>
 #include <cstdio>
@@ -454,25 +455,31 @@ void setDepthState(const Gl& gl, const GlDepthInput& input, bool zeroToOne)
     gl.check("setting the depth state");
 }
 
+// One draw of the whole mesh into the bound framebuffer, cleared first and finished.
+void drawMesh(const Gl& gl, const GlDepthInput& input)
+{
+    gl.Clear(GL_DEPTH_BUFFER_BIT);
+    gl.DrawElements(GL_TRIANGLES, static_cast<GLsizei>(3 * input.triangleCount), GL_UNSIGNED_INT, nullptr);
+    gl.Finish();
+}
+
+// The wall time of step() in milliseconds.
+template <class Step>
+double millisecondsOf(Step step)
+{
+    const auto start = std::chrono::steady_clock::now();
+    step();
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
 // One warm-up draw, then `repeats` timed ones: each one's wall time in milliseconds (GlDepthTiming::drawMs).
 std::vector<double> timeDraws(const Gl& gl, const GlDepthInput& input, int repeats)
 {
-    const auto indexCount = static_cast<GLsizei>(3 * input.triangleCount);
-    const auto draw = [&] {
-        gl.Clear(GL_DEPTH_BUFFER_BIT);
-        gl.DrawElements(GL_TRIANGLES, indexCount, GL_UNSIGNED_INT, nullptr);
-        gl.Finish();
-    };
-    draw(); // warm-up: llvmpipe generates its shader and rasterizer code with LLVM here
+    drawMesh(gl, input);  // warm-up: llvmpipe generates its shader and rasterizer code with LLVM here
     gl.check("warm-up draw");
     std::vector<double> drawMs;
     drawMs.reserve(static_cast<std::size_t>(repeats));
-    for (int repeat = 0; repeat < repeats; ++repeat) {
-        const auto start = std::chrono::steady_clock::now();
-        draw();
-        const auto end = std::chrono::steady_clock::now();
-        drawMs.push_back(std::chrono::duration<double, std::milli>(end - start).count());
-    }
+    for (int repeat = 0; repeat < repeats; ++repeat) drawMs.push_back(millisecondsOf([&] { drawMesh(gl, input); }));
     gl.check("timed draws");
     return drawMs;
 }
@@ -481,7 +488,6 @@ std::vector<double> timeDraws(const Gl& gl, const GlDepthInput& input, int repea
 // after the warm ones: the framebuffer drawn before is bound again at the end.
 std::vector<double> timeColdDraws(const Gl& gl, const GlObjects& objects, const GlDepthInput& input, int repeats)
 {
-    const auto indexCount = static_cast<GLsizei>(3 * input.triangleCount);
     std::vector<double> drawMs;
     drawMs.reserve(static_cast<std::size_t>(repeats));
     for (int repeat = 0; repeat < repeats; ++repeat) {
@@ -489,14 +495,11 @@ std::vector<double> timeColdDraws(const Gl& gl, const GlObjects& objects, const 
         malloc_trim(0);  // memory the C library kept from freed buffers given back: the new one is untouched
 #endif
         GLuint renderbuffer = 0, framebuffer = 0;
-        const auto start = std::chrono::steady_clock::now();
-        createDepthTarget(gl, input, depthFormatOf(input), input.samples, renderbuffer, framebuffer,
-                          "creating a new depth framebuffer");
-        gl.Clear(GL_DEPTH_BUFFER_BIT);
-        gl.DrawElements(GL_TRIANGLES, indexCount, GL_UNSIGNED_INT, nullptr);
-        gl.Finish();
-        const auto end = std::chrono::steady_clock::now();
-        drawMs.push_back(std::chrono::duration<double, std::milli>(end - start).count());
+        drawMs.push_back(millisecondsOf([&] {
+            createDepthTarget(gl, input, depthFormatOf(input), input.samples, renderbuffer, framebuffer,
+                              "creating a new depth framebuffer");
+            drawMesh(gl, input);
+        }));
         gl.BindFramebuffer(GL_FRAMEBUFFER, objects.framebuffer);
         gl.DeleteFramebuffers(1, &framebuffer);
         gl.DeleteRenderbuffers(1, &renderbuffer);
