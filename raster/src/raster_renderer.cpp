@@ -299,9 +299,12 @@ double faultyStoredDepth(const Viewport& vp, double interpolated, int col, int r
 // (48 KB), then copied into the frame once.
 struct TileBuffer {
     static constexpr int kSide = RasterRenderer::kTileSize;
+    // Entries past a row's last pixel that a vector kernel's group of lanes may read and write
+    // back unchanged (at most 7, past the last row's: kept in the buffer).
+    static constexpr int kOverrun = 8;
     int col0, row0;  // the tile's top-left pixel in the frame
-    double key[kSide * kSide];
-    std::uint32_t primitive[kSide * kSide];
+    alignas(64) double key[kSide * kSide + kOverrun];
+    alignas(64) std::uint32_t primitive[kSide * kSide + kOverrun];
 };
 
 // Scan one triangle inside one tile; `PixelFaults`: a fault changes how a pixel's stored
@@ -357,6 +360,7 @@ ZCHECK_ALWAYS_INLINE inline void drawInTileLanes(const DepthSettings& depth, con
     // a group eight pixels on adds 8·A_k·256, a row down B_k·256 (exact: what the scalar loop
     // computes as A_k·px + B_k·py + C_k, in the same wrapping int64 arithmetic).
     constexpr int kLanes = L::kLanes;  // pixels per group
+    static_assert(kLanes - 1 <= TileBuffer::kOverrun, "a row's last group stays in the tile buffer");
     Int64 rowE[3], down[3], across[3];
     for (int k = 0; k < 3; ++k) {
         const std::int64_t px = col0 * kSubpixel + kHalfPixel, py = row0 * kSubpixel + kHalfPixel;
@@ -389,10 +393,17 @@ ZCHECK_ALWAYS_INLINE inline void drawInTileLanes(const DepthSettings& depth, con
             // so it returns every clamped value unchanged (NaN and −0 included).
             const Real key = unorm ? (windowDepth * maxCode + noFractionBits) - noFractionBits
                                    : L::toReal(L::toFloat(windowDepth));
-            const Real stored = L::maskedLoad(covered, keyRow + col);
-            const Mask nearer = covered & (reversed ? stored < key : key < stored);
-            L::maskedStore(nearer, keyRow + col, key);
-            L::maskedStore(nearer, primitiveRow + col, primitive);
+            if constexpr (L::kFastMaskedStores) {
+                const Real stored = L::maskedLoad(covered, keyRow + col);
+                const Mask nearer = covered & (reversed ? stored < key : key < stored);
+                L::maskedStore(nearer, keyRow + col, key);
+                L::maskedStore(nearer, primitiveRow + col, primitive);
+            } else {  // the whole group read and written back, the lanes not nearer unchanged (kOverrun)
+                const Real stored = L::load(keyRow + col);
+                const Mask nearer = covered & (reversed ? stored < key : key < stored);
+                L::store(keyRow + col, L::select(nearer, key, stored));
+                L::store(primitiveRow + col, L::select(nearer, primitive, L::load(primitiveRow + col)));
+            }
             e0 = e0 + across[0], e1 = e1 + across[1], e2 = e2 + across[2];
             centre = centre + groupStep;
         }

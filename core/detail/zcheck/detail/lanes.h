@@ -21,7 +21,10 @@
 //             bits32, and toMask (to a Mask, where doubles' lanes need it)
 // and the loads, stores, gathers and conversions the kernels need, each named for what it does.
 // A masked load reads no memory of a lane outside its mask, a masked store writes none (so a
-// group of eight may run past the end of its row). Every operation on doubles is the one IEEE
+// group of eight may run past the end of its row). L::kFastMaskedStores says whether a masked
+// store costs what a store does: with AVX-512's mask registers it does; AVX2's vmaskmov stores
+// are microcode on AMD's Zen 1–3 and never forward to a later load on Intel, so a hot loop of
+// the AVX2 form that may write its whole group reads it, blends (select) and stores it. Every operation on doubles is the one IEEE
 // operation its name says, so a kernel's lanes compute the bits its scalar form computes.
 //
 // The members carry their form's target and are inlined into the entry function (flatten); call
@@ -111,6 +114,7 @@ struct Lanes32 {
 struct Avx2Lanes : Lanes32 {
 #define ZCHECK_LANE ZCHECK_TARGET_AVX2 inline
     static constexpr int kLanes = 8;
+    static constexpr bool kFastMaskedStores = false;
     ZCHECK_LANES32_NAMES;
     struct Mask {
         __m256i lo, hi;  // per 64-bit lane: all ones (true) or zeros
@@ -340,6 +344,7 @@ struct Avx2Lanes : Lanes32 {
 struct Avx512Lanes : Lanes32 {
 #define ZCHECK_LANE ZCHECK_TARGET_AVX512 inline
     static constexpr int kLanes = 8;
+    static constexpr bool kFastMaskedStores = true;
     ZCHECK_LANES32_NAMES;
     struct Mask {
         __mmask8 k;
@@ -478,6 +483,7 @@ struct Avx512Lanes : Lanes32 {
 struct Avx2Lanes4 {
 #define ZCHECK_LANE ZCHECK_TARGET_AVX2 inline
     static constexpr int kLanes = 4;
+    static constexpr bool kFastMaskedStores = false;
     struct Mask {
         __m256i v;  // per 64-bit lane: all ones or zeros
         friend ZCHECK_LANE Mask operator&(Mask a, Mask b) { return {_mm256_and_si256(a.v, b.v)}; }
@@ -503,8 +509,8 @@ struct Avx2Lanes4 {
     };
     static ZCHECK_LANE Real set1(double x) { return {_mm256_set1_pd(x)}; }
     static ZCHECK_LANE Real load(const double* p) { return {_mm256_loadu_pd(p)}; }
-    static ZCHECK_LANE Real maskedLoad(Mask m, const double* p) { return {_mm256_maskload_pd(p, m.v)}; }
-    static ZCHECK_LANE void maskedStore(Mask m, double* p, Real a) { _mm256_maskstore_pd(p, m.v, a.v); }
+    static ZCHECK_LANE void store(double* p, Real a) { _mm256_storeu_pd(p, a.v); }
+    static ZCHECK_LANE Real select(Mask m, Real ifTrue, Real ifFalse) { return {_mm256_blendv_pd(ifFalse.v, ifTrue.v, _mm256_castsi256_pd(m.v))}; }
     static ZCHECK_LANE Real max(Real a, Real b) { return {_mm256_max_pd(a.v, b.v)}; }
     static ZCHECK_LANE Real min(Real a, Real b) { return {_mm256_min_pd(a.v, b.v)}; }
     static ZCHECK_LANE Float toFloat(Real a) { return {_mm256_cvtpd_ps(a.v)}; }
@@ -517,11 +523,14 @@ struct Avx2Lanes4 {
     }
     static ZCHECK_LANE Mask nonNegative(Int64 a) { return {_mm256_cmpgt_epi64(a.v, _mm256_set1_epi64x(-1))}; }
     static ZCHECK_LANE Int32 set1(std::int32_t x) { return {_mm_set1_epi32(x)}; }
-    static ZCHECK_LANE void maskedStore(Mask m, std::uint32_t* p, Int32 a)
+    static ZCHECK_LANE Int32 load(const std::uint32_t* p) { return {_mm_loadu_si128(reinterpret_cast<const __m128i*>(p))}; }
+    static ZCHECK_LANE void store(std::uint32_t* p, Int32 a) { _mm_storeu_si128(reinterpret_cast<__m128i*>(p), a.v); }
+    // The mask with one 32-bit lane per lane.
+    static ZCHECK_LANE __m128i narrow(Mask m)
     {
-        const __m128i m32 = _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(m.v, _mm256_setr_epi32(0, 2, 4, 6, 0, 0, 0, 0)));
-        _mm_maskstore_epi32(reinterpret_cast<int*>(p), m32, a.v);
+        return _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(m.v, _mm256_setr_epi32(0, 2, 4, 6, 0, 0, 0, 0)));
     }
+    static ZCHECK_LANE Int32 select(Mask m, Int32 ifTrue, Int32 ifFalse) { return {_mm_blendv_epi8(ifFalse.v, ifTrue.v, narrow(m))}; }
 #undef ZCHECK_LANE
 };
 
