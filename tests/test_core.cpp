@@ -727,7 +727,43 @@ TEST_CASE("a 1080p byte-per-pixel buffer gets a huge page of its own and is kept
     }
     REQUIRE(cachedLargeBufferBytes() == kHugePage);
     releaseCachedLargeBuffers();
-    { LargeVector<std::uint8_t> below(kHugePage / 2 - 1); }  // from operator new, not kept
+    { LargeVector<std::uint8_t> below(kHugePage / 2 - 1); }  // pages of its own, not a huge one: kept too
+    REQUIRE(cachedLargeBufferBytes() == kHugePage / 2);
+    releaseCachedLargeBuffers();
+    REQUIRE(cachedLargeBufferBytes() == 0);
+}
+
+// A frame's scratch of tens to hundreds of KiB (the comparison's keepers) was freed to glibc,
+// which gave it back to the system at once, and faulted in again the next frame (~150 faults
+// a warm 1080p comparison). From 64 KiB a buffer is pages of its own, kept as the large ones.
+TEST_CASE("a released buffer of 64 KiB to 1 MiB is kept for the next one of its size, and given back with the rest",
+          "[core][large_buffer]")
+{
+    constexpr std::size_t kStep = std::size_t(64) << 10;
+    releaseCachedLargeBuffers();
+    { LargeVector<std::uint8_t> tooSmall(kStep - 1); }  // from operator new, not kept
+    REQUIRE(cachedLargeBufferBytes() == 0);
+    const void* first = nullptr;
+    {
+        LargeVector<std::uint32_t> keeper;
+        keeper.reserve(41'480);  // a 1080p keeper's 2·keep: 165,920 bytes, three steps
+        REQUIRE(reinterpret_cast<std::uintptr_t>(keeper.data()) % 4096 == 0);
+        keeper.assign(41'480, 9u);
+        first = keeper.data();
+    }
+    REQUIRE(cachedLargeBufferBytes() == 3 * kStep);
+    {
+        LargeVector<float> sameSteps(3 * kStep / sizeof(float));  // another type, the same rounded size
+        REQUIRE(static_cast<const void*>(sameSteps.data()) == first);
+        REQUIRE(cachedLargeBufferBytes() == 0);
+        // A huge-page buffer meanwhile neither takes nor gives up a medium block.
+        { LargeVector<double> depth(kHugePage / sizeof(double)); }
+        REQUIRE(cachedLargeBufferBytes() == kHugePage);
+    }
+    REQUIRE(cachedLargeBufferBytes() == kHugePage + 3 * kStep);
+    { LargeVector<std::uint8_t> otherSize(5 * kStep); }  // finds none of its size: the medium ones given back
+    REQUIRE(cachedLargeBufferBytes() == kHugePage + 5 * kStep);
+    releaseCachedLargeBuffers();
     REQUIRE(cachedLargeBufferBytes() == 0);
 }
 
@@ -748,7 +784,7 @@ TEST_CASE("large buffers given back are the system's again: the next ones are fr
     for (int round = 0; round < 4; ++round) {
         releaseCachedLargeBuffers();
         std::vector<LargeVector<double>> buffers;
-        for (std::size_t size : {kValues, 2 * kValues, kValues / 2, kValues}) {
+        for (std::size_t size : {kValues, 2 * kValues, kValues / 2, kValues, std::size_t(20'000), std::size_t(100'000)}) {
             buffers.emplace_back();
             buffers.back().resize(size);  // uninitialised: what the memory held
             INFO("round " << round << ", " << size << " values");

@@ -32,7 +32,10 @@ std::uint32_t kthSmallestBits(const std::uint32_t* bits, std::size_t n, std::siz
     return found;
 }
 
-LargestValues::LargestValues(std::size_t keep, float floor) : keep_(std::max<std::size_t>(keep, 1)), floor_(floatBits(floor)) {}
+LargestValues::LargestValues(std::size_t keep, float floor) : keep_(std::max<std::size_t>(keep, 1)), floor_(floatBits(floor))
+{
+    kept_.reserve(2 * keep_);
+}
 
 void LargestValues::shrink()
 {
@@ -52,12 +55,11 @@ void LargestValues::shrink()
 
 std::optional<double> LargestValues::percentile99(const std::vector<const LargestValues*>& keepers)
 {
-    std::size_t n = 0;
-    std::vector<std::uint32_t> all;
-    for (const LargestValues* keeper : keepers) {
-        n += keeper->count_;
-        all.insert(all.end(), keeper->kept_.begin(), keeper->kept_.end());
-    }
+    std::size_t n = 0, keptByAll = 0;
+    for (const LargestValues* keeper : keepers) n += keeper->count_, keptByAll += keeper->kept_.size();
+    LargeVector<std::uint32_t> all;  // a block kept from frame to frame, as the keepers' own
+    all.reserve(keptByAll);
+    for (const LargestValues* keeper : keepers) all.insert(all.end(), keeper->kept_.begin(), keeper->kept_.end());
     if (n == 0) return 0.0;
     const std::size_t rank = std::min(n - 1, static_cast<std::size_t>(std::ceil(0.99 * double(n))) - 1);
     const std::size_t fromTop = n - rank;  // the percentile is the fromTop-th largest value

@@ -18,6 +18,7 @@
 //   std::optional<double> p99 = LargestValues::percentile99({&mine, &other});
 #include "zcheck/detail/kernel_choice.h"
 #include "zcheck/detail/lane_mask.h"
+#include "zcheck/large_buffer.h"
 
 #include <algorithm>
 #include <cstddef>
@@ -105,7 +106,9 @@ private:
     std::size_t count_ = 0;
     std::uint32_t floor_;          // values below it are counted, never kept
     std::uint32_t threshold_ = 0;  // the smallest kept value once keep_ are kept
-    std::vector<std::uint32_t> kept_;
+    // At most 2·keep_, reserved at once: ~160 KiB at 1080p, a block kept from frame to frame
+    // (large_buffer.h), where growing a std::vector each frame faulted its pages in again.
+    LargeVector<std::uint32_t> kept_;
 };
 
 }  // namespace zcheck

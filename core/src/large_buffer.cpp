@@ -23,15 +23,26 @@ constexpr std::size_t kHugePage = std::size_t(2) << 20;
 // took was within the noise of this machine: the kernel's zeroing of the pages dominates, and
 // that is the same either way.) A buffer of 1 to 2 MiB leaves at most half of its page unused.
 constexpr std::size_t kLargeFrom = kHugePage / 2;
-constexpr std::size_t kCacheLimit = std::size_t(1) << 30;  // bytes the cache may hold at most
+// From here up to kLargeFrom a buffer is whole pages of its own (mapped, rounded up to
+// kMediumStep), kept when released as the large ones are: per-frame scratch of tens to
+// hundreds of KiB (a comparison's keepers, ~160 KiB each at 1080p) was given back by glibc as
+// soon as it was freed and faulted in again the next frame, ~150 faults a warm comparison.
+constexpr std::size_t kKeptFrom = std::size_t(64) << 10;
+constexpr std::size_t kMediumStep = kKeptFrom;
+constexpr std::size_t kCacheLimit = std::size_t(1) << 30;  // bytes the large blocks' cache may hold at most
+constexpr std::size_t kMediumCacheLimit = std::size_t(64) << 20;
 
-// Blocks of whole huge pages that were released, kept faulted in for an allocation of the
-// same rounded size (the next frame's buffers). An allocation that finds none releases them
-// all before it maps new memory, so that the cache never raises the peak of the memory
-// allocateLarge holds: what it keeps was in use together before, and is given back before
-// more is mapped. Blocks are freed outside the lock.
+// Blocks of one class (whole huge pages, or whole medium steps) that were released, kept
+// faulted in for an allocation of the same rounded size (the next frame's buffers), up to
+// `limit` bytes. An allocation that finds none releases them all before it maps new memory, so
+// that the cache never raises the peak of the memory allocateLarge holds: what it keeps was in
+// use together before, and is given back before more is mapped. Blocks are given back outside
+// the lock.
 class BlockCache {
 public:
+    using GiveBack = void (*)(void* data, std::size_t bytes) noexcept;
+    BlockCache(std::size_t limit, GiveBack giveBack) : limit_(limit), giveBack_(giveBack) {}
+
     void* take(std::size_t rounded)
     {
         Blocks released;
@@ -52,11 +63,11 @@ public:
     void keep(void* data, std::size_t rounded) noexcept
     {
         const std::lock_guard<std::mutex> lock(mutex_);
-        if (held_ + rounded <= kCacheLimit && kept_.count < kMaxBlocks) {
+        if (held_ + rounded <= limit_ && kept_.count < kMaxBlocks) {
             kept_.block[kept_.count++] = {data, rounded};
             held_ += rounded;
         } else {
-            std::free(data);
+            giveBack_(data, rounded);
         }
     }
     void releaseAll() noexcept
@@ -92,24 +103,32 @@ private:
         held_ = 0;
         return all;
     }
-    static void freeAll(const Blocks& blocks) noexcept
+    void freeAll(const Blocks& blocks) const noexcept
     {
-        for (std::size_t k = 0; k < blocks.count; ++k) std::free(blocks.block[k].data);
+        for (std::size_t k = 0; k < blocks.count; ++k) giveBack_(blocks.block[k].data, blocks.block[k].bytes);
     }
+    const std::size_t limit_;
+    const GiveBack giveBack_;
     std::mutex mutex_;
     Blocks kept_;
     std::size_t held_ = 0;
 };
 
-// Never destroyed: buffers may be released by static destructors after this file's ones ran.
+// The caches of large blocks (from std::aligned_alloc) and of medium ones (mapped). Never
+// destroyed: buffers may be released by static destructors after this file's ones ran.
 BlockCache& blockCache()
 {
-    static BlockCache* cache = new BlockCache;
+    static BlockCache* cache = new BlockCache(kCacheLimit, [](void* data, std::size_t) noexcept { std::free(data); });
+    return *cache;
+}
+BlockCache& mediumBlockCache()
+{
+    static BlockCache* cache = new BlockCache(kMediumCacheLimit, [](void* data, std::size_t bytes) noexcept { munmap(data, bytes); });
     return *cache;
 }
 
-// A block's size: whole huge pages (wraps to less than `bytes` only for impossible sizes).
-std::size_t roundedToHugePages(std::size_t bytes) noexcept { return (bytes + kHugePage - 1) / kHugePage * kHugePage; }
+// A block's size: whole steps (wraps to less than `bytes` only for impossible sizes).
+std::size_t roundedUp(std::size_t bytes, std::size_t step) noexcept { return (bytes + step - 1) / step * step; }
 
 }  // namespace
 
@@ -125,8 +144,15 @@ void adviseHugePages(void* data, std::size_t bytes)
 
 void* allocateLarge(std::size_t bytes)
 {
-    if (bytes < kLargeFrom) return ::operator new(bytes);
-    const std::size_t rounded = roundedToHugePages(bytes);
+    if (bytes < kKeptFrom) return ::operator new(bytes);
+    if (bytes < kLargeFrom) {
+        const std::size_t rounded = roundedUp(bytes, kMediumStep);
+        if (void* reused = mediumBlockCache().take(rounded)) return reused;
+        void* data = mmap(nullptr, rounded, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+        if (data == MAP_FAILED) throw std::bad_alloc();
+        return data;
+    }
+    const std::size_t rounded = roundedUp(bytes, kHugePage);
     if (rounded < bytes) throw std::bad_alloc();
     if (void* reused = blockCache().take(rounded)) return reused;
     void* data = std::aligned_alloc(kHugePage, rounded);
@@ -137,21 +163,24 @@ void* allocateLarge(std::size_t bytes)
 
 void releaseLarge(void* data, std::size_t bytes) noexcept
 {
-    if (bytes < kLargeFrom) {
+    if (bytes < kKeptFrom) {
         ::operator delete(data);
+    } else if (bytes < kLargeFrom) {
+        mediumBlockCache().keep(data, roundedUp(bytes, kMediumStep));
     } else {
-        blockCache().keep(data, roundedToHugePages(bytes));
+        blockCache().keep(data, roundedUp(bytes, kHugePage));
     }
 }
 
 void releaseCachedLargeBuffers() noexcept
 {
     blockCache().releaseAll();
+    mediumBlockCache().releaseAll();
 #ifdef __GLIBC__
     malloc_trim(0);  // the heap's free pages too, not only those at its top
 #endif
 }
 
-std::size_t cachedLargeBufferBytes() noexcept { return blockCache().held(); }
+std::size_t cachedLargeBufferBytes() noexcept { return blockCache().held() + mediumBlockCache().held(); }
 
 }  // namespace zcheck

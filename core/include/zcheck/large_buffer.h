@@ -33,19 +33,20 @@
 namespace zcheck {
 
 // Memory for `bytes`: from 1 MiB up, whole 2 MiB pages on a 2 MiB boundary, advised huge
-// pages (a 1080p byte-per-pixel image fits one); smaller from operator new. Release with
-// releaseLarge and the same byte count. Throws std::bad_alloc.
+// pages (a 1080p byte-per-pixel image fits one); from 64 KiB, whole pages mapped for it,
+// rounded up to 64 KiB (a frame's scratch: a comparison's keepers); smaller from operator new.
+// Release with releaseLarge and the same byte count. Throws std::bad_alloc.
 //
-// Released blocks of huge pages are kept (up to 1 GiB), already faulted in, and handed
-// back to the next allocation of the same size rounded up to 2 MiB: a program that renders
-// frame after frame pays the page faults of its buffers once, not per frame (as a GPU
-// driver's reused framebuffer does). An allocation that finds no block of its size first
-// releases every kept one, so the cache never raises the peak of the memory these functions
-// hold: it keeps only memory that was in use together, and gives it back before more is
-// mapped. It does keep that memory resident until then, while the rest of the process (a
-// mesh, a BVH, other allocations) may grow: a long-lived program that is done rendering
-// calls releaseCachedLargeBuffers. Thread-safe. The contents of a reused block are whatever
-// its last user left.
+// Released blocks of 64 KiB and more are kept (huge-page blocks up to 1 GiB, the others up to
+// 64 MiB), already faulted in, and handed back to the next allocation of the same rounded
+// size: a program that renders frame after frame pays the page faults of its buffers once,
+// not per frame (as a GPU driver's reused framebuffer does). An allocation that finds no block
+// of its size first releases every kept one of its class, so the cache never raises the peak
+// of the memory these functions hold: it keeps only memory that was in use together, and
+// gives it back before more is mapped. It does keep that memory resident until then, while
+// the rest of the process (a mesh, a BVH, other allocations) may grow: a long-lived program
+// that is done rendering calls releaseCachedLargeBuffers. Thread-safe. The contents of a
+// reused block are whatever its last user left.
 void* allocateLarge(std::size_t bytes);
 void releaseLarge(void* data, std::size_t bytes) noexcept;
 // Gives every kept block back to the system, and has the C library give back the free memory
@@ -91,8 +92,8 @@ struct LargeBufferAllocator {
     bool operator!=(const LargeBufferAllocator<U>&) const noexcept { return false; }
 };
 
-// A per-frame buffer: a std::vector on aligned huge pages whose resize() leaves new elements
-// of trivial types uninitialised.
+// A per-frame buffer: a std::vector on pages of its own (aligned huge pages from 1 MiB) whose
+// resize() leaves new elements of trivial types uninitialised.
 template <class T>
 using LargeVector = std::vector<T, LargeBufferAllocator<T>>;
 
