@@ -219,10 +219,26 @@ struct Avx2Lanes : Lanes32 {
                 _mm256_mask_i32gather_pd(_mm256_setzero_pd(), table, _mm256_extracti128_si256(index.v, 1), _mm256_castsi256_pd(m.hi), 8)};
     }
     // Eight packed float triples (24 floats from p) as three lanes of doubles: x, y, z.
+    // Element k of each of eight packed triples, from the 24 32-bit values in a, b, c (8 each):
+    // two blends and a permute, where three gathers were several times the work (and slow on
+    // AMD's Zen 2 and 3).
+    template <int k>
+    static ZCHECK_LANE __m256 tripleElements(__m256 a, __m256 b, __m256 c)
+    {
+        // Lane j of a, b, c holds element (j mod 3), (j + 2) mod 3, (j + 1) mod 3 of some triple.
+        constexpr int kFromB = k == 0 ? 0x92 : k == 1 ? 0x24 : 0x49, kFromC = k == 0 ? 0x24 : k == 1 ? 0x49 : 0x92;
+        const __m256 lanes = _mm256_blend_ps(_mm256_blend_ps(a, b, kFromB), c, kFromC);
+        const __m256i order = k == 0 ? _mm256_setr_epi32(0, 3, 6, 1, 4, 7, 2, 5)
+                            : k == 1 ? _mm256_setr_epi32(1, 4, 7, 2, 5, 0, 3, 6)
+                                     : _mm256_setr_epi32(2, 5, 0, 3, 6, 1, 4, 7);
+        return _mm256_permutevar8x32_ps(lanes, order);
+    }
     static ZCHECK_LANE void loadTriples(const float* p, Real (&xyz)[3])
     {
-        const __m256i stride = _mm256_setr_epi32(0, 3, 6, 9, 12, 15, 18, 21);
-        for (int k = 0; k < 3; ++k) xyz[k] = toReal(Float{_mm256_i32gather_ps(p + k, stride, 4)});
+        const __m256 a = _mm256_loadu_ps(p), b = _mm256_loadu_ps(p + 8), c = _mm256_loadu_ps(p + 16);
+        xyz[0] = toReal(Float{tripleElements<0>(a, b, c)});
+        xyz[1] = toReal(Float{tripleElements<1>(a, b, c)});
+        xyz[2] = toReal(Float{tripleElements<2>(a, b, c)});
     }
 
     // 64-bit integers.
@@ -333,8 +349,11 @@ struct Avx2Lanes : Lanes32 {
     // Eight packed int32 triples (24 ints from p) as three lanes: corner 0, 1, 2.
     static ZCHECK_LANE void loadTriples(const std::uint32_t* p, Int32 (&corner)[3])
     {
-        const __m256i stride = _mm256_setr_epi32(0, 3, 6, 9, 12, 15, 18, 21);
-        for (int k = 0; k < 3; ++k) corner[k] = {_mm256_i32gather_epi32(reinterpret_cast<const int*>(p + k), stride, 4)};
+        const float* f = reinterpret_cast<const float*>(p);  // moved as bits, never as numbers
+        const __m256 a = _mm256_loadu_ps(f), b = _mm256_loadu_ps(f + 8), c = _mm256_loadu_ps(f + 16);
+        corner[0] = {_mm256_castps_si256(tripleElements<0>(a, b, c))};
+        corner[1] = {_mm256_castps_si256(tripleElements<1>(a, b, c))};
+        corner[2] = {_mm256_castps_si256(tripleElements<2>(a, b, c))};
     }
 #undef ZCHECK_LANE
 };
