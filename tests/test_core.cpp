@@ -756,13 +756,22 @@ TEST_CASE("a released buffer of 64 KiB to 1 MiB is kept for the next one of its 
         LargeVector<float> sameSteps(3 * kStep / sizeof(float));  // another type, the same rounded size
         REQUIRE(static_cast<const void*>(sameSteps.data()) == first);
         REQUIRE(cachedLargeBufferBytes() == 0);
-        // A huge-page buffer meanwhile neither takes nor gives up a medium block.
-        { LargeVector<double> depth(kHugePage / sizeof(double)); }
-        REQUIRE(cachedLargeBufferBytes() == kHugePage);
     }
-    REQUIRE(cachedLargeBufferBytes() == kHugePage + 3 * kStep);
-    { LargeVector<std::uint8_t> otherSize(5 * kStep); }  // finds none of its size: the medium ones given back
-    REQUIRE(cachedLargeBufferBytes() == kHugePage + 5 * kStep);
+    REQUIRE(cachedLargeBufferBytes() == 3 * kStep);
+    {
+        // A buffer of a size none is kept for, of either class, finds nothing: everything kept, of
+        // both classes, is given back before new memory is mapped (the peak never grows).
+        LargeVector<double> depth(kHugePage / sizeof(double));
+        REQUIRE(cachedLargeBufferBytes() == 0);
+    }
+    REQUIRE(cachedLargeBufferBytes() == kHugePage);
+    { LargeVector<std::uint8_t> otherSize(5 * kStep); }
+    REQUIRE(cachedLargeBufferBytes() == 5 * kStep);
+    {
+        LargeVector<std::uint8_t> again(5 * kStep - 1);  // the same rounded size: the kept block
+        REQUIRE(cachedLargeBufferBytes() == 0);
+    }
+    REQUIRE(cachedLargeBufferBytes() == 5 * kStep);
     releaseCachedLargeBuffers();
     REQUIRE(cachedLargeBufferBytes() == 0);
 }

@@ -55,10 +55,12 @@ void LargestValues::shrink()
 
 std::optional<double> LargestValues::percentile99(const std::vector<const LargestValues*>& keepers)
 {
-    std::size_t n = 0, keptByAll = 0;
-    for (const LargestValues* keeper : keepers) n += keeper->count_, keptByAll += keeper->kept_.size();
-    LargeVector<std::uint32_t> all;  // a block kept from frame to frame, as the keepers' own
-    all.reserve(keptByAll);
+    std::size_t n = 0, most = 0;
+    for (const LargestValues* keeper : keepers) n += keeper->count_, most += 2 * keeper->keep_;
+    // A block kept from frame to frame, as the keepers' own: of the size they may hold at most,
+    // the same each frame (what they hold varies, and a block of a size not kept gives up all).
+    LargeVector<std::uint32_t> all;
+    all.reserve(most);
     for (const LargestValues* keeper : keepers) all.insert(all.end(), keeper->kept_.begin(), keeper->kept_.end());
     if (n == 0) return 0.0;
     const std::size_t rank = std::min(n - 1, static_cast<std::size_t>(std::ceil(0.99 * double(n))) - 1);

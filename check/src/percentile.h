@@ -37,6 +37,8 @@ std::uint32_t kthSmallestBits(const std::uint32_t* bits, std::size_t n, std::siz
 
 class LargestValues {
 public:
+    // Holds 8·keep bytes from the start (2·keep values; large_buffer.h keeps such a block from
+    // frame to frame), whatever it is given.
     explicit LargestValues(std::size_t keep, float floor = 0.0f);
 
     void add(float value)
@@ -106,8 +108,8 @@ private:
     std::size_t count_ = 0;
     std::uint32_t floor_;          // values below it are counted, never kept
     std::uint32_t threshold_ = 0;  // the smallest kept value once keep_ are kept
-    // At most 2·keep_, reserved at once: ~160 KiB at 1080p, a block kept from frame to frame
-    // (large_buffer.h), where growing a std::vector each frame faulted its pages in again.
+    // At most 2·keep_, reserved by the constructor: ~160 KiB at 1080p, a block kept from frame to
+    // frame (large_buffer.h), where growing a std::vector each frame faulted its pages in again.
     LargeVector<std::uint32_t> kept_;
 };
 

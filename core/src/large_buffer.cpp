@@ -23,52 +23,51 @@ constexpr std::size_t kHugePage = std::size_t(2) << 20;
 // took was within the noise of this machine: the kernel's zeroing of the pages dominates, and
 // that is the same either way.) A buffer of 1 to 2 MiB leaves at most half of its page unused.
 constexpr std::size_t kLargeFrom = kHugePage / 2;
-// From here up to kLargeFrom a buffer is whole pages of its own (mapped, rounded up to
-// kMediumStep), kept when released as the large ones are: per-frame scratch of tens to
-// hundreds of KiB (a comparison's keepers, ~160 KiB each at 1080p) was given back by glibc as
-// soon as it was freed and faulted in again the next frame, ~150 faults a warm comparison.
+// From here up to kLargeFrom a buffer is whole pages of its own (rounded up to kMediumStep),
+// kept when released as the large ones are: per-frame scratch of tens to hundreds of KiB (a
+// comparison's keepers, ~160 KiB each at 1080p) was given back by glibc as soon as it was
+// freed and faulted in again the next frame, ~150 faults a warm comparison.
 constexpr std::size_t kKeptFrom = std::size_t(64) << 10;
 constexpr std::size_t kMediumStep = kKeptFrom;
-constexpr std::size_t kCacheLimit = std::size_t(1) << 30;  // bytes the large blocks' cache may hold at most
-constexpr std::size_t kMediumCacheLimit = std::size_t(64) << 20;
+constexpr std::size_t kPage = 4096;
+constexpr std::size_t kCacheLimit = std::size_t(1) << 30;        // bytes the huge-page blocks' cache may hold at most
+constexpr std::size_t kMediumCacheLimit = std::size_t(64) << 20;  // and the medium blocks' (a frame's scratch)
 
 // Blocks of one class (whole huge pages, or whole medium steps) that were released, kept
 // faulted in for an allocation of the same rounded size (the next frame's buffers), up to
-// `limit` bytes. An allocation that finds none releases them all before it maps new memory, so
-// that the cache never raises the peak of the memory allocateLarge holds: what it keeps was in
-// use together before, and is given back before more is mapped. Blocks are given back outside
-// the lock.
+// `limit` bytes. An allocation that finds none (take returns null) has every kept block of both
+// classes released before it maps new memory (allocateLarge), so that the caches never raise
+// the peak of the memory allocateLarge holds: what they keep was in use together before, and
+// is given back before more is mapped. Blocks are given back outside the lock.
 class BlockCache {
 public:
     using GiveBack = void (*)(void* data, std::size_t bytes) noexcept;
     BlockCache(std::size_t limit, GiveBack giveBack) : limit_(limit), giveBack_(giveBack) {}
 
+    // A kept block of `rounded` bytes, or null (none: the caller releases every kept block).
     void* take(std::size_t rounded)
     {
-        Blocks released;
-        {
-            const std::lock_guard<std::mutex> lock(mutex_);
-            for (std::size_t k = 0; k < kept_.count; ++k)
-                if (kept_.block[k].bytes == rounded) {
-                    void* data = kept_.block[k].data;
-                    held_ -= rounded;
-                    kept_.block[k] = kept_.block[--kept_.count];
-                    return data;
-                }
-            released = takeAllLocked();
-        }
-        freeAll(released);
+        const std::lock_guard<std::mutex> lock(mutex_);
+        for (std::size_t k = 0; k < kept_.count; ++k)
+            if (kept_.block[k].bytes == rounded) {
+                void* data = kept_.block[k].data;
+                held_ -= rounded;
+                kept_.block[k] = kept_.block[--kept_.count];
+                return data;
+            }
         return nullptr;
     }
     void keep(void* data, std::size_t rounded) noexcept
     {
-        const std::lock_guard<std::mutex> lock(mutex_);
-        if (held_ + rounded <= limit_ && kept_.count < kMaxBlocks) {
-            kept_.block[kept_.count++] = {data, rounded};
-            held_ += rounded;
-        } else {
-            giveBack_(data, rounded);
+        {
+            const std::lock_guard<std::mutex> lock(mutex_);
+            if (held_ + rounded <= limit_ && kept_.count < kMaxBlocks) {
+                kept_.block[kept_.count++] = {data, rounded};
+                held_ += rounded;
+                return;
+            }
         }
+        giveBack_(data, rounded);
     }
     void releaseAll() noexcept
     {
@@ -86,7 +85,7 @@ public:
     }
 
 private:
-    static constexpr std::size_t kMaxBlocks = 64;
+    static constexpr std::size_t kMaxBlocks = 256;  // a frame's keepers: two a thread
     struct Block {
         void* data;
         std::size_t bytes;
@@ -114,8 +113,23 @@ private:
     std::size_t held_ = 0;
 };
 
-// The caches of large blocks (from std::aligned_alloc) and of medium ones (mapped). Never
-// destroyed: buffers may be released by static destructors after this file's ones ran.
+// A medium block is mapped for itself and unmapped when given back: from glibc's heap, one
+// given back held its old contents after malloc_trim (a "cold" frame's memory was not new).
+// Under AddressSanitizer it comes from the sanitizer's allocator, which watches it.
+#if defined(__SANITIZE_ADDRESS__)
+void* mapMedium(std::size_t bytes) { return std::aligned_alloc(kPage, bytes); }
+void unmapMedium(void* data, std::size_t) noexcept { std::free(data); }
+#else
+void* mapMedium(std::size_t bytes)
+{
+    void* data = mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    return data == MAP_FAILED ? nullptr : data;
+}
+void unmapMedium(void* data, std::size_t bytes) noexcept { munmap(data, bytes); }
+#endif
+
+// The caches of huge-page blocks (from std::aligned_alloc) and of medium ones (mapMedium).
+// Never destroyed: buffers may be released by static destructors after this file's ones ran.
 BlockCache& blockCache()
 {
     static BlockCache* cache = new BlockCache(kCacheLimit, [](void* data, std::size_t) noexcept { std::free(data); });
@@ -123,8 +137,16 @@ BlockCache& blockCache()
 }
 BlockCache& mediumBlockCache()
 {
-    static BlockCache* cache = new BlockCache(kMediumCacheLimit, [](void* data, std::size_t bytes) noexcept { munmap(data, bytes); });
+    static BlockCache* cache = new BlockCache(kMediumCacheLimit, unmapMedium);
     return *cache;
+}
+
+// For an allocation no kept block was for: every kept block of both classes given back,
+// before new memory is mapped.
+void releaseBothCaches() noexcept
+{
+    blockCache().releaseAll();
+    mediumBlockCache().releaseAll();
 }
 
 // A block's size: whole steps (wraps to less than `bytes` only for impossible sizes).
@@ -148,13 +170,15 @@ void* allocateLarge(std::size_t bytes)
     if (bytes < kLargeFrom) {
         const std::size_t rounded = roundedUp(bytes, kMediumStep);
         if (void* reused = mediumBlockCache().take(rounded)) return reused;
-        void* data = mmap(nullptr, rounded, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-        if (data == MAP_FAILED) throw std::bad_alloc();
+        releaseBothCaches();
+        void* data = mapMedium(rounded);
+        if (!data) throw std::bad_alloc();
         return data;
     }
     const std::size_t rounded = roundedUp(bytes, kHugePage);
     if (rounded < bytes) throw std::bad_alloc();
     if (void* reused = blockCache().take(rounded)) return reused;
+    releaseBothCaches();
     void* data = std::aligned_alloc(kHugePage, rounded);
     if (!data) throw std::bad_alloc();
     adviseHugePages(data, rounded);

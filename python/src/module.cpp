@@ -129,7 +129,8 @@ the top, one per non-miss pixel, in scan order.)doc");
     m.def(
         "release_cached_buffers", [] { releaseCachedLargeBuffers(); },
         R"doc(Gives back to the system the per-frame buffers zcheck keeps for the next render of the same
-size (renders and comparisons of 1 MiB and more, up to 1 GiB in all; see cached_buffer_bytes),
+size (renders and comparisons of 1 MiB and more, up to 1 GiB in all, and a frame's scratch of
+64 KiB and more, up to 64 MiB; see cached_buffer_bytes),
 and has the C library give back the free memory its heap holds. A loop over many cameras or
 maps pays their page faults once because of them; a long-lived program that is done checking
 calls this. Safe at any time: buffers in use are not touched.)doc");

@@ -377,7 +377,7 @@ ZCHECK_ALWAYS_INLINE inline void drawInTileLanes(const DepthSettings& depth, con
     const Real noFractionBits = L::set1(4503599627370496.0);  // nearbyintNonNegative's 2^52
     const typename L::Int32 primitive = L::set1(std::int32_t(t.primitive));
     const bool unorm = keys.unorm, reversed = depth.reversed;  // not read again after each store
-    // No branch on coverage: a group with no pixel covered stores nothing (its masks are
+    // No branch on coverage: a group with no pixel covered changes nothing (its masks are
     // empty), and a branch on it was mispredicted often enough to cost 5 %.
     for (int row = row0; row <= row1; ++row) {
         const Real rowDepth = L::set1(t.z0 + t.dzdy * (row + 0.5 - t.y0));

@@ -1,5 +1,6 @@
 #pragma once
-// Per-frame buffers of a million pixels or triangles, filled without a page fault per 4 KiB.
+// Per-frame buffers of a million pixels or triangles, filled without a page fault per 4 KiB,
+// and a frame's scratch of tens of KiB and more, kept from frame to frame.
 //
 // A fresh buffer is faulted in by the kernel page by page on first touch. On the 1M-triangle
 // 1080p workload that was most of the time of a check (the raster route 150 ms instead of
@@ -34,16 +35,15 @@ namespace zcheck {
 
 // Memory for `bytes`: from 1 MiB up, whole 2 MiB pages on a 2 MiB boundary, advised huge
 // pages (a 1080p byte-per-pixel image fits one); from 64 KiB, whole pages mapped for it,
-// rounded up to 64 KiB (a frame's scratch: a comparison's keepers); smaller from operator new.
-// Release with releaseLarge and the same byte count. Throws std::bad_alloc.
+// rounded up to 64 KiB (a frame's scratch: a comparison's keepers); smaller from operator new. Release with releaseLarge and the same byte count. Throws std::bad_alloc.
 //
 // Released blocks of 64 KiB and more are kept (huge-page blocks up to 1 GiB, the others up to
 // 64 MiB), already faulted in, and handed back to the next allocation of the same rounded
 // size: a program that renders frame after frame pays the page faults of its buffers once,
 // not per frame (as a GPU driver's reused framebuffer does). An allocation that finds no block
-// of its size first releases every kept one of its class, so the cache never raises the peak
-// of the memory these functions hold: it keeps only memory that was in use together, and
-// gives it back before more is mapped. It does keep that memory resident until then, while
+// of its size first releases every kept one, so the cache never raises the peak of the memory
+// these functions hold: it keeps only memory that was in use together, and gives it back
+// before more is mapped. It does keep that memory resident until then, while
 // the rest of the process (a mesh, a BVH, other allocations) may grow: a long-lived program
 // that is done rendering calls releaseCachedLargeBuffers. Thread-safe. The contents of a
 // reused block are whatever its last user left.

@@ -22,9 +22,9 @@
 // and the loads, stores, gathers and conversions the kernels need, each named for what it does.
 // A masked load reads no memory of a lane outside its mask, a masked store writes none (so a
 // group of eight may run past the end of its row). L::kFastMaskedStores says whether a masked
-// store costs what a store does: with AVX-512's mask registers it does; AVX2's vmaskmov stores
-// are microcode on AMD's Zen 1–3 and never forward to a later load on Intel, so a hot loop of
-// the AVX2 form that may write its whole group reads it, blends (select) and stores it. Every operation on doubles is the one IEEE
+// store costs what a store does: with AVX-512's mask registers it does; AVX2's vmaskmov
+// stores are microcode on AMD's Zen 1–3 and never forward to a later load on Intel, so a hot
+// loop of the AVX2 form that may write its whole group reads it, blends (select) and stores it. Every operation on doubles is the one IEEE
 // operation its name says, so a kernel's lanes compute the bits its scalar form computes.
 //
 // The members carry their form's target and are inlined into the entry function (flatten); call
@@ -218,7 +218,6 @@ struct Avx2Lanes : Lanes32 {
         return {_mm256_mask_i32gather_pd(_mm256_setzero_pd(), table, _mm256_castsi256_si128(index.v), _mm256_castsi256_pd(m.lo), 8),
                 _mm256_mask_i32gather_pd(_mm256_setzero_pd(), table, _mm256_extracti128_si256(index.v, 1), _mm256_castsi256_pd(m.hi), 8)};
     }
-    // Eight packed float triples (24 floats from p) as three lanes of doubles: x, y, z.
     // Element k of each of eight packed triples, from the 24 32-bit values in a, b, c (8 each):
     // two blends and a permute, where three gathers were several times the work (and slow on
     // AMD's Zen 2 and 3).
@@ -233,6 +232,7 @@ struct Avx2Lanes : Lanes32 {
                                      : _mm256_setr_epi32(2, 5, 0, 3, 6, 1, 4, 7);
         return _mm256_permutevar8x32_ps(lanes, order);
     }
+    // Eight packed float triples (24 floats from p) as three lanes of doubles: x, y, z.
     static ZCHECK_LANE void loadTriples(const float* p, Real (&xyz)[3])
     {
         const __m256 a = _mm256_loadu_ps(p), b = _mm256_loadu_ps(p + 8), c = _mm256_loadu_ps(p + 16);
