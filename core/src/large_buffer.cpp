@@ -141,12 +141,29 @@ BlockCache& mediumBlockCache()
     return *cache;
 }
 
-// For an allocation no kept block was for: every kept block of both classes given back,
-// before new memory is mapped.
 void releaseBothCaches() noexcept
 {
     blockCache().releaseAll();
     mediumBlockCache().releaseAll();
+}
+
+// A kept block of `rounded` bytes from `cache`, else new memory from `allocate` (null: none),
+// every kept block of both classes given back before it is mapped.
+void* keptOrNew(BlockCache& cache, std::size_t rounded, void* (*allocate)(std::size_t bytes))
+{
+    if (void* reused = cache.take(rounded)) return reused;
+    releaseBothCaches();
+    void* data = allocate(rounded);
+    if (!data) throw std::bad_alloc();
+    return data;
+}
+
+// A huge-page block: 2 MiB-aligned and advised huge pages before it is first touched.
+void* allocateHugePages(std::size_t bytes)
+{
+    void* data = std::aligned_alloc(kHugePage, bytes);
+    if (data) adviseHugePages(data, bytes);
+    return data;
 }
 
 // A block's size: whole steps (wraps to less than `bytes` only for impossible sizes).
@@ -167,22 +184,10 @@ void adviseHugePages(void* data, std::size_t bytes)
 void* allocateLarge(std::size_t bytes)
 {
     if (bytes < kKeptFrom) return ::operator new(bytes);
-    if (bytes < kLargeFrom) {
-        const std::size_t rounded = roundedUp(bytes, kMediumStep);
-        if (void* reused = mediumBlockCache().take(rounded)) return reused;
-        releaseBothCaches();
-        void* data = mapMedium(rounded);
-        if (!data) throw std::bad_alloc();
-        return data;
-    }
+    if (bytes < kLargeFrom) return keptOrNew(mediumBlockCache(), roundedUp(bytes, kMediumStep), mapMedium);
     const std::size_t rounded = roundedUp(bytes, kHugePage);
     if (rounded < bytes) throw std::bad_alloc();
-    if (void* reused = blockCache().take(rounded)) return reused;
-    releaseBothCaches();
-    void* data = std::aligned_alloc(kHugePage, rounded);
-    if (!data) throw std::bad_alloc();
-    adviseHugePages(data, rounded);
-    return data;
+    return keptOrNew(blockCache(), rounded, allocateHugePages);
 }
 
 void releaseLarge(void* data, std::size_t bytes) noexcept
@@ -198,8 +203,7 @@ void releaseLarge(void* data, std::size_t bytes) noexcept
 
 void releaseCachedLargeBuffers() noexcept
 {
-    blockCache().releaseAll();
-    mediumBlockCache().releaseAll();
+    releaseBothCaches();
 #ifdef __GLIBC__
     malloc_trim(0);  // the heap's free pages too, not only those at its top
 #endif

@@ -24,8 +24,9 @@
 // group of eight may run past the end of its row). L::kFastMaskedStores says whether a masked
 // store costs what a store does: with AVX-512's mask registers it does; AVX2's vmaskmov
 // stores are microcode on AMD's Zen 1–3 and never forward to a later load on Intel, so a hot
-// loop of the AVX2 form that may write its whole group reads it, blends (select) and stores it. Every operation on doubles is the one IEEE
-// operation its name says, so a kernel's lanes compute the bits its scalar form computes.
+// loop of the AVX2 form that may write its whole group reads it, blends (select) and stores it.
+// Every operation on doubles is the one IEEE operation its name says, so a kernel's lanes
+// compute the bits its scalar form computes.
 //
 // The members carry their form's target and are inlined into the entry function (flatten); call
 // them only from code of that target (ZCHECK_TARGET_AVX2 / _AVX512), never from baseline code.
