@@ -181,14 +181,19 @@ std::pair<Result, double> inChild(int threads, const char* what, Measure measure
 // One whole check as `zcheck check` runs it (its BVH built for one frame's rays, bvhBuildFor;
 // tile by tile, keeping no per-pixel result; cold: as in a fresh `zcheck check` process),
 // then, over a BVH built for many frames (the same one where that was the one-frame choice too),
-// a check that keeps both routes' full-frame renders (the phases the speed targets time: each
-// route's whole image, its buffers new), and that one again (warm: the memory the one before
-// freed is reused, as in a program that checks many cameras or maps, and as the yardsticks'
-// repeated draws and traces run, over Embree's own thorough build).
+// checks that keep both routes' full-frame renders: the process's first ('first': into memory
+// it never touched), one more after the kept buffers and the C library's free memory are given
+// back (the phases the speed targets time: each route's whole image into new buffers, as the
+// yardsticks' cold repeats run, one after another), and that one again (warm: the memory the one
+// before freed is reused, as in a program that checks many cameras or maps, and as the
+// yardsticks' warm repeats run, over Embree's own thorough build). On a virtual machine that
+// hands the guest's free memory back to its host, memory freed seconds before costs more to
+// touch than memory freed a moment before: the first frame's and the cold one's differ by that.
 struct WholeCheck {
     BvhBuild build;                          // the whole check's
     double loadMs, bvhMs, tilesMs, wholeMs;  // tilesMs: the tile-by-tile pass of the whole check
-    double traceMs, rasterMs, compareMs;     // the full-frame check's phases
+    double firstTraceMs, firstRasterMs, firstCompareMs;  // the process's first full frame
+    double traceMs, rasterMs, compareMs;                 // the full-frame check's phases, cold
     double warmTraceMs, warmRasterMs, warmCompareMs;
     std::size_t triangles;
     bool consistent;
@@ -228,16 +233,18 @@ WholeCheck wholeCheckInChild(const std::string& sceneName, const Camera& camera,
         getrusage(RUSAGE_SELF, &usage);
         w.peakMiB = maxResidentMiB(usage);
         buildThorough(checker);  // the phases over the many-frame BVH
-        {
-            releaseCachedLargeBuffers();  // the full-frame check's buffers new, as in a fresh process
-            const CheckResult fullFrame = checker->check(camera);
-            w.traceMs = fullFrame.report.timings.traceMs, w.rasterMs = fullFrame.report.timings.rasterMs;
-            w.compareMs = fullFrame.report.timings.compareMs;
-            w.consistent = w.consistent && fullFrame.report.comparison.consistent();
-        }
-        const CheckResult again = checker->check(camera);
-        w.warmTraceMs = again.report.timings.traceMs, w.warmRasterMs = again.report.timings.rasterMs;
-        w.warmCompareMs = again.report.timings.compareMs;
+        // Each full-frame check's phases, into (first, cold) new buffers or (warm) kept ones.
+        const auto fullFrame = [&](double& traceMs, double& rasterMs, double& compareMs) {
+            const CheckResult run = checker->check(camera);
+            traceMs = run.report.timings.traceMs, rasterMs = run.report.timings.rasterMs;
+            compareMs = run.report.timings.compareMs;
+            w.consistent = w.consistent && run.report.comparison.consistent();
+        };
+        releaseCachedLargeBuffers();
+        fullFrame(w.firstTraceMs, w.firstRasterMs, w.firstCompareMs);
+        releaseCachedLargeBuffers();
+        fullFrame(w.traceMs, w.rasterMs, w.compareMs);
+        fullFrame(w.warmTraceMs, w.warmRasterMs, w.warmCompareMs);
         w.triangles = checker->scene().triangleCount();
         return w;
     }).first;
@@ -420,7 +427,8 @@ struct BenchSetting {
 struct FormPhases {
     KernelForm form = KernelForm::Baseline;
     BvhBuild build = BvhBuild::Thorough;  // the whole check's (WholeCheck)
-    Phase load, bvh, tiles, trace, raster, compare, whole, warmTrace, warmRaster, warmCompare;
+    Phase load, bvh, tiles, firstTrace, firstRaster, firstCompare, trace, raster, compare, whole;
+    Phase warmTrace, warmRaster, warmCompare;
     Phase rayTable, rays, depthTrace, exportOneShot, exportTrace, exportWrite, warmExport;
     std::size_t triangles = 0;
     bool consistent = true;  // every repeat's check
@@ -439,6 +447,8 @@ void addWholeCheck(FormPhases& f, const std::string& sceneName, const Camera& ca
     f.raster.ms.push_back(w.rasterMs), f.compare.ms.push_back(w.compareMs), f.whole.ms.push_back(w.wholeMs);
     f.warmTrace.ms.push_back(w.warmTraceMs), f.warmRaster.ms.push_back(w.warmRasterMs);
     f.warmCompare.ms.push_back(w.warmCompareMs);
+    f.firstTrace.ms.push_back(w.firstTraceMs), f.firstRaster.ms.push_back(w.firstRasterMs);
+    f.firstCompare.ms.push_back(w.firstCompareMs);
     f.triangles = w.triangles;
     f.consistent = f.consistent && w.consistent;
     f.peakMiB = std::max(f.peakMiB, w.peakMiB);
@@ -611,6 +621,8 @@ nlohmann::ordered_json formJson(const FormPhases& f, const BenchSetting& s, cons
     out["phases"] = {{"load", phaseJson(f.load)},     {"bvh", phaseJson(f.bvh)},         {"tiles", phaseJson(f.tiles)},
                      {"trace", phaseJson(f.trace)},
                      {"raster", phaseJson(f.raster)}, {"compare", phaseJson(f.compare)}, {"whole", phaseJson(f.whole)},
+                     {"first_trace", phaseJson(f.firstTrace)}, {"first_raster", phaseJson(f.firstRaster)},
+                     {"first_compare", phaseJson(f.firstCompare)},
                      {"warm_trace", phaseJson(f.warmTrace)}, {"warm_raster", phaseJson(f.warmRaster)},
                      {"warm_compare", phaseJson(f.warmCompare)}};
     if (s.lens)
@@ -649,6 +661,9 @@ void printPhases(const FormPhases& f, const BenchSetting& s)
         printPhase("raster", f.raster, rate(double(f.triangles) / f.raster.median() / 1e3, "Mtris/s"));
         printPhase("compare", f.compare);
     }
+    printPhase("first trace", f.firstTrace, "the process's first full frame, into memory it never touched (no target)");
+    if (!lens) printPhase("first raster", f.firstRaster);
+    printPhase(lens ? "first lens check" : "first compare", f.firstCompare);
     printPhase("whole check", f.whole, "as zcheck check: load + bvh + tile by tile");
     printPhase("tile by tile", f.tiles, "trace, raster and compare interleaved, nothing kept per pixel");
     printPhase("warm trace", f.warmTrace, rate(pixels / f.warmTrace.median() / 1e3, "Mrays/s (the check repeated)"));
@@ -879,11 +894,12 @@ Command addBenchCommand(CLI::App& app)
         "Each repeat is a whole check in a child process of its own, as `zcheck check` runs it: the\n"
         "scene is loaded, the BVH built for one frame's rays (quick below 10 rays per triangle,\n"
         "else thorough), both routes drawn and compared tile by tile ('whole check').\n"
-        "The child then checks again over a thorough BVH (as for many frames; Embree's reference is\n"
-        "built so too) keeping both routes' full-frame renders, whose\n"
-        "trace, raster and compare are the phases timed (their buffers new), and once more ('warm':\n"
-        "memory the check before freed is reused, as when a program checks many cameras). Peak RSS\n"
-        "is the largest child's, after the first check. Embree's reference builds run in children too;\n"
+        "The child then checks over a thorough BVH (as for many frames; Embree's reference is built so\n"
+        "too), keeping both routes' full-frame renders: once into memory the process never touched\n"
+        "('first', no target), again after the kept buffers and the C library's free memory are given\n"
+        "back, as before each of the yardsticks' cold repeats (trace, raster and compare: the phases\n"
+        "timed, their buffers new), and once more ('warm': memory the check before freed is reused, as\n"
+        "when a program checks many cameras). Peak RSS is the largest child's, after the first check. Embree's reference builds run in children too;\n"
         "its trace and llvmpipe's draws repeat in this process (llvmpipe's from the plugin\n"
         "libzcheck_gl_yardstick.so, loaded only here), into the buffers they used before, then\n"
         "each into output memory never touched ('-cold': a new buffer, llvmpipe's made in the timing):\n"

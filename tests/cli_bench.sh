@@ -11,7 +11,8 @@ trap 'rm -rf "$tmp"' EXIT
 
 "$zcheck" bench --scene "builtin:terrain?n=60" --width 320 --height 180 --repeat 2 --threads 1 > "$tmp/bench.txt"
 grep -qE "^zcheck bench: builtin:terrain\?n=60, 6962 triangles, 320x180, .*, kernels (baseline|avx2|avx512), embree auto \((sse2|sse4\.2|avx|avx2|avx512)\), 1 threads, 2 repeats, consistent$" "$tmp/bench.txt"
-for phase in load "bvh build" trace raster compare "whole check" "tile by tile" "warm trace" "warm raster" "warm compare"; do
+for phase in load "bvh build" trace raster compare "first trace" "first raster" "first compare" "whole check" "tile by tile" \
+             "warm trace" "warm raster" "warm compare"; do
     grep -qE "^$phase +median +[0-9.]+ ms +best +[0-9.]+ ms" "$tmp/bench.txt"
 done
 grep -qE "^trace .* [0-9.]+ Mrays/s$" "$tmp/bench.txt"
@@ -36,7 +37,8 @@ assert f'embree auto ({r["embree_runs"]}),' in open(sys.argv[2]).readline()
 assert r["triangles"] == 2 * 59 * 59 and r["width"] == 320 and r["height"] == 180 and r["threads"] == 2, r
 assert r["kernels"] in ("baseline", "avx2", "avx512") and "forms" not in r, r
 p = r["phases"]
-for name in ("load", "bvh", "tiles", "trace", "raster", "compare", "whole", "warm_trace", "warm_raster", "warm_compare"):
+for name in ("load", "bvh", "tiles", "trace", "raster", "compare", "first_trace", "first_raster", "first_compare", "whole",
+             "warm_trace", "warm_raster", "warm_compare"):
     assert len(p[name]["ms"]) == 2 and 0 < p[name]["best_ms"] <= p[name]["median_ms"], (name, p[name])
 # The whole check (as `zcheck check`: tile by tile) contains its phases.
 parts = sum(p[n]["best_ms"] for n in ("load", "bvh", "tiles"))
@@ -90,7 +92,7 @@ cat > "$tmp/fisheye.json" <<'JSON'
 JSON
 "$zcheck" bench --scene "builtin:terrain?n=60&size=2" --camera "$tmp/fisheye.json" --repeat 2 --threads 2 > "$tmp/lens.txt"
 grep -qE "^zcheck bench: builtin:terrain\?n=60&size=2, 6962 triangles, 160x120, lens model opencv_fisheye, distance, kernels (baseline|avx2|avx512), embree auto \((sse2|sse4\.2|avx|avx2|avx512)\), 2 threads, 2 repeats, consistent$" "$tmp/lens.txt"
-for phase in "ray table" trace "depth trace" rays "lens check" export "warm export"; do
+for phase in "ray table" trace "depth trace" rays "lens check" "first trace" "first lens check" export "warm export"; do
     grep -qE "^$phase +median +[0-9.]+ ms +best +[0-9.]+ ms" "$tmp/lens.txt"
 done
 grep -qE "^raster +does not apply" "$tmp/lens.txt"
