@@ -181,14 +181,15 @@ std::pair<Result, double> inChild(int threads, const char* what, Measure measure
 // One whole check as `zcheck check` runs it (its BVH built for one frame's rays, bvhBuildFor;
 // tile by tile, keeping no per-pixel result; cold: as in a fresh `zcheck check` process),
 // then, over a BVH built for many frames (the same one where that was the one-frame choice too),
-// checks that keep both routes' full-frame renders: the process's first ('first': into memory
-// it never touched), one more after the kept buffers and the C library's free memory are given
-// back (the phases the speed targets time: each route's whole image into new buffers, as the
-// yardsticks' cold repeats run, one after another), and that one again (warm: the memory the one
-// before freed is reused, as in a program that checks many cameras or maps, and as the
-// yardsticks' warm repeats run, over Embree's own thorough build). On a virtual machine that
-// hands the guest's free memory back to its host, memory freed seconds before costs more to
-// touch than memory freed a moment before: the first frame's and the cold one's differ by that.
+// checks that keep both routes' full-frame renders, each after the kept buffers and the C
+// library's free memory are given back but the last: the process's first ('first'), one more
+// right after it (the phases the speed targets time: each route's whole image into new buffers,
+// following a frame of its own as each of the yardsticks' cold repeats follows the one before),
+// and that one again (warm: the memory the one before freed is reused, as in a program that
+// checks many cameras or maps, and as the yardsticks' warm repeats run, over Embree's own
+// thorough build). Where a host takes back the memory its guest freed, memory freed seconds
+// before may cost more to touch than memory freed a moment before: the first frame and the cold
+// one would differ by that (on docs/speed.md's machine they did not).
 struct WholeCheck {
     BvhBuild build;                          // the whole check's
     double loadMs, bvhMs, tilesMs, wholeMs;  // tilesMs: the tile-by-tile pass of the whole check
@@ -661,7 +662,7 @@ void printPhases(const FormPhases& f, const BenchSetting& s)
         printPhase("raster", f.raster, rate(double(f.triangles) / f.raster.median() / 1e3, "Mtris/s"));
         printPhase("compare", f.compare);
     }
-    printPhase("first trace", f.firstTrace, "the process's first full frame, into memory it never touched (no target)");
+    printPhase("first trace", f.firstTrace, "the process's first full frame, its buffers new as the cold one's (no target)");
     if (!lens) printPhase("first raster", f.firstRaster);
     printPhase(lens ? "first lens check" : "first compare", f.firstCompare);
     printPhase("whole check", f.whole, "as zcheck check: load + bvh + tile by tile");
@@ -895,13 +896,14 @@ Command addBenchCommand(CLI::App& app)
         "scene is loaded, the BVH built for one frame's rays (quick below 10 rays per triangle,\n"
         "else thorough), both routes drawn and compared tile by tile ('whole check').\n"
         "The child then checks over a thorough BVH (as for many frames; Embree's reference is built so\n"
-        "too), keeping both routes' full-frame renders: once into memory the process never touched\n"
-        "('first', no target), again after the kept buffers and the C library's free memory are given\n"
-        "back, as before each of the yardsticks' cold repeats (trace, raster and compare: the phases\n"
-        "timed, their buffers new), and once more ('warm': memory the check before freed is reused, as\n"
-        "when a program checks many cameras). Peak RSS is the largest child's, after the first check. Embree's reference builds run in children too;\n"
-        "its trace and llvmpipe's draws repeat in this process (llvmpipe's from the plugin\n"
-        "libzcheck_gl_yardstick.so, loaded only here), into the buffers they used before, then\n"
+        "too), keeping both routes' full-frame renders: its first full frame ('first', no target), then\n"
+        "the kept buffers and the C library's free memory given back as before each of the yardsticks'\n"
+        "cold repeats, a frame whose trace, raster and compare are the phases timed (their buffers\n"
+        "new), and once more ('warm': memory the check before freed is reused, as when a program\n"
+        "checks many cameras). The first frame's buffers are new too (the same giving back before it).\n"
+        "Peak RSS is the largest child's, after the first check. Embree's reference builds run in\n"
+        "children too; its trace and llvmpipe's draws repeat in this process (llvmpipe's from the\n"
+        "plugin libzcheck_gl_yardstick.so, loaded only here), into the buffers they used before, then\n"
         "each into output memory never touched ('-cold': a new buffer, llvmpipe's made in the timing):\n"
         "the phases' ratios take the cold ones, the warm phases' the warm ones. Lines are\n"
         "'<phase> median <ms> ms best <ms> ms <rate>' and 'ratio <name> <value> target <bound>'.\n"
