@@ -191,11 +191,12 @@ std::pair<Result, double> inChild(int threads, const char* what, Measure measure
 // before may cost more to touch than memory freed a moment before: the first frame and the cold
 // one would differ by that (on docs/speed.md's machine they did not).
 struct WholeCheck {
+    struct FrameMs {  // a full-frame check's phases
+        double trace, raster, compare;
+    };
     BvhBuild build;                          // the whole check's
     double loadMs, bvhMs, tilesMs, wholeMs;  // tilesMs: the tile-by-tile pass of the whole check
-    double firstTraceMs, firstRasterMs, firstCompareMs;  // the process's first full frame
-    double traceMs, rasterMs, compareMs;                 // the full-frame check's phases, cold
-    double warmTraceMs, warmRasterMs, warmCompareMs;
+    FrameMs first, cold, warm;               // the process's first full frame, the cold one, the warm one
     std::size_t triangles;
     bool consistent;
     double peakMiB;  // the child's maximum resident set, after the cold check
@@ -234,18 +235,18 @@ WholeCheck wholeCheckInChild(const std::string& sceneName, const Camera& camera,
         getrusage(RUSAGE_SELF, &usage);
         w.peakMiB = maxResidentMiB(usage);
         buildThorough(checker);  // the phases over the many-frame BVH
-        // Each full-frame check's phases, into (first, cold) new buffers or (warm) kept ones.
-        const auto fullFrame = [&](double& traceMs, double& rasterMs, double& compareMs) {
+        // A full-frame check's phases, into (first, cold) new buffers or (warm) kept ones.
+        const auto fullFrame = [&] {
             const CheckResult run = checker->check(camera);
-            traceMs = run.report.timings.traceMs, rasterMs = run.report.timings.rasterMs;
-            compareMs = run.report.timings.compareMs;
             w.consistent = w.consistent && run.report.comparison.consistent();
+            return WholeCheck::FrameMs{run.report.timings.traceMs, run.report.timings.rasterMs,
+                                       run.report.timings.compareMs};
         };
         releaseCachedLargeBuffers();
-        fullFrame(w.firstTraceMs, w.firstRasterMs, w.firstCompareMs);
+        w.first = fullFrame();
         releaseCachedLargeBuffers();
-        fullFrame(w.traceMs, w.rasterMs, w.compareMs);
-        fullFrame(w.warmTraceMs, w.warmRasterMs, w.warmCompareMs);
+        w.cold = fullFrame();
+        w.warm = fullFrame();
         w.triangles = checker->scene().triangleCount();
         return w;
     }).first;
@@ -444,12 +445,14 @@ void addWholeCheck(FormPhases& f, const std::string& sceneName, const Camera& ca
         return wholeCheckInChild(sceneName, camera, threads);
     }();
     f.build = w.build;
-    f.load.ms.push_back(w.loadMs), f.bvh.ms.push_back(w.bvhMs), f.tiles.ms.push_back(w.tilesMs), f.trace.ms.push_back(w.traceMs);
-    f.raster.ms.push_back(w.rasterMs), f.compare.ms.push_back(w.compareMs), f.whole.ms.push_back(w.wholeMs);
-    f.warmTrace.ms.push_back(w.warmTraceMs), f.warmRaster.ms.push_back(w.warmRasterMs);
-    f.warmCompare.ms.push_back(w.warmCompareMs);
-    f.firstTrace.ms.push_back(w.firstTraceMs), f.firstRaster.ms.push_back(w.firstRasterMs);
-    f.firstCompare.ms.push_back(w.firstCompareMs);
+    f.load.ms.push_back(w.loadMs), f.bvh.ms.push_back(w.bvhMs), f.tiles.ms.push_back(w.tilesMs);
+    f.whole.ms.push_back(w.wholeMs);
+    const auto add = [](Phase& trace, Phase& raster, Phase& compare, const WholeCheck::FrameMs& frame) {
+        trace.ms.push_back(frame.trace), raster.ms.push_back(frame.raster), compare.ms.push_back(frame.compare);
+    };
+    add(f.firstTrace, f.firstRaster, f.firstCompare, w.first);
+    add(f.trace, f.raster, f.compare, w.cold);
+    add(f.warmTrace, f.warmRaster, f.warmCompare, w.warm);
     f.triangles = w.triangles;
     f.consistent = f.consistent && w.consistent;
     f.peakMiB = std::max(f.peakMiB, w.peakMiB);
