@@ -111,7 +111,8 @@ namespace {
 // Slopes of up to kSlopeLanes consecutive triangles together: their corners dealt into lane
 // arrays, then slopeOfCorners over them, one triangle at a time in the baseline form (which the
 // compiler vectorises as it can) and eight at a time over a lane type in the vector forms (which
-// GCC left scalar for AVX2). Inlined into one function per form (kernel_choice.h).
+// GCC left scalar for AVX2); in the AVX-512 form a whole block's corners are gathered instead
+// (slopesOfWholeBlockGathered). Inlined into one function per form (kernel_choice.h).
 constexpr std::size_t kSlopeLanes = 64;
 
 // The corners of triangles first .. first + n − 1 (n ≤ kSlopeLanes) dealt into lane arrays in
@@ -149,11 +150,42 @@ void slopesTogetherBaseline(const DepthSlopeFrame& frame, const Scene& scene, st
 }
 
 #ifdef ZCHECK_X86_FORMS
+// A whole block's slopes with its corners gathered eight triangles at a time (L::kFastGathers),
+// where the indices allow it (cornersGatherable): each triangle's three indices read as a
+// stream, each corner's x, y and z eight at a time; no array in between. The same floats, made
+// doubles, as cornersOfBlock's.
+template <class L>
+ZCHECK_ALWAYS_INLINE inline void slopesOfWholeBlockGathered(const DepthSlopeFrame& frame, const Scene& scene,
+                                                            std::uint32_t first, double* slope)
+{
+    using Real = typename L::Real;
+    using Int32 = typename L::Int32;
+    const std::size_t nextBlock = first + kSlopeLanes, nextBlockEnd = std::min(scene.triangles.size(), nextBlock + kSlopeLanes);
+    for (std::size_t k = nextBlock; k < nextBlockEnd; k += 64 / sizeof(glm::uvec3)) __builtin_prefetch(&scene.triangles[k]);
+    const float* positions = &scene.positions[0].x;
+    for (std::size_t k = 0; k < kSlopeLanes; k += L::kLanes) {
+        Int32 index[3];
+        L::loadTriples(&scene.triangles[first + k].x, index);
+        Real c[3][3];
+        for (int v = 0; v < 3; ++v) {
+            const Int32 at = index[v] + index[v] + index[v];  // of the vertex's x among the floats
+            for (int axis = 0; axis < 3; ++axis) c[v][axis] = L::toReal(L::gatherFloats(positions + axis, at));
+        }
+        L::store(slope + k, slopeOfCorners<L>(frame, c[0], c[1], c[2]));
+    }
+}
+
+// Whether slopesOfWholeBlockGathered reaches every vertex: its offsets among the floats (3 per
+// vertex) are lanes of non-negative 32-bit integers.
+bool cornersGatherable(const Scene& scene) { return scene.positions.size() <= std::size_t(INT32_MAX) / 3; }
+
 template <class L>
 ZCHECK_ALWAYS_INLINE inline void slopesTogetherLanes(const DepthSlopeFrame& frame, const Scene& scene,
                                                      std::uint32_t first, std::size_t n, double* slope)
 {
     using Real = typename L::Real;
+    if constexpr (L::kFastGathers)
+        if (n == kSlopeLanes && cornersGatherable(scene)) return slopesOfWholeBlockGathered<L>(frame, scene, first, slope);
     alignas(64) double corner[3][3][kSlopeLanes];  // corner, axis, lane
     cornersOfBlock(scene, first, n, corner);
     for (std::size_t k = n; k % L::kLanes != 0; ++k)  // the last group's lanes past n: zeros, not stored

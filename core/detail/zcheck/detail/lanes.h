@@ -25,6 +25,10 @@
 // store costs what a store does: with AVX-512's mask registers it does; AVX2's vmaskmov
 // stores are microcode on AMD's Zen 1–3 and never forward to a later load on Intel, so a hot
 // loop of the AVX2 form that may write its whole group reads it, blends (select) and stores it.
+// L::kFastGathers says whether eight floats gathered from eight places (gatherFloats) cost less
+// than eight loads, converted and dealt into lanes one by one: on Sapphire Rapids in the AVX-512
+// form they did (the comparison's slopes), in the AVX2 form they did not, and on AMD's Zen 2
+// and 3 a gather is microcode.
 // Every operation on doubles is the one IEEE operation its name says, so a kernel's lanes
 // compute the bits its scalar form computes.
 //
@@ -99,6 +103,8 @@ struct Lanes32 {
     static ZCHECK_LANE void maskedStore32(Mask32 m, std::uint32_t* p, Int32 a) { _mm256_maskstore_epi32(reinterpret_cast<int*>(p), m.v, a.v); }
     static ZCHECK_LANE Float zeroWhereNot32(Mask32 m, Float a) { return {_mm256_and_ps(a.v, _mm256_castsi256_ps(m.v))}; }
     static ZCHECK_LANE void store(std::uint32_t* p, Int32 a) { _mm256_storeu_si256(reinterpret_cast<__m256i*>(p), a.v); }
+    // Lane k: base[index[k]], each index a non-negative 32-bit integer.
+    static ZCHECK_LANE Float gatherFloats(const float* base, Int32 index) { return {_mm256_i32gather_ps(base, index.v, 4)}; }
 #undef ZCHECK_LANE
 };
 // The base's overloads of the names a form also defines (set1, load, store, min, max, bitsOf).
@@ -116,6 +122,7 @@ struct Avx2Lanes : Lanes32 {
 #define ZCHECK_LANE ZCHECK_TARGET_AVX2 inline
     static constexpr int kLanes = 8;
     static constexpr bool kFastMaskedStores = false;
+    static constexpr bool kFastGathers = false;
     ZCHECK_LANES32_NAMES;
     struct Mask {
         __m256i lo, hi;  // per 64-bit lane: all ones (true) or zeros
@@ -365,6 +372,7 @@ struct Avx512Lanes : Lanes32 {
 #define ZCHECK_LANE ZCHECK_TARGET_AVX512 inline
     static constexpr int kLanes = 8;
     static constexpr bool kFastMaskedStores = true;
+    static constexpr bool kFastGathers = true;
     ZCHECK_LANES32_NAMES;
     struct Mask {
         __mmask8 k;
