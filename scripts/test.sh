@@ -7,7 +7,8 @@
 #   ./scripts/test.sh --full   also each libFuzzer harness for ZCHECK_FUZZ_SECONDS (default 60)
 #                              under ASan + UBSan, then the whole CTest suite again built with
 #                              ASan + UBSan (but for the Python and package tests, which need an
-#                              uninstrumented build). This is what CI runs (.ci/run).
+#                              uninstrumented build; its sweeps take a third of their cases,
+#                              tests/sweep.h). This is what CI runs (.ci/run).
 # Extra arguments after the options go to the first ctest (e.g. -L unit, -R verify).
 set -euo pipefail
 cd "$(dirname "$0")/.."

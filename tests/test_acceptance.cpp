@@ -12,6 +12,7 @@
 
 #include "diagnosis_helpers.h"
 #include "room.h"
+#include "sweep.h"
 
 #include <catch2/catch.hpp>
 
@@ -293,9 +294,10 @@ TEST_CASE("property: no mistake of the catalogue is accepted under any declarati
          }},
     };
     int mistakes = 0, visible = 0;
-    // A wrong map: rejected as it is, and under every declaration and every suggestion.
+    // A wrong map: rejected as it is, and under every declaration and every suggestion (each
+    // wrong map a case of the sweep, sweep.h).
     auto neverAccepted = [&](const DepthMap& wrong) {
-        ++visible;
+        if (!testing::sweepTakes(0, std::size_t(visible++))) return;
         for (const Declaration& d : declarations) {
             INFO("declared: " << d.name);
             REQUIRE_FALSE(accepted(verifier, camera, d.apply(wrong)));

@@ -13,14 +13,18 @@
 #include "zcheck/camera_file.h"
 
 #include "diagnosis_helpers.h"
+#include "sweep.h"
 
 #include <catch2/catch.hpp>
 
 #include <cmath>
 #include <functional>
+#include <iterator>
 
 using namespace zcheck;
 using testing::mapOf;
+using testing::sweepCases;
+using testing::sweepTakes;
 
 namespace {
 
@@ -47,8 +51,10 @@ struct Bench {
     MapVerifier verifier;
     Camera camera;
     ExportQuantity quantity;
-    explicit Bench(const Setup& s)
-        : scene(builtinScene(s.scene)), checker(scene), verifier(checker), camera(specOf(scene, s)), quantity(s.quantity)
+    std::size_t round;  // the setup's index in kSetups: its round of a sweep (sweep.h)
+    explicit Bench(const Setup& s, std::size_t setupIndex = 0)
+        : scene(builtinScene(s.scene)), checker(scene), verifier(checker), camera(specOf(scene, s)), quantity(s.quantity),
+          round(setupIndex)
     {
     }
     static CameraSpec specOf(const Scene& scene, const Setup& s)
@@ -109,9 +115,10 @@ Hypothesis nearCrossingScaledDiagnosis(double scale)
 // Runs `check` on every setup, naming the setup and its half in the messages.
 void forEachSetup(const std::function<void(const Bench&)>& check)
 {
-    for (const Setup& s : kSetups) {
+    for (std::size_t k = 0; k < std::size(kSetups); ++k) {
+        const Setup& s = kSetups[k];
         INFO(s.half << ": " << s.scene << ", " << s.convention << ", " << toString(s.quantity));
-        const Bench bench(s);
+        const Bench bench(s, k);
         check(bench);
     }
 }
@@ -124,8 +131,8 @@ TEST_CASE("a map sampled off the pixel centre is diagnosed with the offset, MSAA
         // Sample 3 of the standard 4× pattern, (+1/8, +3/8) px in the framebuffer's own axes (y
         // down from the first row; up in OpenGL), as an offset in the image (y down).
         const glm::dvec2 sample3 = windowFromImageOffset(b.camera, glm::dvec2(0.125, 0.375));
-        for (const glm::dvec2 offset : {glm::dvec2(1.0 / 32, -1.0 / 32), sample3, glm::dvec2(-5.0 / 16, 5.0 / 16),
-                                        glm::dvec2(0.5, 0.5), glm::dvec2(1.25, -0.75)}) {
+        for (const glm::dvec2 offset : sweepCases(b.round, {glm::dvec2(1.0 / 32, -1.0 / 32), sample3, glm::dvec2(-5.0 / 16, 5.0 / 16),
+                                                             glm::dvec2(0.5, 0.5), glm::dvec2(1.25, -0.75)})) {
             INFO("offset " << offset.x << ", " << offset.y);
             Departure d;
             d.sampleOffset = offset;
@@ -148,7 +155,7 @@ TEST_CASE("a map sampled off the pixel centre is diagnosed with the offset, MSAA
 TEST_CASE("a map drawn with another field of view is diagnosed with the focal scale", "[fit]")
 {
     forEachSetup([](const Bench& b) {
-        for (double factor : {1.002, 1.02, 0.9, 1.25}) {
+        for (double factor : sweepCases(b.round, {1.002, 1.02, 0.9, 1.25})) {
             INFO("fovy x " << factor);
             CameraSpec drawn = b.camera.spec();
             drawn.projection.fovyDeg *= factor;
@@ -163,7 +170,7 @@ TEST_CASE("a map drawn with another field of view is diagnosed with the focal sc
 TEST_CASE("a map drawn with a moved principal point or another aspect is diagnosed with the intrinsics", "[fit]")
 {
     forEachSetup([](const Bench& b) {
-        for (const glm::dvec2 shift : {glm::dvec2(0.5, 0.0), glm::dvec2(-3.0, 2.0)}) {
+        for (const glm::dvec2 shift : sweepCases(b.round, {glm::dvec2(0.5, 0.0), glm::dvec2(-3.0, 2.0)})) {
             INFO("principal point moved by " << shift.x << ", " << shift.y << " px");
             Departure d;
             d.principalShift = shift;
@@ -177,6 +184,7 @@ TEST_CASE("a map drawn with a moved principal point or another aspect is diagnos
             REQUIRE(std::abs(fittedValue(h, "principal_dx_px") - shift.x) <= 0.01);
             REQUIRE(std::abs(fittedValue(h, "principal_dy_px") - shift.y) <= 0.01);
         }
+        if (!sweepTakes(b.round, 2)) return;  // the third case: another aspect
         Departure wide;
         wide.focalScale = {1.03, 1.0};
         const Hypothesis h = b.diagnosed(b.mapDrawnWith(departedCameraSpec(b.camera, wide)), "intrinsics");
@@ -191,7 +199,7 @@ TEST_CASE("a map drawn with other near and far planes is diagnosed with them", "
 {
     forEachSetup([](const Bench& b) {
         if (b.quantity != ExportQuantity::Window && b.quantity != ExportQuantity::Ndc) return;  // only they see near and far
-        for (const auto& [nearFactor, farFactor] : {std::pair{1.05, 1.0}, std::pair{1.5, 0.5}, std::pair{0.5, 3.0}}) {
+        for (const auto& [nearFactor, farFactor] : sweepCases(b.round, {std::pair{1.05, 1.0}, std::pair{1.5, 0.5}, std::pair{0.5, 3.0}})) {
             INFO("near x " << nearFactor << ", far x " << farFactor);
             CameraSpec drawn = b.camera.spec();
             drawn.projection.near *= nearFactor, drawn.projection.far *= farFactor;
@@ -210,7 +218,7 @@ TEST_CASE("a map in other units or from another origin is diagnosed with its sca
         // A window or NDC map's scale and offset are its near and far (and it has no units).
         if (b.quantity == ExportQuantity::Window || b.quantity == ExportQuantity::Ndc) return;
         const double n = b.camera.nearDistance();
-        for (const auto& [scale, offset] : {std::pair{1.002, 0.0}, std::pair{1000.0, 0.0}, std::pair{1.0, -n}}) {
+        for (const auto& [scale, offset] : sweepCases(b.round, {std::pair{1.002, 0.0}, std::pair{1000.0, 0.0}, std::pair{1.0, -n}})) {
             INFO("value x " << scale << " + " << offset);
             const Hypothesis h = b.diagnosed(scaled(b.mapDrawnWith(b.camera.spec()), scale, offset), "depth-scale", "affine-depth-offset");
             if (h.name == "affine-depth-offset") {
@@ -229,7 +237,7 @@ TEST_CASE("a map drawn from a slightly wrong pose is diagnosed with the eye's po
 {
     forEachSetup([](const Bench& b) {
         const View& v = b.camera.spec().view;
-        for (double farther : {1.003, 1.03, 0.99}) {  // farther, and 1 % nearer the target
+        for (double farther : sweepCases(b.round, {1.003, 1.03, 0.99})) {  // farther, and 1 % nearer the target
             INFO("eye " << farther << " x as far from the target");
             CameraSpec drawn = b.camera.spec();
             drawn.view.eye = v.target + (v.eye - v.target) * farther;

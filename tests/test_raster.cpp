@@ -5,6 +5,7 @@
 
 #include "kernel_testing.h"
 #include "raster_testing.h"
+#include "sweep.h"
 
 #include <catch2/catch.hpp>
 #include <tbb/global_control.h>
@@ -248,13 +249,17 @@ TEST_CASE("the vector kernels are bit-identical to the scalar loops", "[raster][
     // the tiles cut on both edges; and with the fault "no near clipping", whose depths in front
     // of the near plane leave the depth range (the clamp to it then decides), and two other
     // faults of the vertex stage. Compared bit for bit (memcmp), so a signed zero would show.
+    // (A sweep, sweep.h: each soup a round, each of its setups a case.)
     const Scene soups[2] = {triangleSoup(true, 20261126), triangleSoup(false, 20261127)};
-    for (const Scene& soup : soups) {
+    for (std::size_t round = 0; round < 2; ++round) {
+        const Scene& soup = soups[round];
         const RasterRenderer raster(soup);
+        std::size_t item = 0;
         for (const char* convention : {"opengl", "direct3d", "vulkan", "metal", "opencv"})
             for (DepthFormat format : {DepthFormat::Unorm16, DepthFormat::Unorm24, DepthFormat::Float32})
                 for (bool reversed : {false, true})
                     for (int variant = 0; variant < 5; ++variant) {
+                        if (!testing::sweepTakes(round, item++)) continue;
                         const bool narrowRange = variant == 1;
                         RasterFaults faults;
                         faults.noNearClip = variant == 2;
