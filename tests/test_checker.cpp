@@ -330,16 +330,19 @@ TEST_CASE("the 99th percentile from the largest values kept is the sorted one, i
 
 // The keepers select by counting bit patterns (kthSmallestBits); std::nth_element is the
 // independent expectation, over patterns that differ only in their lowest bits, only in their
-// highest, everywhere, and in a few values repeated.
+// highest, everywhere, and in a few values repeated; in one array, and in parts.
 TEST_CASE("the k-th smallest by counting bits is nth_element's", "[compare]")
 {
     std::mt19937 random(5);
     auto uniformBits = [&](std::uint32_t mask, std::uint32_t base) { return base | (std::uint32_t(random()) & mask); };
     const std::vector<std::function<std::uint32_t()>> kinds = {
-        [&] { return uniformBits(0x3FFu, 0x40490000u); },   // the last level's bits alone
-        [&] { return uniformBits(0xFFE00000u, 0x5u); },     // the first level's alone, sign bit included
+        [&] { return uniformBits(0x3FFu, 0x40490000u); },   // the lowest 10 bits alone
+        [&] { return uniformBits(0xFFFFu, 0x40490000u); },  // the low half alone (the second count's)
+        [&] { return uniformBits(0xFFFF0000u, 0x5u); },     // the high half alone, sign bit included
+        [&] { return uniformBits(0xFFE00000u, 0x5u); },     // the top 11 bits alone
         [&] { return uniformBits(0xFFFFFFFFu, 0); },        // everywhere
-        [&] { return std::uint32_t(random() % 3) * 0x00200401u; },  // three values, one in each level
+        [&] { return std::uint32_t(random() % 3) * 0x00210401u; },  // three values, differing in both halves
+        [&] { return 0x3F800000u; },                        // one value only
     };
     for (const auto& kind : kinds)
         for (const std::size_t n : {std::size_t(1), std::size_t(2), std::size_t(37), std::size_t(5000)}) {
@@ -349,7 +352,10 @@ TEST_CASE("the k-th smallest by counting bits is nth_element's", "[compare]")
                 std::vector<std::uint32_t> sorted = bits;
                 std::nth_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(k), sorted.end());
                 INFO("n " << n << ", k " << k);
-                REQUIRE(kthSmallestBits(bits.data(), n, k) == sorted[k]);
+                REQUIRE(kthSmallestBits({{bits.data(), n}}, k) == sorted[k]);
+                // The same patterns in three parts, one of them empty, as three threads' keepers.
+                const std::vector<BitsSpan> parts = {{bits.data(), n / 3}, {bits.data() + n / 3, 0}, {bits.data() + n / 3, n - n / 3}};
+                REQUIRE(kthSmallestBits(parts, k) == sorted[k]);
             }
         }
 }

@@ -29,11 +29,17 @@
 
 namespace zcheck {
 
-// The k-th smallest (from 0, k < n) of n 32-bit patterns as unsigned integers: counted by
-// their top 11 bits, then those in the bucket holding rank k by their next 11, then by the
-// last 10. Exact, linear in n, and the values are not reordered (what std::nth_element would
-// select, in a few passes of counting).
-std::uint32_t kthSmallestBits(const std::uint32_t* bits, std::size_t n, std::size_t k);
+// Patterns to select from: `n` of them at `bits` (a keeper's, or a sample's).
+struct BitsSpan {
+    const std::uint32_t* bits;
+    std::size_t n;
+};
+// The k-th smallest (from 0, k less than the patterns in all the parts) of 32-bit patterns as
+// unsigned integers, the parts taken together: what std::nth_element over their concatenation
+// would select. Exact, in two counting passes over the parts: by their top 16 bits, then those
+// whose top bits hold rank k by their low 16. Nothing is copied or reordered; the counts are a
+// 256 KiB block that large_buffer.h keeps from call to call.
+std::uint32_t kthSmallestBits(const std::vector<BitsSpan>& parts, std::size_t k);
 
 class LargestValues {
 public:
