@@ -197,9 +197,10 @@ TEST_CASE("a map drawn with a moved principal point or another aspect is diagnos
 
 TEST_CASE("a map drawn with other near and far planes is diagnosed with them", "[fit]")
 {
-    forEachSetup([](const Bench& b) {
+    std::size_t round = 0;  // the setups that see near and far, each a round of the sweep
+    forEachSetup([&](const Bench& b) {
         if (b.quantity != ExportQuantity::Window && b.quantity != ExportQuantity::Ndc) return;  // only they see near and far
-        for (const auto& [nearFactor, farFactor] : sweepCases(b.round, {std::pair{1.05, 1.0}, std::pair{1.5, 0.5}, std::pair{0.5, 3.0}})) {
+        for (const auto& [nearFactor, farFactor] : sweepCases(round++, {std::pair{1.05, 1.0}, std::pair{1.5, 0.5}, std::pair{0.5, 3.0}})) {
             INFO("near x " << nearFactor << ", far x " << farFactor);
             CameraSpec drawn = b.camera.spec();
             drawn.projection.near *= nearFactor, drawn.projection.far *= farFactor;
@@ -214,11 +215,12 @@ TEST_CASE("a map drawn with other near and far planes is diagnosed with them", "
 
 TEST_CASE("a map in other units or from another origin is diagnosed with its scale and offset", "[fit]")
 {
-    forEachSetup([](const Bench& b) {
+    std::size_t round = 0;  // the setups with units, each a round of the sweep
+    forEachSetup([&](const Bench& b) {
         // A window or NDC map's scale and offset are its near and far (and it has no units).
         if (b.quantity == ExportQuantity::Window || b.quantity == ExportQuantity::Ndc) return;
         const double n = b.camera.nearDistance();
-        for (const auto& [scale, offset] : sweepCases(b.round, {std::pair{1.002, 0.0}, std::pair{1000.0, 0.0}, std::pair{1.0, -n}})) {
+        for (const auto& [scale, offset] : sweepCases(round++, {std::pair{1.002, 0.0}, std::pair{1000.0, 0.0}, std::pair{1.0, -n}})) {
             INFO("value x " << scale << " + " << offset);
             const Hypothesis h = b.diagnosed(scaled(b.mapDrawnWith(b.camera.spec()), scale, offset), "depth-scale", "affine-depth-offset");
             if (h.name == "affine-depth-offset") {
