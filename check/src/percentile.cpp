@@ -1,7 +1,6 @@
 #include "percentile.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstring>
 
@@ -10,8 +9,8 @@ namespace zcheck {
 std::uint32_t kthSmallestBits(const std::vector<BitsSpan>& parts, std::size_t k)
 {
     // (Three passes of 11, 11 and 10 bits, each copying the patterns of the digit found into a
-    // new array for the next, took ~2.2× as long over a 1080p comparison's keepers, whose
-    // values mostly share their top bits: bench/speed-log.md.)
+    // new array for the next, took ~2× as long over a 1080p comparison's keepers, whose values
+    // mostly share their top bits: bench/speed-log.md, session 8.)
     constexpr std::size_t kDigits = std::size_t(1) << 16;
     LargeVector<std::uint32_t> count;  // counts of under 2^32 patterns: a keeper's, a frame's
     count.assign(kDigits, 0);
