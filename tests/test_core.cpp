@@ -376,6 +376,26 @@ TEST_CASE("storage quanta and quantization follow the formats' definitions", "[c
     REQUIRE(quantizeDepth(DepthFormat::Float32, 0.1) == double(0.1f));
 }
 
+TEST_CASE("a unorm code's value without a division is the quotient code / (2^N - 1), every code of both formats", "[core]")
+{
+    // unormValue's claim, checked exhaustively: bit for bit the division's result (the divisor
+    // read through a volatile, so that the division stays one).
+    for (const DepthFormat format : {DepthFormat::Unorm24, DepthFormat::Unorm16}) {
+        volatile double divisor = unormMax(format);
+        const double maxCode = divisor;
+        std::uint64_t differing = 0;
+        double firstDiffering = -1;
+        for (double code = 0; code <= maxCode; ++code) {
+            const double quotient = code / divisor, value = unormValue(format, code);
+            if (std::memcmp(&quotient, &value, sizeof value) != 0 && differing++ == 0) firstDiffering = code;
+        }
+        INFO(toString(format) << ": first differing code " << firstDiffering);
+        REQUIRE(differing == 0);
+        REQUIRE(unormValue(format, maxCode) == 1.0);
+        REQUIRE(quantizeDepth(format, 0.25) == unormCode(format, 0.25) / divisor);
+    }
+}
+
 TEST_CASE("the inline rounding to a depth code is std::nearbyint, halves to even, in every rounding mode", "[core]")
 {
     // Halves round to even (0.5 -> 0, 1.5 -> 2, 2.5 -> 2), as nearbyint does in the default mode;

@@ -254,22 +254,37 @@ void binChunk(const Viewport& vp, const std::vector<BinItem>& items, Chunk& chun
 struct DepthKeys {
     bool unorm;
     double maxCode;
+    DepthFormat format;
+    bool formatCodes;  // unorm keys are `format`'s codes (false: withCodes' own)
 
-    explicit DepthKeys(DepthFormat f) : unorm(f != DepthFormat::Float32), maxCode(unorm ? unormMax(f) : 1.0) {}
+    explicit DepthKeys(DepthFormat f)
+        : unorm(f != DepthFormat::Float32), maxCode(unorm ? unormMax(f) : 1.0), format(f), formatCodes(unorm)
+    {
+    }
     // Integer codes of `codes` steps whatever the format (RasterFrameTesting's fine keys).
     static DepthKeys withCodes(double codes)
     {
         DepthKeys keys(DepthFormat::Unorm24);
-        keys.maxCode = codes;
+        keys.maxCode = codes, keys.formatCodes = false;
         return keys;
     }
-    // The key of window depth d: value(key(d)) == quantizeDepth(format, d), bit for bit
+    // The key of window depth d: the value it stands for (values()) is quantizeDepth(format, d), bit for bit
     // (unormCode's arithmetic, with maxCode = unormMax(format)).
     double key(double windowDepth) const
     {
         return unorm ? nearbyintNonNegative(std::clamp(windowDepth, 0.0, 1.0) * maxCode) : double(float(windowDepth));
     }
-    double value(double key) const { return unorm ? key / maxCode : key; }
+    // The values n keys stand for, as the buffer stores them (a tile's row as it is copied into
+    // the frame), the case chosen once: a format's codes through unormValue (no division).
+    void values(const double* key, std::size_t n, double* out) const
+    {
+        if (!unorm)
+            std::copy_n(key, n, out);
+        else if (formatCodes)
+            for (std::size_t k = 0; k < n; ++k) out[k] = unormValue(format, key[k]);
+        else
+            for (std::size_t k = 0; k < n; ++k) out[k] = key[k] / maxCode;
+    }
     // The key of a value the buffer can store (code / (2^N − 1) times 2^N − 1 is the code to
     // within 1e-9, so rounding recovers it exactly).
     double keyOfStored(double stored) const { return unorm ? nearbyintNonNegative(stored * maxCode) : stored; }
@@ -866,11 +881,11 @@ void RasterFrame::Impl::drawTile(int tile, double* windowDepth, std::uint32_t* p
         double* depthTo = windowDepth + std::size_t(row - row0) * stride;
         std::uint32_t* primitiveTo = primitive + std::size_t(row - row0) * stride;
         if (stores == RasterFrame::Stores::Cached) {
-            for (int k = 0; k < count; ++k) depthTo[k] = keys.value(tileBuffer.key[from + k]);
+            keys.values(tileBuffer.key + from, std::size_t(count), depthTo);
             std::copy_n(tileBuffer.primitive + from, count, primitiveTo);
         } else {
             double depth[TileBuffer::kSide];
-            for (int k = 0; k < count; ++k) depth[k] = keys.value(tileBuffer.key[from + k]);
+            keys.values(tileBuffer.key + from, std::size_t(count), depth);
             copyRowStreaming(depth, std::size_t(count), depthTo);
             copyRowStreaming(tileBuffer.primitive + from, std::size_t(count), primitiveTo);
         }

@@ -73,13 +73,27 @@ inline double unormCode(DepthFormat format, double windowDepth)
     return nearbyintNonNegative(std::clamp(windowDepth, 0.0, 1.0) * unormMax(format));
 }
 
+// The value a unorm format's code `code` (an integer, 0 ≤ code ≤ 2^N − 1) stands for:
+// code / (2^N − 1) as the division rounds it, bit for bit, without a division (the raster stores
+// one per pixel). 1/(2^N − 1) = 2^−N + 2^−2N + …, so the exact quotient is the code's N bits
+// repeated below the binary point. t (the first two blocks for N = 24, three for N = 16) is
+// exact, t · 2^−48 too, and their sum, the first 96 bits of the quotient, is rounded once. The
+// bits past the 96th cannot change that rounding: they could only where the 96 bits were a tie,
+// whose last set bit lies 18 (N = 24) or 26 (N = 16) places below the code's highest, and a
+// code has fewer bits than that. tests/test_core.cpp checks every code of both formats.
+inline double unormValue(DepthFormat format, double code)
+{
+    const double t = code * (format == DepthFormat::Unorm24 ? 0x1p-24 + 0x1p-48 : 0x1p-16 + 0x1p-32 + 0x1p-48);
+    return t + t * 0x1p-48;
+}
+
 // The value the depth buffer stores for window depth `windowDepth` (clamped to [0,1] for
 // unorm formats, rounded to the nearest code), returned as a double so that all formats
 // compare alike. Inline: the rasterizer calls it per pixel.
 inline double quantizeDepth(DepthFormat format, double windowDepth)
 {
     if (format == DepthFormat::Float32) return static_cast<double>(static_cast<float>(windowDepth));
-    return unormCode(format, windowDepth) / unormMax(format);
+    return unormValue(format, unormCode(format, windowDepth));
 }
 
 // The storage quantum q at a stored value: 1 LSB = 1/(2^N − 1) for unorm-N, the spacing of
