@@ -822,6 +822,63 @@ TEST_CASE("the row pass's maxima leave out NaN and the lanes not in common, in e
     }
 }
 
+TEST_CASE("|d_raster - d_ray| in a unorm format's quanta is the difference times 2^N - 1, in every form", "[compare][kernel]")
+{
+    // A unorm format's quantum is exactly 1/(2^N - 1); its double q only rounds it. inQuanta (and
+    // so the row pass) takes a difference in such quanta as the difference times 2^N - 1, one
+    // rounding of the exact quotient, where a division by q would round twice; any other quantum
+    // divides. A row of lanes with unorm24's, unorm16's and float32-like quanta (the row's own
+    // array: the lane-by-lane rule), and differences among which the two ways part.
+    const Scene scene = builtinScene("builtin:terrain?n=8");
+    const Camera camera(smallCamera(scene));
+    const PixelJudge::ToleranceTerms terms = PixelJudge(scene, camera).toleranceTerms();
+    const double q24 = storageQuantum(DepthFormat::Unorm24, 0.5), q16 = storageQuantum(DepthFormat::Unorm16, 0.5);
+    const double qOther = std::ldexp(1.0, -25);
+    std::mt19937_64 random(46);
+    std::uniform_real_distribution<double> depth(0.0, 1.0);
+    int parted = 0;  // lanes where Δ/q and Δ·(2^N - 1) differ
+    for (int round = 0; round < 200; ++round) {
+        alignas(64) std::uint32_t primitive[kLanes];
+        alignas(64) double rayDepth[kLanes], rasterDepth[kLanes], slope[kLanes], quantum[kLanes], relative[kLanes];
+        for (int j = 0; j < kLanes; ++j) {
+            primitive[j] = 3;
+            rayDepth[j] = depth(random), rasterDepth[j] = depth(random);
+            slope[j] = 0.25, relative[j] = 0.5;
+            quantum[j] = j % 3 == 0 ? q24 : j % 3 == 1 ? q16 : qOther;
+        }
+        RowInputs in;
+        in.rayPrimitive = primitive, in.rasterPrimitive = primitive, in.surface = primitive;
+        in.rayDepth = rayDepth, in.rasterDepth = rasterDepth, in.slope = slope, in.quantum = quantum;
+        in.allowance = kNoAllowance, in.relative = relative, in.n = kLanes;
+        auto pass = [&](void (*rowLanes)(const RowInputs&, const PixelJudge::ToleranceTerms&, StatisticCounts&, RowLanes&)) {
+            StatisticCounts counts{LargestValues(64), LargestValues(64)};
+            RowLanes out{};
+            rowLanes(in, terms, counts, out);
+            return out;
+        };
+        const RowLanes baseline = pass(rowLanesBaseline);
+        for (int j = 0; j < kLanes; ++j) {
+            const double difference = rasterDepth[j] - rayDepth[j];
+            const double expected = j % 3 == 0 ? difference * 16777215.0 : j % 3 == 1 ? difference * 65535.0 : difference / qOther;
+            INFO("lane " << j << ", round " << round);
+            REQUIRE(baseline.signedErrorQuanta[j] == expected);
+            parted += j % 3 != 2 && difference / quantum[j] != expected;
+        }
+#ifdef ZCHECK_X86_FORMS
+        std::vector<std::pair<const char*, RowLanes>> byForm;
+        if (kernelFormSupported(KernelForm::Avx2)) byForm.emplace_back("avx2", pass(rowLanesAvx2));
+        if (kernelFormSupported(KernelForm::Avx512)) byForm.emplace_back("avx512", pass(rowLanesAvx512));
+        for (const auto& [form, lanes] : byForm) {
+            INFO("the " << form << " form");
+            const std::size_t bytes = std::size_t(kLanes) * sizeof(double);
+            REQUIRE(std::memcmp(lanes.signedErrorQuanta, baseline.signedErrorQuanta, bytes) == 0);
+            REQUIRE(std::memcmp(lanes.errorQuanta, baseline.errorQuanta, bytes) == 0);
+        }
+#endif
+    }
+    REQUIRE(parted > 0);  // the rule is not the division under another name
+}
+
 TEST_CASE("the comparison's vector forms on rows of NaN, a zero bound and the bias rule's edge",
           "[compare][kernel]")
 {

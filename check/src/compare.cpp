@@ -196,7 +196,7 @@ ZCHECK_ALWAYS_INLINE inline void tallyCommonLanes(ComparisonReport& r, const Row
 }
 
 // The bias test's sum in scan order (its rounding depends on the order): its signed
-// error, and where its exact depth falls in the quantum (a division per pixel).
+// error, and where its exact depth falls in the quantum (inQuanta: a unorm format's code).
 ZCHECK_ALWAYS_INLINE inline void sumBiasInScanOrder(TileTally& tally, const RowLanes& lanes, const TileRow& tileRow,
                                                     const RowForms& forms, const LanePassArrays& arrays)
 {
@@ -204,7 +204,7 @@ ZCHECK_ALWAYS_INLINE inline void sumBiasInScanOrder(TileTally& tally, const RowL
     std::int64_t quarters[4] = {0, 0, 0, 0};
     forEachSetBit(lanes.bias, [&](std::size_t j) ZCHECK_ALWAYS_INLINE {
         signedErrorSum += lanes.signedErrorQuanta[j];
-        const double position = tileRow.rayDepth[j] / quantumOfLane(forms, arrays, j);  // d/q
+        const double position = inQuanta(tileRow.rayDepth[j], quantumOfLane(forms, arrays, j));  // d/q
         ++quarters[std::clamp(int(4 * (position - std::floor(position))), 0, 3)];
     });
     tally.signedErrorSum = signedErrorSum;
@@ -250,7 +250,7 @@ ZCHECK_ALWAYS_INLINE inline void noteCommonPixel(const TileRow& tileRow, int j, 
     f.rayPrimitive = f.rasterPrimitive = tileRow.rayPrimitive[j];
     f.pixelClass = c;
     f.errorQuanta = lanes.errorQuanta[j];
-    f.toleranceQuanta = lanes.bound[j] / quantumOfLane(forms, arrays, std::size_t(j));
+    f.toleranceQuanta = inQuanta(lanes.bound[j], quantumOfLane(forms, arrays, std::size_t(j)));
     if (worst) r.worst = f;
     if (!agree) noteUnexplained(r, f);
 }
@@ -475,7 +475,7 @@ ZCHECK_ALWAYS_INLINE inline void TileComparison::Impl::judgeOffCommonPixel(const
         f.errorQuanta = std::abs(PixelMeasures::signedErrorQuanta(ray.windowDepth[a], raster.windowDepth[b], q));
         const double ratio = ratioOf(error, bound);
         auto withTolerance = [&](PixelFinding& finding) -> PixelFinding& {  // a finding kept
-            finding.toleranceQuanta = bound / q;
+            finding.toleranceQuanta = inQuanta(bound, q);
             return finding;
         };
         if (f.pixelClass == PixelClass::EdgeSurface) {

@@ -180,6 +180,11 @@ ZCHECK_ALWAYS_INLINE inline void rowLanesOf(const RowInputs& in, const PixelJudg
     const Int32 agreeClass = L::set1(std::int32_t(PixelClass::Agree)), errorClass = L::set1(std::int32_t(PixelClass::DepthError));
     const Int32 bothMissClass = L::set1(std::int32_t(PixelClass::BothMiss));
     const Real constantQuantum = L::set1(in.constantQuantum.value_or(0.0));
+    // inQuanta's unorm quanta: the row's multiplier where its one quantum is one (0: none).
+    const double rowCodesPerUnit = in.constantQuantum ? unormCodesPerUnit(*in.constantQuantum) : 0.0;
+    const Real codesPerUnit = L::set1(rowCodesPerUnit);
+    const Real quantum24 = L::set1(storageQuantum(DepthFormat::Unorm24, 0.0)), codes24 = L::set1(unormMax(DepthFormat::Unorm24));
+    const Real quantum16 = L::set1(storageQuantum(DepthFormat::Unorm16, 0.0)), codes16 = L::set1(unormMax(DepthFormat::Unorm16));
     const Real relativeA = L::set1(in.relativeForm ? in.relativeForm->A : 0.0);
     constexpr bool kClosedForm = kCase != RowCase::General;
     const bool parallel = kClosedForm ? kCase == RowCase::ClosedFormParallel : in.relativeForm && in.relativeForm->parallel;
@@ -235,7 +240,16 @@ ZCHECK_ALWAYS_INLINE inline void rowLanesOf(const RowInputs& in, const PixelJudg
         terms.bound(m, q, allowance, bound);
         const Real difference = rasterDepth - rayDepth;
         const Real error = L::abs(difference);
-        const Real signedErrorQuanta = difference / q;
+        // PixelMeasures::signedErrorQuanta (inQuanta): one multiplication where the row's one
+        // quantum is a unorm format's (a division cost the AVX-512 comparison ~9 %), else lane by lane.
+        Real signedErrorQuanta;
+        if (rowCodesPerUnit != 0) {
+            signedErrorQuanta = difference * codesPerUnit;
+        } else {
+            const Real perUnit = L::select((q >= quantum24) & (q <= quantum24), codes24,
+                                           L::select((q >= quantum16) & (q <= quantum16), codes16, zero));
+            signedErrorQuanta = L::select(perUnit > zero, difference * perUnit, difference / q);
+        }
         const Real errorQuanta = L::abs(signedErrorQuanta);
         // ratioOf(error, bound).
         const Real unbounded = L::select(error > zero, infinity, zero);

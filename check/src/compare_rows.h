@@ -49,8 +49,8 @@ struct PixelMeasures {
     {
         return raster.quantum ? raster.quantum[b] : storageQuantum(format, ray.windowDepth[a]);
     }
-    // (d_raster − d_ray)/q, of which the statistics take the absolute value.
-    static double signedErrorQuanta(double rayDepth, double rasterDepth, double q) { return (rasterDepth - rayDepth) / q; }
+    // (d_raster − d_ray)/q as inQuanta takes it, of which the statistics take the absolute value.
+    static double signedErrorQuanta(double rayDepth, double rasterDepth, double q) { return inQuanta(rasterDepth - rayDepth, q); }
     // quantum() of n pixels of a row, entries a0.. and b0.., into q: several per instruction
     // where the format's quantum is one constant or comes from the raster's own array.
     void quanta(const RoutePixels& ray, const RoutePixels& raster, std::size_t a0, std::size_t b0, std::size_t n,

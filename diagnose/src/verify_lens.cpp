@@ -105,7 +105,7 @@ public:
             out.tolerance = std::abs(error) <= storage + declared ? storage + declared
                                                                   : toleranceOn(primitive, pWindow, quantum, out.truth, declared);
             out.intrinsic = out.tolerance - declared;
-            out.errorQuanta = std::abs(error) / quantum;
+            out.errorQuanta = inQuanta(std::abs(error), quantum);
             out.errorOverTolerance = std::abs(error) / out.tolerance;
             out.primitive = primitive;
             if (std::abs(error) <= out.tolerance) {

@@ -8,6 +8,14 @@ them real meshes, under three conventions, three depth formats, standard and rev
 (faults injected into either route). `python3 tests/python/test_compare_golden.py EXE`
 prints the digests a build gives, in the file's format.
 
+Four digests were recorded again when the comparison took a unorm format's |d_raster - d_ray|/q
+as the difference times 2^N - 1, the quantum exactly (inQuanta; issue 46), where it had divided
+by the quantum's double: the bunny in unorm16 with reversed-Z under the three conventions and
+the quick suite. In each, one figure moved and nothing else: the mean signed error in quanta,
+in its last bit or two (-0.009686778996405578 to -0.009686778996405583 under opengl, the same
+step under direct3d and opencv; -0.005827337893965418 to -0.0058273378939654175 in the suite's
+twelfth configuration). The other 89 stayed as recorded.
+
 The reports hold Embree's hits too, and Embree picks its kernels by processor: the digests
 were recorded where it runs its AVX-512 ones, and on a processor without them the test is
 skipped rather than blame the comparison for a hit that moved across an edge."""

@@ -113,6 +113,24 @@ inline double storageQuantum(DepthFormat format, double windowDepth)
     return static_cast<double>(next) - static_cast<double>(magnitude);
 }
 
+// 2^N − 1 where q is a unorm format's storageQuantum, else 0 (inQuanta's test, lane by lane too).
+inline double unormCodesPerUnit(double q)
+{
+    if (q == storageQuantum(DepthFormat::Unorm24, 0.0)) return unormMax(DepthFormat::Unorm24);
+    if (q == storageQuantum(DepthFormat::Unorm16, 0.0)) return unormMax(DepthFormat::Unorm16);
+    return 0.0;
+}
+
+// A value x in quanta q, x / q. A unorm format's quantum is exactly 1/(2^N − 1), which its
+// storageQuantum can only round: where q is that double, x · (2^N − 1) (the exact quotient,
+// rounded once, and one multiplication for the comparison's every pixel instead of a division);
+// any other q (float32's, a map's own) divides.
+inline double inQuanta(double x, double q)
+{
+    const double codesPerUnit = unormCodesPerUnit(q);
+    return codesPerUnit != 0.0 ? x * codesPerUnit : x / q;
+}
+
 struct DepthSettings {
     DepthFormat format = DepthFormat::Float32;
     bool reversed = false;   // reversed-Z: near → far end of the range, depth test GREATER
