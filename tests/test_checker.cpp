@@ -730,6 +730,44 @@ TEST_CASE("the comparison's vector forms are bit-identical to its baseline form 
     REQUIRE(orderMatters > 0);
 }
 
+namespace {
+
+// A row's lane pass by one form's kernel, with keepers of 64 values.
+using RowLanesKernel = void (*)(const RowInputs&, const PixelJudge::ToleranceTerms&, StatisticCounts&, RowLanes&);
+RowLanes rowPassBy(RowLanesKernel kernel, const RowInputs& in, const PixelJudge::ToleranceTerms& terms)
+{
+    StatisticCounts counts{LargestValues(64), LargestValues(64)};
+    RowLanes out{};
+    kernel(in, terms, counts, out);
+    return out;
+}
+
+// The row's lane pass by each vector form the processor has, named.
+std::vector<std::pair<const char*, RowLanes>> rowPassesOfVectorForms([[maybe_unused]] const RowInputs& in,
+                                                                    [[maybe_unused]] const PixelJudge::ToleranceTerms& terms)
+{
+    std::vector<std::pair<const char*, RowLanes>> byForm;
+#ifdef ZCHECK_X86_FORMS
+    if (kernelFormSupported(KernelForm::Avx2)) byForm.emplace_back("avx2", rowPassBy(rowLanesAvx2, in, terms));
+    if (kernelFormSupported(KernelForm::Avx512)) byForm.emplace_back("avx512", rowPassBy(rowLanesAvx512, in, terms));
+#endif
+    return byForm;
+}
+
+// A row of n lanes from its arrays, without allowances.
+RowInputs rowInputsOf(const std::uint32_t* rayPrimitive, const std::uint32_t* rasterPrimitive, const std::uint32_t* surface,
+                      const double* rayDepth, const double* rasterDepth, const double* slope, const double* quantum,
+                      const double* relative, int n)
+{
+    RowInputs in;
+    in.rayPrimitive = rayPrimitive, in.rasterPrimitive = rasterPrimitive, in.surface = surface;
+    in.rayDepth = rayDepth, in.rasterDepth = rasterDepth, in.slope = slope, in.quantum = quantum;
+    in.allowance = kNoAllowance, in.relative = relative, in.n = n;
+    return in;
+}
+
+}  // namespace
+
 TEST_CASE("the row pass's maxima leave out NaN and the lanes not in common, in every form", "[compare][kernel]")
 {
     // RowLanes::largest: the largest |Δ|/q, relative error and ratio of a row's common lanes,
@@ -777,17 +815,9 @@ TEST_CASE("the row pass's maxima leave out NaN and the lanes not in common, in e
             slope[j] = 0.25, quantum[j] = q;
             relative[j] = lane == NaNDepth ? nan : lane == Error ? 0.125 : lane == Exact ? 0.0 : 0.75;  // a miss's is never read
         }
-        RowInputs in;
-        in.rayPrimitive = rayPrimitive, in.rasterPrimitive = rasterPrimitive, in.surface = surface;
-        in.rayDepth = rayDepth, in.rasterDepth = rasterDepth, in.slope = slope, in.quantum = quantum;
-        in.allowance = kNoAllowance, in.relative = relative, in.n = n;
-        auto pass = [&](void (*rowLanes)(const RowInputs&, const PixelJudge::ToleranceTerms&, StatisticCounts&, RowLanes&)) {
-            StatisticCounts counts{LargestValues(64), LargestValues(64)};
-            RowLanes out{};
-            rowLanes(in, terms, counts, out);
-            return out;
-        };
-        const RowLanes baseline = pass(rowLanesBaseline);
+        const RowInputs in =
+            rowInputsOf(rayPrimitive, rasterPrimitive, surface, rayDepth, rasterDepth, slope, quantum, relative, n);
+        const RowLanes baseline = rowPassBy(rowLanesBaseline, in, terms);
         auto value = [](std::int64_t bits) {
             double x;
             std::memcpy(&x, &bits, sizeof x);
@@ -801,11 +831,7 @@ TEST_CASE("the row pass's maxima leave out NaN and the lanes not in common, in e
             REQUIRE(value(baseline.largest[k]) == expected[k]);
             if (expected[k] < 0) REQUIRE(baseline.largest[k] == -1);
         }
-#ifdef ZCHECK_X86_FORMS
-        std::vector<std::pair<const char*, RowLanes>> byForm;
-        if (kernelFormSupported(KernelForm::Avx2)) byForm.emplace_back("avx2", pass(rowLanesAvx2));
-        if (kernelFormSupported(KernelForm::Avx512)) byForm.emplace_back("avx512", pass(rowLanesAvx512));
-        for (const auto& [form, lanes] : byForm) {
+        for (const auto& [form, lanes] : rowPassesOfVectorForms(in, terms)) {
             INFO("the " << form << " form");
             for (int k = 0; k < 3; ++k) REQUIRE(lanes.largest[k] == baseline.largest[k]);
             REQUIRE(lanes.common == baseline.common);
@@ -818,7 +844,6 @@ TEST_CASE("the row pass's maxima leave out NaN and the lanes not in common, in e
             REQUIRE(std::memcmp(lanes.bound, baseline.bound, bytes) == 0);
             REQUIRE(std::memcmp(lanes.signedErrorQuanta, baseline.signedErrorQuanta, bytes) == 0);
         }
-#endif
     }
 }
 
@@ -846,17 +871,9 @@ TEST_CASE("|d_raster - d_ray| in a unorm format's quanta is the difference times
             slope[j] = 0.25, relative[j] = 0.5;
             quantum[j] = j % 3 == 0 ? q24 : j % 3 == 1 ? q16 : qOther;
         }
-        RowInputs in;
-        in.rayPrimitive = primitive, in.rasterPrimitive = primitive, in.surface = primitive;
-        in.rayDepth = rayDepth, in.rasterDepth = rasterDepth, in.slope = slope, in.quantum = quantum;
-        in.allowance = kNoAllowance, in.relative = relative, in.n = kLanes;
-        auto pass = [&](void (*rowLanes)(const RowInputs&, const PixelJudge::ToleranceTerms&, StatisticCounts&, RowLanes&)) {
-            StatisticCounts counts{LargestValues(64), LargestValues(64)};
-            RowLanes out{};
-            rowLanes(in, terms, counts, out);
-            return out;
-        };
-        const RowLanes baseline = pass(rowLanesBaseline);
+        const RowInputs in =
+            rowInputsOf(primitive, primitive, primitive, rayDepth, rasterDepth, slope, quantum, relative, kLanes);
+        const RowLanes baseline = rowPassBy(rowLanesBaseline, in, terms);
         for (int j = 0; j < kLanes; ++j) {
             const double difference = rasterDepth[j] - rayDepth[j];
             const double expected = j % 3 == 0 ? difference * 16777215.0 : j % 3 == 1 ? difference * 65535.0 : difference / qOther;
@@ -864,17 +881,12 @@ TEST_CASE("|d_raster - d_ray| in a unorm format's quanta is the difference times
             REQUIRE(baseline.signedErrorQuanta[j] == expected);
             parted += j % 3 != 2 && difference / quantum[j] != expected;
         }
-#ifdef ZCHECK_X86_FORMS
-        std::vector<std::pair<const char*, RowLanes>> byForm;
-        if (kernelFormSupported(KernelForm::Avx2)) byForm.emplace_back("avx2", pass(rowLanesAvx2));
-        if (kernelFormSupported(KernelForm::Avx512)) byForm.emplace_back("avx512", pass(rowLanesAvx512));
-        for (const auto& [form, lanes] : byForm) {
+        for (const auto& [form, lanes] : rowPassesOfVectorForms(in, terms)) {
             INFO("the " << form << " form");
             const std::size_t bytes = std::size_t(kLanes) * sizeof(double);
             REQUIRE(std::memcmp(lanes.signedErrorQuanta, baseline.signedErrorQuanta, bytes) == 0);
             REQUIRE(std::memcmp(lanes.errorQuanta, baseline.errorQuanta, bytes) == 0);
         }
-#endif
     }
     REQUIRE(parted > 0);  // the rule is not the division under another name
 }
