@@ -33,6 +33,7 @@
 
 #include <set>
 #include <thread>
+#include <tuple>
 
 using namespace zcheck;
 
@@ -205,7 +206,7 @@ TEST_CASE("the comparison's report is the same for 1 and 2 threads, and its p99 
         const PixelClass c = one.comparison.pixelClass[i];
         if (c != PixelClass::Agree && c != PixelClass::DepthError) continue;
         const double ray = one.ray.windowDepth.value[i], raster = one.raster.windowDepth.value[i];
-        errorQuanta.push_back(float(std::abs(raster - ray) / storageQuantum(spec.depth.format, ray)));
+        errorQuanta.push_back(float(inQuanta(std::abs(raster - ray), storageQuantum(spec.depth.format, ray))));
         maxRatio = std::max(maxRatio, one.comparison.errorOverTolerance[i]);
     }
     REQUIRE(errorQuanta.size() > 1000);
@@ -852,15 +853,26 @@ TEST_CASE("|d_raster - d_ray| in a unorm format's quanta is the difference times
     // A unorm format's quantum is exactly 1/(2^N - 1); its double q only rounds it. inQuanta (and
     // so the row pass) takes a difference in such quanta as the difference times 2^N - 1, one
     // rounding of the exact quotient, where a division by q would round twice; any other quantum
-    // divides. A row of lanes with unorm24's, unorm16's and float32-like quanta (the row's own
-    // array: the lane-by-lane rule), and differences among which the two ways part.
+    // divides, NaN, zero and negative ones too. A row of lanes with unorm24's, unorm16's, a
+    // float32-like quantum and those (the row's own array: the lane-by-lane rule), and differences
+    // among which the two ways part.
     const Scene scene = builtinScene("builtin:terrain?n=8");
     const Camera camera(smallCamera(scene));
     const PixelJudge::ToleranceTerms terms = PixelJudge(scene, camera).toleranceTerms();
     const double q24 = storageQuantum(DepthFormat::Unorm24, 0.5), q16 = storageQuantum(DepthFormat::Unorm16, 0.5);
     const double qOther = std::ldexp(1.0, -25);
+    const std::vector<double> quanta = {q24, q16, qOther, std::numeric_limits<double>::quiet_NaN(), 0.0, -0.0, -q24};
     std::mt19937_64 random(46);
     std::uniform_real_distribution<double> depth(0.0, 1.0);
+    // Pairs of depths whose difference in unorm16 quanta parts from the division (~3 in 10,000:
+    // unorm24's double quantum is so near 1/(2^24 - 1) that random differences almost never
+    // part), one put in a unorm16 lane each round.
+    std::vector<std::pair<double, double>> parting;
+    for (int tries = 0; tries < 10000000 && parting.size() < 16; ++tries) {
+        const double ray = depth(random), raster = depth(random);
+        if ((raster - ray) / q16 != (raster - ray) * 65535.0) parting.emplace_back(ray, raster);
+    }
+    REQUIRE(parting.size() == 16);
     int parted = 0;  // lanes where Δ/q and Δ·(2^N - 1) differ
     for (int round = 0; round < 200; ++round) {
         alignas(64) std::uint32_t primitive[kLanes];
@@ -869,17 +881,18 @@ TEST_CASE("|d_raster - d_ray| in a unorm format's quanta is the difference times
             primitive[j] = 3;
             rayDepth[j] = depth(random), rasterDepth[j] = depth(random);
             slope[j] = 0.25, relative[j] = 0.5;
-            quantum[j] = j % 3 == 0 ? q24 : j % 3 == 1 ? q16 : qOther;
+            quantum[j] = quanta[std::size_t(j) % quanta.size()];
         }
+        std::tie(rayDepth[1], rasterDepth[1]) = parting[std::size_t(round) % parting.size()];  // lane 1: q16
         const RowInputs in =
             rowInputsOf(primitive, primitive, primitive, rayDepth, rasterDepth, slope, quantum, relative, kLanes);
         const RowLanes baseline = rowPassBy(rowLanesBaseline, in, terms);
         for (int j = 0; j < kLanes; ++j) {
-            const double difference = rasterDepth[j] - rayDepth[j];
-            const double expected = j % 3 == 0 ? difference * 16777215.0 : j % 3 == 1 ? difference * 65535.0 : difference / qOther;
-            INFO("lane " << j << ", round " << round);
-            REQUIRE(baseline.signedErrorQuanta[j] == expected);
-            parted += j % 3 != 2 && difference / quantum[j] != expected;
+            const double difference = rasterDepth[j] - rayDepth[j], q = quantum[j];
+            const double expected = q == q24 ? difference * 16777215.0 : q == q16 ? difference * 65535.0 : difference / q;
+            INFO("lane " << j << ", round " << round << ", quantum " << q);
+            REQUIRE(std::memcmp(&baseline.signedErrorQuanta[j], &expected, sizeof expected) == 0);
+            parted += (q == q24 || q == q16) && difference / q != expected;
         }
         for (const auto& [form, lanes] : rowPassesOfVectorForms(in, terms)) {
             INFO("the " << form << " form");
@@ -1305,7 +1318,8 @@ TEST_CASE("a NaN depth is a depth error and never the largest error", "[compare]
             REQUIRE(r.unexplainedSamples.size() == 2);
             CHECK(r.unexplainedSamples[0].col == int(a % width));
             CHECK(r.unexplainedSamples[1].col == int(b % width));
-            CHECK(r.maxErrorQuanta == std::abs((raster.windowDepth.value[b] - quad.ray.windowDepth.value[b]) / q));
+            REQUIRE(q == storageQuantum(DepthFormat::Unorm24, 0.0));  // unorm24's: in quanta, |Δ|·(2^24 - 1)
+            CHECK(r.maxErrorQuanta == std::abs(raster.windowDepth.value[b] - quad.ray.windowDepth.value[b]) * 16777215.0);
             CHECK(std::isfinite(r.maxRelativeEyeZError));
             CHECK(r.maxRelativeEyeZError > 0);
             CHECK(std::isfinite(r.maxErrorOverTolerance));

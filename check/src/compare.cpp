@@ -196,7 +196,7 @@ ZCHECK_ALWAYS_INLINE inline void tallyCommonLanes(ComparisonReport& r, const Row
 }
 
 // The bias test's sum in scan order (its rounding depends on the order): its signed
-// error, and where its exact depth falls in the quantum (inQuanta: a unorm format's code).
+// error, and where its exact depth falls within its quantum (the depth in quanta, inQuanta).
 ZCHECK_ALWAYS_INLINE inline void sumBiasInScanOrder(TileTally& tally, const RowLanes& lanes, const TileRow& tileRow,
                                                     const RowForms& forms, const LanePassArrays& arrays)
 {
@@ -204,7 +204,7 @@ ZCHECK_ALWAYS_INLINE inline void sumBiasInScanOrder(TileTally& tally, const RowL
     std::int64_t quarters[4] = {0, 0, 0, 0};
     forEachSetBit(lanes.bias, [&](std::size_t j) ZCHECK_ALWAYS_INLINE {
         signedErrorSum += lanes.signedErrorQuanta[j];
-        const double position = inQuanta(tileRow.rayDepth[j], quantumOfLane(forms, arrays, j));  // d/q
+        const double position = inQuanta(tileRow.rayDepth[j], quantumOfLane(forms, arrays, j));
         ++quarters[std::clamp(int(4 * (position - std::floor(position))), 0, 3)];
     });
     tally.signedErrorSum = signedErrorSum;

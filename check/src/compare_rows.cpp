@@ -180,7 +180,7 @@ ZCHECK_ALWAYS_INLINE inline void rowLanesOf(const RowInputs& in, const PixelJudg
     const Int32 agreeClass = L::set1(std::int32_t(PixelClass::Agree)), errorClass = L::set1(std::int32_t(PixelClass::DepthError));
     const Int32 bothMissClass = L::set1(std::int32_t(PixelClass::BothMiss));
     const Real constantQuantum = L::set1(in.constantQuantum.value_or(0.0));
-    // inQuanta's unorm quanta: the row's multiplier where its one quantum is one (0: none).
+    // inQuanta's multiplier where the row's constant quantum is a unorm format's (0: none).
     const double rowCodesPerUnit = in.constantQuantum ? unormCodesPerUnit(*in.constantQuantum) : 0.0;
     const Real codesPerUnit = L::set1(rowCodesPerUnit);
     const Real quantum24 = L::set1(storageQuantum(DepthFormat::Unorm24, 0.0)), codes24 = L::set1(unormMax(DepthFormat::Unorm24));

@@ -185,7 +185,7 @@ private:
 // A pixel as the report shows it: the truth as the ray, the map as the second route (distances).
 PixelFinding finding(const LensPixel& p, int col, int row)
 {
-    return {col, row, p.pixelClass, p.truth, p.map, p.errorQuanta, p.quantum > 0 ? p.tolerance / p.quantum : 0,
+    return {col, row, p.pixelClass, p.truth, p.map, p.errorQuanta, p.quantum > 0 ? inQuanta(p.tolerance, p.quantum) : 0,
             p.pixelClass == PixelClass::RasterOnly || p.pixelClass == PixelClass::RasterOnlyEdge ? kNoPrimitive : p.primitive,
             p.primitive};
 }

@@ -416,7 +416,8 @@ ZCHECK_ALWAYS_INLINE inline void drawInTileLanes(const DepthSettings& depth, con
             L::store(primitiveRow + col, L::select(nearer, primitive, L::load(primitiveRow + col)));
         }
     };
-    // Row by row: the plane's depth at (x0, the row's centres), the row's places in the tile buffer.
+    // A row: the plane's depth at x0 on the row's centre line, the row's places in the tile
+    // buffer, then the groups across it; rowE then moves down to the next row.
     auto drawRow = [&](int row, auto acrossTheRow) ZCHECK_ALWAYS_INLINE {
         const Real rowDepth = L::set1(t.z0 + t.dzdy * (row + 0.5 - t.y0));
         double* keyRow = out.key + (row - out.row0) * TileBuffer::kSide - out.col0;
@@ -426,7 +427,7 @@ ZCHECK_ALWAYS_INLINE inline void drawInTileLanes(const DepthSettings& depth, con
     };
     // A box one group wide (most of a million-triangle mesh's at 1080p) in a loop of its own,
     // without the loop across the row, whose exit, after one group or two, was mispredicted row
-    // after row (the raster 0.93–0.96 of its time, bench/speed-log.md).
+    // after row (the raster 0.92–0.96 of its time, bench/speed-log.md).
     if (col1 - col0 < kLanes) {
         for (int row = row0; row <= row1; ++row)
             drawRow(row, [&](double* keyRow, std::uint32_t* primitiveRow, const Real& rowDepth) ZCHECK_ALWAYS_INLINE {
@@ -681,9 +682,9 @@ struct RasterKernels {
     bool (*binItemsOfEight)(const Viewport&, const glm::uvec3*, std::uint32_t, const StoredVertex*,
                             std::vector<BinItem>&) = nullptr;
     unsigned (*setUpEight)(const Viewport&, const glm::uvec3*, const std::uint32_t*, const StoredVertex*, TriangleSetup*) = nullptr;
-    // setUpEight, then draw for each entry set up, in one call of the form's code (where draw is
-    // not null): one call per eight triangles, the draw's constants made once (the `avx2` raster
-    // 0.97–0.98 of its time, `avx512` ~0.99).
+    // setUpEight, then draw for each entry set up, in one call of the form's code; null wherever
+    // draw is: one call per eight triangles, the draw's constants made once (the `avx2` raster
+    // 0.97–0.98 of its time; the `avx512` one's within its noise, median 0.987).
     void (*setUpAndDrawEight)(const Viewport&, const DepthKeys&, const glm::uvec3*, const std::uint32_t*,
                               const StoredVertex*, int, int, int, int, TileBuffer&) = nullptr;
 };
@@ -891,7 +892,7 @@ void RasterFrame::Impl::drawTile(int tile, double* windowDepth, std::uint32_t* p
                 !((binned[k] | binned[k + 1] | binned[k + 2] | binned[k + 3] | binned[k + 4] | binned[k + 5] |
                    binned[k + 6] | binned[k + 7]) & kClippedBit)) {
                 for (std::uint32_t j = 0; j < 8; ++j) askAhead(k + j);
-                if (kernels.setUpAndDrawEight)
+                if (kernels.draw && kernels.setUpAndDrawEight)
                     kernels.setUpAndDrawEight(vp, keys, scene.triangles.data(), binned + k, snapped.data(), col0, row0,
                                               col1, row1, tileBuffer);
                 else

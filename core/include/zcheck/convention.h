@@ -76,11 +76,13 @@ inline double unormCode(DepthFormat format, double windowDepth)
 // The value a unorm format's code `code` (an integer, 0 ≤ code ≤ 2^N − 1) stands for:
 // code / (2^N − 1) as the division rounds it, bit for bit, without a division (the raster stores
 // one per pixel). 1/(2^N − 1) = 2^−N + 2^−2N + …, so the exact quotient is the code's N bits
-// repeated below the binary point. t (the first two blocks for N = 24, three for N = 16) is
+// repeated below the binary point. t (the first two copies for N = 24, three for N = 16) is
 // exact, t · 2^−48 too, and their sum, the first 96 bits of the quotient, is rounded once. The
-// bits past the 96th cannot change that rounding: they could only where the 96 bits were a tie,
-// whose last set bit lies 18 (N = 24) or 26 (N = 16) places below the code's highest, and a
-// code has fewer bits than that. tests/test_core.cpp checks every code of both formats.
+// bits past the 96th add less than one unit of the 96th (the quotient times 2^−96), and every
+// midpoint between two doubles here is a multiple of 2^−77, so they could change the rounding
+// only where the 96-bit sum were itself a midpoint. It never is: a midpoint's last set bit lies
+// 53 places below its leading bit, the sum's (the code's lowest set bit, in its last copy) at
+// least 96 − N places. tests/test_core.cpp checks every code of both formats.
 inline double unormValue(DepthFormat format, double code)
 {
     const double t = code * (format == DepthFormat::Unorm24 ? 0x1p-24 + 0x1p-48 : 0x1p-16 + 0x1p-32 + 0x1p-48);
@@ -122,13 +124,15 @@ inline double unormCodesPerUnit(double q)
 }
 
 // A value x in quanta q, x / q. A unorm format's quantum is exactly 1/(2^N − 1), which its
-// storageQuantum can only round: where q is that double, x · (2^N − 1) (the exact quotient,
-// rounded once, and one multiplication for the comparison's every pixel instead of a division);
-// any other q (float32's, a map's own) divides.
+// storageQuantum can only round: where q is that double, whatever gave it (a format, a map's
+// own quanta), x · (2^N − 1), the exact quotient rounded once (and in the comparison's vector
+// forms one multiplication a pixel instead of a division); any other q divides. (The division
+// is made either way, so that a loop of these needs no branch: a compiler may not make a
+// trapping operation the code skipped.)
 inline double inQuanta(double x, double q)
 {
-    const double codesPerUnit = unormCodesPerUnit(q);
-    return codesPerUnit != 0.0 ? x * codesPerUnit : x / q;
+    const double codesPerUnit = unormCodesPerUnit(q), quotient = x / q;
+    return codesPerUnit != 0.0 ? x * codesPerUnit : quotient;
 }
 
 struct DepthSettings {
