@@ -892,7 +892,7 @@ void RasterFrame::Impl::drawTile(int tile, double* windowDepth, std::uint32_t* p
                 !((binned[k] | binned[k + 1] | binned[k + 2] | binned[k + 3] | binned[k + 4] | binned[k + 5] |
                    binned[k + 6] | binned[k + 7]) & kClippedBit)) {
                 for (std::uint32_t j = 0; j < 8; ++j) askAhead(k + j);
-                if (kernels.draw && kernels.setUpAndDrawEight)
+                if (kernels.setUpAndDrawEight)
                     kernels.setUpAndDrawEight(vp, keys, scene.triangles.data(), binned + k, snapped.data(), col0, row0,
                                               col1, row1, tileBuffer);
                 else
