@@ -303,10 +303,8 @@ double faultyStoredDepth(const Viewport& vp, double interpolated, int col, int r
                                            (camera.farDistance() - camera.nearDistance());
     }
     windowDepth = std::clamp(windowDepth, depth.rangeMin, depth.rangeMax);
-    if (vp.faults.truncateUnorm && depth.format != DepthFormat::Float32) {
-        const double maxCode = 1.0 / storageQuantum(depth.format, windowDepth);
-        return std::floor(windowDepth * maxCode) / maxCode;
-    }
+    if (vp.faults.truncateUnorm && depth.format != DepthFormat::Float32)  // quantizeDepth's code truncated, not rounded
+        return unormValue(depth.format, std::floor(windowDepth * unormMax(depth.format)));
     return quantizeDepth(depth.format, windowDepth);
 }
 
