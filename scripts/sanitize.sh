@@ -6,7 +6,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/deps.sh
 # Line tables only (-g1): a report's stack still names file and line, and the build takes 16
-# minutes on 2 cores instead of 21 with -g (half of this script's time; the tests take the rest).
+# minutes on 2 cores instead of 21 with -g (the tests below take 21-24 more).
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" \
     -DZCHECK_SANITIZE=ON > /dev/null
 cmake --build build-asan --parallel "$(nproc)"
