@@ -404,6 +404,49 @@ TEST_CASE("check of a lens camera: the two directions and the trace agree; a shi
     }
 }
 
+TEST_CASE("regression: a lens camera far from the world origin failed its forward test on rounding alone", "[lens][regression]")
+{
+    // The hit point is eye + t·d in world coordinates, so its direction from the eye is rounded by
+    // ~2^-53·|eye|/t radians: a camera in UTM coordinates (5·10⁶ m out) 0.2 m from a wall moved its
+    // hits ~2·10⁻⁶ px at f = 1000, and near a lens's fold the lens magnifies that a thousandfold;
+    // the bare bound of 10⁻⁶ px called such chains inconsistent. The wall: the plane z = 20, exact
+    // in binary32, two triangles of 2 km.
+    auto wallAround = [](const glm::dvec3& centre) {
+        Scene scene;
+        scene.name = "wall";
+        for (const glm::dvec2 corner : {glm::dvec2(-1, -1), glm::dvec2(1, -1), glm::dvec2(1, 1), glm::dvec2(-1, 1)})
+            scene.positions.push_back(glm::vec3(glm::dvec3(centre.x + 1000 * corner.x, centre.y + 1000 * corner.y, 20)));
+        scene.triangles = {{0, 1, 2}, {0, 2, 3}};
+        return scene;
+    };
+    struct Case {
+        const char* what;
+        glm::dvec3 eye;
+        LensSpec lens;
+        int width, height;
+    };
+    // The division lens folds at |m|² = 1/k = 2.004: its image corners (|m|² = 2) sit just inside.
+    for (const Case& c : {Case{"UTM", {300000, 5000000, 20.2}, {"opencv", {1000, 1000, 319.5, 239.5, -0.1, 0.02, 1e-3, -5e-4}}, 640, 480},
+                          Case{"near a fold", {1000000, 1000, 20.5}, {"division", {100, 100, 99.5, 99.5, 0.499}}, 200, 200}}) {
+        INFO(c.what);
+        const Checker checker(wallAround(c.eye));
+        const Camera camera(lensSpec(c.lens, c.width, c.height, View::lookAt(c.eye, c.eye - glm::dvec3(0, 0, 1), {0, 1, 0})));
+        const CheckResult clean = checker.check(camera);
+        const LensCheck& lens = *clean.report.lens;
+        REQUIRE(lens.hits == std::int64_t(c.width) * c.height);
+        REQUIRE(lens.forwardMaxPx > LensCheck::kForwardBoundPx);  // the rounding is there to allow
+        REQUIRE(lens.forwardFailures == 0);
+        REQUIRE(lens.forwardWidestBoundPx < 1e-4);
+        REQUIRE(clean.report.comparison.consistent());
+        // A ray shifted by 10⁻⁴ px is still caught at every pixel.
+        CheckOptions shifted;
+        shifted.faults.ray.shiftPixels = {1e-4, 0.0};
+        const CheckResult wrong = checker.check(camera, shifted);
+        REQUIRE(!wrong.report.comparison.consistent());
+        REQUIRE(wrong.report.lens->forwardFailures == lens.hits);
+    }
+}
+
 TEST_CASE("verify of a lens camera's map: the truth passes, a distortion mistake or a scale does not", "[lens]")
 {
     const Checker checker(builtinScene("default"));

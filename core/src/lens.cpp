@@ -997,6 +997,30 @@ std::optional<glm::dvec2> LensModel::imageFromDirection(const glm::dvec3& d) con
     return glm::dvec2(t.fx * md.x + t.skew * md.y + t.cx + 0.5, t.fy * md.y + t.cy + 0.5);
 }
 
+double LensModel::pixelsPerRadian(const glm::dvec3& dCam) const
+{
+    const std::optional<glm::dvec2> centre = imageFromDirection(dCam);
+    if (!centre) return 0;
+    const glm::dvec3 u = glm::normalize(dCam);
+    // Two unit tangents of the sphere at u, and the image's motion along each.
+    const glm::dvec3 e1 = glm::normalize(std::abs(u.x) < 0.9 ? glm::cross(u, glm::dvec3(1, 0, 0)) : glm::cross(u, glm::dvec3(0, 1, 0)));
+    const glm::dvec3 e2 = glm::cross(u, e1);
+    constexpr double h = 1e-7;
+    auto motion = [&](const glm::dvec3& e, glm::dvec2& perRadian) {
+        const std::optional<glm::dvec2> ahead = imageFromDirection(u + h * e), behind = imageFromDirection(u - h * e);
+        if (ahead && behind) perRadian = (*ahead - *behind) / (2 * h);
+        else if (ahead || behind) perRadian = (ahead ? *ahead - *centre : *centre - *behind) / h;
+        else return false;
+        return true;
+    };
+    glm::dvec2 c1, c2;
+    if (!motion(e1, c1) || !motion(e2, c2)) return 0;
+    // The larger eigenvalue of JᵀJ, J = [c1 c2].
+    const double g11 = glm::dot(c1, c1), g22 = glm::dot(c2, c2), g12 = glm::dot(c1, c2);
+    const double half = (g11 - g22) / 2;
+    return std::sqrt((g11 + g22) / 2 + std::sqrt(half * half + g12 * g12));
+}
+
 std::optional<glm::dvec3> LensModel::directionFromImage(const glm::dvec2& p) const
 {
     return directionFromImage(p, nullptr);

@@ -205,7 +205,8 @@ nlohmann::json toJson(const CheckReport& report)
             {"round_trip", {{"max_px", lens.roundTripMaxPx}, {"bound_px", LensCheck::kRoundTripBoundPx},
                             {"col", lens.roundTripCol}, {"row", lens.roundTripRow}, {"beyond", lens.roundTripFailures}}},
             {"forward", {{"max_px", lens.forwardMaxPx}, {"bound_px", LensCheck::kForwardBoundPx},
-                         {"col", lens.forwardCol}, {"row", lens.forwardRow}, {"beyond", lens.forwardFailures}}},
+                         {"widest_bound_px", lens.forwardWidestBoundPx}, {"col", lens.forwardCol},
+                         {"row", lens.forwardRow}, {"beyond", lens.forwardFailures}}},
             {"raster", "does not apply: a lens model has no projection matrix to rasterize through"},
         };
     }
@@ -258,9 +259,15 @@ std::string formatLensCheck(const CheckReport& report)
     out << line;
     if (lens.roundTripRow >= 0) out << " at (" << lens.roundTripCol << ", " << lens.roundTripRow << ")";
     out << "; " << lens.roundTripFailures << " beyond\n";
-    std::snprintf(line, sizeof line, "forward     traced hit -> pixel: max %.3g px (bound %g px)", lens.forwardMaxPx,
+    std::snprintf(line, sizeof line, "forward     traced hit -> pixel: max %.3g px (bound %g px", lens.forwardMaxPx,
                   LensCheck::kForwardBoundPx);
     out << line;
+    if (lens.forwardWidestBoundPx > LensCheck::kForwardBoundPx) {
+        std::snprintf(line, sizeof line, ", up to %.3g px where the hit's rounding, as the lens magnifies it, allows",
+                      lens.forwardWidestBoundPx);
+        out << line;
+    }
+    out << ")";
     if (lens.forwardRow >= 0) out << " at (" << lens.forwardCol << ", " << lens.forwardRow << ")";
     out << "; " << lens.forwardFailures << " beyond\n";
     out << "raster     does not apply: a lens model has no projection matrix to rasterize through\n";

@@ -74,10 +74,20 @@ struct MapErrors {
 // its two directions are checked against each other and against the trace. Over the field, every
 // pixel centre's ray projected back lands on the centre (the round trip, ≤ kRoundTripBoundPx), and
 // every traced hit point projected forward by the closed form lands on its own pixel centre
-// (≤ kForwardBoundPx). Pixels outside the field have no ray: counted, never traced.
+// (≤ kForwardBoundPx, plus what rounding allows: forwardBoundPx). Pixels outside the field have
+// no ray: counted, never traced.
 struct LensCheck {
     static constexpr double kRoundTripBoundPx = 1e-9;
     static constexpr double kForwardBoundPx = 1e-6;
+    // A hit's forward bound: kForwardBoundPx plus the rounding of its direction as the lens
+    // magnifies it. The hit point is eye + t·d in world coordinates, so its direction from the eye
+    // is rounded by up to 2^-52·(|eye|/t + 16) radians (|eye| the eye's distance from the world
+    // origin, t the hit's from the eye: a camera in UTM coordinates, 5·10⁶ m out, looking at a wall
+    // 0.5 m away, 2·10⁻⁹ rad); the lens turns a radian into up to `pixelsPerRadian` pixels there
+    // (LensModel::pixelsPerRadian: ~f away from the edge of its field, far more where the map
+    // nears a fold), taken twice, as it is estimated by differences. Far below what a wrong chain
+    // moves a hit by: a ray shifted by 10⁻⁴ px fails at every pixel of such a camera (test_lens.cpp).
+    static double forwardBoundPx(double eyeFromOrigin, double t, double pixelsPerRadian);
     std::string model;                 // the lens model's name
     double fieldAngleDeg = 0;          // the field's largest angle from the axis
     std::int64_t inField = 0;          // pixel centres with a ray
@@ -88,7 +98,8 @@ struct LensCheck {
     std::int64_t roundTripFailures = 0;  // pixels beyond kRoundTripBoundPx (or whose ray has no image)
     double forwardMaxPx = 0;           // max |image(hit) − p| over the hits
     int forwardCol = -1, forwardRow = -1;
-    std::int64_t forwardFailures = 0;  // hits beyond kForwardBoundPx
+    std::int64_t forwardFailures = 0;  // hits beyond their forward bound
+    double forwardWidestBoundPx = kForwardBoundPx;  // the widest forward bound a hit was judged by
 };
 
 // What was compared, how long it took, what was found (report.h prints it).

@@ -115,6 +115,12 @@ public:
     // The image point of a direction in the camera frame (any length > 0); empty outside the
     // valid field.
     std::optional<glm::dvec2> imageFromDirection(const glm::dvec3& dCam) const;
+    // How far the image point moves per radian the direction turns, at its most, around direction
+    // dCam (camera frame, any length > 0): the largest singular value of imageFromDirection's
+    // Jacobian on the sphere of directions, by central differences 10⁻⁷ rad either side (one side
+    // where the other leaves the field). About the focal length in pixels on a mild lens; far more
+    // where a lens nears a fold. 0 where no side is in the field (or dCam is not).
+    double pixelsPerRadian(const glm::dvec3& dCam) const;
     // The unit direction, camera frame, through image point pImage; empty outside the valid
     // field (or where the inverse does not converge: then the pixel is outside it too).
     std::optional<glm::dvec3> directionFromImage(const glm::dvec2& pImage) const;
