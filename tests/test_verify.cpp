@@ -214,6 +214,43 @@ TEST_CASE("regression: verify rejected a correct map whose sample landed across 
     REQUIRE(failedNearer);  // far enough from both surfaces the map is rejected
 }
 
+TEST_CASE("regression: a correct window or NDC map of a narrowed depth range was out of range at the range's ends",
+          "[verify][regression]")
+{
+    // A unorm code stands for a multiple of 1/(2^N − 1), which may lie up to half a code beyond a
+    // narrowed range's end: glDepthRange(0.11498, 0.28484) in unorm16 stores its far end as
+    // 18667/65535 = 0.2848402, above 0.2848395, and its near end as 7535/65535, below 0.11498.
+    // A correct map's background (the clear value) and its nearest or farthest surfaces were
+    // counted as values the quantity cannot hold. Found by a random property run of verify.
+    Setup s;
+    const Checker checker(s.scene);
+    const MapVerifier verifier(checker);
+    int outside = 0;
+    for (const DepthFormat format : {DepthFormat::Unorm16, DepthFormat::Unorm24, DepthFormat::Float32})
+        for (const bool reversed : {false, true})
+            for (const auto& [lo, hi] : {std::pair{0.11498228885851841, 0.284839548883169}, std::pair{0.3, 0.7}}) {
+                CameraSpec spec = s.spec;
+                spec.depth = {format, reversed, lo, hi};
+                const Camera camera(spec);
+                const double clear = camera.clearDepth();
+                outside += clear < lo || clear > hi;
+                for (const bool raster : {true, false}) {
+                    const RenderResult route = raster ? checker.renderRaster(camera) : checker.renderRay(camera);
+                    for (const ExportQuantity q : {ExportQuantity::Window, ExportQuantity::Ndc}) {
+                        const VerifyResult run = verifier.verify(camera, mapOf(s.scene, camera, route, q));
+                        const ComparisonReport& r = run.comparison.report;
+                        INFO(toString(format) << (reversed ? " reversed" : "") << " [" << lo << ", " << hi << "], "
+                                              << (raster ? "raster " : "ray ") << toString(q) << ": out of range "
+                                              << r.outOfRange << ", unexplained " << r.unexplained());
+                        REQUIRE(r.bothHit > 10000);
+                        REQUIRE(r.outOfRange == 0);
+                        REQUIRE(r.consistent());
+                    }
+                }
+            }
+    REQUIRE(outside >= 2);  // the unorm16 range's clear values, near end and far end, lie outside it
+}
+
 TEST_CASE("the comparison accepts a depth exactly at its tolerance and rejects the next value", "[compare]")
 {
     const SharedEdge s(0.5, 0.0);  // both triangles face the camera: m = 0

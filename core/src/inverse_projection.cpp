@@ -179,12 +179,21 @@ double eyeZFromDistance(const Camera& camera, const glm::dvec2& pWindow, double 
 }
 
 namespace {
-// The closed interval of window or NDC depths; eye-z and distance: [0, inf].
+// The closed interval of window or NDC depths: the camera's depth range (its NDC range), and
+// what its depth buffer stores at the range's ends, where that lies outside. A unorm code stands
+// for a multiple of 1/(2^N − 1), which may lie up to half a code beyond the ends of a narrowed
+// range: [0.11498, 0.28484] in unorm16 stores its far end as 18667/65535 = 0.2848402, above
+// 0.2848395. Eye-z and distance: [0, inf].
 std::pair<double, double> depthValueBounds(const Camera& camera, DepthQuantity quantity)
 {
+    const DepthSettings& depth = camera.depth();
+    const double lo = std::min(depth.rangeMin, quantizeDepth(depth.format, depth.rangeMin));
+    const double hi = std::max(depth.rangeMax, quantizeDepth(depth.format, depth.rangeMax));
     switch (quantity) {
-    case DepthQuantity::Window: return {camera.depth().rangeMin, camera.depth().rangeMax};
-    case DepthQuantity::Ndc: return {camera.convention().ndcZMin(), 1.0};
+    case DepthQuantity::Window: return {lo, hi};
+    case DepthQuantity::Ndc:  // the viewport's map from NDC to window depth increases
+        return {std::min(camera.convention().ndcZMin(), camera.ndcZFromWindowDepth(lo)),
+                std::max(1.0, camera.ndcZFromWindowDepth(hi))};
     case DepthQuantity::EyeZ:
     case DepthQuantity::Distance: break;
     }
@@ -201,8 +210,15 @@ DepthValueKind kindOfDepthValue(const Camera& camera, DepthQuantity quantity, do
     const auto [lo, hi] = depthValueBounds(camera, quantity);
     const double slack = 0x1p-23 * std::max({1.0, std::abs(lo), std::abs(hi)});  // one binary32 step
     if (!(value >= lo - slack && value <= hi + slack)) return DepthValueKind::OutOfRange;
-    const double window = quantity == DepthQuantity::Ndc ? camera.windowDepthFromNdcZ(value) : value;
-    return window == camera.clearDepth() || window == camera.windowDepthFar() ? DepthValueKind::Miss : DepthValueKind::Depth;
+    // The clear value (or the far plane's depth) marks a miss, as the map holds it: exact, or
+    // rounded to binary32 (a float32 file of a unorm buffer whose clear value no float holds).
+    const bool ndc = quantity == DepthQuantity::Ndc;
+    const double window = ndc ? camera.windowDepthFromNdcZ(value) : value;
+    for (const double missWindow : {camera.clearDepth(), camera.windowDepthFar()}) {
+        const double miss = ndc ? camera.ndcZFromWindowDepth(missWindow) : missWindow;
+        if (window == missWindow || value == miss || value == double(float(miss))) return DepthValueKind::Miss;
+    }
+    return DepthValueKind::Depth;
 }
 
 std::string depthValueRange(const Camera& camera, DepthQuantity quantity)
@@ -210,8 +226,12 @@ std::string depthValueRange(const Camera& camera, DepthQuantity quantity)
     if (quantity == DepthQuantity::EyeZ || quantity == DepthQuantity::Distance) return "> 0 (0 means no depth)";
     if (camera.lens()) return "nothing: a lens model has no depth buffer (use eye-z or distance)";
     const auto [lo, hi] = depthValueBounds(camera, quantity);
+    const DepthSettings& depth = camera.depth();
+    const bool widened = quantizeDepth(depth.format, depth.rangeMin) < depth.rangeMin ||
+                         quantizeDepth(depth.format, depth.rangeMax) > depth.rangeMax;
     return "[" + formatNumber(lo) + ", " + formatNumber(hi) + "], the camera's " +
-           (quantity == DepthQuantity::Window ? "depth range" : "NDC depth range");
+           (quantity == DepthQuantity::Window ? "depth range" : "NDC depth range") +
+           (widened ? " as its " + toString(depth.format) + " buffer stores its ends" : "");
 }
 
 std::optional<glm::dvec3> eyePointFromDepth(const Camera& camera, const glm::dvec2& pWindow, double value,

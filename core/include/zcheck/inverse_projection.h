@@ -98,10 +98,12 @@ double eyeZFromDistance(const Camera& camera, const glm::dvec2& pWindow, double 
 double depthValueFromEyeZ(const Camera& camera, const glm::dvec2& pWindow, double eyeZ, DepthQuantity quantity);
 
 // What a stored value is to a map of `quantity` made by `camera`. A miss: not finite, the clear
-// value (window, ndc), or 0 (eye-z, distance: "no depth"). Out of range — a value the quantity
+// value or the far plane's depth (window, ndc; exact, or rounded to binary32 as a float32 file
+// holds it), or 0 (eye-z, distance: "no depth"). Out of range — a value the quantity
 // cannot hold, an error and never a miss: window depth outside the depth range, z_ndc outside
-// the convention's NDC depth range (each with one binary32 step of slack), a negative eye-z or
-// distance. Otherwise a depth.
+// the convention's NDC depth range (each with one binary32 step of slack, and widened to what the
+// depth buffer stores at the range's ends: a unorm code may stand for a value half a code beyond
+// a narrowed range's end), a negative eye-z or distance. Otherwise a depth.
 enum class DepthValueKind { Depth, Miss, OutOfRange };
 DepthValueKind kindOfDepthValue(const Camera& camera, DepthQuantity quantity, double value);
 // The interval a quantity's depths lie in, as text: "[0, 1], the camera's depth range", "> 0".
