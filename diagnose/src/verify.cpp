@@ -125,10 +125,24 @@ MapPixel mapPixelDepth(const Camera& camera, DepthQuantity quantity, double valu
     MapPixel out;
     WindowDepthAt windowDepthOf(camera, windowFromPixelCentre(camera, col, row), quantity);
     out.depth = windowDepthOf(value);
+    const bool linear = quantity == DepthQuantity::EyeZ || quantity == DepthQuantity::Distance;
+    const DepthFormat format = camera.depth().format;
+    if (!linear && format != DepthFormat::Float32 && accuracy.step == 0 && std::isfinite(out.depth)) {
+        // A unorm buffer's value stored in binary32 (a float file of window or NDC depth, a depth
+        // buffer read back as GL_FLOAT) is its code's value rounded once more, by up to half a
+        // binary32 step, and alike for neighbouring codes: in [0.5, 1) that step is one unorm24
+        // code and every code's value rounds up, a bias of +0.3 q that no buffer made. A value
+        // within that rounding of a code's value stands for the code, and is read as it.
+        const double code = quantizeDepth(format, out.depth);
+        const double step = storageQuantum(DepthFormat::Float32, value);
+        double neighbour = windowDepthOf(value + step);
+        if (!std::isfinite(neighbour)) neighbour = windowDepthOf(value - step);
+        if (std::isfinite(neighbour) && std::abs(out.depth - code) <= 0.5 * std::abs(neighbour - out.depth) * (1 + 0x1p-20))
+            out.depth = code;
+    }
     const double depth = out.depth;
     // The storage step, carried into window units through the quantity's mapping.
     const double reference = std::isfinite(depth) ? depth : truthDepth;
-    const bool linear = quantity == DepthQuantity::EyeZ || quantity == DepthQuantity::Distance;
     out.quantum = storageQuantum(camera.depth().format, reference);
     if (std::isfinite(depth) && (linear || accuracy.step > 0)) {
         const double step = accuracy.step > 0 ? accuracy.step
