@@ -144,6 +144,15 @@ MapPixel mapPixelDepth(const Camera& camera, DepthQuantity quantity, double valu
     // The storage step, carried into window units through the quantity's mapping.
     const double reference = std::isfinite(depth) ? depth : truthDepth;
     out.quantum = storageQuantum(camera.depth().format, reference);
+    if (quantity == DepthQuantity::Ndc && accuracy.step == 0 && std::isfinite(depth)) {
+        // An NDC value in binary32 is rounded to binary32's step at the NDC value, which near
+        // window depth 0 of a [-1, 1] convention (z_ndc near −1) is far coarser than the depth
+        // buffer's step: window 10⁻⁴ of a float32 buffer, 2000 of its steps.
+        const double step = storageQuantum(DepthFormat::Float32, value);
+        double other = windowDepthOf(value + step);
+        if (!std::isfinite(other)) other = windowDepthOf(value - step);
+        if (std::isfinite(other)) out.quantum = std::max(out.quantum, std::abs(other - depth));
+    }
     if (std::isfinite(depth) && (linear || accuracy.step > 0)) {
         const double step = accuracy.step > 0 ? accuracy.step
                                               : double(std::nextafter(float(std::abs(value)), INFINITY)) - std::abs(double(float(value)));
@@ -243,10 +252,11 @@ MapPixel MapReader::read(int col, int row, bool search) const
             seen.push_back(seenNear);
             neighbours_.forEachNeighbour(seenNear, consider);
         });
-    // Nor them: where no ray meets a surface, one the rasterizer draws there (a sliver's or a
-    // triangle tip's snapped footprint reaches the pixel centre while no ray within S does; the
-    // regression "verify rejected the raster route's own map at a silhouette sliver").
-    if (closest == INFINITY && here == kNoPrimitive && neighbours_.raster())
+    // Nor them: one the rasterizer draws there (a sliver's or a triangle tip's snapped footprint
+    // reaches the pixel centre while no ray within S does), in front of the truth's surface or
+    // where no ray meets one (the regressions "verify rejected the raster route's own map at a
+    // silhouette sliver" and "... at a sliver in front of a surface").
+    if (closest == INFINITY && neighbours_.raster())
         for (int dy = -1; dy <= 1; ++dy)
             for (int dx = -1; dx <= 1; ++dx) {
                 const int c = col + dx, r = row + dy;
