@@ -5,6 +5,7 @@
 #include "zcheck/camera_file.h"
 #include "zcheck/checker.h"
 #include "zcheck/error.h"
+#include "zcheck/export.h"
 #include "zcheck/lens.h"
 #include "zcheck/lens_mistakes.h"
 #include "zcheck/map_verifier.h"
@@ -444,6 +445,35 @@ TEST_CASE("regression: a lens camera far from the world origin failed its forwar
         const CheckResult wrong = checker.check(camera, shifted);
         REQUIRE(!wrong.report.comparison.consistent());
         REQUIRE(wrong.report.lens->forwardFailures == lens.hits);
+    }
+}
+
+TEST_CASE("regression: quantityImage of a lens camera's render without eye points read its distances as window depths", "[lens][regression]")
+{
+    // A lens camera's route holds the distance along each pixel's ray, not a window depth; from a
+    // render that kept no eye points, quantityImage unprojected it through the camera's matrices
+    // (which a lens has none of) and wrote wrong eye-z, distances and positions without a word.
+    // Found by the property test of verify (test_verify.cpp).
+    const Checker checker(builtinScene("default"));
+    const Camera camera(lensSpec({"opencv_fisheye", {120, 120, 99.5, 74.5, 0.02, -0.004}}, 200, 150,
+                                 View::lookAt({0.3, 0.8, 2.5}, {0, 0, 0}, {0, 1, 0})));
+    const RenderResult withoutEyePoints = checker.renderRay(camera);
+    REQUIRE(withoutEyePoints.pEye.empty());
+    for (const ExportQuantity q : {ExportQuantity::EyeZ, ExportQuantity::Distance, ExportQuantity::PositionEye, ExportQuantity::PositionWorld}) {
+        INFO(toString(q));
+        const QuantityImage fromDepth = quantityImage(checker.scene(), camera, withoutEyePoints, q);
+        const QuantityImage exact = checker.render(camera, q, Route::Ray);
+        REQUIRE(fromDepth.value.size() == exact.value.size());
+        std::size_t compared = 0;
+        for (std::size_t i = 0; i < exact.value.size(); ++i) {
+            if (!std::isfinite(exact.value[i])) {
+                REQUIRE_FALSE(std::isfinite(fromDepth.value[i]));
+                continue;
+            }
+            REQUIRE(fromDepth.value[i] == Approx(exact.value[i]).epsilon(1e-12).margin(1e-12));
+            ++compared;
+        }
+        REQUIRE(compared > 10000);
     }
 }
 

@@ -4,6 +4,7 @@
 #include "zcheck/inverse_projection.h"
 
 #include <cmath>
+#include <optional>
 
 namespace zcheck {
 
@@ -43,8 +44,19 @@ QuantityImage quantityImage(const Scene& scene, const Camera& camera, const Rend
             if (!route.hit(i)) continue;
             const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
             const double windowDepth = route.windowDepth.value[i];
-            // The ray route carries the exact hit; the raster route its stored depth.
-            const glm::dvec3 pEye = route.pEye.empty() ? eyeFromWindow(camera, {pWindow, windowDepth}) : route.pEye[i];
+            // The ray route carries the exact hit (when asked to keep it); otherwise the point is
+            // unprojected from the route's depth: the stored depth of the raster route, and a lens
+            // camera's distance along the pixel's ray (it has no depth buffer).
+            glm::dvec3 pEye;
+            if (!route.pEye.empty()) {
+                pEye = route.pEye[i];
+            } else if (camera.lens()) {
+                const std::optional<glm::dvec3> p = eyePointFromDepth(camera, pWindow, windowDepth, DepthQuantity::Distance);
+                if (!p) continue;  // no ray there: outside the lens's field
+                pEye = *p;
+            } else {
+                pEye = eyeFromWindow(camera, {pWindow, windowDepth});
+            }
             double* out = &image.value[i * C];
             switch (quantity) {
             case ExportQuantity::Window: out[0] = windowDepth; break;

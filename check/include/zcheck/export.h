@@ -2,8 +2,10 @@
 // A route's render as one of the exported quantities (table in quantity.h).
 //
 // The normal is the triangle's geometric normal, turned to face the camera. Ray route:
-// values from the exact hit (double). Raster route: positions are unprojected from the
-// stored window depth, so they carry the depth format's quantization.
+// values from the exact hit (double) where the render kept its eye points (EyePoints::Keep),
+// else from its depth. Raster route: positions are unprojected from the stored window depth, so
+// they carry the depth format's quantization. A lens camera's route holds the distance along each
+// pixel's ray (it has no depth buffer), and its points are unprojected from that.
 #include "zcheck/camera.h"
 #include "zcheck/quantity.h"
 #include "zcheck/render.h"
