@@ -126,42 +126,31 @@ MapPixel mapPixelDepth(const Camera& camera, DepthQuantity quantity, double valu
     WindowDepthAt windowDepthOf(camera, windowFromPixelCentre(camera, col, row), quantity);
     out.depth = windowDepthOf(value);
     const bool linear = quantity == DepthQuantity::EyeZ || quantity == DepthQuantity::Distance;
-    const DepthFormat format = camera.depth().format;
-    if (!linear && format != DepthFormat::Float32 && accuracy.step == 0 && std::isfinite(out.depth)) {
-        // A unorm buffer's value stored in binary32 (a float file of window or NDC depth, a depth
-        // buffer read back as GL_FLOAT) is its code's value rounded once more, by up to half a
-        // binary32 step, and alike for neighbouring codes: in [0.5, 1) that step is one unorm24
-        // code and every code's value rounds up, a bias of +0.3 q that no buffer made. A value
-        // within that rounding of a code's value stands for the code, and is read as it.
-        const double code = quantizeDepth(format, out.depth);
-        const double step = storageQuantum(DepthFormat::Float32, value);
-        double neighbour = windowDepthOf(value + step);
-        if (!std::isfinite(neighbour)) neighbour = windowDepthOf(value - step);
-        if (std::isfinite(neighbour) && std::abs(out.depth - code) <= 0.5 * std::abs(neighbour - out.depth) * (1 + 0x1p-20))
-            out.depth = code;
-    }
     const double depth = out.depth;
     // The storage step, carried into window units through the quantity's mapping.
     const double reference = std::isfinite(depth) ? depth : truthDepth;
     out.quantum = storageQuantum(camera.depth().format, reference);
-    if (quantity == DepthQuantity::Ndc && accuracy.step == 0 && std::isfinite(depth)) {
-        // An NDC value in binary32 is rounded to binary32's step at the NDC value, which near
-        // window depth 0 of a [-1, 1] convention (z_ndc near −1) is far coarser than the depth
-        // buffer's step: window 10⁻⁴ of a float32 buffer, 2000 of its steps.
-        const double step = storageQuantum(DepthFormat::Float32, value);
+    // The window change of a change of `step` in the stored value (either side that is a depth).
+    auto windowChange = [&](double step) {
         double other = windowDepthOf(value + step);
         if (!std::isfinite(other)) other = windowDepthOf(value - step);
-        if (std::isfinite(other)) out.quantum = std::max(out.quantum, std::abs(other - depth));
-    }
+        return std::abs(other - depth);  // NaN where neither side is a depth
+    };
+    // A window or NDC value in binary32 (nothing stated of its storage) is rounded to binary32's
+    // step at the value, in window units:
+    const double binary32Change = !linear && accuracy.step == 0 && std::isfinite(depth)
+                                      ? windowChange(storageQuantum(DepthFormat::Float32, value))
+                                      : NAN;
+    // at an NDC value near −1 of a [-1, 1] convention (window depth near 0) far coarser than the
+    // depth buffer's step (window 10⁻⁴ of a float32 buffer: 2000 of its steps);
+    if (quantity == DepthQuantity::Ndc && std::isfinite(binary32Change)) out.quantum = std::max(out.quantum, binary32Change);
     if (std::isfinite(depth) && (linear || accuracy.step > 0)) {
         const double step = accuracy.step > 0 ? accuracy.step
                                               : double(std::nextafter(float(std::abs(value)), INFINITY)) - std::abs(double(float(value)));
-        double other = windowDepthOf(value + step);
-        if (!std::isfinite(other)) other = windowDepthOf(value - step);
         // A window or NDC value's step is at least binary32's at its window depth; a linear map's
         // is at least a linearized depth buffer's (linearizedBufferStep), whatever the camera's own.
-        if (std::isfinite(other)) {
-            out.quantum = std::abs(other - depth);
+        if (const double change = windowChange(step); std::isfinite(change)) {
+            out.quantum = change;
             if (!linear) {
                 out.quantum = std::max(out.quantum, storageQuantum(DepthFormat::Float32, depth));
             } else {
@@ -178,6 +167,14 @@ MapPixel mapPixelDepth(const Camera& camera, DepthQuantity quantity, double valu
         for (const double side : {value - declared, value + declared})
             if (const double there = windowDepthOf(side); std::isfinite(there))
                 out.allowance = std::max(out.allowance, std::abs(there - depth));
+    // A unorm buffer's value held in binary32 (a float file, a buffer read back as GL_FLOAT) was
+    // rounded once more, by up to half binary32's step, alike for neighbouring values: in [0.5, 1)
+    // the step is one unorm24 code, and a buffer's code values all round up there (+0.3 q), while
+    // exact depths stored the same way do not. Which a map holds cannot be told, so the rounding
+    // is allowed for: the pixel's tolerance takes it, and where it is over a tenth of a code the
+    // bias test leaves the pixel out.
+    if (camera.depth().format != DepthFormat::Float32 && std::isfinite(binary32Change))
+        out.allowance += 0.5 * binary32Change;
     return out;
 }
 
@@ -300,7 +297,12 @@ RenderResult renderResultFromMap(const PixelJudge& judge, const DepthMap& map, c
     const int W = camera.width(), H = camera.height();
     RenderResult out = RenderResult::cleared(W, H, camera.clearDepth());
     quantum.assign(std::size_t(W) * H, 0.0);
-    const bool declared = map.accuracy.anyAccuracy();
+    // Allowances: what the map declares, and the binary32 rounding of a unorm buffer's window or
+    // NDC values (mapPixelDepth).
+    const bool unormInBinary32 = camera.depth().format != DepthFormat::Float32 &&
+                                 (map.quantity == DepthQuantity::Window || map.quantity == DepthQuantity::Ndc) &&
+                                 map.valueQuantum == 0 && map.valueStep.empty();
+    const bool declared = map.accuracy.anyAccuracy() || unormInBinary32;
     allowance.assign(declared ? std::size_t(W) * H : 0, 0.0);
     const MapReader reader(judge, map, truth, neighbours);
     // Rows in parallel: each pixel's choice reads only the truth and the map.
