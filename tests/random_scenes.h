@@ -142,7 +142,6 @@ inline std::string randomCameraJson(std::mt19937_64& random, const glm::dvec3& e
     return text.str();
 }
 
-
 // Case k of a property run: a scene of kind k % 6 and a camera looking at it, both as far from the
 // world origin as one of 0 to 5·10⁶ m per axis; no camera where its file is refused (a lens that
 // folds inside its image) or every triangle collapsed on binary32's grid.

@@ -2,18 +2,14 @@
 // check's sensitivity to deliberately broken chains.
 #include "zcheck/checker.h"
 
-#include "zcheck/camera_file.h"
-#include "zcheck/error.h"
 #include "zcheck/mesh_loader.h"
 
 #include "random_scenes.h"
 
 #include <catch2/catch.hpp>
 
-#include <cmath>
 #include <cstdlib>
 #include <fstream>
-#include <optional>
 #include <random>
 #include <sstream>
 
@@ -313,7 +309,6 @@ TEST_CASE("regression: with an infinite far plane every coverage mismatch was ex
         REQUIRE_FALSE(r.consistent());
     }
 }
-
 
 TEST_CASE("property: random triangle soups through random cameras raise no false alarm", "[e2e][property]")
 {

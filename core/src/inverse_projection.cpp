@@ -227,8 +227,8 @@ std::string depthValueRange(const Camera& camera, DepthQuantity quantity)
     if (camera.lens()) return "nothing: a lens model has no depth buffer (use eye-z or distance)";
     const auto [lo, hi] = depthValueBounds(camera, quantity);
     const DepthSettings& depth = camera.depth();
-    const bool widened = quantizeDepth(depth.format, depth.rangeMin) < depth.rangeMin ||
-                         quantizeDepth(depth.format, depth.rangeMax) > depth.rangeMax;
+    const auto [windowLo, windowHi] = depthValueBounds(camera, DepthQuantity::Window);
+    const bool widened = windowLo < depth.rangeMin || windowHi > depth.rangeMax;
     return "[" + formatNumber(lo) + ", " + formatNumber(hi) + "], the camera's " +
            (quantity == DepthQuantity::Window ? "depth range" : "NDC depth range") +
            (widened ? " as its " + toString(depth.format) + " buffer stores its ends" : "");

@@ -70,6 +70,14 @@ private:
     std::optional<EyePlaneRay> planeRay_;
 };
 
+// Whether a map's values are a unorm buffer's window or NDC depths held in binary32 (nothing
+// stated of their storage step, `storageStep` 0), whose rounding mapPixelDepth allows for.
+bool unormInBinary32(const Camera& camera, DepthQuantity quantity, double storageStep)
+{
+    return camera.depth().format != DepthFormat::Float32 &&
+           (quantity == DepthQuantity::Window || quantity == DepthQuantity::Ndc) && storageStep == 0;
+}
+
 // Window depth of a triangle's plane where the pixel's ray meets it (NaN if it does not).
 double planeWindowDepth(const Scene& scene, const Camera& camera, std::uint32_t primitive, const EyePlaneRay& ray)
 {
@@ -145,8 +153,7 @@ MapPixel mapPixelDepth(const Camera& camera, DepthQuantity quantity, double valu
     // depth buffer's step (window 10⁻⁴ of a float32 buffer: 2000 of its steps);
     if (quantity == DepthQuantity::Ndc && std::isfinite(binary32Change)) out.quantum = std::max(out.quantum, binary32Change);
     if (std::isfinite(depth) && (linear || accuracy.step > 0)) {
-        const double step = accuracy.step > 0 ? accuracy.step
-                                              : double(std::nextafter(float(std::abs(value)), INFINITY)) - std::abs(double(float(value)));
+        const double step = accuracy.step > 0 ? accuracy.step : storageQuantum(DepthFormat::Float32, value);
         // A window or NDC value's step is at least binary32's at its window depth; a linear map's
         // is at least a linearized depth buffer's (linearizedBufferStep), whatever the camera's own.
         if (const double change = windowChange(step); std::isfinite(change)) {
@@ -173,8 +180,7 @@ MapPixel mapPixelDepth(const Camera& camera, DepthQuantity quantity, double valu
     // exact depths stored the same way do not. Which a map holds cannot be told, so the rounding
     // is allowed for: the pixel's tolerance takes it, and where it is over a tenth of a code the
     // bias test leaves the pixel out.
-    if (camera.depth().format != DepthFormat::Float32 && std::isfinite(binary32Change))
-        out.allowance += 0.5 * binary32Change;
+    if (unormInBinary32(camera, quantity, accuracy.step) && std::isfinite(binary32Change)) out.allowance += 0.5 * binary32Change;
     return out;
 }
 
@@ -299,10 +305,8 @@ RenderResult renderResultFromMap(const PixelJudge& judge, const DepthMap& map, c
     quantum.assign(std::size_t(W) * H, 0.0);
     // Allowances: what the map declares, and the binary32 rounding of a unorm buffer's window or
     // NDC values (mapPixelDepth).
-    const bool unormInBinary32 = camera.depth().format != DepthFormat::Float32 &&
-                                 (map.quantity == DepthQuantity::Window || map.quantity == DepthQuantity::Ndc) &&
-                                 map.valueQuantum == 0 && map.valueStep.empty();
-    const bool declared = map.accuracy.anyAccuracy() || unormInBinary32;
+    const bool declared = map.accuracy.anyAccuracy() ||
+                          unormInBinary32(camera, map.quantity, map.valueStep.empty() ? map.valueQuantum : 1.0);
     allowance.assign(declared ? std::size_t(W) * H : 0, 0.0);
     const MapReader reader(judge, map, truth, neighbours);
     // Rows in parallel: each pixel's choice reads only the truth and the map.
