@@ -296,6 +296,23 @@ TEST_CASE("regression: a unorm24 buffer's window or NDC values in a float32 file
             }
         }
     }
+    // Near window depth 1 (the whole range, the surfaces far from a small near plane) a unorm24
+    // code's value and its binary32 rounding nearly coincide: a truncating buffer in a float file
+    // is a bias there (the first version of this fix left every such pixel out of the test).
+    spec.depth = {DepthFormat::Unorm24, false, 0.0, 1.0};
+    spec.projection = Projection::perspective(20, 0.004, INFINITY);
+    const Camera full(spec);
+    for (const ExportQuantity q : {ExportQuantity::Window, ExportQuantity::Ndc}) {
+        INFO("unorm24 [0, 1] " << toString(q));
+        const ComparisonReport r = verifier.verify(full, mapOf(scene, full, checker.renderRaster(full), q)).comparison.report;
+        REQUIRE(r.biasSamples > 1000);
+        REQUIRE(r.consistent());
+        const ComparisonReport t = verifier.verify(full, mapOf(scene, full, checker.renderRaster(full, truncate), q)).comparison.report;
+        INFO("truncated: mean signed error " << t.meanSignedErrorQuanta << " q over " << t.biasSamples);
+        REQUIRE(t.meanSignedErrorQuanta < -0.4);
+        REQUIRE(t.depthBias);
+        REQUIRE_FALSE(t.consistent());
+    }
 }
 
 TEST_CASE("regression: verify rejected the raster route's own map at a sliver in front of a surface", "[verify][regression]")

@@ -176,11 +176,16 @@ MapPixel mapPixelDepth(const Camera& camera, DepthQuantity quantity, double valu
                 out.allowance = std::max(out.allowance, std::abs(there - depth));
     // A unorm buffer's value held in binary32 (a float file, a buffer read back as GL_FLOAT) was
     // rounded once more, by up to half binary32's step, alike for neighbouring values: in [0.5, 1)
-    // the step is one unorm24 code, and a buffer's code values all round up there (+0.3 q), while
-    // exact depths stored the same way do not. Which a map holds cannot be told, so the rounding
-    // is allowed for: the pixel's tolerance takes it, and where it is over a tenth of a code the
-    // bias test leaves the pixel out.
-    if (unormInBinary32(camera, quantity, accuracy.step) && std::isfinite(binary32Change)) out.allowance += 0.5 * binary32Change;
+    // the step is one unorm24 code, and a buffer's code values at window depth 0.57 all round up
+    // by 0.43 of a code, while exact depths stored the same way do not. A value that close to a
+    // code's value may be either, so its distance from that code's value is allowed for: the
+    // pixel's tolerance takes it, and where it is over a tenth of a code the bias test leaves the
+    // pixel out. Near window depth 1 codes and binary32 values nearly coincide, the distance is
+    // small, and a truncating buffer is still a bias there.
+    if (unormInBinary32(camera, quantity, accuracy.step) && std::isfinite(binary32Change)) {
+        const double fromCode = std::abs(depth - quantizeDepth(camera.depth().format, depth));
+        if (fromCode <= 0.5 * binary32Change * (1 + 0x1p-20)) out.allowance += fromCode;
+    }
     return out;
 }
 
