@@ -1,6 +1,7 @@
 // Rasterizer rules and analytic depths through both routes.
 #include "zcheck/checker.h"
 
+#include "zcheck/drawn_polygon.h"
 #include "zcheck/inverse_projection.h"
 
 #include "kernel_testing.h"
@@ -200,6 +201,53 @@ TEST_CASE("a triangle wholly behind the camera draws nothing", "[raster][clippin
     const Scene behind = sceneOf({{-5, -5, 3}, {5, -5, 3}, {0, 5, 1}}, {{0, 1, 2}});
     const RenderResult image = RasterRenderer(behind).render(Camera(spec));
     for (std::size_t i = 0; i < image.primitiveId.size(); ++i) REQUIRE_FALSE(image.hit(i));
+}
+
+TEST_CASE("drawnDepthsNear: the window depths a triangle as drawn takes around a window point", "[raster][clipping]")
+{
+    // OpenGL, gluPerspective(90°, 1, 0.5, 10), 100 × 100, eye at the origin looking down −z: the
+    // window point (50, 50) is the axis, and window x = 50 ± r is x_eye = ±(r / 50)·d at distance d.
+    CameraSpec spec;
+    spec.width = spec.height = 100;
+    spec.projection = Projection::perspective(90.0, 0.5, 10.0);
+    spec.view = View::lookAt({0, 0, 0}, {0, 0, -1}, {0, 1, 0});
+    const Camera camera(spec);
+    const double n = 0.5, f = 10.0, r = 1.0 / 256;
+    const auto windowDepth = [&](double d) { return ((f + n) / (f - n) - 2 * f * n / ((f - n) * d) + 1) / 2; };  // textbook
+    const glm::dvec2 axis(50, 50);
+
+    // Face-on at distance 2: one depth.
+    const WindowDepthRange faceOn = drawnDepthsNear(camera, {-1, -1, -2}, {1, -1, -2}, {0, 1, -2}, axis, r);
+    REQUIRE(faceOn.lo == Approx(windowDepth(2)).epsilon(1e-13));
+    REQUIRE(faceOn.hi == Approx(windowDepth(2)).epsilon(1e-13));
+
+    // The plane z = −2 − x/2 across the whole square: d = 2 / (1 − x_ndc/2), x_ndc = ±r/50.
+    const WindowDepthRange tilted = drawnDepthsNear(camera, {-1, -1, -1.5}, {1, -1, -2.5}, {0, 1, -2}, axis, r);
+    REQUIRE(tilted.lo == Approx(windowDepth(2 / (1 + r / 100))).epsilon(1e-12));
+    REQUIRE(tilted.hi == Approx(windowDepth(2 / (1 - r / 100))).epsilon(1e-12));
+    REQUIRE(tilted.hi - tilted.lo > 1e-6);
+
+    // Edge-on, its plane (y = 0) through the eye: a segment in the window, and at the axis the
+    // triangle's whole cross-section along it, from distance 1 to distance 3. Its plane meets the
+    // axis everywhere, so no single depth would do.
+    const WindowDepthRange edgeOn = drawnDepthsNear(camera, {0, 0, -1}, {0, 0, -3}, {1, 0, -1}, axis, r);
+    REQUIRE(edgeOn.lo == Approx(windowDepth(1)).epsilon(1e-13));
+    REQUIRE(edgeOn.hi == Approx(windowDepth(3)).epsilon(1e-13));
+
+    // No area at all (three points on a line) still has its depths where the line passes.
+    const WindowDepthRange line = drawnDepthsNear(camera, {-1, 0, -2}, {0, 0, -2}, {1, 0, -2}, axis, r);
+    REQUIRE(line.lo == Approx(windowDepth(2)).epsilon(1e-13));
+    REQUIRE(line.hi == Approx(windowDepth(2)).epsilon(1e-13));
+
+    // Nothing of it within r of the point (the triangle's nearest edge 2r away), or only behind
+    // the near plane: empty.
+    const double x = 2 * r / 50 * 2;  // x_eye of window x = 50 + 2r at distance 2
+    REQUIRE(drawnDepthsNear(camera, {x, -1, -2}, {x + 1, -1, -2}, {x, 1, -2}, axis, r).empty());
+    REQUIRE(drawnDepthsNear(camera, {-1, -1, -0.4}, {1, -1, -0.4}, {0, 1, -0.3}, axis, r).empty());
+    // Cut by the near plane: only its part beyond it, from the near plane on.
+    const WindowDepthRange cut = drawnDepthsNear(camera, {0, 0, -0.25}, {0, 0, -4}, {1, 0, -0.25}, axis, r);
+    REQUIRE(cut.lo == Approx(windowDepth(n)).margin(1e-13));
+    REQUIRE(cut.hi == Approx(windowDepth(4)).epsilon(1e-13));
 }
 
 TEST_CASE("the raster result is bit-identical for any number of threads", "[raster][determinism]")

@@ -225,18 +225,30 @@ MapPixel MapReader::read(int col, int row, bool search) const
     auto consider = [&](std::uint32_t candidate) {
         if (candidate == here || std::find(considered.begin(), considered.end(), candidate) != considered.end()) return;
         considered.push_back(candidate);
+        const glm::uvec3 t = scene_.triangles[candidate];
+        const glm::dvec3 a(scene_.positions[t[0]]), b(scene_.positions[t[1]]), c(scene_.positions[t[2]]);
+        // The candidate's depths within S of the centre: its plane's depth on the pixel's ray,
+        // give or take its tolerance; or, where that leaves the map's depth out, the depths its
+        // drawn polygon takes within S, give or take the tolerance of a face-on surface. The
+        // two agree for a triangle seen at an angle; only the second holds for one seen edge-on
+        // or made a line by binary32 positions far from the origin, whose plane the ray meets
+        // anywhere or nowhere (the regression "verify rejected the raster's sliver of a
+        // triangle without area").
         const double plane = planeWindowDepth(scene_, camera_, candidate, ray);
-        if (!std::isfinite(plane)) return;
         const double tolerance = judge_.surfaceTolerance(candidate, q, allowance);
-        double lo = plane - tolerance, hi = plane + tolerance;
+        double lo = plane - tolerance, hi = plane + tolerance, gap = std::abs(plane - depth);
+        if (!(depth >= lo && depth <= hi)) {
+            const WindowDepthRange drawn = drawnDepthsNear(camera_, a, b, c, pWindow, judge_.snapPixels());
+            if (drawn.empty()) return;
+            const double flat = judge_.toleranceForSlope(0, q, allowance);
+            lo = drawn.lo - flat, hi = drawn.hi + flat;
+            gap = std::max({drawn.lo - depth, depth - drawn.hi, 0.0});
+        }
         if (here != kNoPrimitive) {
             const double truthTolerance = judge_.surfaceTolerance(here, q, allowance);
             lo = std::min(lo, truthDepth - truthTolerance), hi = std::max(hi, truthDepth + truthTolerance);
         }
-        const double gap = std::abs(plane - depth);
         if (!(depth >= lo && depth <= hi) || gap >= closest) return;
-        const glm::uvec3 t = scene_.triangles[candidate];
-        const glm::dvec3 a(scene_.positions[t[0]]), b(scene_.positions[t[1]]), c(scene_.positions[t[2]]);
         if (!insideDrawnTriangle(camera_, a, b, c, pWindow) && !judge_.nearEdge(candidate, pWindow)) return;
         const bool explained = here != kNoPrimitive
                                    ? judge_.bothHit(truthDepth, here, depth, candidate, q, pWindow, bound, allowance) != PixelClass::DepthError

@@ -61,4 +61,30 @@ bool insideDrawnTriangle(const Camera& camera, const glm::dvec3& a, const glm::d
     return polygon.size() >= 3 && (positive == 0 || negative == 0);
 }
 
+WindowDepthRange drawnDepthsNear(const Camera& camera, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c,
+                                 const glm::dvec2& pWindow, double radius)
+{
+    // The square around pWindow as four clip-space planes (the viewport is affine, and the near
+    // and far planes keep w > 0): x_ndc ≥ lo is x − lo·w ≥ 0, and so on.
+    const glm::dvec4 corner0 = camera.ndcFromWindow * glm::dvec4(pWindow - radius, 0.0, 1.0);
+    const glm::dvec4 corner1 = camera.ndcFromWindow * glm::dvec4(pWindow + radius, 0.0, 1.0);
+    const glm::dvec2 lo = glm::min(glm::dvec2(corner0), glm::dvec2(corner1));
+    const glm::dvec2 hi = glm::max(glm::dvec2(corner0), glm::dvec2(corner1));
+    ClipPlanes planes = depthClipPlanes(camera.convention().ndcZMin());
+    planes.plane[planes.size++] = {1.0, 0.0, 0.0, -lo.x};
+    planes.plane[planes.size++] = {-1.0, 0.0, 0.0, hi.x};
+    planes.plane[planes.size++] = {0.0, 1.0, 0.0, -lo.y};
+    planes.plane[planes.size++] = {0.0, -1.0, 0.0, hi.y};
+    const ClipPolygon polygon =
+        clipTriangle(camera.clipFromWorld * glm::dvec4(a, 1.0), camera.clipFromWorld * glm::dvec4(b, 1.0),
+                     camera.clipFromWorld * glm::dvec4(c, 1.0), planes);
+    WindowDepthRange range;
+    for (int i = 0; i < polygon.size; ++i) {
+        const glm::dvec4& pClip = polygon.pClip[i];
+        const double z = (camera.windowFromNdc * glm::dvec4(glm::dvec3(pClip) / pClip.w, 1.0)).z;
+        range.lo = std::min(range.lo, z), range.hi = std::max(range.hi, z);
+    }
+    return range;
+}
+
 }  // namespace zcheck
