@@ -291,9 +291,13 @@ std::vector<Mistake> samplingMistakes()
                                  halfPixel);
     half.reread = [](const Camera& camera, const DepthMap&) {
         Rereadings out;
+        // Window offsets. The mixed ones are a principal point off by half a pixel in image
+        // coordinates (y down) under a window whose y grows upward (OpenGL): cx, cy = W/2, H/2
+        // where (W − 1)/2, (H − 1)/2 belong moves the image +0.5 in x and −0.5 in window y.
         for (auto [dx, dy, what] : {std::tuple{-0.5, -0.5, "x and y"}, std::tuple{-0.5, 0.0, "x"},
                                     std::tuple{0.0, -0.5, "y"}, std::tuple{0.5, 0.5, "x and y, the other way"},
-                                    std::tuple{0.5, 0.0, "x, the other way"}, std::tuple{0.0, 0.5, "y, the other way"}}) {
+                                    std::tuple{0.5, 0.0, "x, the other way"}, std::tuple{0.0, 0.5, "y, the other way"},
+                                    std::tuple{0.5, -0.5, "x the other way and y"}, std::tuple{-0.5, 0.5, "x and y the other way"}}) {
             Rereading r;
             r.variant = what;
             r.explanation = std::string("consistent if rendered with pixel centres half a pixel off in ") + what +

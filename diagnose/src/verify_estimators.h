@@ -95,11 +95,12 @@ void requireDepthsInRange(const Camera& camera, const DepthMap& map, const std::
 
 // How near a hypothesis comes, before a truth is rendered for it: at a 16×16 grid of pixel
 // centres, one ray each (RayRenderer::primitiveAt), whether `map`, read through `camera`,
-// agrees with the surface the ray meets by the comparison's rule (PixelJudge). `agreeing`:
-// the share of the grid's pixels where the map or the truth sees a surface at which they agree
-// (0 where none does); `seen`: that share of the whole grid. A consistent reading fails only at
-// edges and where the map shows a neighbouring surface, which a coarse grid seldom meets: an
-// `agreeing` under 3/4 rules it out.
+// agrees with the surface the ray meets by the comparison's rule (PixelJudge); where the grid
+// meets a surface at fewer than 16 pixels (a small object), also at up to 256 of the pixels
+// where the map holds a surface. `agreeing`: the share of the probed pixels where the map or
+// the truth sees a surface at which they agree (0 where none does); `seen`: the share of the
+// image they stand for. A consistent reading fails only at edges and where the map shows a
+// neighbouring surface, which a coarse grid seldom meets: an `agreeing` under 3/4 rules it out.
 struct Probe {
     double agreeing = 0, seen = 0;
     bool rulesOut() const { return agreeing < 0.75; }

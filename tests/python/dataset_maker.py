@@ -91,10 +91,10 @@ def write_hdf5(path, **datasets):
 
 
 class Trajectory:
-    """`frames` cameras on a ring around the scene's bounds, looking at its centre; intrinsics
-    FX, FY, CX, CY scaled to a `width` x `height` image."""
+    """`frames` cameras on a ring around the scene's bounds, `orbit` times their half-diagonal from
+    its centre and looking at it; intrinsics FX, FY, CX, CY scaled to a `width` x `height` image."""
 
-    def __init__(self, scene, frames=FRAMES, width=W, height=H):
+    def __init__(self, scene, frames=FRAMES, width=W, height=H, orbit=2.2):
         self.width, self.height = width, height
         self.fx = FX * width / W
         self.cx, self.cy = width / 2, height / 2
@@ -105,7 +105,7 @@ class Trajectory:
         self.clip = []   # the renderer's near and far: hugging the scene, as a renderer's would
         for i in range(frames):
             a = 2 * math.pi * i / frames
-            eye = self.center + radius * np.array([2.2 * math.sin(a), 0.8 + 0.3 * math.sin(3 * a), 2.2 * math.cos(a)])
+            eye = self.center + radius * np.array([orbit * math.sin(a), 0.8 + 0.3 * math.sin(3 * a), orbit * math.cos(a)])
             self.poses.append(look_at_cam_from_world(eye, self.center))
             d = np.linalg.norm(eye - self.center)
             self.clip.append((0.5 * (d - radius), 1.5 * (d + radius)))
@@ -119,13 +119,13 @@ class Trajectory:
 
 
 class DatasetMaker:
-    def __init__(self, root, mesh, frames=FRAMES, width=W, height=H):
+    def __init__(self, root, mesh, frames=FRAMES, width=W, height=H, orbit=2.2):
         self.root = Path(root)
         self.root.mkdir(parents=True, exist_ok=True)
         self.mesh = str(mesh)
         self.scene = zcheck.Scene.from_file(self.mesh)
         self.checker = zcheck.Checker(self.scene)
-        self.trajectory = Trajectory(self.scene, frames, width, height)
+        self.trajectory = Trajectory(self.scene, frames, width, height, orbit)
         self.frames = frames
         self._eye_z = {}
         self._distance = {}
