@@ -318,6 +318,45 @@ TEST_CASE("regression: a finely tessellated mesh gave the fits no sample pixels,
     REQUIRE(std::abs(fittedValue(h, "sample_dy_px") - d.sampleOffset.y) <= 1.0 / 256);
 }
 
+TEST_CASE("regression: diagnose did not name a depth scale on a small curved object", "[fit][regression]")
+{
+    // Found by a random run of diagnose (Spot, a cow of 5,856 triangles, over 7 % of a 96 × 120
+    // image, its eye-z values × 1.05): too few pixels had neighbourhoods on one plane, every fit
+    // had nothing to fit, and the map went unnamed. The families that change the values alone
+    // (a scale and offset, near and far) now take every pixel inside the silhouette. A sphere of
+    // 16 × 32 quads, 14 pixels across.
+    Scene scene;
+    scene.name = "sphere";
+    constexpr int kRings = 16, kSegments = 32;
+    for (int i = 0; i <= kRings; ++i)
+        for (int j = 0; j < kSegments; ++j) {
+            const double theta = M_PI * i / kRings, phi = 2 * M_PI * j / kSegments;
+            scene.positions.emplace_back(std::sin(theta) * std::cos(phi), std::cos(theta), std::sin(theta) * std::sin(phi));
+        }
+    for (int i = 0; i < kRings; ++i)
+        for (int j = 0; j < kSegments; ++j) {
+            const std::uint32_t a = i * kSegments + j, b = i * kSegments + (j + 1) % kSegments;
+            scene.triangles.push_back({a, a + kSegments, b + kSegments});
+            scene.triangles.push_back({a, b + kSegments, b});
+        }
+    const Camera camera(cameraSpecFromJsonText(
+        R"({"convention": "opencv", "image": {"width": 96, "height": 120},
+            "projection": {"type": "pinhole", "fx": 125, "fy": 125, "cx": 47.5, "cy": 59.5, "near": 0.01, "far": 160},
+            "view": {"eye": [0.3, 0.5, 17], "target": [0, 0, 0], "up": [0, 1, 0]}})",
+        "sphere camera"));
+    const Checker checker(scene);
+    const MapVerifier verifier(checker);
+    const DepthMap map = scaled(mapOf(scene, camera, checker.renderRay(camera), ExportQuantity::EyeZ), 1.05);
+    REQUIRE_FALSE(verifier.verify(camera, map).comparison.report.consistent());
+    const std::vector<Hypothesis> diagnosis = verifier.diagnose(camera, map);
+    REQUIRE_FALSE(diagnosis.empty());
+    const Hypothesis& h = diagnosis.front();
+    INFO(h.name << ": " << h.explanation);
+    REQUIRE(h.name == "depth-scale");
+    REQUIRE(h.consistent);
+    REQUIRE(std::abs(fittedValue(h, "value_scale") - 1.05) <= 1e-4);
+}
+
 TEST_CASE("regression: a rescaled NDC map's far-plane misses read as surfaces once its scale was undone", "[fit][regression]")
 {
     // The far plane's NDC 1, scaled by 1.002 and back, is 1 − 2^−25 in double: no longer the

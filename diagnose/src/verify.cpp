@@ -737,6 +737,15 @@ bool onePlaneAround(const RenderResult& truth, int width, int height, int col, i
     return one;
 }
 
+bool hitAllAround(const RenderResult& truth, int width, int height, int col, int row)
+{
+    for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx)
+            if (!truth.hit(std::size_t(std::clamp(row + dy, 0, height - 1)) * width + std::clamp(col + dx, 0, width - 1)))
+                return false;
+    return true;
+}
+
 EdgeTally tallyEdges(const Camera& camera, const RenderResult& truth, const RenderResult& map, const Comparison& comparison)
 {
     const int W = camera.width(), H = camera.height();

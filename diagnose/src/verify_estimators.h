@@ -116,6 +116,9 @@ Probe probeAgreement(const Scene& scene, const RayRenderer& rays, const Camera& 
 // (there the second difference is as large as the rise) and at sharp creases; true on a
 // finely tessellated curved surface, whose gentle creases bend depth far less.
 bool onePlaneAround(const RenderResult& truth, int width, int height, int col, int row);
+// Whether the truth hits at pixel (col, row) and all round it (its 3×3 neighbourhood, clamped
+// at the image's border): inside a surface's silhouette, whatever its shape.
+bool hitAllAround(const RenderResult& truth, int width, int height, int col, int row);
 
 // Of a comparison's unexplained pixels, those at edges of the truth (a 3×3 neighbourhood that
 // is not one plane, or a coverage change), and of those the ones whose map depth lies between
