@@ -426,9 +426,9 @@ Probe probeAgreement(const Scene& scene, const RayRenderer& rays, const Camera& 
     // (almost) nothing says nothing (it ruled out every camera of a map whose object covered
     // 0.6 % of the image: the regression "diagnose did not name a mistake in a map of a small
     // object"). Then the pixels where the map, read through this camera, holds a surface are
-    // probed too: up to kSamples of them, found among at most 2^16 pixels read.
+    // probed too: up to kSamples of them, found among at most 2^14 pixels read.
     if (seen < kGrid) {
-        const int stride = std::max(1, int(std::ceil(std::sqrt(double(W) * H / 65536.0))));
+        const int stride = std::max(1, int(std::ceil(std::sqrt(double(W) * H / 16384.0))));
         std::vector<std::pair<int, int>> surface;
         for (int row = stride / 2; row < H; row += stride)
             for (int col = stride / 2; col < W; col += stride)
