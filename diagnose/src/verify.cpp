@@ -78,6 +78,12 @@ bool unormInBinary32(const Camera& camera, DepthQuantity quantity, double storag
            (quantity == DepthQuantity::Window || quantity == DepthQuantity::Ndc) && storageStep == 0;
 }
 
+// The same for a whole map: no storage step stated for any of its values.
+bool unormInBinary32(const Camera& camera, const DepthMap& map)
+{
+    return map.valueStep.empty() && unormInBinary32(camera, map.quantity, map.valueQuantum);
+}
+
 // Window depth of a triangle's plane where the pixel's ray meets it (NaN if it does not).
 double planeWindowDepth(const Scene& scene, const Camera& camera, std::uint32_t primitive, const EyePlaneRay& ray)
 {
@@ -323,7 +329,7 @@ RenderResult renderResultFromMap(const PixelJudge& judge, const DepthMap& map, c
     // Allowances: what the map declares, and the binary32 rounding of a unorm buffer's window or
     // NDC values (mapPixelDepth).
     const bool declared = map.accuracy.anyAccuracy() ||
-                          unormInBinary32(camera, map.quantity, map.valueStep.empty() ? map.valueQuantum : 1.0);
+                          unormInBinary32(camera, map);
     allowance.assign(declared ? std::size_t(W) * H : 0, 0.0);
     const MapReader reader(judge, map, truth, neighbours);
     // Rows in parallel: each pixel's choice reads only the truth and the map.

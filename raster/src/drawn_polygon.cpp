@@ -21,17 +21,28 @@ double distanceToSegment(const glm::dvec2& p, const glm::dvec2& a, const glm::dv
 
 namespace {
 
-// The triangle as drawn: clipped to the near and far planes, its vertices in window space.
-std::vector<glm::dvec2> drawnPolygon(const Camera& camera, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c)
+// The triangle clipped by `planes` (the near and far planes among them, so w > 0), its vertices
+// divided and put through the viewport: window x, y and depth.
+std::vector<glm::dvec3> clippedInWindow(const Camera& camera, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c,
+                                        const ClipPlanes& planes)
 {
     const ClipPolygon polygon =
         clipTriangle(camera.clipFromWorld * glm::dvec4(a, 1.0), camera.clipFromWorld * glm::dvec4(b, 1.0),
-                     camera.clipFromWorld * glm::dvec4(c, 1.0), depthClipPlanes(camera.convention().ndcZMin()));
-    std::vector<glm::dvec2> window;
+                     camera.clipFromWorld * glm::dvec4(c, 1.0), planes);
+    std::vector<glm::dvec3> window;
     for (int i = 0; i < polygon.size; ++i) {
         const glm::dvec4& pClip = polygon.pClip[i];
         window.emplace_back(camera.windowFromNdc * glm::dvec4(glm::dvec3(pClip) / pClip.w, 1.0));
     }
+    return window;
+}
+
+// The triangle as drawn: clipped to the near and far planes, its vertices in window space.
+std::vector<glm::dvec2> drawnPolygon(const Camera& camera, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c)
+{
+    std::vector<glm::dvec2> window;
+    for (const glm::dvec3& p : clippedInWindow(camera, a, b, c, depthClipPlanes(camera.convention().ndcZMin())))
+        window.emplace_back(p);
     return window;
 }
 
@@ -75,15 +86,9 @@ WindowDepthRange drawnDepthsNear(const Camera& camera, const glm::dvec3& a, cons
     planes.plane[planes.size++] = {-1.0, 0.0, 0.0, hi.x};
     planes.plane[planes.size++] = {0.0, 1.0, 0.0, -lo.y};
     planes.plane[planes.size++] = {0.0, -1.0, 0.0, hi.y};
-    const ClipPolygon polygon =
-        clipTriangle(camera.clipFromWorld * glm::dvec4(a, 1.0), camera.clipFromWorld * glm::dvec4(b, 1.0),
-                     camera.clipFromWorld * glm::dvec4(c, 1.0), planes);
     WindowDepthRange range;
-    for (int i = 0; i < polygon.size; ++i) {
-        const glm::dvec4& pClip = polygon.pClip[i];
-        const double z = (camera.windowFromNdc * glm::dvec4(glm::dvec3(pClip) / pClip.w, 1.0)).z;
-        range.lo = std::min(range.lo, z), range.hi = std::max(range.hi, z);
-    }
+    for (const glm::dvec3& p : clippedInWindow(camera, a, b, c, planes))
+        range.lo = std::min(range.lo, p.z), range.hi = std::max(range.hi, p.z);
     return range;
 }
 
