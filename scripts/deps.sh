@@ -2,7 +2,10 @@
 # Installs zcheck's build dependencies from the Debian 12 archive (idempotent); with --test, also
 # the real programs the tests start: COLMAP (its model converter writes real models), Blender
 # (headless, its own Z pass), Slurm and munge (a local cluster), h5py (HDF5 maps written by
-# another library), Chromium (headless: the dataset report's page as a browser shows it).
+# another library), Chromium (headless: the dataset report's page as a browser shows it), and
+# the independent implementations the tests hold zcheck to: OpenCV (lens models), Open3D (its
+# closest-point queries) and VTK (its ray casts). Every module a test imports is installed here
+# (tests/python/test_setup.py requires it).
 set -euo pipefail
 packages=(cmake ninja-build g++ pkg-config python3
           libembree-dev libglm-dev libopenimageio-dev openimageio-tools catch2 libtbb-dev
@@ -10,7 +13,7 @@ packages=(cmake ninja-build g++ pkg-config python3
           pybind11-dev python3-dev python3-numpy python3-pytest python3-venv
           libegl-dev libgl1-mesa-dri)  # the llvmpipe yardstick of `zcheck bench --reference`
 if [[ ${1:-} == --test ]]; then
-    packages+=(colmap blender slurm-wlm munge python3-h5py chromium)
+    packages+=(colmap blender slurm-wlm munge python3-h5py chromium python3-opencv python3-open3d python3-vtk9)
 fi
 missing=()
 for p in "${packages[@]}"; do

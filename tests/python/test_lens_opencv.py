@@ -5,12 +5,11 @@ projections agree to 1e-9 relative, and zcheck's unprojection, projected by Open
 on the pixel."""
 import math
 
+import cv2  # python3-opencv, installed by the test command (scripts/deps.sh --test): never skipped
 import numpy as np
 import pytest
 
 import zcheck
-
-cv2 = pytest.importorskip("cv2")
 
 W, H = 1280, 960
 
