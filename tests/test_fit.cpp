@@ -318,13 +318,13 @@ TEST_CASE("regression: a finely tessellated mesh gave the fits no sample pixels,
     REQUIRE(std::abs(fittedValue(h, "sample_dy_px") - d.sampleOffset.y) <= 1.0 / 256);
 }
 
-TEST_CASE("regression: diagnose did not name a depth scale on a small curved object", "[fit][regression]")
+namespace {
+
+// A sphere of 16 × 32 quads of radius 1 at the origin, and a pinhole camera 17 units away that
+// sees it 14 pixels across in a 96 × 120 image (fx = fy = `focal`): an object too small and
+// curved for the fits' one-plane samples.
+Scene smallSphere()
 {
-    // Found by a random run of diagnose (Spot, a cow of 5,856 triangles, over 7 % of a 96 × 120
-    // image, its eye-z values × 1.05): too few pixels had neighbourhoods on one plane, every fit
-    // had nothing to fit, and the map went unnamed. The families that change the values alone
-    // (a scale and offset, near and far) now take every pixel inside the silhouette. A sphere of
-    // 16 × 32 quads, 14 pixels across.
     Scene scene;
     scene.name = "sphere";
     constexpr int kRings = 16, kSegments = 32;
@@ -339,11 +339,29 @@ TEST_CASE("regression: diagnose did not name a depth scale on a small curved obj
             scene.triangles.push_back({a, a + kSegments, b + kSegments});
             scene.triangles.push_back({a, b + kSegments, b});
         }
-    const Camera camera(cameraSpecFromJsonText(
+    return scene;
+}
+
+Camera smallSphereCamera(double focal)
+{
+    return Camera(cameraSpecFromJsonText(
         R"({"convention": "opencv", "image": {"width": 96, "height": 120},
-            "projection": {"type": "pinhole", "fx": 125, "fy": 125, "cx": 47.5, "cy": 59.5, "near": 0.01, "far": 160},
+            "projection": {"type": "pinhole", "fx": )" + std::to_string(focal) + R"(, "fy": )" + std::to_string(focal) +
+            R"(, "cx": 47.5, "cy": 59.5, "near": 0.01, "far": 160},
             "view": {"eye": [0.3, 0.5, 17], "target": [0, 0, 0], "up": [0, 1, 0]}})",
         "sphere camera"));
+}
+
+}  // namespace
+
+TEST_CASE("regression: diagnose did not name a depth scale on a small curved object", "[fit][regression]")
+{
+    // Found by a random run of diagnose (Spot, a cow of 5,856 triangles, over 7 % of a 96 × 120
+    // image, its eye-z values × 1.05): too few pixels had neighbourhoods on one plane, every fit
+    // had nothing to fit, and the map went unnamed. The families that change the values alone
+    // (a scale and offset, near and far) now take every pixel inside the silhouette.
+    const Scene scene = smallSphere();
+    const Camera camera = smallSphereCamera(125);
     const Checker checker(scene);
     const MapVerifier verifier(checker);
     const DepthMap map = scaled(mapOf(scene, camera, checker.renderRay(camera), ExportQuantity::EyeZ), 1.05);
@@ -355,6 +373,28 @@ TEST_CASE("regression: diagnose did not name a depth scale on a small curved obj
     REQUIRE(h.name == "depth-scale");
     REQUIRE(h.consistent);
     REQUIRE(std::abs(fittedValue(h, "value_scale") - 1.05) <= 1e-4);
+}
+
+TEST_CASE("regression: diagnose did not name a focal length on a small curved object", "[fit][regression]")
+{
+    // Found by a random run of diagnose against maps made from VTK's ray casts (a cow over
+    // 925 of 69 × 44 pixels, rendered with fx and fy 1 % longer than declared): as for the depth
+    // scale above, no fit had samples, and the families that move the rays (field of view,
+    // sample offset, intrinsics, pose) did not take the fallback. They now take every pixel
+    // inside the silhouette too, with the plane of the triangle each one hit.
+    const Scene scene = smallSphere();
+    const Camera declared = smallSphereCamera(125), drawn = smallSphereCamera(126.25);
+    const Checker checker(scene);
+    const MapVerifier verifier(checker);
+    const DepthMap map = mapOf(scene, drawn, checker.renderRay(drawn), ExportQuantity::EyeZ);
+    REQUIRE_FALSE(verifier.verify(declared, map).comparison.report.consistent());
+    const std::vector<Hypothesis> diagnosis = verifier.diagnose(declared, map);
+    REQUIRE_FALSE(diagnosis.empty());
+    const Hypothesis& h = diagnosis.front();
+    INFO(h.name << ": " << h.explanation);
+    REQUIRE(h.name == "field-of-view");
+    REQUIRE(h.consistent);
+    REQUIRE(std::abs(fittedValue(h, "focal_scale") - 1.01) <= 1e-4);
 }
 
 TEST_CASE("regression: a rescaled NDC map's far-plane misses read as surfaces once its scale was undone", "[fit][regression]")

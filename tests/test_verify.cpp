@@ -757,6 +757,57 @@ TEST_CASE("a mirrored principal point, depth without near added, and a map quant
     REQUIRE(testing::diagnosedAs(verifier, camera, testing::windowMapOf(unorm16, checker.renderRaster(unorm16)), "quantized-depth"));
 }
 
+TEST_CASE("regression: diagnose did not name a map clipped at other planes than declared", "[verify][diagnose][regression]")
+{
+    // Found by a random run of diagnose against maps made from VTK's ray casts: a ray tracer
+    // clips at no far plane, and its eye-z map of a scene the declared far plane cuts held
+    // surfaces beyond it; no hypothesis named that. clip-planes re-reads the map with the
+    // tightest planes around what it holds. A quad 5 units ahead in front of a wall 20 away.
+    Scene scene;
+    scene.name = "quad before a wall";
+    auto quad = [&](double z, double half) {
+        const auto first = std::uint32_t(scene.positions.size());
+        for (const glm::dvec2 corner : {glm::dvec2(-1, -1), glm::dvec2(1, -1), glm::dvec2(1, 1), glm::dvec2(-1, 1)})
+            scene.positions.emplace_back(half * corner.x, half * corner.y, z);
+        scene.triangles.push_back({first, first + 1, first + 2});
+        scene.triangles.push_back({first, first + 2, first + 3});
+    };
+    quad(5, 1), quad(20, 40);
+    auto camera = [](double near, double far) {
+        return Camera(cameraSpecFromJsonText(
+            R"({"convention": "opencv", "image": {"width": 64, "height": 48},
+                "projection": {"type": "pinhole", "fx": 40, "fy": 40, "cx": 31.5, "cy": 23.5, "near": )" +
+                std::to_string(near) + R"(, "far": )" + std::to_string(far) + R"(},
+                "view": {"eye": [0, 0, 0], "target": [0, 0, 1], "up": [0, -1, 0]}})",
+            "camera"));
+    };
+    const Checker checker(scene);
+    const MapVerifier verifier(checker);
+    const Camera declared = camera(0.1, 12);
+    for (const ExportQuantity quantity : {ExportQuantity::EyeZ, ExportQuantity::Distance}) {
+        // A ray tracer's map: nothing clipped (far 1000); the declared far plane cuts the wall.
+        const Camera unclipped = camera(0.1, 1000);
+        const DepthMap traced = mapOf(scene, unclipped, checker.renderRay(unclipped), quantity);
+        REQUIRE_FALSE(verifier.verify(declared, traced).comparison.report.consistent());
+        const std::vector<Hypothesis> diagnosis = verifier.diagnose(declared, traced);
+        REQUIRE_FALSE(diagnosis.empty());
+        INFO(diagnosis.front().name << ": " << diagnosis.front().explanation);
+        REQUIRE(diagnosis.front().name == "clip-planes");
+        REQUIRE(diagnosis.front().consistent);
+        REQUIRE(diagnosis.front().explanation.find("far ≥ 20 (eye-z) instead of the declared near 0.1 and far 12") !=
+                std::string::npos);
+        // A renderer whose near plane (6) clipped the quad away: its map shows the wall there.
+        const Camera nearer = camera(6, 30), wide = camera(0.1, 30);
+        const DepthMap clipped = mapOf(scene, nearer, checker.renderRay(nearer), quantity);
+        REQUIRE_FALSE(verifier.verify(wide, clipped).comparison.report.consistent());
+        REQUIRE(testing::diagnosedAs(verifier, wide, clipped, "clip-planes"));
+        // A map the planes do not explain: the quad's depths scaled, nothing clipped.
+        DepthMap scaledMap = mapOf(scene, wide, checker.renderRay(wide), quantity);
+        for (double& v : scaledMap.value) v *= 1.01;
+        REQUIRE_FALSE(testing::diagnosedAs(verifier, wide, scaledMap, "clip-planes"));
+    }
+}
+
 TEST_CASE("two camera mistakes at once are diagnosed by both names: reversed and aspect inverted", "[verify][diagnose]")
 {
     // A reversed-Z renderer that also computes its aspect as height / width: both change the

@@ -459,9 +459,12 @@ FitResult fitDeparture(const Scene& scene, const Camera& camera, const DepthMap&
         Problem problem{camera, map, family, d, 1, 1, samplesOf(scene, camera, departed, map, rendered ? *rendered : truth)};
         // A small or coarsely tessellated object seen small has few pixels whose neighbours lie on
         // one plane (a cow of 5,856 triangles over 7 % of a 96 × 120 image had too few to fit
-        // anything: the regression "diagnose did not name a depth scale on a small curved
-        // object"); a family that changes the values alone needs no plane around its samples.
-        if ((family == FitFamily::DepthScale || family == FitFamily::NearFar) && problem.samples.size() < 64)
+        // anything: the regressions "diagnose did not name a depth scale on a small curved
+        // object" and "... a focal length on a small curved object"). Then every pixel inside the
+        // silhouette is a sample: a family that changes the values alone needs no plane around
+        // it, and one that moves the rays takes the plane of the triangle it hit, the next round
+        // the planes where the moved rays land (a fit is confirmed by a full comparison).
+        if (problem.samples.size() < 64)
             problem.samples = samplesOf(scene, camera, departed, map, rendered ? *rendered : truth, SampleRule::InsideSurface);
         if (shiftedStart) {
             // Along a long shift only surfaces whose depth changes along it tell one shift from the

@@ -644,6 +644,70 @@ std::vector<Mistake> projectionMistakes()
     return all;
 }
 
+// A significant-digits form of a plane's distance, for people.
+std::string planeText(double distance)
+{
+    char text[32];
+    std::snprintf(text, sizeof text, "%.4g", distance);
+    return text;
+}
+
+// An eye-z or distance map clipped by other planes than the camera declares: a ray tracer's,
+// which clips at none or only far away (VTK's and Embree's casts, Blender's Z pass up to its clip
+// end), or the renderer's own near and far. Re-read with the tightest planes around what the map
+// holds: where the map and the truth differ only in surfaces beyond one plane or the other, the
+// truth clipped there is the map. The planes bound eye-z, or, for a lens model, the distance
+// along each ray; a frustum's extents lie on its near plane and move with it; an oblique box
+// (sheared from its near plane) and a raw matrix keep their own.
+Mistake clipPlanesMistake()
+{
+    Mistake clip{"clip-planes",
+                 "the map clipped at other near and far planes than declared (a ray tracer that does not clip, or "
+                 "the renderer's own planes)",
+                 Route::Ray, {}, {}};
+    clip.alone = true;
+    clip.reread = [](const Camera& camera, const DepthMap& map) {
+        if (map.quantity != DepthQuantity::EyeZ && map.quantity != DepthQuantity::Distance) return Rereadings{};
+        CameraSpec spec = camera.spec();
+        Projection& p = spec.projection;
+        const bool alongRays = p.type == ProjectionType::NonLinear;
+        if (p.type == ProjectionType::Oblique || p.type == ProjectionType::Matrix) return Rereadings{};
+        double nearest = INFINITY, farthest = 0;  // in the planes' measure
+        for (int row = 0; row < map.height; ++row)
+            for (int col = 0; col < map.width; ++col) {
+                const double v = map.value[std::size_t(row) * map.width + col];
+                if (!(v > 0) || !std::isfinite(v)) continue;  // a miss
+                const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
+                double measure = v;
+                if (alongRays && map.quantity == DepthQuantity::EyeZ) measure = distanceFromEyeZ(camera, pWindow, v);
+                if (!alongRays && map.quantity == DepthQuantity::Distance) measure = eyeZFromDistance(camera, pWindow, v);
+                if (!(measure > 0) || !std::isfinite(measure)) continue;
+                nearest = std::min(nearest, measure), farthest = std::max(farthest, measure);
+            }
+        if (!(farthest > 0)) return Rereadings{};
+        const double nearPlane = nearest * (1 - 1e-6), farPlane = farthest * (1 + 1e-6);
+        if (p.type == ProjectionType::Frustum) {
+            const double k = nearPlane / p.near;
+            p.left *= k, p.right *= k, p.bottom *= k, p.top *= k;
+        }
+        const std::string declared = "near " + planeText(p.near) + " and far " + planeText(p.far);
+        const std::string measure = alongRays ? " (distances along the rays)" : " (eye-z)";
+        std::string beyond;  // the declared planes the map holds surfaces beyond
+        if (nearest < p.near) beyond = "near ≤ " + planeText(nearest);
+        if (farthest > p.far) beyond += (beyond.empty() ? "" : " and ") + ("far ≥ " + planeText(farthest));
+        const std::string explanation =
+            beyond.empty()
+                ? "consistent if the map was clipped tighter than the declared " + declared + measure +
+                      ": it holds surfaces only from " + planeText(nearest) + " to " + planeText(farthest) +
+                      "; give the renderer's own planes"
+                : "consistent if the renderer's planes were " + beyond + measure + " instead of the declared " +
+                      declared + ": give its own, or, for a ray tracer that does not clip, planes around the scene";
+        p.near = nearPlane, p.far = farPlane;
+        return Rereadings{{"", explanation, spec, {}, {}}};
+    };
+    return clip;
+}
+
 // What the numbers are: linear depth, an offset, a coarser storage, and every swap of the four
 // quantities.
 std::vector<Mistake> quantityMistakes()
@@ -674,6 +738,7 @@ std::vector<Mistake> quantityMistakes()
                                  [n](double v) { return std::isfinite(v) ? v + n : v; })};
     };
     all.push_back(affineOffset);
+    all.push_back(clipPlanesMistake());
     // A map stored in fewer bits than declared: its values lie on an integer grid.
     // (unorm24 cannot be told apart: binary32 has no finer resolution than its grid near 1.)
     Mistake quantized{"quantized-depth", "window depth stored as unorm16 where float32 was declared", Route::Raster, {}, {}};
