@@ -18,6 +18,14 @@ ZCHECK_EXE = os.environ.get("ZCHECK_EXE", str(REPO / "build" / "cli" / "zcheck")
 
 W, H = 160, 120  # small images keep the suite fast
 
+# The shared meshes (../shared/data/models beside the repository, or ZCHECK_MODELS_DIR).
+MODELS = Path(os.environ.get("ZCHECK_MODELS_DIR", REPO.parent / "shared" / "data" / "models"))
+
+# Each convention's eye axes from OpenCV's (x right, y down, looking down +z): docs/conventions.md.
+# A pose in OpenCV's axes (R, t) is (A @ R, A @ t) in the convention's.
+AXES_FROM_OPENCV = {"opencv": np.eye(3), "opengl": np.diag([1.0, -1.0, -1.0]), "vulkan": np.diag([1.0, -1.0, -1.0]),
+                    "metal": np.diag([1.0, -1.0, -1.0]), "direct3d": np.diag([1.0, -1.0, 1.0])}
+
 
 def run_cli(*args, check_rc=None):
     """Runs the zcheck command; returns (returncode, stdout, stderr)."""

@@ -13,9 +13,8 @@ import pytest
 import zcheck
 
 from dataset_maker import DatasetMaker, FRAMES, has
-from helpers import run_cli
+from helpers import MODELS, run_cli
 
-MODELS = Path(os.environ.get("ZCHECK_MODELS_DIR", Path(__file__).resolve().parents[3] / "shared" / "data" / "models"))
 BUNNY = MODELS / "stanford-bunny.obj"
 pytestmark = pytest.mark.skipif(not BUNNY.exists(), reason="the shared models are not beside the repository")
 

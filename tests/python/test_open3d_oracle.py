@@ -11,17 +11,14 @@ mesh too); VTK's ray casts hold that (test_vtk_oracle.py). Open3D's own ray cast
 mask 0 and Debian's libembree3 3.13.5 is built with ray masks (EMBREE_RAY_MASK), so every ray
 passes every triangle. The last test pins that, so that the day it works it can cast them too.
 """
-import os
-from pathlib import Path
-
 import cv2
 import numpy as np
 import open3d as o3d
 import pytest
 
 import zcheck
+from helpers import AXES_FROM_OPENCV, MODELS
 
-MODELS = Path(os.environ.get("ZCHECK_MODELS_DIR", Path(__file__).resolve().parents[3] / "shared" / "data" / "models"))
 pytestmark = pytest.mark.skipif(not (MODELS / "spot.obj").exists(),
                                 reason="the shared models are not beside the repository")
 W, H = 320, 240
@@ -91,9 +88,6 @@ def test_every_pixels_point_is_on_the_mesh_and_projects_onto_the_pixel(model, le
     assert np.median(model.distance_to_mesh(wrong)) > 1e-3
 
 
-# The eye axes of each convention from OpenCV's (x right, y down, looking down +z): docs/conventions.md.
-AXES_FROM_OPENCV = {"opencv": np.eye(3), "opengl": np.diag([1.0, -1.0, -1.0]), "vulkan": np.diag([1.0, -1.0, -1.0]),
-                    "metal": np.diag([1.0, -1.0, -1.0]), "direct3d": np.diag([1.0, -1.0, 1.0])}
 
 
 @pytest.mark.parametrize("convention, depth", [("opencv", {}), ("opencv", {"reversed": True}),

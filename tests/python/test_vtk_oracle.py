@@ -15,9 +15,7 @@ so a map made here holds no zcheck code:
 test_open3d_oracle.py says why.)
 """
 import copy
-import os
 import zlib
-from pathlib import Path
 
 import cv2
 import numpy as np
@@ -26,8 +24,8 @@ import vtk
 from vtk.util import numpy_support
 
 import zcheck
+from helpers import AXES_FROM_OPENCV, MODELS
 
-MODELS = Path(os.environ.get("ZCHECK_MODELS_DIR", Path(__file__).resolve().parents[3] / "shared" / "data" / "models"))
 pytestmark = pytest.mark.skipif(not (MODELS / "spot.obj").exists(),
                                 reason="the shared models are not beside the repository")
 W, H = 120, 90
@@ -119,8 +117,8 @@ def test_maps_made_from_vtks_hits_verify_and_their_mistakes_are_named(model):
         window_d3d = f / (f - n) - f * n / ((f - n) * eye_z)        # D3DXMatrixPerspectiveFovLH's
     window_gl = np.where(np.isfinite(eye_z), (ndc_gl + 1) / 2, 1.0)  # glDepthRange(0, 1); misses cleared to 1
     window_d3d = np.where(np.isfinite(eye_z), window_d3d, 1.0)
-    gl = {"convention": "opengl", "R": np.diag([1.0, -1.0, -1.0]) @ model.R}
-    d3d = {"convention": "direct3d", "R": np.diag([1.0, -1.0, 1.0]) @ model.R}
+    gl = {"convention": "opengl", "R": AXES_FROM_OPENCV["opengl"] @ model.R}
+    d3d = {"convention": "direct3d", "R": AXES_FROM_OPENCV["direct3d"] @ model.R}
 
     def camera(axes=None, **settings):
         if axes is None:
@@ -177,8 +175,6 @@ def test_a_lens_map_of_opencvs_rays_and_vtks_hits_verifies(model, D, fisheye):
     assert not report.consistent
 
 
-AXES_FROM_OPENCV = {"opencv": np.eye(3), "opengl": np.diag([1.0, -1.0, -1.0]), "vulkan": np.diag([1.0, -1.0, -1.0]),
-                    "metal": np.diag([1.0, -1.0, -1.0]), "direct3d": np.diag([1.0, -1.0, 1.0])}
 
 
 def random_view(model, rng):
