@@ -676,7 +676,7 @@ Mistake clipPlanesMistake()
         for (int row = 0; row < map.height; ++row)
             for (int col = 0; col < map.width; ++col) {
                 const double v = map.value[std::size_t(row) * map.width + col];
-                if (!(v > 0) || !std::isfinite(v)) continue;  // a miss
+                if (kindOfDepthValue(camera, map.quantity, v) != DepthValueKind::Depth) continue;
                 const glm::dvec2 pWindow = windowFromPixelCentre(camera, col, row);
                 double measure = v;
                 if (alongRays && map.quantity == DepthQuantity::EyeZ) measure = distanceFromEyeZ(camera, pWindow, v);
