@@ -806,6 +806,20 @@ TEST_CASE("regression: diagnose did not name a map clipped at other planes than 
         for (double& v : scaledMap.value) v *= 1.01;
         REQUIRE_FALSE(testing::diagnosedAs(verifier, wide, scaledMap, "clip-planes"));
     }
+    // Through a fisheye, whose near and far are distances along the rays (the lens diagnosis).
+    auto fisheye = [](double far) {
+        return Camera(cameraSpecFromJsonText(
+            R"({"convention": "opencv", "image": {"width": 64, "height": 48},
+                "projection": {"type": "pinhole", "fx": 40, "fy": 40, "cx": 31.5, "cy": 23.5, "near": 0.1, "far": )" +
+                std::to_string(far) + R"(},
+                "lens": {"model": "opencv_fisheye", "k1": 0.02, "k2": -0.005},
+                "view": {"eye": [0, 0, 0], "target": [0, 0, 1], "up": [0, -1, 0]}})",
+            "fisheye"));
+    };
+    const Camera unclippedLens = fisheye(1000), declaredLens = fisheye(12);
+    const DepthMap tracedThroughLens = mapOf(scene, unclippedLens, checker.renderRay(unclippedLens), ExportQuantity::Distance);
+    REQUIRE_FALSE(verifier.verify(declaredLens, tracedThroughLens).comparison.report.consistent());
+    REQUIRE(testing::diagnosedAs(verifier, declaredLens, tracedThroughLens, "clip-planes"));
 }
 
 TEST_CASE("two camera mistakes at once are diagnosed by both names: reversed and aspect inverted", "[verify][diagnose]")

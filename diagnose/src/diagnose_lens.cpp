@@ -67,7 +67,8 @@ std::vector<Hypothesis> declaredLensReadings(const MapVerifier& verifier, const 
 }
 
 // The catalogue's re-readings (mistakes.h) that keep the lens, the convention, the map and the
-// truth's sampling and change the view alone: the pose's mistakes, through the lens camera.
+// truth's sampling and change the view alone (the pose's mistakes) or the near and far distances
+// alone (clip-planes), through the lens camera.
 // Those the lens family has its own form of (the image's flips and shifts, the principal point,
 // the quantity) are the lens family's; handedness, a mirrored eye x axis, is its x-flip.
 std::vector<LensMistake> poseMistakes(const Camera& camera, const DepthMap& map)
@@ -85,10 +86,17 @@ std::vector<LensMistake> poseMistakes(const Camera& camera, const DepthMap& map)
             if (!r.camera || r.map || !r.truthFaults.none()) continue;
             const Projection& p = r.camera->projection;
             const Projection& declared = camera.spec().projection;
-            if (p.type != ProjectionType::NonLinear || !(p.lens == declared.lens) || p.near != declared.near ||
-                p.far != declared.far || r.camera->convention.name != camera.convention().name ||
-                r.camera->width != camera.width() || r.camera->height != camera.height())
+            if (p.type != ProjectionType::NonLinear || !(p.lens == declared.lens) ||
+                r.camera->convention.name != camera.convention().name || r.camera->width != camera.width() ||
+                r.camera->height != camera.height())
                 continue;
+            if (p.near != declared.near || p.far != declared.far) {  // the planes: then the view kept
+                try {
+                    if (Camera(*r.camera).eyeFromWorld != camera.eyeFromWorld) continue;
+                } catch (const Error&) {
+                    continue;
+                }
+            }
             out.push_back({mistake.name, r.variant, r.explanation, *r.camera, std::nullopt, 0});
         }
     }
