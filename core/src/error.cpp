@@ -42,4 +42,11 @@ std::string formatNumber(double value)
     return buffer;
 }
 
+std::string fourSignificantDigits(double value)
+{
+    char text[32];
+    std::snprintf(text, sizeof text, "%.4g", value);
+    return text;
+}
+
 }  // namespace zcheck

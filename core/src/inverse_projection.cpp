@@ -39,10 +39,9 @@ void requireRayThroughWindow(const Camera& camera, const glm::dvec2& pWindow)
     if (!camera.lens() || eyeDirectionThroughWindow(camera, pWindow)) return;
     char where[96];
     std::snprintf(where, sizeof where, "image point (%.6g, %.6g)", pWindow.x, camera.imageYFromWindowY(pWindow.y));
-    char field[32];
-    std::snprintf(field, sizeof field, "%.4g", camera.lens()->fieldAngle() * 180 / 3.14159265358979323846);
     throw Error(std::string(where) + " is outside the lens model's field (" + camera.lens()->spec().model + ", up to " +
-                field + "° from the axis, where it is one-to-one): it has no ray");
+                fourSignificantDigits(camera.lens()->fieldAngle() * 180 / 3.14159265358979323846) +
+                "° from the axis, where it is one-to-one): it has no ray");
 }
 
 EyePlaneRay eyePlaneRayThroughWindow(const Camera& camera, const glm::dvec2& pWindow)

@@ -922,10 +922,8 @@ void LensModel::requireNoFoldInImage() const
     if (directionFromImage(edge)) return;
     // Beyond the field: a fold, or the profile's end (θ at π, a fisheye past its circle)?
     if (!fieldEndsInFold_) return;
-    char angle[32];
-    std::snprintf(angle, sizeof angle, "%.4g", fieldAngle_ * 180 / kPi);
-    throw Error("lens model " + spec_.model + " folds (is no longer one-to-one) " + angle +
-                "° from the axis, inside the image: pixel (" + std::to_string(int(std::floor(edge.x))) + ", " +
+    throw Error("lens model " + spec_.model + " folds (is no longer one-to-one) " +
+                fourSignificantDigits(fieldAngle_ * 180 / kPi) + "° from the axis, inside the image: pixel (" + std::to_string(int(std::floor(edge.x))) + ", " +
                 std::to_string(int(std::floor(edge.y))) + ") on the principal point's " +
                 (nearest < 2 ? "row" : "column") + " lies beyond it; the coefficients do not describe this image");
 }

@@ -644,14 +644,6 @@ std::vector<Mistake> projectionMistakes()
     return all;
 }
 
-// A significant-digits form of a plane's distance, for people.
-std::string planeText(double distance)
-{
-    char text[32];
-    std::snprintf(text, sizeof text, "%.4g", distance);
-    return text;
-}
-
 // An eye-z or distance map clipped by other planes than the camera declares: a ray tracer's,
 // which clips at none or only far away (VTK's and Embree's casts, Blender's Z pass up to its clip
 // end), or the renderer's own near and far. Re-read with the tightest planes around what the map
@@ -690,15 +682,15 @@ Mistake clipPlanesMistake()
             const double k = nearPlane / p.near;
             p.left *= k, p.right *= k, p.bottom *= k, p.top *= k;
         }
-        const std::string declared = "near " + planeText(p.near) + " and far " + planeText(p.far);
+        const std::string declared = "near " + fourSignificantDigits(p.near) + " and far " + fourSignificantDigits(p.far);
         const std::string measure = alongRays ? " (distances along the rays)" : " (eye-z)";
         std::string beyond;  // the declared planes the map holds surfaces beyond
-        if (nearest < p.near) beyond = "near ≤ " + planeText(nearest);
-        if (farthest > p.far) beyond += (beyond.empty() ? "" : " and ") + ("far ≥ " + planeText(farthest));
+        if (nearest < p.near) beyond = "near ≤ " + fourSignificantDigits(nearest);
+        if (farthest > p.far) beyond += (beyond.empty() ? "" : " and ") + ("far ≥ " + fourSignificantDigits(farthest));
         const std::string explanation =
             beyond.empty()
                 ? "consistent if the map was clipped tighter than the declared " + declared + measure +
-                      ": it holds surfaces only from " + planeText(nearest) + " to " + planeText(farthest) +
+                      ": it holds surfaces only from " + fourSignificantDigits(nearest) + " to " + fourSignificantDigits(farthest) +
                       "; give the renderer's own planes"
                 : "consistent if the renderer's planes were " + beyond + measure + " instead of the declared " +
                       declared + ": give its own, or, for a ray tracer that does not clip, planes around the scene";

@@ -520,14 +520,6 @@ double medianOfField(const std::vector<DeclaredPixel>& pixels, double DeclaredPi
 // "12.5%": a fraction as a percentage to a tenth.
 std::string percentText(double fraction) { return formatNumber(std::round(fraction * 1000) / 10) + "%"; }
 
-// Four significant digits.
-std::string fourDigits(double v)
-{
-    char text[32];
-    std::snprintf(text, sizeof text, "%.4g", v);
-    return std::string(text);
-}
-
 // judgeDeclaredAccuracy's "holes": why allowed holes cannot stand (more than half the pixels
 // where the surface is hit), or "".
 std::string holesRefusal(const DepthMap& map, const ComparisonReport& report)
@@ -607,7 +599,7 @@ std::string coarseRefusal(const std::vector<DeclaredPixel>& all)
     const double relative = medianOfField(all, &DeclaredPixel::relativeEyeZ);
     if (relative <= 0.1) return "";
     return "the declared accuracy is as coarse as the depths: ±" +
-           fourDigits(medianOfField(all, &DeclaredPixel::declared)) + " at the median pixel, " +
+           fourSignificantDigits(medianOfField(all, &DeclaredPixel::declared)) + " at the median pixel, " +
            (std::isfinite(relative) ? percentText(relative) : std::string("beyond the far plane")) +
            " of its eye-z (a declaration zcheck can judge is under a tenth of the depth); a "
            "map of the wrong scale or quantity would pass it";
@@ -651,10 +643,10 @@ std::string biasRefusal(double Q, const std::vector<DeclaredPixel>& all)
     const double exact = medianOfField(all, &DeclaredPixel::intrinsic);
     const double allowed = exact + 6 * sampling;
     if (std::abs(bias) <= allowed) return "";
-    return "the map's errors are systematic: their mean is " + fourDigits(bias) + " (map units" +
-           (Q > 0 ? ", against the truth rounded to the grid" : "") + "), beyond the ±" + fourDigits(allowed) +
-           " an unbiased map may show (an exact map's median tolerance " + fourDigits(exact) +
-           ", and six times the mean's sampling error " + fourDigits(sampling) +
+    return "the map's errors are systematic: their mean is " + fourSignificantDigits(bias) + " (map units" +
+           (Q > 0 ? ", against the truth rounded to the grid" : "") + "), beyond the ±" + fourSignificantDigits(allowed) +
+           " an unbiased map may show (an exact map's median tolerance " + fourSignificantDigits(exact) +
+           ", and six times the mean's sampling error " + fourSignificantDigits(sampling) +
            "); a declared accuracy absorbs rounding and noise, never a wrong scale, quantity, offset or pose";
 }
 

@@ -17,6 +17,9 @@ public:
 
 // "1.5", "inf", "nan": numbers in messages printed the way a user would type them back.
 std::string formatNumber(double value);
+// "12.35", "0.001235", "1.235e+07": four significant digits (printf's %.4g), for a measured value
+// a sentence reports rather than one to be typed back exactly.
+std::string fourSignificantDigits(double value);
 
 // At most `maxChars` characters of `text` for a message, each byte outside printable ASCII
 // as '?': file contents quoted in an error stay one readable line.
