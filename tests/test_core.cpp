@@ -469,6 +469,18 @@ TEST_CASE("invalid cameras are refused with a message naming the parameter", "[c
     refuses(s, "projection.far");
 }
 
+TEST_CASE("regression: a far/near ratio of exactly 1e12 was refused as exceeding 1e12", "[core][validation][regression]")
+{
+    // docs/camera.md: far/near <= 10^12. 1e8 / 1e-4 is 1e12 exactly in binary64.
+    CameraSpec s = specWith("opengl", ProjectionType::Perspective);
+    s.projection.near = 1e-4, s.projection.far = 1e8;
+    REQUIRE(s.projection.far / s.projection.near == 1e12);
+    REQUIRE_NOTHROW(Camera(s));
+    s.projection.far = std::nextafter(1e8, INFINITY);
+    REQUIRE_THROWS_WITH(Camera(s), Catch::Contains("'projection.far' / 'projection.near'") &&
+                                       Catch::Contains("exceeds 1e12"));
+}
+
 TEST_CASE("an image side is a whole 1..16384 pixels and an image at most 2^25 pixels, at the bounds exactly", "[core][validation]")
 {
     // Camera's rule, which the camera constructor and every importer and depth-map reader ask.

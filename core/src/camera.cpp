@@ -176,7 +176,7 @@ void validateNearFar(const Projection& p)
     if (!(p.far > p.near))
         throw Error("'projection.far' must be > projection.near (" + formatNumber(p.near) + "), got " +
                     formatNumber(p.far));
-    if (!std::isinf(p.far) && !(p.far / p.near < 1e12))
+    if (!std::isinf(p.far) && !(p.far / p.near <= 1e12))
         throw Error("'projection.far' / 'projection.near' = " + formatNumber(p.far / p.near) +
                     " exceeds 1e12: depth cannot be resolved");
 }
