@@ -66,6 +66,17 @@ def gl_frustum(l, r, b, t, n, f):
                      [0, 0, -1, 0]], dtype=float)
 
 
+def opencv_look_at(eye, target, down):
+    """OpenCV's R, t (cam_from_world: x right, y down the image, z forward) of a camera at eye
+    looking at target, its image's rows running towards `down` (made perpendicular to the view)."""
+    eye, target, down = (np.asarray(v, dtype=float) for v in (eye, target, down))
+    z = (target - eye) / np.linalg.norm(target - eye)
+    x = np.cross(z, -down)
+    x /= np.linalg.norm(x)
+    R = np.stack([x, np.cross(z, x), z])
+    return R, -R @ eye
+
+
 def gl_look_at(eye, target, up):
     """gluLookAt: OpenGL eye space (x right, y up, looking down -z) from world."""
     eye, target, up = (np.asarray(v, dtype=float) for v in (eye, target, up))

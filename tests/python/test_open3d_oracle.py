@@ -17,7 +17,7 @@ import open3d as o3d
 import pytest
 
 import zcheck
-from helpers import AXES_FROM_OPENCV, MODELS
+from helpers import AXES_FROM_OPENCV, MODELS, opencv_look_at
 
 pytestmark = pytest.mark.skipif(not (MODELS / "spot.obj").exists(),
                                 reason="the shared models are not beside the repository")
@@ -44,12 +44,7 @@ class Model:
 
     def pose_towards(self, offset):
         """OpenCV's R, t (cam_from_world) of a camera at centre + offset·radius looking at the centre."""
-        eye = self.centre + np.asarray(offset, float) * self.radius
-        z = (self.centre - eye) / np.linalg.norm(self.centre - eye)
-        x = np.cross(z, [0.0, -1.0, 0.0])
-        x /= np.linalg.norm(x)
-        R = np.stack([x, np.cross(z, x), z])
-        return R, -R @ eye
+        return opencv_look_at(self.centre + np.asarray(offset, float) * self.radius, self.centre, down=[0.0, 1.0, 0.0])
 
     def distance_to_mesh(self, points):
         """Open3D's distance from each point to the nearest point of the mesh, over the radius."""

@@ -24,7 +24,7 @@ import vtk
 from vtk.util import numpy_support
 
 import zcheck
-from helpers import AXES_FROM_OPENCV, MODELS
+from helpers import AXES_FROM_OPENCV, MODELS, opencv_look_at
 
 pytestmark = pytest.mark.skipif(not (MODELS / "spot.obj").exists(),
                                 reason="the shared models are not beside the repository")
@@ -53,11 +53,7 @@ class VtkModel:
         self.centre, self.radius = (low + high) / 2, np.linalg.norm(high - low) / 2
         # OpenCV's R, t (cam_from_world) of a camera 1.7 radii off, looking at the centre.
         self.eye = self.centre + np.array([0.45, -0.35, -1.6]) * self.radius
-        z = (self.centre - self.eye) / np.linalg.norm(self.centre - self.eye)
-        x = np.cross(z, [0.0, -1.0, 0.0])
-        x /= np.linalg.norm(x)
-        self.R = np.stack([x, np.cross(z, x), z])
-        self.t = -self.R @ self.eye
+        self.R, self.t = opencv_look_at(self.eye, self.centre, down=[0.0, 1.0, 0.0])
         self.near, self.far = 0.01 * self.radius, 8 * self.radius
 
     def first_hits(self, directions_cam, start=0.0):
@@ -188,11 +184,8 @@ def random_view(model, rng):
     away = rng.normal(size=3)
     away *= model.radius * (rng.uniform(0.3, 1.05) if rng.random() < 0.25 else rng.uniform(1.05, 4.0)) / np.linalg.norm(away)
     eye = model.centre + away
-    z = model.centre + rng.normal(size=3) * model.radius * 0.3 - eye
-    z /= np.linalg.norm(z)
-    x = np.cross(z, rng.normal(size=3))
-    x /= np.linalg.norm(x)
-    R = np.stack([x, np.cross(z, x), z])
+    target = model.centre + rng.normal(size=3) * model.radius * 0.3
+    R, t = opencv_look_at(eye, target, down=-rng.normal(size=3))
     near = model.radius * rng.uniform(0.001, 0.04)
     far = np.linalg.norm(away) + model.radius * (rng.uniform(0.0, 1.0) if rng.random() < 0.3 else 2.0)
     lens = rng.choice(["pinhole", "pinhole", "pinhole", "opencv", "fisheye"])
@@ -219,7 +212,7 @@ def random_view(model, rng):
         directions = rays.reshape(h, w, 3)
     length = np.linalg.norm(directions, axis=2)
     model = copy.copy(model)  # the same mesh and tree, seen from this view
-    model.eye, model.R, model.t = eye, R, -R @ eye
+    model.eye, model.R, model.t = eye, R, t
     # The near plane: eye-z for a pinhole (the rays' parameter), a distance along the ray for a lens.
     s = model.first_hits(directions, start=near if lens == "pinhole" else near / length)
     eye_z, distance = s.copy(), s * length
