@@ -241,6 +241,71 @@ TEST_CASE("polygons of more than 3 corners: non-planar ones are counted and meas
     REQUIRE(flat.planarity.warning("f.obj").empty());
 }
 
+TEST_CASE("regression: a mesh in UTM coordinates was rounded to binary32 without a word", "[mesh][regression]")
+{
+    // (512345.678, 4212345.321, 123.4) as binary32: x to a sixteenth (512345.6875, 0.0095 off),
+    // y to a half (4212345.5, 0.179 off), z by ~3e-6: the vertex moves by ~0.1793 of a mesh 1.41
+    // across, which is no longer the file's mesh.
+    const double moved = std::hypot(512345.6875 - 512345.678, 4212345.5 - 4212345.321, double(123.4f) - 123.4);
+    auto requireMaterial = [&](Scene scene, const std::string& mesh) {
+        INFO(mesh);
+        REQUIRE(scene.rounding.largestMove == Approx(moved).epsilon(1e-6));
+        scene = frameScene(std::move(scene), "cannot load mesh '" + mesh + "'");
+        REQUIRE(scene.rounding.size == Approx(std::sqrt(2.0)).epsilon(0.01));
+        REQUIRE(scene.rounding.material());
+        const std::string warning = scene.rounding.warning(mesh);
+        REQUIRE_THAT(warning, Catch::StartsWith("mesh '" + mesh + "': held in binary32"));
+        REQUIRE_THAT(warning, Catch::Contains("its vertices moved by up to 0.1793"));
+        REQUIRE_THAT(warning, Catch::Contains("coordinates up to 4.212e+06, where binary32 steps by 0.5"));
+        REQUIRE_THAT(warning, Catch::Contains("move the mesh and its cameras near the origin"));
+    };
+    const std::string obj = "v 512345.678 4212345.321 123.4\nv 512346.678 4212345.321 123.4\nv 512345.678 4212346.321 123.4\nf 1 2 3\n";
+    requireMaterial(readObj("utm.obj", obj), "utm.obj");
+    requireMaterial(readStl("utm.stl", "solid t\nfacet normal 0 0 1\nouter loop\nvertex 512345.678 4212345.321 123.4\n"
+                                       "vertex 512346.678 4212345.321 123.4\nvertex 512345.678 4212346.321 123.4\nendloop\nendfacet\n"
+                                       "endsolid t\n"),
+                    "utm.stl");
+    std::string doubles = ply("binary_little_endian", "element vertex 3\nproperty double x\nproperty double y\nproperty double z\n"
+                                                      "element face 1\nproperty list uchar int vertex_indices\n");
+    for (const glm::dvec3 p : {glm::dvec3(512345.678, 4212345.321, 123.4), glm::dvec3(512346.678, 4212345.321, 123.4),
+                               glm::dvec3(512345.678, 4212346.321, 123.4)})
+        put(doubles, p.x), put(doubles, p.y), put(doubles, p.z);
+    put(doubles, std::uint8_t(3)), put(doubles, 0), put(doubles, 1), put(doubles, 2);
+    requireMaterial(readPly("utm.ply", doubles), "utm.ply");
+    // A glTF's binary32 triangle placed in UTM coordinates by its node (applied in binary64).
+    const std::string gltf = R"({"asset": {"version": "2.0"},
+        "buffers": [{"byteLength": 44, "uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAAIAAAA="}],
+        "bufferViews": [{"buffer": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 6}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+                      {"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+        "nodes": [{"mesh": 0, "translation": [512345.678, 4212345.321, 123.4]}],
+        "scenes": [{"nodes": [0]}], "scene": 0})";
+    requireMaterial(readGltf("utm.gltf", gltf), "utm.gltf");
+
+    // Digits like those a few sizes from the origin, and UTM coordinates a file already holds in binary32 (a
+    // float PLY: every reader gets the same mesh), are no news.
+    Scene near = frameScene(readObj("near.obj", "v 1.678 2.321 3.4\nv 2.678 2.321 3.4\nv 1.678 3.321 3.4\nf 1 2 3\n"), "near");
+    REQUIRE(near.rounding.largestMove > 0);
+    REQUIRE_FALSE(near.rounding.material());
+    REQUIRE(near.rounding.warning("near.obj").empty());
+    std::string floats = ply("binary_little_endian", "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                                                     "element face 1\nproperty list uchar int vertex_indices\n");
+    for (const glm::vec3 p : {glm::vec3(512345.678f, 4212345.321f, 123.4f), glm::vec3(512346.678f, 4212345.321f, 123.4f),
+                              glm::vec3(512345.678f, 4212346.321f, 123.4f)})
+        put(floats, p.x), put(floats, p.y), put(floats, p.z);
+    put(floats, std::uint8_t(3)), put(floats, 0), put(floats, 1), put(floats, 2);
+    const Scene stored = frameScene(readPly("f.ply", floats), "f");
+    REQUIRE(stored.rounding.largestMove == 0);
+    REQUIRE(stored.rounding.warning("f.ply").empty());
+
+    // Coordinates whose binary32 steps swallow the whole mesh: the refusal says why.
+    REQUIRE_THROWS_WITH(frameScene(readObj("far.obj", "v 1e8 1e8 0\nv 100000000.5 1e8 0\nv 1e8 100000000.5 0\nf 1 2 3\n"),
+                                   "cannot load mesh 'far.obj'"),
+                        Catch::Contains("degenerate") && Catch::Contains("where binary32 steps by 8") &&
+                            Catch::Contains("move the mesh near the origin"));
+}
+
 TEST_CASE("validateScene names the first offending vertex or index in order, however large the scene", "[mesh][scene]")
 {
     // 300,000 vertices and triangles: the search runs in parallel parts (65,536 elements each), and

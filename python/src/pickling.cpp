@@ -129,8 +129,10 @@ Camera cameraFromState(const py::tuple& state)
 py::tuple sceneState(const Scene& scene)
 {
     if (isBuiltinSceneName(scene.name) || isFile(scene.name)) return py::make_tuple("source", scene.name);
+    const PositionRounding& r = scene.rounding;  // what the arrays' binary64 values lost, for the reports
     return py::make_tuple("arrays", scene.name, bytesOf(scene.positions.data(), scene.positions.size()),
-                          bytesOf(scene.triangles.data(), scene.triangles.size()));
+                          bytesOf(scene.triangles.data(), scene.triangles.size()),
+                          py::make_tuple(r.largestMove, r.movedVertex.x, r.movedVertex.y, r.movedVertex.z));
 }
 
 Scene sceneFromState(const py::tuple& state)
@@ -141,6 +143,11 @@ Scene sceneFromState(const py::tuple& state)
     scene.name = state[1].cast<std::string>();
     assignBytes(scene.positions, state[2].cast<py::bytes>());
     assignBytes(scene.triangles, state[3].cast<py::bytes>());
+    if (state.size() > 4) {
+        const auto r = state[4].cast<std::tuple<double, double, double, double>>();
+        scene.rounding.largestMove = std::get<0>(r);
+        scene.rounding.movedVertex = {std::get<1>(r), std::get<2>(r), std::get<3>(r)};
+    }
     return frameScene(std::move(scene), "a pickled Scene");
 }
 

@@ -47,8 +47,8 @@ Scene sceneFromArrays(py::object vertices, py::object triangles, const std::stri
             if (!std::isfinite(x) || !std::isfinite(f))
                 fail(where + "vertices[" + std::to_string(i) + ", " + std::to_string(k) + "] = " + formatNumber(x) +
                      (std::isfinite(x) ? " does not fit in binary32" : " is not finite"));
-            scene.positions[std::size_t(i)][k] = f;
         }
+        scene.positions[std::size_t(i)] = scene.rounding.store({pv(i, 0), pv(i, 1), pv(i, 2)});
     }
     const std::size_t n = scene.positions.size();
     const bool isSigned = t.dtype().kind() == 'i';

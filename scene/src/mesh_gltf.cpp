@@ -1109,7 +1109,7 @@ private:
             if (!(std::abs(world.x) <= kMaxFloat && std::abs(world.y) <= kMaxFloat && std::abs(world.z) <= kMaxFloat))
                 fail("nodes[" + str(node) + "] moves element " + str(v) + " of " + at("accessors", a.index) +
                      " beyond the binary32 range");
-            scene.positions.emplace_back(float(world.x), float(world.y), float(world.z));
+            scene.positions.push_back(scene.rounding.store(glm::dvec3(world)));
         }
     }
 

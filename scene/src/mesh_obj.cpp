@@ -121,7 +121,7 @@ private:
             if (!(std::abs(v[axis]) <= 3.4e38))
                 fail("vertex coordinate " + formatNumber(v[axis]) + " is not a finite binary32 number");
         if (scene_.positions.size() >= 0xFFFFFFFEu) fail("too many vertices for 32-bit indices");
-        scene_.positions.emplace_back(v[0], v[1], v[2]);
+        scene_.positions.push_back(scene_.rounding.store({v[0], v[1], v[2]}));
     }
 
     // One face corner: v, v/vt, v/vt/vn or v//vn; the position index, 0-based.

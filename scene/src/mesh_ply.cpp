@@ -331,7 +331,7 @@ private:
                 for (int axis = 0; axis < 3; ++axis)
                     if (!(std::abs(position[axis]) <= 3.4e38))
                         failItem(element, item, "coordinate " + formatNumber(position[axis]) + " is not a finite binary32 number");
-                scene_.positions.emplace_back(position);
+                scene_.positions.push_back(scene_.rounding.store(position));
             }
         }
     }

@@ -25,7 +25,7 @@ void addVertex(Scene& scene, const std::string& path, const double v[3])
     for (int axis = 0; axis < 3; ++axis)
         if (!(std::abs(v[axis]) <= 3.4e38))
             fail(path, "vertex coordinate " + formatNumber(v[axis]) + " is not a finite binary32 number");
-    scene.positions.emplace_back(v[0], v[1], v[2]);
+    scene.positions.push_back(scene.rounding.store({v[0], v[1], v[2]}));
 }
 
 void addTriangle(Scene& scene)

@@ -77,10 +77,44 @@ std::string PolygonPlanarity::warning(const std::string& mesh) const
            "their depth depends on the split: triangulate the mesh before rendering it";
 }
 
+glm::vec3 PositionRounding::store(const glm::dvec3& position)
+{
+    const glm::vec3 stored(position);
+    const double move = glm::length(glm::dvec3(stored) - position);
+    if (move > largestMove) largestMove = move, movedVertex = position;
+    return stored;
+}
+
+namespace {
+
+// What binary32 made of the coordinates: "moved its vertices by up to 0.2344 (...)".
+std::string roundingText(const PositionRounding& r)
+{
+    const float farthest = float(std::max({std::abs(r.movedVertex.x), std::abs(r.movedVertex.y), std::abs(r.movedVertex.z)}));
+    const double step = double(std::nextafter(farthest, INFINITY)) - double(farthest);
+    std::string text = "held in binary32 (as Embree and GPUs hold positions), its vertices moved by up to " +
+                       fourSignificantDigits(r.largestMove) + " (";
+    if (r.size > 0) text += fourSignificantDigits(100 * r.largestMove / r.size) + " % of its size; ";
+    return text + "coordinates up to " + fourSignificantDigits(farthest) + ", where binary32 steps by " +
+           fourSignificantDigits(step) + ")";
+}
+
+}  // namespace
+
+std::string PositionRounding::warning(const std::string& mesh) const
+{
+    if (!material()) return "";
+    return "mesh '" + mesh + "': " + roundingText(*this) +
+           ": a map rendered from the file's own digits (in binary64, or around a local origin as large-world "
+           "renderers do) shows another mesh than this check's truth, by up to that much; move the mesh and its "
+           "cameras near the origin";
+}
+
 Scene::Scene(const Scene& other)
     : name(other.name),
       defaultCamera(other.defaultCamera),
       planarity(other.planarity),
+      rounding(other.rounding),
       cameras(other.cameras),
       chunks(other.chunks)
 {
@@ -154,10 +188,12 @@ Scene frameScene(Scene scene, const std::string& what)
         const glm::dvec3 a(scene.positions[t[0]]), b(scene.positions[t[1]]), c(scene.positions[t[2]]);
         return glm::length(glm::cross(b - a, c - a)) > 0;
     });
+    const glm::dvec3 lo = scene.boundsMin(), hi = scene.boundsMax();
+    scene.rounding.size = glm::length(hi - lo);
     if (!anyArea)
         throw Error(what + ": all its " + std::to_string(scene.triangles.size()) +
-                    " triangles are degenerate (zero area): nothing to draw");
-    const glm::dvec3 lo = scene.boundsMin(), hi = scene.boundsMax();
+                    " triangles are degenerate (zero area): nothing to draw" +
+                    (scene.rounding.material() ? ": " + roundingText(scene.rounding) + ": move the mesh near the origin" : ""));
     const double radius = std::max(glm::length(hi - lo) / 2, 1e-6);
     scene.defaultCamera = framingCameraSpec((lo + hi) / 2.0, radius);
     scene.chunks = triangleChunksOf(scene);

@@ -312,3 +312,36 @@ def test_verify_reports_the_map_in_its_units_and_counts_values_out_of_range(defa
     assert bad.to_dict()["out_of_range"]["first"] == {"col": 20, "row": 10, "stored": -1.0}
     with pytest.raises(zcheck.Error, match="it holds no eye-z depth"):
         default_checker.verify(small_camera, np.full_like(z, -2.0), "eye-z")
+
+
+def test_regression_a_mesh_in_utm_coordinates_was_rounded_to_binary32_without_a_word():
+    """A wall at northing 4212345.321, 10 m before an OpenCV camera looking north: every pixel's
+    eye-z is 10 for the file's digits (a renderer in binary64, or one drawing around a local
+    origin), and 4212345.5 − 4212335.321 = 10.179 for the wall as binary32 holds it (a GPU fed the
+    same floats). zcheck traces the second; both verdicts stand, and the report says why they
+    part, with the move, the coordinates and binary32's step there."""
+    x0, y, z0 = 512345.678, 4212345.321, 123.4
+    vertices = np.array([[x0 - 30, y, z0 - 30], [x0 + 30, y, z0 - 30], [x0 + 30, y, z0 + 30], [x0 - 30, y, z0 + 30]])
+    scene = zcheck.Scene.from_arrays(vertices, [[0, 1, 2], [0, 2, 3]], name="utm wall")
+    # OpenCV camera at (x0, y − 10, z0): x east, y down (−up), z north.
+    world_from_eye = np.array([[1, 0, 0, x0], [0, 0, 1, y - 10], [0, -1, 0, z0], [0, 0, 0, 1]], dtype=float)
+    camera = zcheck.Camera.from_dict({
+        "convention": "opencv", "image": {"width": 32, "height": 24},
+        "view": {"world_from_eye": world_from_eye.ravel().tolist(), "layout": "row-major", "vectors": "column"},
+        "projection": {"type": "pinhole", "fx": 20, "fy": 20, "cx": 15.5, "cy": 11.5, "near": 1, "far": 100}})
+    checker = zcheck.Checker(scene)
+    stored_wall = float(np.float32(y)) - (y - 10)
+    assert abs(stored_wall - 10.179) < 1e-9
+    for depth, consistent in ((10.0, False), (stored_wall, True)):
+        report = checker.verify(camera, np.full((24, 32), depth, dtype=np.float32), "eye-z")
+        assert report.consistent == consistent, depth
+        warnings = [w for w in report.to_dict()["warnings"] if "binary32" in w]
+        assert len(warnings) == 1, report.to_dict()["warnings"]
+        assert warnings[0].startswith("mesh 'utm wall': held in binary32")
+        assert "its vertices moved by up to 0.1793" in warnings[0]
+        assert "where binary32 steps by 0.5" in warnings[0]
+        assert "binary32" in report.summary()
+    # The same wall 100 m from the origin: no word.
+    near = zcheck.Scene.from_arrays(vertices - [x0 - 100, y - 100, z0], [[0, 1, 2], [0, 2, 3]], name="near wall")
+    assert not [w for w in zcheck.Checker(near).check(near.default_camera.replace(width=32, height=24)).to_dict()["warnings"]
+                if "binary32" in w]

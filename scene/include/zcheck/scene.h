@@ -35,6 +35,30 @@ struct PolygonPlanarity {
     std::string warning(const std::string& mesh) const;
 };
 
+// How far storing a mesh's coordinates as binary32 (what zcheck, Embree and a GPU hold) moved
+// its vertices. A file may hold more digits (OBJ and PLY text, PLY doubles, a glTF node's
+// transform applied in binary64, a Python float64 array). Near the origin the move is below
+// 2^-24 of the mesh's size and nobody draws anything else; far from it against the mesh's size
+// (UTM or ECEF coordinates: binary32 steps by 0.5 at 4.2e6) the stored mesh is another mesh, and a
+// renderer keeping the file's digits (binary64, or a local origin as large-world engines do) draws
+// the file's: its maps then disagree with zcheck's truth by up to the move, and reports say so.
+struct PositionRounding {
+    // A move over this fraction of the mesh's size (its bounding box's diagonal) is material: the
+    // coordinates lie some ten sizes or more from the origin. A camera that sees the mesh stands
+    // about its size away, and a binary32 eye-z map is judged to ~2^-22 of its depth
+    // (tolerance.md), so a move of 2^-20 of the size can already part such a map from the truth.
+    static constexpr double kMaterial = 0x1p-20;
+    double largestMove = 0;     // the longest distance a vertex moved, in the file's units
+    glm::dvec3 movedVertex{0};  // that vertex as the file holds it
+    double size = 0;            // the stored mesh's bounding-box diagonal (frameScene sets it)
+
+    // `position` as binary32 (the caller has checked it is within range), its move recorded.
+    glm::vec3 store(const glm::dvec3& position);
+    bool material() const { return largestMove > kMaterial * size; }
+    // "" unless material(); else one sentence naming `mesh`, the move and what to do.
+    std::string warning(const std::string& mesh) const;
+};
+
 // Bounding boxes of runs of consecutive triangles (meshes keep neighbours close), so that a
 // question about the whole scene seen from a camera (camera_sources.h's sceneNearFar) can skip
 // what cannot change its answer. Made once per scene (indexTriangleChunks).
@@ -57,6 +81,7 @@ struct Scene {
     std::vector<glm::uvec3> triangles;    // indices into positions; the index is the primitive id
     CameraSpec defaultCamera;             // used when the user gives no camera file
     PolygonPlanarity planarity;           // of the file's polygons (mesh files; none built in)
+    PositionRounding rounding;            // of the file's coordinates to binary32 (mesh files, arrays)
     std::vector<ImportedCamera> cameras;  // the file's camera nodes (glTF), in file order; the
                                           // first is the default camera (camera_sources.h)
     std::shared_ptr<const TriangleChunks> chunks;  // made by indexTriangleChunks; none: made on use
@@ -75,7 +100,8 @@ void validateScene(const Scene& scene);
 std::shared_ptr<const TriangleChunks> triangleChunksOf(const Scene& scene);
 
 // Makes a triangle soup a scene to check: validates it (validateScene), refuses it when no
-// triangle has a nonzero area (nothing to draw), and gives it a default camera that frames its
+// triangle has a nonzero area (nothing to draw; naming binary32's rounding when it was material),
+// sets rounding.size, and gives it a default camera that frames its
 // bounding sphere (framingCameraSpec). Messages begin with `what` ("cannot load mesh 'a.obj'").
 // The mesh loader and the Python module's Scene.from_arrays use it.
 Scene frameScene(Scene scene, const std::string& what);
