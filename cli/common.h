@@ -103,7 +103,8 @@ void addImageSizeOptions(CLI::App* command, ImageSize& size);
 // --channel, --scale, --offset and --miss, as verify and unproject read a depth map.
 struct DepthMapOptions {
     std::string channel, miss, sidecar;
-    double scale = 0, offset = 0;
+    double scale = 0;
+    std::optional<double> offset;  // none: not given
     MapAccuracy accuracy;
     // The reading for a map of quantity `quantityName`: the options, and for those not given,
     // the sidecar's keys ("channel", "miss", "scale", "offset"; others ignored); throws Error

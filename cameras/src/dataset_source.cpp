@@ -190,7 +190,7 @@ private:
             const DepthMapReading reading = withSidecar(DepthMapReading{}, sidecar);
             if (!frame.channel && !reading.channel.empty()) frame.channel = reading.channel;
             if (!frame.scale && reading.scale > 0) frame.scale = reading.scale;
-            if (!frame.offset && reading.offset != 0) frame.offset = reading.offset;
+            if (!frame.offset && reading.offset) frame.offset = reading.offset;
             if (!frame.miss && reading.miss.given()) frame.miss = reading.miss.text();
             frame.accuracy = frame.accuracy.over(reading.accuracy);
             const SidecarSubject subject = sidecarSubject(sidecar);

@@ -110,7 +110,7 @@ void setDepthMapFormatLoader(std::function<void()> loader)
 DepthMapFile readDepthMapFile(const std::string& path, const DepthMapReading& reading, int expectedWidth, int expectedHeight)
 {
     if (reading.scale != 0) DepthMapReading::requireScale(reading.scale, "--scale");
-    DepthMapReading::requireOffset(reading.offset, "--offset");
+    if (reading.offset) DepthMapReading::requireOffset(*reading.offset, "--offset");
     checkInputFile(path, kDepthMapInput);
     char head[kDepthMapHeadBytes] = {};
     std::streamsize headBytes = 0;

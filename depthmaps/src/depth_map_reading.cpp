@@ -282,7 +282,7 @@ DepthMapReading withSidecar(DepthMapReading r, const std::string& sidecar)
             throw bad("scale", "must be a positive finite number");
         r.scale = doc["scale"].get<double>();
     }
-    if (given("offset") && r.offset == 0) {
+    if (given("offset") && !r.offset) {
         if (!doc["offset"].is_number() || !std::isfinite(doc["offset"].get<double>())) throw bad("offset", "must be a finite number");
         r.offset = doc["offset"].get<double>();
     }

@@ -77,7 +77,7 @@ DepthMapReading readingOf(const ReadingArguments& a)
     if (scale) DepthMapReading::requireScale(*scale, "scale");
     if (offset) DepthMapReading::requireOffset(*offset, "offset");
     reading.scale = scale ? *scale : 0.0;
-    reading.offset = offset ? *offset : 0.0;
+    reading.offset = offset;
     if (py::isinstance<py::str>(a.miss)) {
         reading.miss = MissRule::parse(a.miss.cast<std::string>());
     } else if (!a.miss.is_none()) {

@@ -61,7 +61,7 @@ py::dict frameDict(const PyDataset& d, std::size_t index)
         py::dict reading;
         if (!plan.reading.channel.empty()) reading["channel"] = plan.reading.channel;
         if (plan.reading.scale > 0) reading["scale"] = plan.reading.scale;
-        if (plan.reading.offset != 0) reading["offset"] = plan.reading.offset;
+        if (plan.reading.offset.value_or(0.0) != 0) reading["offset"] = *plan.reading.offset;
         if (plan.reading.miss.given()) reading["miss"] = plan.reading.miss.text();
         const MapAccuracy& declared = plan.reading.accuracy;
         if (declared.quantum > 0) reading["quantum"] = declared.quantum;

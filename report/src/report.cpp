@@ -143,7 +143,7 @@ nlohmann::json depthMapJson(const DepthMapSource& source)
             {"quantity", source.quantity},
             {"channel", source.channel},
             {"scale", r.scale > 0 ? nlohmann::json(r.scale) : nlohmann::json(nullptr)},  // null: none given
-            {"offset", r.offset},
+            {"offset", r.offset.value_or(0.0)},
             {"miss", r.miss.given() ? nlohmann::json(r.miss.text()) : nlohmann::json(nullptr)},
             {"declared", toJson(r.accuracy)}};
 }

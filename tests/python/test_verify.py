@@ -199,6 +199,26 @@ def test_sidecar_describes_the_file(tmp_path, default_checker, small_camera, sma
         zcheck.read_depth_map(path, small_camera, quantity="eye-z", sidecar=sidecar)
 
 
+def test_regression_an_explicit_offset_0_lost_to_the_sidecars_offset(tmp_path, default_checker, small_camera,
+                                                                      small_camera_file):
+    """--offset 0 (offset=0) is given: it wins over a sidecar's offset like any other value."""
+    path = tmp_path / "z.exr"
+    run_cli("export", "--camera", small_camera_file, "--quantity", "eye-z", "-o", path, check_rc=0)
+    sidecar = tmp_path / "side.json"
+    sidecar.write_text('{"offset": 0.5}')
+    # the sidecar alone shifts the map by 0.5: wrong
+    assert not default_checker.verify_file(small_camera, path, "eye-z", sidecar=sidecar).consistent
+    for offset in (0, 0.0):
+        report = default_checker.verify_file(small_camera, path, "eye-z", sidecar=sidecar, offset=offset)
+        assert report.consistent and report.to_dict()["depth_map"]["offset"] == 0
+    rc, out, _ = run_cli("verify", "--camera", small_camera_file, "--depth-map", path, "--quantity", "eye-z",
+                         "--sidecar", sidecar, "--offset", "0", "--json")
+    assert rc == 0 and json.loads(out)["depth_map"]["offset"] == 0
+    rc, out, _ = run_cli("verify", "--camera", small_camera_file, "--depth-map", path, "--quantity", "eye-z",
+                         "--sidecar", sidecar, "--json")
+    assert rc == 1 and json.loads(out)["depth_map"]["offset"] == 0.5
+
+
 def test_declared_reading_accepts_real_world_maps_and_the_diagnosis_names_the_option(default_checker, small_camera):
     """Issue 36: millimetre-rounded floats (cv2.imread(p, -1) / 1000.0), float16, a miss value, holes."""
     z = default_checker.render(small_camera, "eye-z", dtype="float64")

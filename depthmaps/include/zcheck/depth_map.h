@@ -49,7 +49,7 @@ struct DepthMap {
     static DepthMap of(DepthMapFile file, DepthQuantity quantity, const DepthMapReading& reading)
     {
         return {file.width,           file.height,      quantity,      std::move(file.value), file.valueQuantum,
-                std::move(file.valueStep), reading.accuracy, reading.scale, reading.offset};
+                std::move(file.valueStep), reading.accuracy, reading.scale, reading.offset.value_or(0.0)};
     }
     // A map of values exact to their binary32 spacing, nothing declared (tests, arrays).
     static DepthMap exact(int width, int height, DepthQuantity quantity, std::vector<double> values)

@@ -87,7 +87,7 @@ struct DepthMapReading {
     std::string quantityChannel;  // zcheck's own name for the declared quantity's channel
                                   // (export.h), preferred when several channels name depth
     double scale = 0;             // 0: not given
-    double offset = 0;
+    std::optional<double> offset; // none: not given (0); a given 0 still wins over a sidecar's
     MissRule miss;                // not given: integer files' 0 is a miss; NaN always is
     MapAccuracy accuracy;         // what the producer declares (judged with, not applied)
 
@@ -95,7 +95,7 @@ struct DepthMapReading {
     double depthOf(double stored, bool integerFile) const
     {
         if (std::isnan(stored) || (miss.given() ? miss.matches(stored) : integerFile && stored == 0)) return NAN;
-        return (scale > 0 ? stored / scale : stored) + offset;
+        return (scale > 0 ? stored / scale : stored) + offset.value_or(0.0);
     }
     // A step between stored values as a step between depths.
     double depthStepOf(double storedStep) const { return scale > 0 ? storedStep / scale : storedStep; }
@@ -155,7 +155,7 @@ void requireDepthMapSize(const std::string& path, long long width, long long hei
 // subnormal's for the smallest): what a half-float map's value may have been rounded by.
 double binary16Step(double stored);
 
-// The reading with the fields not given (an empty channel, scale 0, offset 0, no miss rule,
+// The reading with the fields not given (an empty channel, scale 0, no offset, no miss rule,
 // nothing declared) taken from a sidecar: a JSON object whose "channel", "miss" (a number, or a
 // rule such as ">=1e9", "nan", "inf"), "scale", "offset", "quantum", "rel_tolerance",
 // "abs_tolerance" and "allow_holes" keys describe the map; other keys are ignored and null is
