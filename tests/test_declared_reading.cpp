@@ -213,3 +213,64 @@ TEST_CASE("a noisy, quantized, holed RGB-D map: accepted with its options; flipp
         REQUIRE_FALSE(consistent(verifier, camera, fromElsewhere));
     }
 }
+
+TEST_CASE("regression: a declared accuracy hid an offset on maps under 256 pixels and a tenth of the depth passed",
+          "[declared][regression]")
+{
+    // A wall at eye-z 5 across an orthographic view (OpenGL): every pixel's truth is exactly 5.
+    Scene wall;
+    wall.name = "wall";
+    wall.positions = {{-10, -10, -5}, {10, -10, -5}, {10, 10, -5}, {-10, 10, -5}};
+    wall.triangles = {{0, 1, 2}, {0, 2, 3}};
+    wall = frameScene(wall, "wall");
+    const Checker checker(wall);
+    const MapVerifier verifier(checker);
+    auto orthographic = [](int width, int height) {
+        CameraSpec spec;
+        spec.convention = Convention::preset("opengl");
+        spec.width = width, spec.height = height;
+        spec.projection.type = ProjectionType::Orthographic;
+        spec.projection.left = -1, spec.projection.right = 1, spec.projection.bottom = -0.75, spec.projection.top = 0.75;
+        spec.projection.near = 1, spec.projection.far = 10;
+        spec.view = View::lookAt({0, 0, 0}, {0, 0, -1}, {0, 1, 0});
+        return Camera(spec);
+    };
+    auto refusal = [&](const Camera& camera, const DepthMap& map) {
+        const auto report = verifier.verify(camera, map).comparison.report;
+        REQUIRE(report.consistent() == report.declaredAccuracyRefused.empty());
+        return report.declaredAccuracyRefused;
+    };
+    auto filled = [](const Camera& camera, auto value) {
+        std::vector<double> values(std::size_t(camera.width()) * std::size_t(camera.height()));
+        for (double& v : values) v = double(float(value()));
+        return DepthMap::exact(camera.width(), camera.height(), DepthQuantity::EyeZ, std::move(values));
+    };
+    const Camera small = orthographic(16, 12);  // 192 pixels: the bias rule used to skip such maps
+
+    // One centimetre far everywhere, under a declared ±2 cm: an offset, never noise.
+    DepthMap offset = filled(small, [] { return 5.01; });
+    REQUIRE_FALSE(verifier.verify(small, offset).comparison.report.consistent());
+    offset.accuracy.absolute = 0.02;
+    REQUIRE_THAT(refusal(small, offset), Catch::Contains("the map's errors are systematic"));
+    // Unbiased noise of σ 5 mm under ±3 cm stands.
+    std::mt19937 random(7);
+    std::normal_distribution<double> noise(0, 0.005);
+    DepthMap noisy = filled(small, [&] { return 5 + noise(random); });
+    noisy.accuracy.absolute = 0.03;
+    REQUIRE(refusal(small, noisy).empty());
+
+    // Exactly a tenth of the depth is "a tenth or more": refused; just under it stands.
+    DepthMap exact = filled(small, [] { return 5.0; });
+    exact.accuracy.absolute = 0.5;
+    REQUIRE_THAT(refusal(small, exact), Catch::Contains("as coarse as the depths"));
+    exact.accuracy.absolute = 0.4999;
+    REQUIRE(refusal(small, exact).empty());
+
+    // Sixteen pixels cannot tell noise from an offset: any declared accuracy is refused, the map
+    // declaring none is judged pixel by pixel as ever.
+    const Camera tiny = orthographic(4, 4);
+    DepthMap few = filled(tiny, [] { return 5.0; });
+    REQUIRE(verifier.verify(tiny, few).comparison.report.consistent());
+    few.accuracy.absolute = 0.02;
+    REQUIRE_THAT(refusal(tiny, few), Catch::Contains("only 16 pixels are compared, too few"));
+}

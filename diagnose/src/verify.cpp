@@ -597,7 +597,7 @@ std::vector<DeclaredPixel> declaredPixels(const PixelJudge& judge, const DepthMa
 std::string coarseRefusal(const std::vector<DeclaredPixel>& all)
 {
     const double relative = medianOfField(all, &DeclaredPixel::relativeEyeZ);
-    if (relative <= 0.1) return "";
+    if (relative < 0.1) return "";
     return "the declared accuracy is as coarse as the depths: ±" +
            fourSignificantDigits(medianOfField(all, &DeclaredPixel::declared)) + " at the median pixel, " +
            (std::isfinite(relative) ? percentText(relative) : std::string("beyond the far plane")) +
@@ -619,11 +619,23 @@ std::string gridRefusal(double Q, const std::vector<DeclaredPixel>& all)
            "); --quantum states the step the values were rounded to";
 }
 
-// judgeDeclaredAccuracy's "bias": why the mean error of `all` (256 pixels or more) is beyond what
-// an unbiased map shows, or "" (also for fewer pixels, or a single interleaved sample).
+// The fewest pixels compared on which a declared accuracy is judged: two a sample of the bias's
+// sixteen on average. Fewer cannot tell noise from a wrong scale, and are refused (fewRefusal).
+constexpr std::size_t kFewestToJudge = 32;
+
+// judgeDeclaredAccuracy's "few": why `all` are too few to judge a declared accuracy by, or "".
+std::string fewRefusal(const std::vector<DeclaredPixel>& all)
+{
+    if (all.size() >= kFewestToJudge) return "";
+    return "only " + std::to_string(all.size()) + " pixels are compared, too few to tell rounding or noise from a wrong "
+           "scale or offset (a declared accuracy is judged on " + std::to_string(kFewestToJudge) +
+           " or more); declare none, or verify a larger part of the map";
+}
+
+// judgeDeclaredAccuracy's "bias": why the mean error of `all` (kFewestToJudge pixels or more) is
+// beyond what an unbiased map shows, or "" (also for a single interleaved sample).
 std::string biasRefusal(double Q, const std::vector<DeclaredPixel>& all)
 {
-    if (all.size() < 256) return "";
     // The mean's own sampling error, from the means of 16 interleaved samples (pixel
     // (col, row) in sample 4·(row mod 4) + col mod 4, each spread over the whole image).
     std::array<double, 16> sum{}, count{};
@@ -664,7 +676,8 @@ std::string declaredAccuracyRefusal(const DepthMap& map, const ComparisonReport&
 {
     std::string refused = holesRefusal(map, report);
     if (!refused.empty() || !map.accuracy.anyAccuracy() || all.empty()) return refused;
-    refused = coarseRefusal(all);
+    refused = fewRefusal(all);
+    if (refused.empty()) refused = coarseRefusal(all);
     if (refused.empty()) refused = gridRefusal(map.accuracy.quantum, all);
     if (refused.empty()) refused = biasRefusal(map.accuracy.quantum, all);
     return refused;

@@ -138,8 +138,9 @@ EdgeTally tallyEdges(const Camera& camera, const RenderResult& truth, const Rend
 //           a grid or tolerance as coarse as the depths accepts any map of the right order;
 //   grid    a declared quantum Q is the grid the values were rounded to: ≥ 99 % of them (less
 //           the offset) lie within 1/1000 of Q (or four binary32 spacings) of a multiple of Q;
+//   few     32 or more pixels show the truth's own surface: fewer cannot tell noise from a scale;
 //   bias    rounding and noise are unbiased: over the pixels where the map shows the truth's own
-//           surface (256 or more), |mean(map − truth)| — the truth rounded to the declared grid,
+//           surface, |mean(map − truth)| — the truth rounded to the declared grid,
 //           if any, so that a rounding's own error is no bias — is within the median of C·q + S·m
 //           + E (the tolerance of a map declaring nothing) plus six times the mean's sampling
 //           error (the spread of the means of 16 interleaved samples, over 4). A declared
