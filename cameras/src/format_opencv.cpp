@@ -217,6 +217,15 @@ private:
         return int(value);
     }
 
+    // A matrix's row or column count: a whole number in 0..64 (an empty D is written 1 x 0).
+    std::size_t matrixSide(const Node& node, const std::string& what) const
+    {
+        const double value = number(node, what);
+        if (!(value >= 0 && value <= 64 && value == std::floor(value)))
+            fail("'" + what + "' must be a whole number of matrix rows or columns in 0..64, got " + formatNumber(value));
+        return std::size_t(value);
+    }
+
     // A matrix: {rows, cols, data} (OpenCV's !!opencv-matrix, ROS's calibration file), a flat
     // list, or a list of rows. `rows`, `cols` of 0 accept any shape.
     Matrix matrix(const Node& node, const std::string& key) const
@@ -242,8 +251,8 @@ private:
             const Node* cols = node.find("cols");
             const Node* data = node.find("data");
             if (!rows || !cols || !data) fail("'" + key + "' must have rows, cols and data");
-            m.rows = std::size_t(pixels(*rows, key + ".rows"));
-            m.cols = std::size_t(pixels(*cols, key + ".cols"));
+            m.rows = matrixSide(*rows, key + ".rows");
+            m.cols = matrixSide(*cols, key + ".cols");
             if (const Node* dt = node.find("dt"); dt && dt->kind == Node::Kind::Scalar) {
                 const std::string type = dt->scalar;
                 if (type != "d" && type != "f" && type != "i" && type != "s" && type != "w" && type != "u" && type != "c")

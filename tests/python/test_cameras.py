@@ -201,3 +201,26 @@ def test_from_matrices_glfrustum_and_direct3d(default_checker):
                                            "view": {"eye": list(EYE), "target": list(TARGET)}})
     assert renders_match(default_checker, camera, perspective)
     assert default_checker.check(camera).consistent
+
+
+def test_regression_a_ros_calibration_with_an_empty_d_was_refused(tmp_path):
+    """camera_calibration_parsers writes an empty D as rows 1, cols 0, data []: a pinhole (the
+    raw camera and the rectified alike), whose pixel (10, 20) at eye-z 2 lies at K⁻¹(10, 20, 1)·2.
+    A matrix side beyond any camera matrix's is refused naming the key."""
+    K = np.array([[50.0, 0, 31.5], [0, 50.0, 23.5], [0, 0, 1]])
+    text = ("image_width: 64\nimage_height: 48\ncamera_name: cam\n"
+            "camera_matrix:\n  rows: 3\n  cols: 3\n  data: [50, 0, 31.5, 0, 50, 23.5, 0, 0, 1]\n"
+            "distortion_model: plumb_bob\ndistortion_coefficients:\n  rows: 1\n  cols: 0\n  data: []\n"
+            "rectification_matrix:\n  rows: 3\n  cols: 3\n  data: [1, 0, 0, 0, 1, 0, 0, 0, 1]\n"
+            "projection_matrix:\n  rows: 3\n  cols: 4\n  data: [50, 0, 31.5, 0, 0, 50, 23.5, 0, 0, 0, 1, 0]\n")
+    path = tmp_path / "camera_info.yaml"
+    path.write_text(text)
+    for frame in ("raw", "rectified"):
+        camera = zcheck.Camera.from_file(f"{path}#{frame}", format="ros", near=0.1, far=100.0)
+        assert camera.lens is None
+        eye = camera.point_at(10, 20, 2.0, "eye-z")["eye"]
+        assert np.allclose(np.abs(eye), np.abs(2.0 * np.linalg.solve(K, [10, 20, 1.0])), atol=1e-12)
+    path.write_text(text.replace("cols: 0", "cols: 70"))
+    with pytest.raises(zcheck.Error, match=r"'distortion_coefficients.cols' must be a whole number of matrix rows "
+                                           r"or columns in 0..64, got 70"):
+        zcheck.Camera.from_file(f"{path}#raw", format="ros", near=0.1, far=100.0)
