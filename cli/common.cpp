@@ -42,6 +42,16 @@ CLI::Validator number(bool (*holds)(double), const std::string& rule, const std:
 
 const CLI::Validator kNonEmptyPath = nonEmpty("path", "PATH");
 const CLI::Validator kNonEmptyList = nonEmpty("list", "LIST");
+const CLI::Validator kMissRule(
+    [](std::string& value) {
+        try {
+            MissRule::parse(value);
+            return std::string();
+        } catch (const Error& e) {
+            return std::string(e.what());
+        }
+    },
+    "RULE");
 const CLI::Validator kPositiveFinite = number([](double v) { return std::isfinite(v) && v > 0; },
                                                "a positive finite number", "NUMBER > 0");
 const CLI::Validator kBelowOne = number([](double v) { return v > 0 && v < 1; }, "a number in (0, 1)", "0 < NUMBER < 1");
@@ -191,7 +201,8 @@ void addDepthMapOptions(CLI::App* command, DepthMapOptions& options)
     command->add_option("--offset", options.offset, "added to every depth after --scale (default 0)");
     command->add_option("--miss", options.miss,
                         "the stored value that means 'no surface', or a comparison: 0, 65535, 1e10, nan, inf, '>=1e9'\n"
-                        "(default: 0 in integer files; NaN is always a miss)");
+                        "(default: 0 in integer files; NaN is always a miss)")
+        ->check(kMissRule);
     addAccuracyOptions(command, options.accuracy);
     command->add_option("--sidecar", options.sidecar,
                         "a JSON file describing the map: {\"miss\": 65535 or \">=1e9\", \"scale\": 1000, \"offset\": 0,\n"

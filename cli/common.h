@@ -45,6 +45,7 @@ Command addFormatsCommand(CLI::App& app);
 // Option validators, the same in every subcommand.
 extern const CLI::Validator kNonEmptyPath;
 extern const CLI::Validator kNonEmptyList;
+extern const CLI::Validator kMissRule;  // MissRule::parse's rule: "" and "abc" are refused with its message
 extern const CLI::Validator kPositiveFinite;
 extern const CLI::Range kThreadRange;
 extern const CLI::Range kImageSideRange;

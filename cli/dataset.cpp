@@ -54,7 +54,8 @@ void addDatasetVerifyOptions(CLI::App* command, DatasetVerifyOptions& o)
     command->add_option("--scale", o.scale, "stored value = depth x scale (integer maps; replaces nerfstudio's 1000)")
         ->check(kPositiveFinite);
     command->add_option("--offset", o.offset, "added to every depth after --scale");
-    command->add_option("--miss", o.miss, "the stored value meaning 'no surface': 0, 65535, 1e10, nan, inf, '>=1e9'");
+    command->add_option("--miss", o.miss, "the stored value meaning 'no surface': 0, 65535, 1e10, nan, inf, '>=1e9'")
+        ->check(kMissRule);
     command->add_option("--channel", o.channel, "the channel or HDF5 dataset to read (depth, distance, Z, ...)");
     addAccuracyOptions(command, o.accuracy);
     command->add_option("--camera-format", o.cameraFormat, "the source's format when its content should not decide: " +

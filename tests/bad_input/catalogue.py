@@ -806,6 +806,8 @@ map_case("scale-0", {"m.pfm": GOOD_MAP}, r"--scale.*\b0\b", extra=["--scale", "0
 map_case("scale-inf", {"m.pfm": GOOD_MAP}, r"--scale.*inf", extra=["--scale", "inf"])
 map_case("miss-not-a-number", {"m.pfm": GOOD_MAP}, r"miss value 'abc' is neither a number", extra=["--miss", "abc"])
 map_case("miss-comparison-with-inf", {"m.pfm": GOOD_MAP}, r"miss value '>=inf'", extra=["--miss", ">=inf"])
+# regression: an empty --miss was silently taken for none given
+map_case("miss-empty", {"m.pfm": GOOD_MAP}, r"--miss: miss value '' is neither a number", extra=["--miss", ""])
 map_case("offset-nan", {"m.pfm": GOOD_MAP}, r"--offset.*nan", extra=["--offset", "nan"])
 map_case("channel-absent", {"m.pfm": GOOD_MAP}, rf"'{M}'.*no channel 'Depth\.Z'.*'Y'", extra=["--channel", "Depth.Z"])
 map_case("pfm-rgb-no-depth-channel", {"m.pfm": pfm(64, 48, channels=3)},
