@@ -60,9 +60,11 @@ void addDatasetVerifyOptions(CLI::App* command, DatasetVerifyOptions& o)
     addAccuracyOptions(command, o.accuracy);
     command->add_option("--camera-format", o.cameraFormat, "the source's format when its content should not decide: " +
                                                             cameraFormatChoices(CameraFormatsWith::Dataset));
-    command->add_option("--near", o.near, "near plane of cameras whose file has none (default: from the scene)")
+    command->add_option("--near", o.near, "near plane of every frame whose manifest line gives none, over its camera file's (default:\n"
+                                        "the camera file's, else from the scene)")
         ->check(kPositiveFinite);
-    command->add_option("--far", o.far, "far plane of cameras whose file has none (default: from the scene)")
+    command->add_option("--far", o.far, "far plane of every frame whose manifest line gives none, over its camera file's (default:\n"
+                                       "the camera file's, else from the scene)")
         ->check(kPositiveFinite);
     command->add_option("--convention", o.convention, "replace every camera's convention");
     command->add_flag("--diagnose", o.diagnose, "diagnose the inconsistent frames (only they pay for it)");

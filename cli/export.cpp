@@ -94,7 +94,7 @@ Command addExportCommand(CLI::App& app)
     command->add_option("--backend", o->backend, "ray | raster")->capture_default_str();
     command->add_option("--quantity", o->quantities,
                               "comma-separated: window, ndc, eye-z, distance, position-eye, position-world, normal, "
-                              "primitive-id (several only into .exr)")
+                              "primitive-id (several only into .exr or .h5)")
         ->capture_default_str();
     addSceneAndCameraOptions(command, o->input);
     command->add_option("-o,--output", o->output, "the depth file, in its extension's format (`zcheck formats` lists them: .exr, .npy, .png, ...;\nwritten atomically)")

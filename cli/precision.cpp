@@ -63,7 +63,8 @@ Command addPrecisionCommand(CLI::App& app)
                      "values at each distance, and which layout is best.");
     addCameraOptions(command, o->camera, cameraFileHelp());
     command->get_option("--camera")->required();
-    command->add_option("--at", o->at, "eye-z distances, comma-separated (default: 9 log-spaced from near to far)")
+    command->add_option("--at", o->at, "eye-z distances, comma-separated (default: 9 log-spaced from near to 0.95 far;\n"
+                                    "an infinite far: to 10^4 near)")
         ->check(kNonEmptyList);
     command->add_flag("--json", o->json, "print JSON instead of tables");
     return {command, [o] { return runPrecisionCommand(o->camera, o->at, o->json); }};

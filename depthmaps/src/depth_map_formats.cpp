@@ -134,6 +134,7 @@ std::string writeDepthMapFile(const std::string& path, const std::vector<Quantit
     if (!format) throw Error("cannot write '" + path + "': unknown format '" + extension + "' (expected " + listed(true) + ")");
     if (images.empty()) throw Error("nothing to write to '" + path + "'");
     if (images.size() > 1 && !format->writesSeveral) {
+        loadMore();  // the formats that take several may not be registered yet
         std::vector<std::string> extensions;
         for (const DepthMapFormat* row : depthMapFormats())
             if (row->writesSeveral) extensions.push_back(row->extensions.front());

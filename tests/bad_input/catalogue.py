@@ -845,6 +845,9 @@ case("output", "export-preview-same-as-existing-output",
      files=dict(MAP_CAM), guard=("d.png",))
 case("output", "export-preview-same-as-sidecar", EXPORT + ["-o", "k.exr", "--preview", "k.exr.json"],
      r"'k\.exr\.json'.*same file", files=dict(MAP_CAM), guard=("k.exr",))
+# regression: the message listed only the formats loaded so far (".h5" for a .npy, not ".exr")
+case("output", "export-several-quantities-into-npy", EXPORT + ["--quantity", "eye-z,distance", "-o", "k.npy"],
+     r"'k\.npy': several quantities go into one file only as \.exr or \.h5$", files=dict(MAP_CAM))
 case("output", "export-preview-missing-folder", EXPORT + ["-o", "k.exr", "--preview", "no/such/dir/p.png"],
      r"'no/such/dir/p\.png'.*(does not exist|No such)", files=dict(MAP_CAM), guard=("k.exr",))
 # Must fail before the work: rendering this terrain (8.4 M triangles) takes ~6 s of CPU.
