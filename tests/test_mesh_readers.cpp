@@ -142,7 +142,7 @@ TEST_CASE("OBJ: malformed files are refused with the line and the rule", "[mesh]
     refused("v 0 0 0\nf 1 1\n", "at least 3 vertices");
 }
 
-TEST_CASE("STL: ascii and binary give the same triangles; the binary size must match its count", "[mesh][stl]")
+TEST_CASE("STL: ascii and binary give the same triangles, the binary size must match its count", "[mesh][stl]")
 {
     const std::string ascii = "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 1 1 0\nendloop\n"
                               "endfacet\nendsolid t\n";
@@ -265,12 +265,20 @@ TEST_CASE("regression: a mesh in UTM coordinates was rounded to binary32 without
                                        "vertex 512346.678 4212345.321 123.4\nvertex 512345.678 4212346.321 123.4\nendloop\nendfacet\n"
                                        "endsolid t\n"),
                     "utm.stl");
-    std::string doubles = ply("binary_little_endian", "element vertex 3\nproperty double x\nproperty double y\nproperty double z\n"
-                                                      "element face 1\nproperty list uchar int vertex_indices\n");
-    for (const glm::dvec3 p : {glm::dvec3(512345.678, 4212345.321, 123.4), glm::dvec3(512346.678, 4212345.321, 123.4),
-                               glm::dvec3(512345.678, 4212346.321, 123.4)})
-        put(doubles, p.x), put(doubles, p.y), put(doubles, p.z);
-    put(doubles, std::uint8_t(3)), put(doubles, 0), put(doubles, 1), put(doubles, 2);
+    // The UTM triangle as a binary PLY of `Coordinate` (double or float) x, y, z.
+    auto binaryPly = [](auto coordinate) {
+        using Coordinate = decltype(coordinate);
+        const std::string type = sizeof(Coordinate) == 8 ? "double" : "float";
+        std::string out = ply("binary_little_endian", "element vertex 3\nproperty " + type + " x\nproperty " + type +
+                                                          " y\nproperty " + type + " z\nelement face 1\n"
+                                                          "property list uchar int vertex_indices\n");
+        for (const glm::dvec3 p : {glm::dvec3(512345.678, 4212345.321, 123.4), glm::dvec3(512346.678, 4212345.321, 123.4),
+                                   glm::dvec3(512345.678, 4212346.321, 123.4)})
+            put(out, Coordinate(p.x)), put(out, Coordinate(p.y)), put(out, Coordinate(p.z));
+        put(out, std::uint8_t(3)), put(out, 0), put(out, 1), put(out, 2);
+        return out;
+    };
+    const std::string doubles = binaryPly(0.0);
     requireMaterial(readPly("utm.ply", doubles), "utm.ply");
     // A glTF's binary32 triangle placed in UTM coordinates by its node (applied in binary64).
     const std::string gltf = R"({"asset": {"version": "2.0"},
@@ -289,13 +297,7 @@ TEST_CASE("regression: a mesh in UTM coordinates was rounded to binary32 without
     REQUIRE(near.rounding.largestMove > 0);
     REQUIRE_FALSE(near.rounding.material());
     REQUIRE(near.rounding.warning("near.obj").empty());
-    std::string floats = ply("binary_little_endian", "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-                                                     "element face 1\nproperty list uchar int vertex_indices\n");
-    for (const glm::vec3 p : {glm::vec3(512345.678f, 4212345.321f, 123.4f), glm::vec3(512346.678f, 4212345.321f, 123.4f),
-                              glm::vec3(512345.678f, 4212346.321f, 123.4f)})
-        put(floats, p.x), put(floats, p.y), put(floats, p.z);
-    put(floats, std::uint8_t(3)), put(floats, 0), put(floats, 1), put(floats, 2);
-    const Scene stored = frameScene(readPly("f.ply", floats), "f");
+    const Scene stored = frameScene(readPly("f.ply", binaryPly(0.0f)), "f");
     REQUIRE(stored.rounding.largestMove == 0);
     REQUIRE(stored.rounding.warning("f.ply").empty());
 
