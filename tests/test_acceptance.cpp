@@ -206,7 +206,7 @@ TEST_CASE("regression: a uniform scale 4e-4 short was accepted as --rel-toleranc
     REQUIRE(named);
 }
 
-TEST_CASE("regression: Kinect-like noise was blamed on a convention; it is answered with a noise model", "[acceptance]")
+TEST_CASE("regression: Kinect-like noise was blamed on a convention, it is answered with a noise model", "[acceptance]")
 {
     const RoomVerifier room;
     const MapVerifier& verifier = room.verifier;
@@ -243,7 +243,7 @@ TEST_CASE("regression: Kinect-like noise was blamed on a convention; it is answe
     REQUIRE_FALSE(accepted(verifier, camera, far));
 }
 
-TEST_CASE("noise models: kinect, A+B*z^2 and A+B*(z-C)^2, each read back from its text; others refused by name",
+TEST_CASE("noise models: kinect, A+B*z^2 and A+B*(z-C)^2, each read back from its text, others refused by name",
           "[acceptance]")
 {
     const NoiseModel kinect = NoiseModel::parse("kinect");

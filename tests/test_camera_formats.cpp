@@ -102,7 +102,7 @@ TEST_CASE("camera formats: every name and alias names its row, and an unknown on
     REQUIRE_THROWS_WITH(registerCameraFormat(cameraFormatNamed("colmap")), Catch::Contains("registered twice"));
 }
 
-TEST_CASE("camera formats: each seed is detected as its format; any other format claiming it comes later")
+TEST_CASE("camera formats: each seed is detected as its format, any other format claiming it comes later")
 {
     const std::vector<Seed> all = seeds();
     REQUIRE(all.size() > 30);

@@ -94,7 +94,7 @@ TEST_CASE("the folded depth mapping is the inverse-projection module's, and its 
     });
 }
 
-TEST_CASE("the depth mapping lane by lane is windowDepth's, bit for bit; a raw matrix has none", "[camera_rays]")
+TEST_CASE("the depth mapping lane by lane is windowDepth's, bit for bit, a raw matrix has none", "[camera_rays]")
 {
     forEachExampleCamera([](const Camera& camera) {
         const CameraRays rays(camera);

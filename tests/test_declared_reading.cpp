@@ -147,7 +147,7 @@ TEST_CASE("a miss value where nothing is hit is named with the --miss rule that 
     }
 }
 
-TEST_CASE("holes are failures unless allowed; allowed, they are counted and a flipped map still fails", "[declared]")
+TEST_CASE("holes are failures unless allowed, allowed, they are counted and a flipped map still fails", "[declared]")
 {
     const Room room;
     const Checker checker(room.scene);
@@ -175,7 +175,7 @@ TEST_CASE("holes are failures unless allowed; allowed, they are counted and a fl
     REQUIRE(bestConsistent(verifier, camera, flipped) == "y-flip");
 }
 
-TEST_CASE("a noisy, quantized, holed RGB-D map: accepted with its options; flipped, distance or moved: rejected and named",
+TEST_CASE("a noisy, quantized, holed RGB-D map: accepted with its options, flipped, distance or moved: rejected and named",
           "[declared]")
 {
     for (const char* convention : {"opencv", "opengl"}) {

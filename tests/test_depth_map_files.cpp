@@ -111,7 +111,7 @@ TEST_CASE("regression: a multi-layer EXR was read from its first channel, the co
     requireValues(colour, {0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.6f});
 }
 
-TEST_CASE("channels: the only one, the quantity's own, one named as depth; else refused with the list", "[depthmap]")
+TEST_CASE("channels: the only one, the quantity's own, one named as depth, else refused with the list", "[depthmap]")
 {
     REQUIRE(read(exrWith("one.exr", {"Y"}, {kDepth})).channel == "Y");
     // zcheck's own export of several quantities: the declared quantity's channel.
@@ -208,7 +208,7 @@ TEST_CASE("depthsFromStored: the one rule readers and Python's arrays apply to s
     REQUIRE_THROWS_WITH(MapAccuracy::requireDeclared(-0.1, "quantum", false), "quantum must be a finite number >= 0, got -0.1");
 }
 
-TEST_CASE("integer maps: depth = stored / scale + offset, 0 a miss unless --miss says otherwise; 8 bits refused", "[depthmap]")
+TEST_CASE("integer maps: depth = stored / scale + offset, 0 a miss unless --miss says otherwise, 8 bits refused", "[depthmap]")
 {
     const std::string path = tiffWith("mm.tif", OIIO::TypeDesc::UINT16, {0, 1000, 1500, 5000, 65534, 65535});
     DepthMapReading millimetres;
@@ -340,7 +340,7 @@ TEST_CASE("COLMAP dense depth maps: W&H&C& then float32 rows, 0 where there is n
     REQUIRE_THROWS_WITH(read(bytesFile("w.bin", "4&2&1&" + raw(std::vector<float>(8, 1.0f)))), Catch::Contains("camera's image is 3x2"));
 }
 
-TEST_CASE("HDF5 maps: a dataset chosen by --channel or by its name; malformed files are refused, not fatal", "[depthmap][hdf5]")
+TEST_CASE("HDF5 maps: a dataset chosen by --channel or by its name, malformed files are refused, not fatal", "[depthmap][hdf5]")
 {
     QuantityImage depth, distance;
     depth.quantity = ExportQuantity::EyeZ, depth.width = W, depth.height = H, depth.channels = {"depth"};

@@ -375,7 +375,7 @@ TEST_CASE("a camera file's lens object reads and writes back as itself", "[lens]
     REQUIRE(refusal(head + R"("lens": {"model": "equirectangular"}})").find("does not take a pinhole's fx") != std::string::npos);
 }
 
-TEST_CASE("check of a lens camera: the two directions and the trace agree; a shifted ray does not", "[lens]")
+TEST_CASE("check of a lens camera: the two directions and the trace agree, a shifted ray does not", "[lens]")
 {
     const Checker checker(builtinScene("default"));
     for (const LensSpec& lens : {LensSpec{"opencv_fisheye", {200, 200, 319.5, 239.5, 0.02, -0.005, 0.001}},

@@ -110,7 +110,7 @@ TEST_CASE("rigidInverse equals the general inverse of a rigid transform", "[pose
     }
 }
 
-TEST_CASE("a pose rounded to 5 decimals is re-orthonormalised and noted; scale, shear and reflections are refused", "[pose]")
+TEST_CASE("a pose rounded to 5 decimals is re-orthonormalised and noted, scale, shear and reflections are refused", "[pose]")
 {
     std::mt19937 random(11);
     const glm::dmat3 exact = randomRotation(random);

@@ -376,7 +376,7 @@ TEST_CASE("A ROS 1 rostopic echo message reads its flow lists and quoted frame i
     CHECK(at(at(root, "roi"), "do_rectify").scalar == "False");
 }
 
-TEST_CASE("YAML flow collections nest, span lines and take tags; OpenCV's {x:1} reads as a key and a value", "[io]")
+TEST_CASE("YAML flow collections nest, span lines and take tags, OpenCV's {x:1} reads as a key and a value", "[io]")
 {
     const yaml::Node root = yaml::parse("%YAML 1.2\n"
                                         "---\n"
@@ -447,7 +447,7 @@ TEST_CASE("YAML block sequences hold maps, nested sequences and empty items", "[
     CHECK(at(root, "last").quoted);
 }
 
-TEST_CASE("YAML comments count only after whitespace; quoted scalars keep '#' and resolve escapes", "[io]")
+TEST_CASE("YAML comments count only after whitespace, quoted scalars keep '#' and resolve escapes", "[io]")
 {
     const yaml::Node root = yaml::parse("# a calibration\n"
                                         "a: 1 # one\n"

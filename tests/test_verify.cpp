@@ -647,7 +647,7 @@ TEST_CASE("a fitted field of view and intrinsics are named in the camera's own p
     CHECK(pinholeValues[7].declared == 239.5);
 }
 
-TEST_CASE("regression: the other NDC range was never tried for a raw-matrix camera; parallel ones are covered too", "[verify][diagnose][regression]")
+TEST_CASE("regression: the other NDC range was never tried for a raw-matrix camera, parallel ones are covered too", "[verify][diagnose][regression]")
 {
     // The hypothesis rebuilt the camera from its spec with the other range, which a raw matrix
     // has no spec for (and which could fail for cameras the rebuild refused), so it was
