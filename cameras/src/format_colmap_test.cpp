@@ -450,7 +450,7 @@ TEST_CASE("each COLMAP camera model projects as models.h's formula, text and bin
     REQUIRE(binary.cameras[2].spec.projection.lens == set.cameras[9].spec.projection.lens);
 }
 
-TEST_CASE("COLMAP models whose distortion is nothing are linear pinholes; fisheyes stay fisheyes", "[import][colmap][lens]")
+TEST_CASE("COLMAP models whose distortion is nothing are linear pinholes, fisheyes stay fisheyes", "[import][colmap][lens]")
 {
     const fs::path dir = scratch("colmap_linear");
     const std::vector<ModelCase> cases = {

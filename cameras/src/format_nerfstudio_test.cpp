@@ -158,7 +158,7 @@ TEST_CASE("nerfstudio OPENCV is brown_conrady: k4 an r⁸ term, OpenCV's tangent
     REQUIRE(zero.spec.projection.type == ProjectionType::Pinhole);
 }
 
-TEST_CASE("nerfstudio OPENCV_FISHEYE is opencv_fisheye, to θ past 90°; with p1, p2 thin_prism_fisheye", "[import][nerfstudio]")
+TEST_CASE("nerfstudio OPENCV_FISHEYE is opencv_fisheye, to θ past 90°, with p1, p2 thin_prism_fisheye", "[import][nerfstudio]")
 {
     const ImportedCamera camera = readOne(
         "fisheye.json", oneFrame(std::string(R"("camera_model": "OPENCV_FISHEYE", )") + kIntrinsics +
@@ -338,7 +338,7 @@ TEST_CASE("nerfstudio camera models without one centre of projection, and unknow
                  Catch::Contains("transforms file '") && Catch::Contains("frames[0]: camera_model KANNALA is not one of nerfstudio's (SIMPLE_PINHOLE"));
 }
 
-TEST_CASE("a lens camera written as nerfstudio's transforms.json reads back as the same lens; the rest is refused", "[import][nerfstudio][roundtrip]")
+TEST_CASE("a lens camera written as nerfstudio's transforms.json reads back as the same lens, the rest is refused", "[import][nerfstudio][roundtrip]")
 {
     const fs::path dir = scratch("nerfstudio_write");
     const auto specWith = [](const std::string& model, const std::vector<double>& coefficients, int width = 640, int height = 480) {

@@ -429,7 +429,7 @@ TEST_CASE("OpenCV distortion that is no lens is refused naming the file, the key
                  Catch::Contains("camera_matrix[0, 1] (skew) must be 0"));
 }
 
-TEST_CASE("ROS CameraInfo: plumb_bob and rational_polynomial are lens opencv, equidistant lens opencv_fisheye; P stays a pinhole",
+TEST_CASE("ROS CameraInfo: plumb_bob and rational_polynomial are lens opencv, equidistant lens opencv_fisheye, P stays a pinhole",
           "[import][ros][lens]")
 {
     const fs::path dir = scratch("ros_lens");
