@@ -87,7 +87,7 @@ glm::vec3 PositionRounding::store(const glm::dvec3& position)
 
 namespace {
 
-// What binary32 made of the coordinates: "moved its vertices by up to 0.2344 (...)".
+// What binary32 made of the coordinates: "held in binary32 (...), its vertices moved by up to 0.2344 (...)".
 std::string roundingText(const PositionRounding& r)
 {
     const float farthest = float(std::max({std::abs(r.movedVertex.x), std::abs(r.movedVertex.y), std::abs(r.movedVertex.z)}));
