@@ -1,5 +1,6 @@
 """Checker.verify / verify_file / diagnose and read_depth_map against `zcheck export` + `zcheck verify`."""
 import json
+import pickle
 
 import numpy as np
 import pytest
@@ -361,6 +362,10 @@ def test_regression_a_mesh_in_utm_coordinates_was_rounded_to_binary32_without_a_
         assert "its vertices moved by up to 0.1793" in warnings[0]
         assert "where binary32 steps by 0.5" in warnings[0]
         assert "binary32" in report.summary()
+    # A pickled scene (worker processes) keeps what its arrays lost: the same warning.
+    unpickled = zcheck.Checker(pickle.loads(pickle.dumps(scene)))
+    assert [w for w in unpickled.verify(camera, np.full((24, 32), 10.0, dtype=np.float32), "eye-z").to_dict()["warnings"]
+            if "binary32" in w] == warnings
     # The same wall 100 m from the origin: no word.
     near = zcheck.Scene.from_arrays(vertices - [x0 - 100, y - 100, z0], [[0, 1, 2], [0, 2, 3]], name="near wall")
     assert not [w for w in zcheck.Checker(near).check(near.default_camera.replace(width=32, height=24)).to_dict()["warnings"]
