@@ -532,8 +532,9 @@ References measureReferences(const std::string& sceneName, const Camera& camera,
         input.vertexCount = scene.positions.size();
         input.indices = &scene.triangles[0].x;
         input.triangleCount = scene.triangles.size();
+        const CameraInSceneFrame local(scene, camera);  // the positions are the scene's frame
         for (int c = 0; c < 4; ++c)
-            for (int k = 0; k < 4; ++k) input.clipFromWorld[std::size_t(4 * c + k)] = camera.clipFromWorld[c][k];
+            for (int k = 0; k < 4; ++k) input.clipFromWorld[std::size_t(4 * c + k)] = local.get().clipFromWorld[c][k];
         input.width = camera.width(), input.height = camera.height();
         input.reversedZ = camera.depth().reversed;
         input.zeroToOne = camera.convention().ndcZMin() == 0.0;

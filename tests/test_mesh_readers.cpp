@@ -245,19 +245,31 @@ TEST_CASE("regression: a mesh in UTM coordinates was rounded to binary32 without
 {
     // (512345.678, 4212345.321, 123.4) as binary32: x to a sixteenth (512345.6875, 0.0095 off),
     // y to a half (4212345.5, 0.179 off), z by ~3e-6: the vertex moves by ~0.1793 of a mesh 1.41
-    // across, which is no longer the file's mesh.
+    // across, which is no longer the file's mesh. The mesh is now held about a local origin
+    // instead (the regression "a correct map of a mesh in UTM coordinates was judged against the
+    // mesh rounded to binary32"), and the reports say what binary32 at the file's coordinates does.
     const double moved = std::hypot(512345.6875 - 512345.678, 4212345.5 - 4212345.321, double(123.4f) - 123.4);
+    const glm::dvec3 file[3] = {{512345.678, 4212345.321, 123.4}, {512346.678, 4212345.321, 123.4}, {512345.678, 4212346.321, 123.4}};
     auto requireMaterial = [&](Scene scene, const std::string& mesh) {
         INFO(mesh);
         REQUIRE(scene.rounding.largestMove == Approx(moved).epsilon(1e-6));
         scene = frameScene(std::move(scene), "cannot load mesh '" + mesh + "'");
         REQUIRE(scene.rounding.size == Approx(std::sqrt(2.0)).epsilon(0.01));
         REQUIRE(scene.rounding.material());
-        const std::string warning = scene.rounding.warning(mesh);
-        REQUIRE_THAT(warning, Catch::StartsWith("mesh '" + mesh + "': held in binary32"));
+        // The centre of the box (512346.178, 4212345.821, 123.4) on the grid of 1 (the power of
+        // two at or below the size, 1.41): (512346, 4212346, 123).
+        REQUIRE(scene.origin == glm::dvec3(512346, 4212346, 123));
+        // Each vertex, in the world, is the file's to binary32 of the mesh's own size (2^-24 of
+        // coordinates under 1.5 about the origin), not to the 0.5 steps at 4.2e6.
+        for (int v = 0; v < 3; ++v) REQUIRE(glm::length(scene.worldPosition(v) - file[v]) < 1e-7);
+        REQUIRE(scene.rounding.unrounded.empty());  // freed once placed
+        const std::string warning = scene.rounding.warning(mesh, scene.origin);
+        REQUIRE_THAT(warning, Catch::StartsWith("mesh '" + mesh + "': far from the origin, held about (512346, 4212346, 123)"));
         REQUIRE_THAT(warning, Catch::Contains("its vertices moved by up to 0.1793"));
         REQUIRE_THAT(warning, Catch::Contains("coordinates up to 4.212e+06, where binary32 steps by 0.5"));
-        REQUIRE_THAT(warning, Catch::Contains("move the mesh and its cameras near the origin"));
+        REQUIRE_THAT(warning, Catch::Contains("a map rendered so shows another mesh"));
+        // The default camera frames it in the world.
+        REQUIRE(glm::length(scene.defaultCamera.view.target - glm::dvec3(512346.178, 4212345.821, 123.4)) < 1e-3);
     };
     const std::string obj = "v 512345.678 4212345.321 123.4\nv 512346.678 4212345.321 123.4\nv 512345.678 4212346.321 123.4\nf 1 2 3\n";
     requireMaterial(readObj("utm.obj", obj), "utm.obj");
@@ -297,13 +309,26 @@ TEST_CASE("regression: a mesh in UTM coordinates was rounded to binary32 without
     REQUIRE(near.rounding.largestMove > 0);
     REQUIRE_FALSE(near.rounding.material());
     REQUIRE(near.rounding.warning("near.obj").empty());
+    REQUIRE_FALSE(near.heldAboutOrigin());
     const Scene stored = frameScene(readPly("f.ply", binaryPly(0.0f)), "f");
     REQUIRE(stored.rounding.largestMove == 0);
     REQUIRE(stored.rounding.warning("f.ply").empty());
+    REQUIRE_FALSE(stored.heldAboutOrigin());
 
-    // Coordinates whose binary32 steps swallow the whole mesh: the refusal says why.
-    REQUIRE_THROWS_WITH(frameScene(readObj("far.obj", "v 1e8 1e8 0\nv 100000000.5 1e8 0\nv 1e8 100000000.5 0\nf 1 2 3\n"),
-                                   "cannot load mesh 'far.obj'"),
+    // Coordinates whose binary32 steps swallow the whole mesh (8 at 1e8) were refused as
+    // degenerate; about its own origin the triangle keeps its area.
+    const Scene far = frameScene(readObj("far.obj", "v 1e8 1e8 0\nv 100000000.5 1e8 0\nv 1e8 100000000.5 0\nf 1 2 3\n"),
+                                 "cannot load mesh 'far.obj'");
+    REQUIRE(far.heldAboutOrigin());
+    REQUIRE(far.worldPosition(1) == glm::dvec3(100000000.5, 1e8, 0));
+    REQUIRE_THAT(far.rounding.warning("far.obj", far.origin), Catch::Contains("where binary32 steps by 8"));
+    // A scene put together without its file's coordinates (no reader stored them) cannot be
+    // placed: collapsed, it is still refused with the reason.
+    Scene collapsed = far;
+    collapsed.origin = glm::dvec3(0.0);
+    for (glm::vec3& p : collapsed.positions) p = glm::vec3(1e8f, 1e8f, 0.0f);  // as binary32 holds the file's
+    collapsed.rounding.storedCount = 0;
+    REQUIRE_THROWS_WITH(frameScene(collapsed, "cannot load mesh 'far.obj'"),
                         Catch::Contains("degenerate") && Catch::Contains("where binary32 steps by 8") &&
                             Catch::Contains("move the mesh near the origin"));
 }

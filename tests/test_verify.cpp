@@ -13,6 +13,7 @@
 #include "random_scenes.h"
 
 #include <catch2/catch.hpp>
+#include <glm/gtc/matrix_transform.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -881,4 +882,104 @@ TEST_CASE("property: the maps zcheck renders of random soups verify, in every qu
     REQUIRE(verified >= 400);
     REQUIRE(raster >= 100);
     REQUIRE(lens >= 20);
+}
+
+TEST_CASE("regression: a correct map of a mesh in UTM coordinates was judged against its binary32 rounding",
+          "[verify][regression]")
+{
+    // builtin:default moved to UTM coordinates in binary64, as a mesh file with more digits holds it,
+    // and its cameras with it. binary32 at those coordinates steps by 0.5 (northing) and moved every
+    // vertex by up to ~0.25; zcheck traced that mesh, so a correct map was INCONSISTENT. Held about
+    // a local origin, both routes see the file's mesh: what they see of it is what they see at home.
+    const glm::dvec3 offset(512345.678, 4212345.321, 123.4);
+    const Scene home = builtinScene("builtin:default");
+    Scene file;
+    file.name = "away";
+    for (const glm::vec3& p : home.positions) file.positions.push_back(file.rounding.store(glm::dvec3(p) + offset));
+    file.triangles = home.triangles;
+    // The same binary32 values with nothing to undo them: what a renderer without a local origin draws.
+    Scene rounded = file;
+    rounded.rounding.storedCount = 0;
+    const Scene away = frameScene(std::move(file), "away");
+    REQUIRE(away.heldAboutOrigin());
+    REQUIRE(away.rounding.largestMove > 0.1);
+    rounded = frameScene(std::move(rounded), "rounded");
+    REQUIRE_FALSE(rounded.heldAboutOrigin());
+
+    const Checker atHome(home), there(away), roundedThere(rounded);
+    const MapVerifier verifier(there);
+    auto moved = [&](CameraSpec spec) {
+        if (spec.view.hasMatrix) spec.view.eyeFromWorld = spec.view.eyeFromWorld * glm::translate(glm::dmat4(1.0), -offset);
+        spec.view.eye += offset, spec.view.target += offset;
+        return spec;
+    };
+    CameraSpec perspective = home.defaultCamera;
+    perspective.width = 160, perspective.height = 120;
+    CameraSpec reversed = perspective;
+    reversed.convention = Convention::preset("direct3d");
+    reversed.depth.reversed = true;
+    CameraSpec orthographic = perspective;
+    orthographic.projection.type = ProjectionType::Orthographic;
+    orthographic.projection.left = -4, orthographic.projection.right = 4;
+    orthographic.projection.bottom = -3, orthographic.projection.top = 3;
+    CameraSpec matrix = perspective;  // a raw view matrix, as camera files from SfM give it
+    matrix.view.eyeFromWorld = Camera(perspective).eyeFromWorld;
+    matrix.view.hasMatrix = true;
+    for (const CameraSpec& spec : {perspective, reversed, orthographic, matrix}) {
+        INFO(toString(spec.projection.type) << (spec.depth.reversed ? " reversed" : "") << (spec.view.hasMatrix ? " matrix" : ""));
+        const Camera here(spec), far(moved(spec));
+        // The ray route's eye-z, pixel by pixel, as at home: to binary32 of the mesh's own size
+        // (held about the origin, the mesh rounds once more: 2^-24 of coordinates under its size),
+        // where the file's coordinates in binary32 move it by ~0.25.
+        const RenderResult a = atHome.renderRay(here, {}, EyePoints::Keep), b = there.renderRay(far, {}, EyePoints::Keep);
+        std::int64_t compared = 0;
+        double worst = 0;
+        for (std::size_t i = 0; i < a.primitiveId.size(); ++i)
+            if (a.primitiveId[i] == b.primitiveId[i] && a.hit(i))
+                ++compared, worst = std::max(worst, std::abs(b.pEye[i].z - a.pEye[i].z));
+        REQUIRE(compared > std::int64_t(a.primitiveId.size()) / 2);
+        INFO("worst " << worst << ", size " << away.rounding.size);
+        REQUIRE(worst < 0x1p-22 * away.rounding.size);
+        // Both routes agree there, and a map drawn at home verifies there, in eye-z and window depth.
+        REQUIRE(there.check(far).report.comparison.consistent());
+        const RenderResult drawn = atHome.renderRaster(here);
+        for (ExportQuantity q : {ExportQuantity::EyeZ, ExportQuantity::Window}) {
+            const VerifyResult run = verifier.verify(far, mapOf(home, here, drawn, q));
+            INFO(toString(q) << ": unexplained " << run.comparison.report.unexplained());
+            REQUIRE(run.comparison.report.consistent());
+        }
+        // The map of the mesh binary32 made at the file's coordinates is another mesh's.
+        const DepthMap other = mapOf(rounded, far, roundedThere.renderRaster(far), ExportQuantity::EyeZ);
+        REQUIRE_FALSE(verifier.verify(far, other).comparison.report.consistent());
+    }
+    // Mistakes made there are caught and named as at home, those drawn through a wrong matrix too
+    // (the catalogue's raster faults hold clip-from-world matrices of the world's). (A wrong view,
+    // such as an inverted extrinsic, looks away from a mesh 4·10⁶ out: nothing to name.)
+    const Camera far(moved(perspective));
+    for (const std::string name : {"y-flip", "handedness", "aspect-inverted", "fovy-radians", "half-fov"}) {
+        INFO(name);
+        RouteFaults faults;
+        REQUIRE(testing::mistakeNamed(name).inject(far, faults));
+        const RenderResult wrong = testing::mistakeNamed(name).route == Route::Ray ? there.renderRay(far, faults.ray)
+                                                                                    : there.renderRaster(far, faults.raster);
+        const DepthMap map = mapOf(away, far, wrong, ExportQuantity::Window);
+        REQUIRE_FALSE(verifier.verify(far, map).comparison.report.consistent());
+        REQUIRE(testing::diagnosedAs(verifier, far, map, name));
+    }
+    // A lens camera (OpenCV fisheye) sees the same distances there as at home, to binary32 of the mesh's size.
+    CameraSpec fisheye = perspective;
+    fisheye.convention = Convention::preset("opencv");
+    fisheye.projection.type = ProjectionType::NonLinear;
+    fisheye.projection.lens = LensSpec{"opencv_fisheye", {60, 60, 79.5, 59.5, 0.05, -0.01, 0, 0}};
+    const Camera lensHere(fisheye), lensFar(moved(fisheye));
+    const RenderResult a = atHome.renderRay(lensHere), b = there.renderRay(lensFar);
+    std::int64_t compared = 0;
+    for (std::size_t i = 0; i < a.primitiveId.size(); ++i)
+        if (a.primitiveId[i] == b.primitiveId[i] && a.hit(i)) {
+            ++compared;
+            // (its wide field meets surfaces more obliquely: a move along them shows more)
+            REQUIRE(std::abs(b.windowDepth.value[i] - a.windowDepth.value[i]) < 0x1p-20 * away.rounding.size);
+        }
+    REQUIRE(compared > std::int64_t(a.primitiveId.size()) / 2);
+    REQUIRE(there.check(lensFar).report.comparison.consistent());
 }

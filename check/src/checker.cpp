@@ -121,7 +121,7 @@ void CheckReport::describeInputs(const Scene& checked, const Camera& used, const
     scene = checked.name;
     triangles = checked.triangleCount();
     warnings.clear();
-    for (const std::string& w : {checked.planarity.warning(checked.name), checked.rounding.warning(checked.name)})
+    for (const std::string& w : {checked.planarity.warning(checked.name), checked.rounding.warning(checked.name, checked.origin)})
         if (!w.empty()) warnings.push_back(w);
     for (const std::string& note : cameraNotes(used.spec())) warnings.push_back(note);
     camera = used.spec();

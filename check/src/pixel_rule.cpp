@@ -226,11 +226,12 @@ ZCHECK_KERNEL_ENTRY_AVX512 void slopesTogetherAvx512(const DepthSlopeFrame& fram
 PixelJudge::PixelJudge(const Scene& scene, const Camera& camera, const ToleranceModel& tolerance, SlopeSource slopes)
     : scene_(scene),
       camera_(camera),
+      local_(scene, camera),
       tolerance_(tolerance),
       terms_{tolerance.constantFor(camera.depth()), tolerance.snapPixels(),
              16 * std::ldexp(1.0, -52) * std::max(std::abs(camera.depth().rangeMin), std::abs(camera.depth().rangeMax))},
       form_(kernelForm()),
-      slopeFrame_(camera, tolerance.slopeCredit)
+      slopeFrame_(local_.get(), tolerance.slopeCredit)
 {
     if (slopes == SlopeSource::TableOfSeen) table_ = std::make_unique<SlopeTable>(scene_, slopeFrame_, form_);
 }
@@ -293,7 +294,7 @@ double PixelJudge::surfaceTolerance(std::uint32_t primitive, double q, double al
 bool PixelJudge::atClipPlane(std::uint32_t primitive, const glm::dvec2& pWindow) const
 {
     if (!known(primitive)) return false;
-    const EyePlaneRay ray = worldEyePlaneRayThroughWindow(camera_, pWindow);
+    const EyePlaneRay ray = worldEyePlaneRayThroughWindow(local_.get(), pWindow);
     const glm::dvec3 a = vertex(primitive, 0);
     const glm::dvec3 normal = glm::cross(vertex(primitive, 1) - a, vertex(primitive, 2) - a);
     const double t = glm::dot(normal, a - ray.origin) / glm::dot(normal, ray.direction);
@@ -306,7 +307,7 @@ bool PixelJudge::atClipPlane(std::uint32_t primitive, const glm::dvec2& pWindow)
 bool PixelJudge::nearEdge(std::uint32_t primitive, const glm::dvec2& pWindow) const
 {
     if (!known(primitive)) return false;
-    return distanceToDrawnEdge(camera_, vertex(primitive, 0), vertex(primitive, 1), vertex(primitive, 2), pWindow) <= terms_.S;
+    return distanceToDrawnEdge(local_.get(), vertex(primitive, 0), vertex(primitive, 1), vertex(primitive, 2), pWindow) <= terms_.S;
 }
 
 PixelClass PixelJudge::bothHit(double rayDepth, std::uint32_t rayPrimitive, double rasterDepth,

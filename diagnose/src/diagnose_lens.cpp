@@ -197,10 +197,8 @@ std::optional<Hypothesis> fitRadialDistortion(const MapVerifier& verifier, const
             const std::uint32_t hit = rays.primitiveAt(*trial, pWindow);
             if (hit == kNoPrimitive) return;
             const glm::dvec3 eye(trial->worldFromEye[3]), d(trial->worldFromEye * glm::dvec4(*dEye, 0.0));
-            const glm::uvec3 t = scene.triangles[hit];
-            const glm::dvec3 a(scene.positions[t[0]]), b(scene.positions[t[1]]), c(scene.positions[t[2]]);
-            const glm::dvec3 n = glm::cross(b - a, c - a);
-            const double distance = glm::dot(n, a - eye) / glm::dot(n, d);
+            const Scene::Plane plane = scene.worldPlane(hit);
+            const double distance = glm::dot(plane.normal, plane.point - eye) / glm::dot(plane.normal, d);
             const double predicted = map.quantity == DepthQuantity::Distance ? distance : distance * trial->eyeZOf(*dEye);
             const double value = map.value[std::size_t(samples[s].y) * W + samples[s].x];
             const double r = (predicted - value) / value;

@@ -317,15 +317,14 @@ std::vector<Sample> samplesOf(const Scene& scene, const Camera& declared, const 
             if (!truth.hit(i)) continue;
             const glm::dvec2 pWindow = windowFromPixelCentre(declared, col, row);
             if (isMissValue(declared, pWindow, map.value[i], map.quantity)) continue;
-            const glm::uvec3 t = scene.triangles[truth.primitiveId[i]];
-            const glm::dvec3 a(scene.positions[t[0]]), b(scene.positions[t[1]]), c(scene.positions[t[2]]);
-            const glm::dvec3 normal = glm::cross(b - a, c - a);
+            const Scene::Plane plane = scene.worldPlane(truth.primitiveId[i]);
             if (rule == SampleRule::OnePlane ? !onePlaneAround(truth, W, H, col, row) : !hitAllAround(truth, W, H, col, row))
                 continue;
             const double z = eyeZFromWindowDepth(departed, windowFromPixelCentre(departed, col, row), truth.windowDepth.value[i]);
             const double sigma = valuePerRelativeEyeZ(declared, pWindow, z, map.quantity);
             if (!(sigma > 0) || !std::isfinite(sigma)) continue;
-            ofRow[std::size_t(row)].push_back({col, row, normal, glm::dot(normal, a), map.value[i], sigma, truth.primitiveId[i]});
+            ofRow[std::size_t(row)].push_back({col, row, plane.normal, glm::dot(plane.normal, plane.point), map.value[i], sigma,
+                                               truth.primitiveId[i]});
         }
     });
     std::vector<Sample> all;

@@ -171,8 +171,8 @@ bool differsVisibly(const Scene& scene, const Camera& camera, const RenderResult
             ++different;
         } else if (clean.hit(i)) {
             const glm::uvec3 t = scene.triangles[clean.primitiveId[i]];
-            const double m = windowDepthSlope(camera, glm::dvec3(scene.positions[t[0]]), glm::dvec3(scene.positions[t[1]]),
-                                              glm::dvec3(scene.positions[t[2]]));
+            const double m = windowDepthSlope(camera, scene.worldPosition(t[0]), scene.worldPosition(t[1]),
+                                              scene.worldPosition(t[2]));
             const double q = storageQuantum(camera.depth().format, clean.windowDepth.value[i]);
             if (!(std::abs(faulty.windowDepth.value[i] - clean.windowDepth.value[i]) <= 4 * q + 2 * S * m)) ++different;
         }

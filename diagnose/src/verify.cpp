@@ -87,10 +87,8 @@ bool unormInBinary32(const Camera& camera, const DepthMap& map)
 // Window depth of a triangle's plane where the pixel's ray meets it (NaN if it does not).
 double planeWindowDepth(const Scene& scene, const Camera& camera, std::uint32_t primitive, const EyePlaneRay& ray)
 {
-    const glm::uvec3 t = scene.triangles[primitive];
-    const glm::dvec3 a(scene.positions[t[0]]), b(scene.positions[t[1]]), c(scene.positions[t[2]]);
-    const glm::dvec3 normal = glm::cross(b - a, c - a);
-    const double s = glm::dot(normal, a - ray.origin) / glm::dot(normal, ray.direction);
+    const Scene::Plane plane = scene.worldPlane(primitive);
+    const double s = glm::dot(plane.normal, plane.point - ray.origin) / glm::dot(plane.normal, ray.direction);
     return std::isfinite(s) ? windowFromWorld(camera, ray.origin + s * ray.direction).z : NAN;
 }
 
@@ -232,7 +230,7 @@ MapPixel MapReader::read(int col, int row, bool search) const
         if (candidate == here || std::find(considered.begin(), considered.end(), candidate) != considered.end()) return;
         considered.push_back(candidate);
         const glm::uvec3 t = scene_.triangles[candidate];
-        const glm::dvec3 a(scene_.positions[t[0]]), b(scene_.positions[t[1]]), c(scene_.positions[t[2]]);
+        const glm::dvec3 a = scene_.worldPosition(t[0]), b = scene_.worldPosition(t[1]), c = scene_.worldPosition(t[2]);
         // The candidate's depths within S of the centre: its plane's depth on the pixel's ray,
         // give or take its tolerance; or, where that leaves the map's depth out, the depths its
         // drawn polygon takes within S, give or take the tolerance of a face-on surface. The

@@ -42,10 +42,8 @@ constexpr double kSnap = 1.0 / 256;  // S: a map sampled up to 2^-8 px off the c
 // The distance along a unit world ray from `origin` to a triangle's plane (NaN if parallel).
 double planeDistance(const Scene& scene, std::uint32_t primitive, const glm::dvec3& origin, const glm::dvec3& direction)
 {
-    const glm::uvec3 t = scene.triangles[primitive];
-    const glm::dvec3 a(scene.positions[t[0]]), b(scene.positions[t[1]]), c(scene.positions[t[2]]);
-    const glm::dvec3 normal = glm::cross(b - a, c - a);
-    const double s = glm::dot(normal, a - origin) / glm::dot(normal, direction);
+    const Scene::Plane plane = scene.worldPlane(primitive);
+    const double s = glm::dot(plane.normal, plane.point - origin) / glm::dot(plane.normal, direction);
     return std::isfinite(s) ? s : NAN;
 }
 

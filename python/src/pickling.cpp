@@ -132,7 +132,8 @@ py::tuple sceneState(const Scene& scene)
     const PositionRounding& r = scene.rounding;  // what the arrays' binary64 values lost, for the reports
     return py::make_tuple("arrays", scene.name, bytesOf(scene.positions.data(), scene.positions.size()),
                           bytesOf(scene.triangles.data(), scene.triangles.size()),
-                          py::make_tuple(r.largestMove, r.movedVertex.x, r.movedVertex.y, r.movedVertex.z));
+                          py::make_tuple(r.largestMove, r.movedVertex.x, r.movedVertex.y, r.movedVertex.z),
+                          py::make_tuple(scene.origin.x, scene.origin.y, scene.origin.z));
 }
 
 Scene sceneFromState(const py::tuple& state)
@@ -147,6 +148,10 @@ Scene sceneFromState(const py::tuple& state)
         const auto r = state[4].cast<std::tuple<double, double, double, double>>();
         scene.rounding.largestMove = std::get<0>(r);
         scene.rounding.movedVertex = {std::get<1>(r), std::get<2>(r), std::get<3>(r)};
+    }
+    if (state.size() > 5) {  // the local origin its positions are held about (Scene::origin)
+        const auto o = state[5].cast<std::tuple<double, double, double>>();
+        scene.origin = {std::get<0>(o), std::get<1>(o), std::get<2>(o)};
     }
     return frameScene(std::move(scene), "a pickled Scene");
 }

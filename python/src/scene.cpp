@@ -114,14 +114,21 @@ Raises zcheck.Error naming the argument, the entry and the rule.)doc")
         .def_property_readonly(
             "vertices",
             [](const Scene& s) { return rowsOf<float>(s.positions); },
-            "(N, 3) float32 copy of the world-space positions.")
+            "(N, 3) float32 copy of the positions, in the scene's frame: world = origin + vertex.")
+        .def_property_readonly(
+            "origin", [](const Scene& s) { return arrayFromVec3(s.origin); },
+            "The world point the vertices are held about: (0, 0, 0), but for a mesh whose coordinates binary32\n"
+            "would have moved materially (far from the origin against its size: UTM, ECEF), held about the\n"
+            "centre of its box as large-world renderers hold it. Cameras are always given in the world.")
         .def_property_readonly(
             "triangles",
             [](const Scene& s) { return rowsOf<std::uint32_t>(s.triangles); },
             "(M, 3) uint32 copy of the vertex indices; row k is primitive id k.")
         .def_property_readonly(
             "bounds",
-            [](const Scene& s) { return py::make_tuple(arrayFromVec3(s.boundsMin()), arrayFromVec3(s.boundsMax())); },
+            [](const Scene& s) {
+                return py::make_tuple(arrayFromVec3(s.origin + s.boundsMin()), arrayFromVec3(s.origin + s.boundsMax()));
+            },
             "(min, max) corners of the axis-aligned bounding box, world coordinates.")
         .def_property_readonly(
             "default_camera", [](const Scene& s) { return makeCamera(s.defaultCamera, "Scene.default_camera"); },

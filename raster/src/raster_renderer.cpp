@@ -930,8 +930,21 @@ void RasterFrame::Impl::drawTile(int tile, double* windowDepth, std::uint32_t* p
     if (stores == RasterFrame::Stores::Streaming) finishStreamingCopies();
 }
 
+namespace {
+
+// `faults` for the frame a scene is held in: a clip-from-world matrix given for the world
+// (overrideClipFromWorld) moved about Scene::origin, as the camera is (cameraAboutOrigin).
+RasterFaults faultsInSceneFrame(const Scene& scene, RasterFaults faults)
+{
+    if (faults.overrideClipFromWorld && scene.heldAboutOrigin())
+        faults.clipFromWorld[3] = faults.clipFromWorld * glm::dvec4(scene.origin, 1.0);
+    return faults;
+}
+
+}  // namespace
+
 RasterFrame::RasterFrame(const Scene& scene, const Camera& camera, const RasterFaults& faults)
-    : RasterFrame(std::make_unique<Impl>(scene, camera, faults))
+    : RasterFrame(std::make_unique<Impl>(scene, CameraInSceneFrame(scene, camera).get(), faultsInSceneFrame(scene, faults)))
 {
 }
 
@@ -991,7 +1004,7 @@ RenderResult RasterRenderer::render(const Camera& camera, const RasterFaults& fa
 struct RasterFrameTesting {
     static RenderResult renderWithFineKeys(const Scene& scene, const Camera& camera)
     {
-        const RasterFrame frame(std::make_unique<RasterFrame::Impl>(scene, camera, RasterFaults{}, 4503599627370496.0));
+        const RasterFrame frame(std::make_unique<RasterFrame::Impl>(scene, CameraInSceneFrame(scene, camera).get(), RasterFaults{}, 4503599627370496.0));
         return drawnFrame(frame, camera.width(), camera.height());
     }
 };

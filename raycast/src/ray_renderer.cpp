@@ -305,12 +305,13 @@ int RayRenderer::embreeNativePacket() const
 std::uint32_t RayRenderer::primitiveAt(const Camera& camera, const glm::dvec2& pWindow) const
 {
     const EyePlaneRay r = worldEyePlaneRayThroughWindow(camera, pWindow);
+    const glm::dvec3 origin = r.origin - scene_.origin;  // in the scene's frame (the same bits at a zero origin)
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     alignas(16) RTCRayHit hit{};
-    hit.ray.org_x = float(r.origin.x - embree_->frameOrigin.x);
-    hit.ray.org_y = float(r.origin.y - embree_->frameOrigin.y);
-    hit.ray.org_z = float(r.origin.z - embree_->frameOrigin.z);
+    hit.ray.org_x = float(origin.x - embree_->frameOrigin.x);
+    hit.ray.org_y = float(origin.y - embree_->frameOrigin.y);
+    hit.ray.org_z = float(origin.z - embree_->frameOrigin.z);
     hit.ray.dir_x = float(r.direction.x), hit.ray.dir_y = float(r.direction.y), hit.ray.dir_z = float(r.direction.z);
     hit.ray.tnear = float(std::max(0.0, r.tNear));  // see traceRect
     hit.ray.tfar = std::isinf(r.tFar) ? INFINITY : float(r.tFar);
@@ -325,6 +326,7 @@ RenderResult RayRenderer::render(const Camera& camera, const RayFaults& fault, E
 {
     const auto start = Clock::now();
     const int W = camera.width(), H = camera.height();
+    const CameraInSceneFrame local(scene_, camera);
     RenderResult result = RenderResult::allocated(W, H);  // traceRect writes every pixel, hit or not
     if (eyePoints == EyePoints::Keep) result.pEye.resize(std::size_t(W) * H);  // uninitialised: traceRect writes each
     // 64×64 regions in parallel (a region's set-up, the camera's rays, is made once). Each is
@@ -342,7 +344,7 @@ RenderResult RayRenderer::render(const Camera& camera, const RayFaults& fault, E
         alignas(64) thread_local std::uint32_t primitive[kRegion * kRegion];
         alignas(64) thread_local glm::dvec3 eye[kRegion * kRegion];
         const bool keep = eyePoints == EyePoints::Keep;
-        traceRect(camera, rect, depth, primitive, kRegion, fault, keep ? eye : nullptr);
+        traceRectInSceneFrame(local.get(), rect, depth, primitive, kRegion, fault, keep ? eye : nullptr);
         for (int r = 0; r < rect.height(); ++r) {
             const std::size_t to = first + std::size_t(r) * std::size_t(W), from = std::size_t(r) * kRegion;
             copyRowStreaming(depth + from, std::size_t(rect.width()), result.windowDepth.value.data() + to);
@@ -699,6 +701,13 @@ ZCHECK_TRACE_FORM(ZCHECK_KERNEL_ENTRY_AVX512, Avx512)
 
 void RayRenderer::traceRect(const Camera& camera, const PixelRect& rect, double* windowDepth, std::uint32_t* primitiveId,
                             std::size_t stride, const RayFaults& fault, glm::dvec3* pEye) const
+{
+    traceRectInSceneFrame(CameraInSceneFrame(scene_, camera).get(), rect, windowDepth, primitiveId, stride, fault, pEye);
+}
+
+void RayRenderer::traceRectInSceneFrame(const Camera& camera, const PixelRect& rect, double* windowDepth,
+                                        std::uint32_t* primitiveId, std::size_t stride, const RayFaults& fault,
+                                        glm::dvec3* pEye) const
 {
     auto* form = &traceRectBaseline;
 #ifdef ZCHECK_X86_FORMS

@@ -47,6 +47,7 @@ struct EmbreeReference::Embree {
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
     glm::dvec3 frameOrigin{0.0};  // as the ray route: binary32 coordinates centred on the scene
+    glm::dvec3 worldFrameOrigin{0.0};  // that centre in the world (the scene may be held about Scene::origin)
 
     ~Embree()
     {
@@ -75,6 +76,7 @@ EmbreeReference::EmbreeReference(const Scene& scene) : embree_(std::make_unique<
         throw Error("reference: Embree could not allocate geometry buffers");
     }
     embree_->frameOrigin = glm::dvec3(glm::vec3((scene.boundsMin() + scene.boundsMax()) / 2.0));
+    embree_->worldFrameOrigin = scene.heldAboutOrigin() ? scene.origin + embree_->frameOrigin : embree_->frameOrigin;
     for (std::size_t v = 0; v < scene.positions.size(); ++v)
         for (int k = 0; k < 3; ++k) vertices[3 * v + k] = float(double(scene.positions[v][k]) - embree_->frameOrigin[k]);
     rtcCommitGeometry(geometry);
@@ -101,7 +103,7 @@ double EmbreeReference::trace(const Camera& camera, std::uint32_t* primitiveId) 
     const bool lens = camera.lens() != nullptr;
     const AffineRays rays = lens ? AffineRays{} : yardstickRays(camera);
     const glm::vec3 dOdx(rays.originPerX), dOdy(rays.originPerY), dDdx(rays.directionPerX), dDdy(rays.directionPerY);
-    glm::vec3 o00(rays.originAt({0.5, 0.5}) - embree_->frameOrigin), d00(rays.directionAt({0.5, 0.5}));
+    glm::vec3 o00(rays.originAt({0.5, 0.5}) - embree_->worldFrameOrigin), d00(rays.directionAt({0.5, 0.5}));
     std::vector<glm::vec3> directions;
     if (lens) {
         const CameraRays cameraRays(camera);
@@ -114,7 +116,7 @@ double EmbreeReference::trace(const Camera& camera, std::uint32_t* primitiveId) 
         });
         for (std::size_t i = 0; i < directions.size(); ++i)  // every ray starts at the eye
             if (const std::optional<EyePlaneRay> ray = cameraRays.worldRay({i % W + 0.5, i / W + 0.5})) {
-                o00 = glm::vec3(ray->origin - embree_->frameOrigin);
+                o00 = glm::vec3(ray->origin - embree_->worldFrameOrigin);
                 break;
             }
     }

@@ -132,7 +132,9 @@ SceneNearFar lensNearFar(const Scene& scene, const Camera& camera)
 
 SceneNearFar sceneNearFar(const Scene& scene, const CameraSpec& spec)
 {
-    const Camera camera(spec);  // its near and far may be placeholders: the side planes do not depend on them
+    const Camera given(spec);  // its near and far may be placeholders: the side planes do not depend on them
+    const CameraInSceneFrame local(scene, given);  // the chunks' boxes and the positions are the scene's frame
+    const Camera& camera = local.get();
     if (camera.lens()) return lensNearFar(scene, camera);
     const glm::dmat4 clipFromWorld = camera.clipFromEye * camera.eyeFromWorld;
     const glm::dvec4 eyeZRow(camera.eyeFromWorld[0][2] * camera.convention().eyeForwardZ,

@@ -13,6 +13,13 @@
 
 namespace zcheck {
 
+Scene::Plane Scene::worldPlane(std::size_t t) const
+{
+    const glm::uvec3& corners = triangles[t];
+    const glm::dvec3 a(positions[corners[0]]), b(positions[corners[1]]), c(positions[corners[2]]);
+    return {glm::cross(b - a, c - a), worldPosition(corners[0])};
+}
+
 glm::dvec3 Scene::boundsMin() const
 {
     glm::dvec3 lo(INFINITY);
@@ -82,6 +89,8 @@ glm::vec3 PositionRounding::store(const glm::dvec3& position)
     const glm::vec3 stored(position);
     const double move = glm::length(glm::dvec3(stored) - position);
     if (move > largestMove) largestMove = move, movedVertex = position;
+    if (move > 0) unrounded.emplace_back(storedCount, position);
+    ++storedCount;
     return stored;
 }
 
@@ -92,8 +101,7 @@ std::string roundingText(const PositionRounding& r)
 {
     const float farthest = float(std::max({std::abs(r.movedVertex.x), std::abs(r.movedVertex.y), std::abs(r.movedVertex.z)}));
     const double step = double(std::nextafter(farthest, INFINITY)) - double(farthest);
-    std::string text = "held in binary32 (as Embree and GPUs hold positions), its vertices moved by up to " +
-                       fourSignificantDigits(r.largestMove) + " (";
+    std::string text = "its vertices moved by up to " + fourSignificantDigits(r.largestMove) + " (";
     if (r.size > 0) text += fourSignificantDigits(100 * r.largestMove / r.size) + " % of its size; ";
     return text + "coordinates up to " + fourSignificantDigits(farthest) + ", where binary32 steps by " +
            fourSignificantDigits(step) + ")";
@@ -101,17 +109,25 @@ std::string roundingText(const PositionRounding& r)
 
 }  // namespace
 
-std::string PositionRounding::warning(const std::string& mesh) const
+std::string PositionRounding::warning(const std::string& mesh, const glm::dvec3& origin) const
 {
     if (!material()) return "";
-    return "mesh '" + mesh + "': " + roundingText(*this) +
-           ": a map rendered from the file's own digits (in binary64, or around a local origin as large-world "
-           "renderers do) shows another mesh than this check's truth, by up to that much; move the mesh and its "
-           "cameras near the origin";
+    if (origin == glm::dvec3(0.0))
+        return "mesh '" + mesh + "': held in binary32 (as Embree and GPUs hold positions), " + roundingText(*this) +
+               ": a map rendered from the file's own digits (in binary64, or around a local origin as large-world "
+               "renderers do) shows another mesh than this check's truth, by up to that much; move the mesh and its "
+               "cameras near the origin";
+    char about[96];
+    std::snprintf(about, sizeof about, "(%.10g, %.10g, %.10g)", origin.x, origin.y, origin.z);
+    return "mesh '" + mesh + "': far from the origin, held about " + about +
+           " as large-world renderers hold it; held at the file's own coordinates in binary32, as a renderer without "
+           "a local origin holds them, " +
+           roundingText(*this) + ": a map rendered so shows another mesh, off by up to that much";
 }
 
 Scene::Scene(const Scene& other)
     : name(other.name),
+      origin(other.origin),
       defaultCamera(other.defaultCamera),
       planarity(other.planarity),
       rounding(other.rounding),
@@ -181,21 +197,55 @@ void validateScene(const Scene& scene)
                 throw Error(what + " has a vertex index out of range (" + std::to_string(index) + ")");
 }
 
+namespace {
+
+// A local origin for a mesh spanning [lo, hi]: the centre of its box on a grid of the power of two
+// at or below its size, so that it prints short and its coordinates about it stay under its size.
+glm::dvec3 localOrigin(const glm::dvec3& lo, const glm::dvec3& hi)
+{
+    const double size = glm::length(hi - lo);
+    const double grid = size > 0 ? std::exp2(std::floor(std::log2(size))) : 1.0;
+    return glm::round((lo + hi) / 2.0 / grid) * grid;
+}
+
+// Holds `scene` about a local origin: each vertex from the file's coordinates (rounding.unrounded,
+// or its binary32 value where binary32 moved nothing), less the origin, rounded once.
+void holdAboutLocalOrigin(Scene& scene)
+{
+    PositionRounding& rounding = scene.rounding;
+    scene.origin = localOrigin(scene.boundsMin(), scene.boundsMax());
+    std::size_t next = 0;  // into rounding.unrounded, by index
+    for (std::size_t v = 0; v < scene.positions.size(); ++v) {
+        glm::dvec3 exact(scene.positions[v]);
+        if (next < rounding.unrounded.size() && rounding.unrounded[next].first == v) exact = rounding.unrounded[next++].second;
+        scene.positions[v] = glm::vec3(exact - scene.origin);
+    }
+}
+
+}  // namespace
+
 Scene frameScene(Scene scene, const std::string& what)
 {
     validateScene(scene);
+    scene.rounding.size = glm::length(scene.boundsMax() - scene.boundsMin());
+    // Whatever stored the vertices, once each, in order (a reader, Scene.from_arrays): their file
+    // coordinates are at hand, and a material move is undone about a local origin.
+    if (scene.rounding.material() && scene.rounding.storedCount == scene.positions.size()) holdAboutLocalOrigin(scene);
+    scene.rounding.unrounded.clear();
+    scene.rounding.unrounded.shrink_to_fit();
     const bool anyArea = std::any_of(scene.triangles.begin(), scene.triangles.end(), [&](const glm::uvec3& t) {
         const glm::dvec3 a(scene.positions[t[0]]), b(scene.positions[t[1]]), c(scene.positions[t[2]]);
         return glm::length(glm::cross(b - a, c - a)) > 0;
     });
     const glm::dvec3 lo = scene.boundsMin(), hi = scene.boundsMax();
-    scene.rounding.size = glm::length(hi - lo);
     if (!anyArea)
         throw Error(what + ": all its " + std::to_string(scene.triangles.size()) +
                     " triangles are degenerate (zero area): nothing to draw" +
-                    (scene.rounding.material() ? ": " + roundingText(scene.rounding) + ": move the mesh near the origin" : ""));
+                    (scene.rounding.material() && !scene.heldAboutOrigin()
+                         ? ": held in binary32, " + roundingText(scene.rounding) + ": move the mesh near the origin"
+                         : ""));
     const double radius = std::max(glm::length(hi - lo) / 2, 1e-6);
-    scene.defaultCamera = framingCameraSpec((lo + hi) / 2.0, radius);
+    scene.defaultCamera = framingCameraSpec(scene.origin + (lo + hi) / 2.0, radius);  // in the world
     scene.chunks = triangleChunksOf(scene);
     return scene;
 }

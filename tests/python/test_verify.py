@@ -335,15 +335,22 @@ def test_verify_reports_the_map_in_its_units_and_counts_values_out_of_range(defa
         default_checker.verify(small_camera, np.full_like(z, -2.0), "eye-z")
 
 
-def test_regression_a_mesh_in_utm_coordinates_was_rounded_to_binary32_without_a_word():
+def test_regression_a_correct_map_of_a_mesh_in_utm_coordinates_was_judged_against_its_binary32_rounding():
     """A wall at northing 4212345.321, 10 m before an OpenCV camera looking north: every pixel's
     eye-z is 10 for the file's digits (a renderer in binary64, or one drawing around a local
-    origin), and 4212345.5 − 4212335.321 = 10.179 for the wall as binary32 holds it (a GPU fed the
-    same floats). zcheck traces the second; both verdicts stand, and the report says why they
-    part, with the move, the coordinates and binary32's step there."""
+    origin), and 4212345.5 − 4212335.321 = 10.179 for the wall as binary32 holds it at the file's
+    coordinates (a GPU fed those floats). zcheck traced the second and called the correct map
+    INCONSISTENT. It now holds the wall about a local origin, as large-world renderers do: the
+    correct map is CONSISTENT, the rounded one is not, and the report says what binary32 at the
+    file's coordinates does (the move, the coordinates and its step there)."""
     x0, y, z0 = 512345.678, 4212345.321, 123.4
     vertices = np.array([[x0 - 30, y, z0 - 30], [x0 + 30, y, z0 - 30], [x0 + 30, y, z0 + 30], [x0 - 30, y, z0 + 30]])
     scene = zcheck.Scene.from_arrays(vertices, [[0, 1, 2], [0, 2, 3]], name="utm wall")
+    # The box's centre (512345.678, 4212345.321, 123.4) on the grid of 64 (the power of two at or
+    # below its diagonal, 84.9): the vertices are held about it, in the world where they were.
+    assert scene.origin.tolist() == [512320.0, 4212352.0, 128.0]
+    assert np.abs(scene.vertices + scene.origin - vertices).max() < 1e-5
+    assert np.abs(scene.bounds[0] - vertices.min(axis=0)).max() < 1e-5
     # OpenCV camera at (x0, y − 10, z0): x east, y down (−up), z north.
     world_from_eye = np.array([[1, 0, 0, x0], [0, 0, 1, y - 10], [0, -1, 0, z0], [0, 0, 0, 1]], dtype=float)
     camera = zcheck.Camera.from_dict({
@@ -351,22 +358,36 @@ def test_regression_a_mesh_in_utm_coordinates_was_rounded_to_binary32_without_a_
         "view": {"world_from_eye": world_from_eye.ravel().tolist(), "layout": "row-major", "vectors": "column"},
         "projection": {"type": "pinhole", "fx": 20, "fy": 20, "cx": 15.5, "cy": 11.5, "near": 1, "far": 100}})
     checker = zcheck.Checker(scene)
+    # Both routes see the file's wall: eye-z 10 at every pixel, to binary64 rounding at 4.2e6.
+    traced = checker.render(camera, "eye-z", route="ray")
+    drawn = checker.render(camera, "eye-z", route="raster")
+    assert np.abs(traced - 10.0).max() < 1e-6
+    assert np.abs(drawn - 10.0).max() < 1e-4  # unorm24 at far/near 100
+    assert checker.check(camera).consistent
+    # World positions are the world's: the wall's northing at every pixel.
+    world = checker.render(camera, "position-world", route="ray", dtype="float64")
+    assert np.abs(world[..., 1] - y).max() < 1e-6
     stored_wall = float(np.float32(y)) - (y - 10)
     assert abs(stored_wall - 10.179) < 1e-9
-    for depth, consistent in ((10.0, False), (stored_wall, True)):
+    for depth, consistent in ((10.0, True), (stored_wall, False)):
         report = checker.verify(camera, np.full((24, 32), depth, dtype=np.float32), "eye-z")
         assert report.consistent == consistent, depth
         warnings = [w for w in report.to_dict()["warnings"] if "binary32" in w]
         assert len(warnings) == 1, report.to_dict()["warnings"]
-        assert warnings[0].startswith("mesh 'utm wall': held in binary32")
+        assert warnings[0].startswith("mesh 'utm wall': far from the origin, held about (512320, 4212352, 128)")
         assert "its vertices moved by up to 0.1793" in warnings[0]
         assert "where binary32 steps by 0.5" in warnings[0]
         assert "binary32" in report.summary()
-    # A pickled scene (worker processes) keeps what its arrays lost: the same warning.
-    unpickled = zcheck.Checker(pickle.loads(pickle.dumps(scene)))
-    assert [w for w in unpickled.verify(camera, np.full((24, 32), 10.0, dtype=np.float32), "eye-z").to_dict()["warnings"]
-            if "binary32" in w] == warnings
-    # The same wall 100 m from the origin: no word.
+    # A pickled scene (worker processes) keeps its origin and what its arrays lost: the same verdict and note.
+    copy = pickle.loads(pickle.dumps(scene))
+    assert copy.origin.tolist() == scene.origin.tolist()
+    unpickled = zcheck.Checker(copy).verify(camera, np.full((24, 32), 10.0, dtype=np.float32), "eye-z")
+    assert unpickled.consistent
+    assert [w for w in unpickled.to_dict()["warnings"] if "binary32" in w] == [
+        w for w in checker.verify(camera, np.full((24, 32), 10.0, dtype=np.float32), "eye-z").to_dict()["warnings"]
+        if "binary32" in w]
+    # The same wall 100 m from the origin: no word, and held where it is.
     near = zcheck.Scene.from_arrays(vertices - [x0 - 100, y - 100, z0], [[0, 1, 2], [0, 2, 3]], name="near wall")
+    assert near.origin.tolist() == [0.0, 0.0, 0.0]
     assert not [w for w in zcheck.Checker(near).check(near.default_camera.replace(width=32, height=24)).to_dict()["warnings"]
                 if "binary32" in w]

@@ -271,6 +271,8 @@ public:
     // What it was made for.
     const Scene& scene() const { return scene_; }
     const Camera& camera() const { return camera_; }
+    // The camera in the scene's frame (CameraInSceneFrame): what meets scene().positions.
+    const Camera& cameraInSceneFrame() const { return local_.get(); }
     const ToleranceModel& tolerance() const { return tolerance_; }
 
 private:
@@ -280,6 +282,7 @@ private:
 
     const Scene& scene_;
     const Camera& camera_;
+    CameraInSceneFrame local_;  // cameraInSceneFrame()
     ToleranceModel tolerance_;
     ToleranceTerms terms_;
     KernelForm form_;  // form()

@@ -261,6 +261,14 @@ struct IntrinsicParameter {
 std::vector<IntrinsicParameter> intrinsicParameters(const Projection& projection, IntrinsicChange change,
                                                     const glm::dvec2& focalScale, const glm::dvec2& principalShift);
 
+// The same camera in a world moved by −origin: the frame a scene far from the world's origin is
+// held in (Scene::origin). Eye space, projection, lens and image are the camera's own; only the
+// view's place moves, in binary64 (eye and scene then meet to ~2^-53 of their distance from the
+// world's origin, where binary32 positions would part by ~2^-24 of it). A zero origin gives the
+// camera unchanged.
+CameraSpec cameraSpecAboutOrigin(CameraSpec spec, const glm::dvec3& origin);
+Camera cameraAboutOrigin(const Camera& camera, const glm::dvec3& origin);
+
 // A camera that sees a bounding sphere (centre, radius) whole, looking at it from the front
 // right and above, 640×480, near/far hugging the sphere. Used for meshes without a camera.
 CameraSpec framingCameraSpec(const glm::dvec3& centre, double radius);

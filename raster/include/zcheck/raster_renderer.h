@@ -39,7 +39,7 @@ namespace zcheck {
 // render(); the defaults are the correct chain).
 struct RasterFaults {
     bool overrideClipFromWorld = false;  // draw with `clipFromWorld` instead of the camera's
-    glm::dmat4 clipFromWorld{1.0};       // (a wrong projection or view matrix)
+    glm::dmat4 clipFromWorld{1.0};       // (a wrong projection or view matrix; the world's, as cameras are)
     bool noNearClip = false;             // clip against the far plane and guard band only
     bool screenLinearEyeZ = false;       // interpolate eye-z linearly in screen space, then map it to depth
     bool viewportMinusOne = false;       // viewport scaled by (width − 1, height − 1)
@@ -53,7 +53,8 @@ struct RasterFaults {
 // One camera's frame made ready to draw (RasterRenderer::prepare): vertices snapped, triangles
 // set up and binned. Its tiles (kTileSize squares numbered row by row) can then be drawn in
 // any order, from several threads at once: a check that compares tile by tile draws a tile
-// into a buffer of its own. Holds copies of the camera and faults; the scene must outlive it.
+// into a buffer of its own. Holds copies of the camera (a world camera, moved into the frame of
+// a scene held about a local origin: CameraInSceneFrame) and faults; the scene must outlive it.
 class RasterFrame {
 public:
     RasterFrame(const Scene& scene, const Camera& camera, const RasterFaults& faults);

@@ -105,7 +105,9 @@ public:
     RayRenderer(const RayRenderer&) = delete;
     RayRenderer& operator=(const RayRenderer&) = delete;
 
-    // EyePoints::Keep also fills RenderResult::pEye (24 bytes per pixel more).
+    // Cameras are the world's; a scene held about a local origin (Scene::origin) is traced with
+    // each camera moved into its frame. EyePoints::Keep also fills RenderResult::pEye (24 bytes
+    // per pixel more).
     RenderResult render(const Camera& camera, const RayFaults& faults = {}, EyePoints eyePoints = EyePoints::Omit) const;
 
     // The pixels `rect` of render(camera, faults), each one written (a miss: the clear value
@@ -128,6 +130,11 @@ public:
     int embreeNativePacket() const;
 
 private:
+    // traceRect for a camera already in the scene's frame (CameraInSceneFrame).
+    void traceRectInSceneFrame(const Camera& camera, const PixelRect& rect, double* windowDepth,
+                               std::uint32_t* primitiveId, std::size_t stride, const RayFaults& faults,
+                               glm::dvec3* pEye) const;
+
     struct Embree;
     std::unique_ptr<Embree> embree_;
     const Scene& scene_;

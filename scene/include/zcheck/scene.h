@@ -1,8 +1,9 @@
 #pragma once
-// Scenes: a triangle soup in world space plus the camera it is best looked at with.
+// Scenes: a triangle soup plus the camera it is best looked at with.
 //
-// Positions are binary32 (what a GPU and Embree consume); every route converts them to
-// double before it transforms them. Scenes are addressed by name: `builtin:NAME[?k=v&…]`
+// Positions are binary32 (what a GPU and Embree consume), in the world or, for a mesh far from
+// the world's origin, about a local origin (Scene::origin); every route converts them to double
+// before it transforms them. Scenes are addressed by name: `builtin:NAME[?k=v&…]`
 // or a mesh file path (loaded by mesh_loader.h).
 #include "zcheck/camera.h"
 #include "zcheck/camera_import.h"
@@ -11,6 +12,8 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -35,13 +38,14 @@ struct PolygonPlanarity {
     std::string warning(const std::string& mesh) const;
 };
 
-// How far storing a mesh's coordinates as binary32 (what zcheck, Embree and a GPU hold) moved
-// its vertices. A file may hold more digits (OBJ and PLY text, PLY doubles, a glTF node's
-// transform applied in binary64, a Python float64 array). Near the origin the move is below
-// 2^-24 of the mesh's size and nobody draws anything else; far from it against the mesh's size
-// (UTM or ECEF coordinates: binary32 steps by 0.5 at 4.2e6) the stored mesh is another mesh, and a
-// renderer keeping the file's digits (binary64, or a local origin as large-world engines do) draws
-// the file's: its maps then disagree with zcheck's truth by up to the move, and reports say so.
+// How far binary32 (what zcheck, Embree and a GPU hold) would move a mesh's vertices at the file's
+// own coordinates. A file may hold more digits (OBJ and PLY text, PLY doubles, a glTF node's
+// transform applied in binary64, a Python float64 array). Near the origin the move is below 2^-24
+// of the mesh's size and nobody draws anything else; far from it against the mesh's size (UTM or
+// ECEF coordinates: binary32 steps by 0.5 at 4.2e6) the rounded mesh is another mesh. frameScene
+// then holds the mesh about a local origin (Scene::origin), as large-world renderers do, and
+// keeps the file's mesh to binary32 of its own size; what is recorded here is what a renderer
+// holding the file's coordinates in binary32 draws instead, which reports name.
 struct PositionRounding {
     // A move over this fraction of the mesh's size (its bounding box's diagonal) is material: the
     // coordinates lie some ten sizes or more from the origin. A camera that sees the mesh stands
@@ -51,12 +55,18 @@ struct PositionRounding {
     double largestMove = 0;     // the longest distance a vertex moved, in the file's units
     glm::dvec3 movedVertex{0};  // that vertex as the file holds it
     double size = 0;            // the stored mesh's bounding-box diagonal (frameScene sets it)
+    // The file's coordinates of every vertex binary32 moved, by its index, until frameScene has
+    // placed the mesh (then emptied): what it holds about a local origin when the move is material.
+    std::vector<std::pair<std::size_t, glm::dvec3>> unrounded;
+    std::size_t storedCount = 0;  // store() calls, i.e. the index of the next vertex
 
     // `position` as binary32 (the caller has checked it is within range), its move recorded.
+    // A reader calls it once per vertex, in the order of Scene::positions.
     glm::vec3 store(const glm::dvec3& position);
     bool material() const { return largestMove > kMaterial * size; }
-    // "" unless material(); else one sentence naming `mesh`, the move and what to do.
-    std::string warning(const std::string& mesh) const;
+    // "" unless material(); else one sentence naming `mesh`, the move, and where the mesh is held
+    // (`origin`, Scene::origin; zero: at the file's coordinates, and the move is this check's own).
+    std::string warning(const std::string& mesh, const glm::dvec3& origin = glm::dvec3(0.0)) const;
 };
 
 // Bounding boxes of runs of consecutive triangles (meshes keep neighbours close), so that a
@@ -64,7 +74,7 @@ struct PositionRounding {
 // what cannot change its answer. Made once per scene (indexTriangleChunks).
 struct TriangleChunks {
     static constexpr std::size_t kSize = 1024;  // triangles per chunk; the last may hold fewer
-    std::vector<glm::vec3> lo, hi;              // per chunk, world space
+    std::vector<glm::vec3> lo, hi;              // per chunk, in the scene's frame
 };
 
 struct Scene {
@@ -77,7 +87,12 @@ struct Scene {
     Scene& operator=(Scene&&) = default;
 
     std::string name;                     // as addressed: "builtin:default", a file path
-    std::vector<glm::vec3> positions;     // world space
+    // World = origin + position: zero but for a mesh whose file coordinates binary32 would have
+    // moved materially (PositionRounding), which frameScene holds about the centre of its box.
+    // Cameras stay in the world; whatever meets them with positions goes through worldPosition()
+    // or a camera in the scene's frame (CameraInSceneFrame).
+    glm::dvec3 origin{0.0};
+    std::vector<glm::vec3> positions;     // the scene's frame: world − origin
     std::vector<glm::uvec3> triangles;    // indices into positions; the index is the primitive id
     CameraSpec defaultCamera;             // used when the user gives no camera file
     PolygonPlanarity planarity;           // of the file's polygons (mesh files; none built in)
@@ -87,10 +102,39 @@ struct Scene {
     std::shared_ptr<const TriangleChunks> chunks;  // made by indexTriangleChunks; none: made on use
 
     std::size_t triangleCount() const { return triangles.size(); }
-    glm::dvec3 boundsMin() const;
+    bool heldAboutOrigin() const { return origin != glm::dvec3(0.0); }
+    // Vertex v in the world, in binary64 (exactly its position when origin is zero).
+    glm::dvec3 worldPosition(std::size_t v) const
+    {
+        return heldAboutOrigin() ? origin + glm::dvec3(positions[v]) : glm::dvec3(positions[v]);
+    }
+    // Triangle t's plane in the world: `normal` = cross(b − a, c − a) of its positions (their
+    // differences exact in binary64, wherever the scene is held) through `point`, its first
+    // corner in the world (worldPosition).
+    struct Plane {
+        glm::dvec3 normal, point;
+    };
+    Plane worldPlane(std::size_t t) const;
+    glm::dvec3 boundsMin() const;  // in the scene's frame (add origin for the world's)
     glm::dvec3 boundsMax() const;
     // Appends another soup (indices are offset).
     void append(const std::vector<glm::vec3>& morePositions, const std::vector<glm::uvec3>& moreTriangles);
+};
+
+// A world camera as the routes draw a scene with: moved by −scene.origin (cameraAboutOrigin), so
+// that eye and vertices meet in the scene's frame; the camera itself when the origin is zero.
+class CameraInSceneFrame {
+public:
+    CameraInSceneFrame(const Scene& scene, const Camera& camera)
+        : given_(camera), moved_(scene.heldAboutOrigin() ? std::optional<Camera>(cameraAboutOrigin(camera, scene.origin))
+                                                         : std::nullopt)
+    {
+    }
+    const Camera& get() const { return moved_ ? *moved_ : given_; }
+
+private:
+    const Camera& given_;
+    std::optional<Camera> moved_;
 };
 
 // Throws Error for a scene with no triangles or an index out of range.
@@ -99,9 +143,10 @@ void validateScene(const Scene& scene);
 // The scene's TriangleChunks (indices must be valid). loadScene and frameScene make them.
 std::shared_ptr<const TriangleChunks> triangleChunksOf(const Scene& scene);
 
-// Makes a triangle soup a scene to check: validates it (validateScene), refuses it when no
-// triangle has a nonzero area (nothing to draw; naming binary32's rounding when it was material),
-// sets rounding.size, and gives it a default camera that frames its
+// Makes a triangle soup a scene to check: validates it (validateScene), sets rounding.size, holds
+// it about a local origin when binary32 at the file's coordinates moved it materially (its
+// vertices then rounded again from rounding.unrounded, about the centre of its box), refuses it
+// when no triangle has a nonzero area (nothing to draw), and gives it a default camera that frames its
 // bounding sphere (framingCameraSpec). Messages begin with `what` ("cannot load mesh 'a.obj'").
 // The mesh loader and the Python module's Scene.from_arrays use it.
 Scene frameScene(Scene scene, const std::string& what);
