@@ -262,7 +262,11 @@ TEST_CASE("regression: a mesh in UTM coordinates was rounded to binary32 without
         // Each vertex, in the world, is the file's to binary32 of the mesh's own size (2^-24 of
         // coordinates under 1.5 about the origin), not to the 0.5 steps at 4.2e6.
         for (int v = 0; v < 3; ++v) REQUIRE(glm::length(scene.worldPosition(v) - file[v]) < 1e-7);
-        REQUIRE(scene.rounding.unrounded.empty());  // freed once placed
+        REQUIRE(scene.rounding.residual.empty());  // freed once placed
+        // Framed again (a copy, a pickle), it stays where it is held.
+        const Scene again = frameScene(scene, "again");
+        REQUIRE(again.origin == scene.origin);
+        REQUIRE(again.positions == scene.positions);
         const std::string warning = scene.rounding.warning(mesh, scene.origin);
         REQUIRE_THAT(warning, Catch::StartsWith("mesh '" + mesh + "': far from the origin, held about (512346, 4212346, 123)"));
         REQUIRE_THAT(warning, Catch::Contains("its vertices moved by up to 0.1793"));

@@ -84,10 +84,10 @@ bool unormInBinary32(const Camera& camera, const DepthMap& map)
     return map.valueStep.empty() && unormInBinary32(camera, map.quantity, map.valueQuantum);
 }
 
-// Window depth of a triangle's plane where the pixel's ray meets it (NaN if it does not).
-double planeWindowDepth(const Scene& scene, const Camera& camera, std::uint32_t primitive, const EyePlaneRay& ray)
+// Window depth of a triangle's plane (in the frame of `camera` and `ray`) where the pixel's ray
+// meets it (NaN if it does not).
+double planeWindowDepth(const Camera& camera, const Scene::Plane& plane, const EyePlaneRay& ray)
 {
-    const Scene::Plane plane = scene.worldPlane(primitive);
     const double s = glm::dot(plane.normal, plane.point - ray.origin) / glm::dot(plane.normal, ray.direction);
     return std::isfinite(s) ? windowFromWorld(camera, ray.origin + s * ray.direction).z : NAN;
 }
@@ -224,25 +224,26 @@ MapPixel MapReader::read(int col, int row, bool search) const
         return out;
     }
     double closest = INFINITY;
-    const EyePlaneRay ray = worldEyePlaneRayThroughWindow(camera_, pWindow);
+    // The candidates' corners meet the camera in the scene's frame, as the judge's rules do.
+    const Camera& local = judge_.cameraInSceneFrame();
+    const EyePlaneRay ray = worldEyePlaneRayThroughWindow(local, pWindow);
     considered.clear();
     auto consider = [&](std::uint32_t candidate) {
         if (candidate == here || std::find(considered.begin(), considered.end(), candidate) != considered.end()) return;
         considered.push_back(candidate);
         const glm::uvec3 t = scene_.triangles[candidate];
-        const glm::dvec3 a = scene_.worldPosition(t[0]), b = scene_.worldPosition(t[1]), c = scene_.worldPosition(t[2]);
+        const glm::dvec3 a(scene_.positions[t[0]]), b(scene_.positions[t[1]]), c(scene_.positions[t[2]]);
         // The candidate's depths within S of the centre: its plane's depth on the pixel's ray,
         // give or take its tolerance; or, where that leaves the map's depth out, the depths its
         // drawn polygon takes within S, give or take the tolerance of a face-on surface. The
         // two agree for a triangle seen at an angle; only the second holds for one seen edge-on
-        // or made a line by binary32 positions far from the origin, whose plane the ray meets
-        // anywhere or nowhere (the regression "verify rejected the raster's sliver of a
-        // triangle without area").
-        const double plane = planeWindowDepth(scene_, camera_, candidate, ray);
+        // or made a line by its binary32 corners, whose plane the ray meets anywhere or nowhere
+        // (the regression "verify rejected the raster's sliver of a triangle without area").
+        const double plane = planeWindowDepth(local, {glm::cross(b - a, c - a), a}, ray);
         const double tolerance = judge_.surfaceTolerance(candidate, q, allowance);
         double lo = plane - tolerance, hi = plane + tolerance, gap = std::abs(plane - depth);
         if (!(depth >= lo && depth <= hi)) {
-            const WindowDepthRange drawn = drawnDepthsNear(camera_, a, b, c, pWindow, judge_.snapPixels());
+            const WindowDepthRange drawn = drawnDepthsNear(local, a, b, c, pWindow, judge_.snapPixels());
             if (drawn.empty()) return;
             const double flat = judge_.toleranceForSlope(0, q, allowance);
             lo = drawn.lo - flat, hi = drawn.hi + flat;
@@ -253,7 +254,7 @@ MapPixel MapReader::read(int col, int row, bool search) const
             lo = std::min(lo, truthDepth - truthTolerance), hi = std::max(hi, truthDepth + truthTolerance);
         }
         if (!(depth >= lo && depth <= hi) || gap >= closest) return;
-        if (!insideDrawnTriangle(camera_, a, b, c, pWindow) && !judge_.nearEdge(candidate, pWindow)) return;
+        if (!insideDrawnTriangle(local, a, b, c, pWindow) && !judge_.nearEdge(candidate, pWindow)) return;
         const bool explained = here != kNoPrimitive
                                    ? judge_.bothHit(truthDepth, here, depth, candidate, q, pWindow, bound, allowance) != PixelClass::DepthError
                                    : judge_.nearEdge(candidate, pWindow) || judge_.atClipPlane(candidate, pWindow);
@@ -414,7 +415,7 @@ Probe probeAgreement(const Scene& scene, const RayRenderer& rays, const Camera& 
         const std::uint32_t primitive = rays.primitiveAt(camera, pWindow);
         const double truthDepth = primitive == kNoPrimitive
                                       ? camera.clearDepth()
-                                      : planeWindowDepth(scene, camera, primitive, worldEyePlaneRayThroughWindow(camera, pWindow));
+                                      : planeWindowDepth(camera, scene.worldPlane(primitive), worldEyePlaneRayThroughWindow(camera, pWindow));
         const MapPixel pixel = mapPixelDepth(camera, map, col, row, truthDepth);
         if (primitive == kNoPrimitive && !std::isfinite(pixel.depth)) return;  // background: says nothing
         ++seen;

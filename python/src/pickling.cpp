@@ -133,7 +133,7 @@ py::tuple sceneState(const Scene& scene)
     return py::make_tuple("arrays", scene.name, bytesOf(scene.positions.data(), scene.positions.size()),
                           bytesOf(scene.triangles.data(), scene.triangles.size()),
                           py::make_tuple(r.largestMove, r.movedVertex.x, r.movedVertex.y, r.movedVertex.z),
-                          py::make_tuple(scene.origin.x, scene.origin.y, scene.origin.z));
+                          py::make_tuple(scene.origin.x, scene.origin.y, scene.origin.z), r.size);
 }
 
 Scene sceneFromState(const py::tuple& state)
@@ -152,8 +152,14 @@ Scene sceneFromState(const py::tuple& state)
     if (state.size() > 5) {  // the local origin its positions are held about (Scene::origin)
         const auto o = state[5].cast<std::tuple<double, double, double>>();
         scene.origin = {std::get<0>(o), std::get<1>(o), std::get<2>(o)};
+        for (int k = 0; k < 3; ++k)
+            if (!(std::abs(scene.origin[k]) <= 1e15))
+                throw Error("a pickled Scene: its origin (" + formatNumber(scene.origin.x) + ", " + formatNumber(scene.origin.y) +
+                            ", " + formatNumber(scene.origin.z) + ") is not a point within 1e15 of the world's");
     }
-    return frameScene(std::move(scene), "a pickled Scene");
+    scene = frameScene(std::move(scene), "a pickled Scene");
+    if (state.size() > 6) scene.rounding.size = state[6].cast<double>();  // the file's mesh's, as the warning gave it
+    return scene;
 }
 
 py::tuple reportState(const PyReport& r)

@@ -386,6 +386,11 @@ def test_regression_a_correct_map_of_a_mesh_in_utm_coordinates_was_judged_agains
     assert [w for w in unpickled.to_dict()["warnings"] if "binary32" in w] == [
         w for w in checker.verify(camera, np.full((24, 32), 10.0, dtype=np.float32), "eye-z").to_dict()["warnings"]
         if "binary32" in w]
+    # A tampered pickle's origin is refused, named.
+    state = list(scene.__getstate__())
+    state[5] = (float("nan"), 0.0, 0.0)
+    with pytest.raises(zcheck.Error, match=r"a pickled Scene: its origin \(nan, 0, 0\) is not a point within 1e15"):
+        zcheck.Scene.__new__(zcheck.Scene).__setstate__(tuple(state))
     # The same wall 100 m from the origin: no word, and held where it is.
     near = zcheck.Scene.from_arrays(vertices - [x0 - 100, y - 100, z0], [[0, 1, 2], [0, 2, 3]], name="near wall")
     assert near.origin.tolist() == [0.0, 0.0, 0.0]

@@ -13,7 +13,6 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
-#include <utility>
 #include <string>
 #include <vector>
 
@@ -55,10 +54,12 @@ struct PositionRounding {
     double largestMove = 0;     // the longest distance a vertex moved, in the file's units
     glm::dvec3 movedVertex{0};  // that vertex as the file holds it
     double size = 0;            // the stored mesh's bounding-box diagonal (frameScene sets it)
-    // The file's coordinates of every vertex binary32 moved, by its index, until frameScene has
-    // placed the mesh (then emptied): what it holds about a local origin when the move is material.
-    std::vector<std::pair<std::size_t, glm::dvec3>> unrounded;
-    std::size_t storedCount = 0;  // store() calls, i.e. the index of the next vertex
+    // What binary32 left of each vertex's file coordinates (file − stored, itself in binary32:
+    // the file's value to ~2^-48 of it), by index from the first vertex that moved (empty while
+    // none has), until frameScene has placed the mesh: what it rounds again about a local origin
+    // when the move is material.
+    std::vector<glm::vec3> residual;
+    std::size_t storedCount = 0;  // store() calls since the last frameScene: the index of the next vertex
 
     // `position` as binary32 (the caller has checked it is within range), its move recorded.
     // A reader calls it once per vertex, in the order of Scene::positions.
@@ -145,7 +146,7 @@ std::shared_ptr<const TriangleChunks> triangleChunksOf(const Scene& scene);
 
 // Makes a triangle soup a scene to check: validates it (validateScene), sets rounding.size, holds
 // it about a local origin when binary32 at the file's coordinates moved it materially (its
-// vertices then rounded again from rounding.unrounded, about the centre of its box), refuses it
+// vertices then rounded again from rounding.residual, about the centre of its box), refuses it
 // when no triangle has a nonzero area (nothing to draw), and gives it a default camera that frames its
 // bounding sphere (framingCameraSpec). Messages begin with `what` ("cannot load mesh 'a.obj'").
 // The mesh loader and the Python module's Scene.from_arrays use it.
