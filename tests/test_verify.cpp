@@ -899,7 +899,7 @@ TEST_CASE("regression: a correct map of a mesh in UTM coordinates was judged aga
     file.triangles = home.triangles;
     // The same binary32 values with nothing to undo them: what a renderer without a local origin draws.
     Scene rounded = file;
-    rounded.rounding.storedCount = 0;
+    rounded.rounding.residual.clear();  // the file's coordinates not kept
     const Scene away = frameScene(std::move(file), "away");
     REQUIRE(away.heldAboutOrigin());
     REQUIRE(away.rounding.largestMove > 0.1);

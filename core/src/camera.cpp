@@ -434,19 +434,15 @@ double Camera::ndcZFromWindowDepth(double windowDepth) const
     return (windowDepth - windowFromNdc[3][2]) / windowFromNdc[2][2];
 }
 
-CameraSpec cameraSpecAboutOrigin(CameraSpec spec, const glm::dvec3& origin)
+Camera cameraAboutOrigin(const Camera& camera, const glm::dvec3& origin)
 {
-    if (origin == glm::dvec3(0.0)) return spec;
+    if (origin == glm::dvec3(0.0)) return camera;
+    CameraSpec spec = camera.spec();
     View& view = spec.view;
     view.eye -= origin, view.target -= origin;  // an axonometric view's eye follows its target
     // eye ← world ← frame: the rotation's columns as they were, the translation R·origin + t.
     if (view.hasMatrix) view.eyeFromWorld[3] = view.eyeFromWorld * glm::dvec4(origin, 1.0);
-    return spec;
-}
-
-Camera cameraAboutOrigin(const Camera& camera, const glm::dvec3& origin)
-{
-    return origin == glm::dvec3(0.0) ? camera : Camera(cameraSpecAboutOrigin(camera.spec(), origin));
+    return Camera(spec);
 }
 
 CameraSpec framingCameraSpec(const glm::dvec3& centre, double radius)

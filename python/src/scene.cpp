@@ -127,9 +127,7 @@ Raises zcheck.Error naming the argument, the entry and the rule.)doc")
         .def_property_readonly(
             "bounds",
             [](const Scene& s) {
-                const glm::dvec3 lo = s.boundsMin(), hi = s.boundsMax();
-                if (!s.heldAboutOrigin()) return py::make_tuple(arrayFromVec3(lo), arrayFromVec3(hi));
-                return py::make_tuple(arrayFromVec3(s.origin + lo), arrayFromVec3(s.origin + hi));
+                return py::make_tuple(arrayFromVec3(s.worldFromScene(s.boundsMin())), arrayFromVec3(s.worldFromScene(s.boundsMax())));
             },
             "(min, max) corners of the axis-aligned bounding box, world coordinates.")
         .def_property_readonly(

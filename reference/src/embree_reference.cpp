@@ -76,7 +76,7 @@ EmbreeReference::EmbreeReference(const Scene& scene) : embree_(std::make_unique<
         throw Error("reference: Embree could not allocate geometry buffers");
     }
     embree_->frameOrigin = glm::dvec3(glm::vec3((scene.boundsMin() + scene.boundsMax()) / 2.0));
-    embree_->worldFrameOrigin = scene.heldAboutOrigin() ? scene.origin + embree_->frameOrigin : embree_->frameOrigin;
+    embree_->worldFrameOrigin = scene.worldFromScene(embree_->frameOrigin);
     for (std::size_t v = 0; v < scene.positions.size(); ++v)
         for (int k = 0; k < 3; ++k) vertices[3 * v + k] = float(double(scene.positions[v][k]) - embree_->frameOrigin[k]);
     rtcCommitGeometry(geometry);

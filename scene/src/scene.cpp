@@ -218,12 +218,12 @@ glm::dvec3 localOrigin(const glm::dvec3& lo, const glm::dvec3& hi)
     return glm::round((lo + hi) / 2.0 / grid) * grid;
 }
 
-// Holds `scene` about a local origin: each vertex from the file's coordinates (its binary32 value
-// and what binary32 left, rounding.residual), less the origin, rounded once.
-void holdAboutLocalOrigin(Scene& scene)
+// Holds `scene`, spanning [lo, hi], about a local origin: each vertex from the file's coordinates
+// (its binary32 value and what binary32 left, rounding.residual), less the origin, rounded once.
+void holdAboutLocalOrigin(Scene& scene, const glm::dvec3& lo, const glm::dvec3& hi)
 {
     const std::vector<glm::vec3>& residual = scene.rounding.residual;
-    scene.origin = localOrigin(scene.boundsMin(), scene.boundsMax());
+    scene.origin = localOrigin(lo, hi);
     for (std::size_t v = 0; v < scene.positions.size(); ++v) {
         const glm::dvec3 file = glm::dvec3(scene.positions[v]) + glm::dvec3(residual[v]);
         scene.positions[v] = glm::vec3(file - scene.origin);
@@ -235,21 +235,22 @@ void holdAboutLocalOrigin(Scene& scene)
 Scene frameScene(Scene scene, const std::string& what)
 {
     validateScene(scene);
-    scene.rounding.size = glm::length(scene.boundsMax() - scene.boundsMin());
-    // Whatever stored the vertices, once each, in order (a reader, Scene.from_arrays): their file
-    // coordinates are at hand, and a material move is undone about a local origin (once: a scene
-    // framed again keeps its origin).
+    glm::dvec3 lo = scene.boundsMin(), hi = scene.boundsMax();
+    scene.rounding.size = glm::length(hi - lo);
+    // Whatever stored the vertices, once each, in order (a reader, Scene.from_arrays: a residual
+    // for each vertex, once one moved): their file coordinates are at hand, and a material move is
+    // undone about a local origin (once: a scene framed again keeps its origin).
     PositionRounding& rounding = scene.rounding;
-    if (rounding.material() && !scene.heldAboutOrigin() && rounding.storedCount == scene.positions.size() &&
-        rounding.residual.size() == scene.positions.size())
-        holdAboutLocalOrigin(scene);
+    if (rounding.material() && !scene.heldAboutOrigin() && rounding.residual.size() == scene.positions.size()) {
+        holdAboutLocalOrigin(scene, lo, hi);
+        lo = scene.boundsMin(), hi = scene.boundsMax();
+    }
     rounding.residual = {};
     rounding.storedCount = 0;
     const bool anyArea = std::any_of(scene.triangles.begin(), scene.triangles.end(), [&](const glm::uvec3& t) {
         const glm::dvec3 a(scene.positions[t[0]]), b(scene.positions[t[1]]), c(scene.positions[t[2]]);
         return glm::length(glm::cross(b - a, c - a)) > 0;
     });
-    const glm::dvec3 lo = scene.boundsMin(), hi = scene.boundsMax();
     if (!anyArea)
         throw Error(what + ": all its " + std::to_string(scene.triangles.size()) +
                     " triangles are degenerate (zero area): nothing to draw" +
@@ -257,8 +258,7 @@ Scene frameScene(Scene scene, const std::string& what)
                          ? ": held in binary32, " + roundingText(scene.rounding) + ": move the mesh near the origin"
                          : ""));
     const double radius = std::max(glm::length(hi - lo) / 2, 1e-6);
-    const glm::dvec3 centre = (lo + hi) / 2.0;
-    scene.defaultCamera = framingCameraSpec(scene.heldAboutOrigin() ? scene.origin + centre : centre, radius);  // in the world
+    scene.defaultCamera = framingCameraSpec(scene.worldFromScene((lo + hi) / 2.0), radius);  // in the world
     scene.chunks = triangleChunksOf(scene);
     return scene;
 }

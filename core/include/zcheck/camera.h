@@ -266,7 +266,6 @@ std::vector<IntrinsicParameter> intrinsicParameters(const Projection& projection
 // view's place moves, in binary64 (eye and scene then meet to ~2^-53 of their distance from the
 // world's origin, where binary32 positions would part by ~2^-24 of it). A zero origin gives the
 // camera unchanged.
-CameraSpec cameraSpecAboutOrigin(CameraSpec spec, const glm::dvec3& origin);
 Camera cameraAboutOrigin(const Camera& camera, const glm::dvec3& origin);
 
 // A camera that sees a bounding sphere (centre, radius) whole, looking at it from the front

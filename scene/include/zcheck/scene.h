@@ -104,11 +104,11 @@ struct Scene {
 
     std::size_t triangleCount() const { return triangles.size(); }
     bool heldAboutOrigin() const { return origin != glm::dvec3(0.0); }
-    // Vertex v in the world, in binary64 (exactly its position when origin is zero).
-    glm::dvec3 worldPosition(std::size_t v) const
-    {
-        return heldAboutOrigin() ? origin + glm::dvec3(positions[v]) : glm::dvec3(positions[v]);
-    }
+    // A point of the scene's frame in the world, in binary64 (the same bits when origin is zero:
+    // 0 + x would turn −0 into +0).
+    glm::dvec3 worldFromScene(const glm::dvec3& pScene) const { return heldAboutOrigin() ? origin + pScene : pScene; }
+    // Vertex v in the world.
+    glm::dvec3 worldPosition(std::size_t v) const { return worldFromScene(glm::dvec3(positions[v])); }
     // Triangle t's plane in the world: `normal` = cross(b − a, c − a) of its positions (their
     // differences exact in binary64, wherever the scene is held) through `point`, its first
     // corner in the world (worldPosition).
