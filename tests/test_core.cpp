@@ -10,6 +10,7 @@
 #include "zcheck/large_buffer.h"
 #include "zcheck/tile_grid.h"
 
+#include "binary32_shapes.h"
 #include "matrix_assert.h"
 
 #include <catch2/catch.hpp>
@@ -374,6 +375,17 @@ TEST_CASE("storage quanta and quantization follow the formats' definitions", "[c
     REQUIRE(quantizeDepth(DepthFormat::Unorm16, 0.5) == 32768.0 / 65535);  // round(0.5·65535) = 32768
     REQUIRE(quantizeDepth(DepthFormat::Unorm16, 1.2) == 1.0);
     REQUIRE(quantizeDepth(DepthFormat::Float32, 0.1) == double(0.1f));
+}
+
+namespace {
+struct PlainRound {  // as zcheck's own sources may write it
+    static double of(double x) { return double(float(x)); }
+};
+}  // namespace
+
+TEST_CASE("regression: GCC 12's SLP vectoriser took double(float(x)) for x", "[core]")
+{
+    binary32_shapes::requireBothShapesRound<PlainRound>();
 }
 
 TEST_CASE("a unorm code's value without a division is the quotient code / (2^N - 1), every code of both formats", "[core]")

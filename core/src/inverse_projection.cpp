@@ -215,7 +215,7 @@ DepthValueKind kindOfDepthValue(const Camera& camera, DepthQuantity quantity, do
     const double window = ndc ? camera.windowDepthFromNdcZ(value) : value;
     for (const double missWindow : {camera.clearDepth(), camera.windowDepthFar()}) {
         const double miss = ndc ? camera.ndcZFromWindowDepth(missWindow) : missWindow;
-        if (window == missWindow || value == miss || value == double(float(miss))) return DepthValueKind::Miss;
+        if (window == missWindow || value == miss || value == roundedToBinary32(miss)) return DepthValueKind::Miss;
     }
     return DepthValueKind::Depth;
 }

@@ -1,6 +1,7 @@
 #include "zcheck/point_cloud.h"
 
 #include "zcheck/atomic_file.h"
+#include "zcheck/convention.h"
 #include "zcheck/error.h"
 
 #include <cstdint>
@@ -30,8 +31,8 @@ void writePointCloudPly(const std::string& path, const std::vector<glm::dvec3>& 
     } else {
         char line[64];
         for (const auto& p : points) {
-            const int n = std::snprintf(line, sizeof line, "%.9g %.9g %.9g\n", double(float(p.x)), double(float(p.y)),
-                                        double(float(p.z)));
+            const int n = std::snprintf(line, sizeof line, "%.9g %.9g %.9g\n", roundedToBinary32(p.x),
+                                        roundedToBinary32(p.y), roundedToBinary32(p.z));
             bytes.append(line, std::size_t(n));
         }
     }

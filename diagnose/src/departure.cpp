@@ -79,7 +79,7 @@ DepthMap departedReading(const Camera& declared, const DepthMap& map, const Depa
             // 1.002 and back is 1 − 2^−25, which only rounding returns to the far plane.
             double& v = out.value[std::size_t(row) * map.width + col];
             const double undone = (v - d.valueOffset) / d.valueScale;
-            v = isMiss(declared, v, map.quantity) || isMiss(declared, double(float(undone)), map.quantity) ? NAN : undone;
+            v = isMiss(declared, v, map.quantity) || isMiss(declared, roundedToBinary32(undone), map.quantity) ? NAN : undone;
         }
     const double scale = std::abs(d.valueScale);
     out.valueQuantum /= scale, out.accuracy.quantum /= scale, out.accuracy.absolute /= scale;

@@ -193,7 +193,7 @@ DepthMap renderedMap(const Checker& checker, const Camera& camera, DepthQuantity
     const QuantityImage image = checker.render(camera, exportQuantityOf(quantity), Route::Ray);
     std::vector<double> values(image.value.size());
     for (std::size_t i = 0; i < values.size(); ++i)
-        values[i] = image.isMiss(i) || !std::isfinite(image.value[i]) ? 0.0 : double(float(image.value[i]));
+        values[i] = image.isMiss(i) || !std::isfinite(image.value[i]) ? 0.0 : roundedToBinary32(image.value[i]);
     return DepthMap::exact(camera.width(), camera.height(), quantity, std::move(values));
 }
 

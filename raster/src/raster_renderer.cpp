@@ -272,7 +272,7 @@ struct DepthKeys {
     // (unormCode's arithmetic, with maxCode = unormMax(format)).
     double key(double windowDepth) const
     {
-        return unorm ? nearbyintNonNegative(std::clamp(windowDepth, 0.0, 1.0) * maxCode) : double(float(windowDepth));
+        return unorm ? nearbyintNonNegative(std::clamp(windowDepth, 0.0, 1.0) * maxCode) : roundedToBinary32(windowDepth);
     }
     // The values n keys stand for, as the buffer stores them (a tile's row as it is copied into
     // the frame), the case chosen once: a format's codes through unormValue (no division).

@@ -276,7 +276,8 @@ RayRenderer::RayRenderer(const Scene& scene, BvhBuild build)
                                sizeof(glm::uvec3), scene.triangles.size());
     embree_->check("setting the geometry buffers");
     if (!vertices) throw Error("Embree could not allocate geometry buffers");
-    embree_->frameOrigin = glm::dvec3(glm::vec3((scene.boundsMin() + scene.boundsMax()) / 2.0));
+    const glm::dvec3 centre = (scene.boundsMin() + scene.boundsMax()) / 2.0;
+    embree_->frameOrigin = {roundedToBinary32(centre.x), roundedToBinary32(centre.y), roundedToBinary32(centre.z)};
     for (std::size_t v = 0; v < scene.positions.size(); ++v)
         for (int k = 0; k < 3; ++k)
             vertices[3 * v + k] = float(double(scene.positions[v][k]) - embree_->frameOrigin[k]);

@@ -86,14 +86,10 @@ std::string PolygonPlanarity::warning(const std::string& mesh) const
 
 glm::vec3 PositionRounding::store(const glm::dvec3& position)
 {
-    // Each coordinate rounded through memory: GCC 12 at -O3 vectorised double(float(x)) − x for x
-    // and y into x − x, and recorded no move at all (the regression test of UTM coordinates).
-    glm::vec3 stored;
-    for (int axis = 0; axis < 3; ++axis) {
-        const volatile float rounded = float(position[axis]);
-        stored[axis] = rounded;
-    }
-    const glm::dvec3 left = position - glm::dvec3(stored);
+    // (GCC 12's SLP vectoriser once made position − stored 0 in x and y here: roundedToBinary32.)
+    const glm::dvec3 kept(roundedToBinary32(position.x), roundedToBinary32(position.y), roundedToBinary32(position.z));
+    const glm::vec3 stored(kept);  // exact
+    const glm::dvec3 left = position - kept;
     const double move = glm::length(left);
     if (move > largestMove) largestMove = move, movedVertex = position;
     if (move > 0 || !residual.empty()) {  // 12 bytes a vertex from the first that moved

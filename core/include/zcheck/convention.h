@@ -89,12 +89,31 @@ inline double unormValue(DepthFormat format, double code)
     return t + t * 0x1p-48;
 }
 
+// The binary32 number nearest x, as a double: what a float32 buffer or file keeps of x. Every
+// place zcheck rounds to binary32 on purpose and reads the value back as a double goes through
+// this, because a compiler may lose that rounding: GCC 12's basic-block SLP vectoriser (Debian
+// 12's 12.2) takes double(float(x)) for x where it packs two or more such conversions side by
+// side. zcheck builds with that vectoriser off (CMakeLists.txt) but for its trace and raster
+// kernels, which are faster with it; the empty asm keeps the rounding there, and in a
+// consumer's code built with it on (tests/test_binary32.cpp).
+inline double roundedToBinary32(double x)
+{
+    float kept = static_cast<float>(x);
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+    asm("" : "+x"(kept));  // the float as such: the conversion back is not folded into the one before
+#else
+    const volatile float opaque = kept;
+    kept = opaque;
+#endif
+    return static_cast<double>(kept);
+}
+
 // The value the depth buffer stores for window depth `windowDepth` (clamped to [0,1] for
 // unorm formats, rounded to the nearest code), returned as a double so that all formats
 // compare alike. Inline: the rasterizer calls it per pixel.
 inline double quantizeDepth(DepthFormat format, double windowDepth)
 {
-    if (format == DepthFormat::Float32) return static_cast<double>(static_cast<float>(windowDepth));
+    if (format == DepthFormat::Float32) return roundedToBinary32(windowDepth);
     return unormValue(format, unormCode(format, windowDepth));
 }
 
