@@ -123,6 +123,19 @@ ZCHECK_ALWAYS_INLINE inline void prefetchNextBlock(const Scene& scene, std::size
     for (std::size_t k = next; k < end; k += 64 / sizeof(glm::uvec3)) __builtin_prefetch(&scene.triangles[k]);
 }
 
+// Asks for every corner of triangles first .. first + n − 1, and the next block's index triples:
+// the loads of a block's corners then overlap, where reading them in order waited on each few in
+// turn (the scene's vertices are out of the caches after both routes rendered). Before the
+// gathered form did this too, its slopes were a third of an AVX-512 comparison, mostly waiting on
+// its gathers; with it the comparison (`bench/zcheck_bench --phase compare`) took 4.3-4.6 ms
+// instead of 4.8-5.0 in six pairs (Zen 5).
+ZCHECK_ALWAYS_INLINE inline void prefetchCorners(const Scene& scene, std::uint32_t first, std::size_t n)
+{
+    for (std::size_t k = 0; k < n; ++k)
+        for (int v = 0; v < 3; ++v) __builtin_prefetch(&scene.positions[scene.triangles[first + k][v]]);
+    prefetchNextBlock(scene, first + n);
+}
+
 // The corners of triangles first .. first + n − 1 (n ≤ kSlopeLanes) dealt into lane arrays in
 // double, for kernels that then work on several triangles per instruction: corner[v][axis][k] is
 // corner v of triangle first + k. The indices must be in range (validateScene). Always inlined,
@@ -130,11 +143,7 @@ ZCHECK_ALWAYS_INLINE inline void prefetchNextBlock(const Scene& scene, std::size
 ZCHECK_ALWAYS_INLINE inline void cornersOfBlock(const Scene& scene, std::uint32_t first, std::size_t n,
                                                 double (&corner)[3][3][kSlopeLanes])
 {
-    // Every corner asked for before the first is read (the loads then overlap, where reading
-    // them in order waited on each few in turn), and the next block's index triples too.
-    for (std::size_t k = 0; k < n; ++k)
-        for (int v = 0; v < 3; ++v) __builtin_prefetch(&scene.positions[scene.triangles[first + k][v]]);
-    prefetchNextBlock(scene, first + n);
+    prefetchCorners(scene, first, n);
     for (std::size_t k = 0; k < n; ++k) {
         const glm::uvec3& t = scene.triangles[first + k];
         for (int v = 0; v < 3; ++v)
@@ -166,7 +175,7 @@ ZCHECK_ALWAYS_INLINE inline void slopesOfWholeBlockGathered(const DepthSlopeFram
 {
     using Real = typename L::Real;
     using Int32 = typename L::Int32;
-    prefetchNextBlock(scene, first + kSlopeLanes);
+    prefetchCorners(scene, first, kSlopeLanes);
     const float* positions = &scene.positions[0].x;
     for (std::size_t k = 0; k < kSlopeLanes; k += L::kLanes) {
         Int32 index[3];
