@@ -241,6 +241,41 @@ TEST_CASE("polygons of more than 3 corners: non-planar ones are counted and meas
     REQUIRE(flat.planarity.warning("f.obj").empty());
 }
 
+TEST_CASE("regression: a planar polygon far from the origin was called non-planar, measured after binary32 moved its corners",
+          "[mesh][regression]")
+{
+    // A quad, not aligned with the axes, on the plane z = (x − 512000)/2 + (y − 4212000)/4: every
+    // coordinate a multiple of 1/32, so the file's corners lie on it exactly. Binary32 steps by
+    // 0.5 at y ≈ 4.2e6 and moves the corners' y by +1/8, +1/8, −1/8 and 0: so rounded, they lie
+    // 8.2e-5 of the quad's size off one plane (numpy, by the Newell plane below), over the
+    // threshold of 1e-5; as the file holds them, on it.
+    const std::string planar = "v 512300.125 4212340.375 235.15625\n"
+                               "v 512360.625 4212345.875 266.78125\n"
+                               "v 512355.375 4212390.125 275.21875\n"
+                               "v 512296.875 4212384.5 244.5625\n"
+                               "f 1 2 3 4\n";
+    const Scene quad = frameScene(readObj("utm_quad.obj", planar), "utm_quad.obj");
+    REQUIRE(quad.heldAboutOrigin());  // binary32's move was material: the case this is about
+    REQUIRE(quad.planarity.polygons == 1);
+    REQUIRE(quad.planarity.nonPlanar == 0);
+    REQUIRE(quad.planarity.warning("utm_quad.obj").empty());
+    // The same quad as a PLY face of doubles (the readers share the measure).
+    const std::string header = "element vertex 4\nproperty double x\nproperty double y\nproperty double z\n"
+                               "element face 1\nproperty list uchar int vertex_indices\n";
+    const Scene plyQuad = readPly("utm_quad.ply", ply("ascii", header) +
+                                                      "512300.125 4212340.375 235.15625\n512360.625 4212345.875 266.78125\n"
+                                                      "512355.375 4212390.125 275.21875\n512296.875 4212384.5 244.5625\n"
+                                                      "4 0 1 2 3\n");
+    REQUIRE(plyQuad.planarity.polygons == 1);
+    REQUIRE(plyQuad.planarity.nonPlanar == 0);
+    // A saddle there is still one, measured as near the origin: corners h off in turn, 1 apart.
+    const double h = 0.1, expected = h / (2 * std::sqrt(2.0));
+    const Scene saddle = readObj("utm_saddle.obj", "v 512000.3 4212000.3 100\nv 512001.3 4212000.3 100.1\n"
+                                                   "v 512001.3 4212001.3 100\nv 512000.3 4212001.3 100.1\nf 1 2 3 4\n");
+    REQUIRE(saddle.planarity.nonPlanar == 1);
+    REQUIRE(saddle.planarity.worst == Approx(expected).epsilon(1e-6));
+}
+
 TEST_CASE("regression: a mesh in UTM coordinates was rounded to binary32 without a word", "[mesh][regression]")
 {
     // (512345.678, 4212345.321, 123.4) as binary32: x to a sixteenth (512345.6875, 0.0095 off),

@@ -58,7 +58,7 @@ public:
                                 std::to_string(t[k] + 1) + " but the file defines " +
                                 std::to_string(scene_.positions.size()));
         for (const auto& [firstTriangle, corners] : fans_)
-            scene_.planarity.addFan(scene_.positions, scene_.triangles, firstTriangle, corners);
+            scene_.planarity.addFan(scene_.positions, scene_.rounding, scene_.triangles, firstTriangle, corners);
         return std::move(scene_);
     }
 

@@ -72,7 +72,7 @@ public:
                     fail("a face refers to vertex " + std::to_string(t[k]) + " but the file has " +
                          std::to_string(scene_.positions.size()) + " vertices");
         for (const auto& [firstTriangle, corners] : fans_)
-            scene_.planarity.addFan(scene_.positions, scene_.triangles, firstTriangle, corners);
+            scene_.planarity.addFan(scene_.positions, scene_.rounding, scene_.triangles, firstTriangle, corners);
         return std::move(scene_);
     }
 

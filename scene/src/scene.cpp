@@ -41,15 +41,19 @@ void Scene::append(const std::vector<glm::vec3>& morePositions, const std::vecto
     for (const auto& t : moreTriangles) triangles.push_back(t + glm::uvec3(offset));
 }
 
-void PolygonPlanarity::addFan(const std::vector<glm::vec3>& positions, const std::vector<glm::uvec3>& triangles,
-                              std::size_t firstTriangle, std::size_t cornerCount)
+void PolygonPlanarity::addFan(const std::vector<glm::vec3>& positions, const PositionRounding& rounding,
+                              const std::vector<glm::uvec3>& triangles, std::size_t firstTriangle,
+                              std::size_t cornerCount)
 {
     if (cornerCount <= 3) return;
-    std::vector<glm::dvec3> corners;
+    // The corners relative to the first (the distances below do not depend on where the polygon
+    // lies, and UTM-sized coordinates would lose digits in Newell's sums).
     const glm::uvec3& first = triangles[firstTriangle];
-    for (int k = 0; k < 3; ++k) corners.emplace_back(positions[first[k]]);
+    const glm::dvec3 firstCorner = rounding.fileCoordinates(positions, first[0]);
+    std::vector<glm::dvec3> corners;
+    for (int k = 0; k < 3; ++k) corners.push_back(rounding.fileCoordinates(positions, first[k]) - firstCorner);
     for (std::size_t t = firstTriangle + 1; t < firstTriangle + cornerCount - 2; ++t)
-        corners.emplace_back(positions[triangles[t][2]]);
+        corners.push_back(rounding.fileCoordinates(positions, triangles[t][2]) - firstCorner);
     ++polygons;
     // Newell's normal (robust for any simple polygon) through the centroid.
     glm::dvec3 normal(0.0), centroid(0.0);
@@ -218,12 +222,9 @@ glm::dvec3 localOrigin(const glm::dvec3& lo, const glm::dvec3& hi)
 // (its binary32 value and what binary32 left, rounding.residual), less the origin, rounded once.
 void holdAboutLocalOrigin(Scene& scene, const glm::dvec3& lo, const glm::dvec3& hi)
 {
-    const std::vector<glm::vec3>& residual = scene.rounding.residual;
     scene.origin = localOrigin(lo, hi);
-    for (std::size_t v = 0; v < scene.positions.size(); ++v) {
-        const glm::dvec3 file = glm::dvec3(scene.positions[v]) + glm::dvec3(residual[v]);
-        scene.positions[v] = glm::vec3(file - scene.origin);
-    }
+    for (std::size_t v = 0; v < scene.positions.size(); ++v)
+        scene.positions[v] = glm::vec3(scene.rounding.fileCoordinates(scene.positions, v) - scene.origin);
 }
 
 }  // namespace

@@ -18,25 +18,6 @@
 
 namespace zcheck {
 
-// How far the polygons of more than 3 corners that a mesh file held lie from one plane. A
-// reader splits such a polygon into a fan; a renderer may split it along other diagonals, and
-// where the polygon is not planar its depth then depends on the split.
-struct PolygonPlanarity {
-    // Corners off the polygon's plane by more than this fraction of its size count as non-planar
-    // (binary32 positions alone stay near 1e-7).
-    static constexpr double kTolerance = 1e-5;
-    std::uint64_t polygons = 0;   // polygons of more than 3 corners
-    std::uint64_t nonPlanar = 0;  // of those, not planar
-    double worst = 0;             // the largest corner distance from the plane, relative to the polygon's size
-
-    // A polygon split by a reader into the fan of `cornerCount` − 2 consecutive triangles of
-    // `scene` from `firstTriangle` (each sharing its first corner with the first triangle).
-    void addFan(const std::vector<glm::vec3>& positions, const std::vector<glm::uvec3>& triangles,
-                std::size_t firstTriangle, std::size_t cornerCount);
-    // "" when every polygon is planar; else one sentence naming `mesh`, the count and the worst.
-    std::string warning(const std::string& mesh) const;
-};
-
 // How far binary32 (what zcheck, Embree and a GPU hold) would move a mesh's vertices at the file's
 // own coordinates. A file may hold more digits (OBJ and PLY text, PLY doubles, a glTF node's
 // transform applied in binary64, a Python float64 array). Near the origin the move is below 2^-24
@@ -64,10 +45,37 @@ struct PositionRounding {
     // `position` as binary32 (the caller has checked it is within range), its move recorded.
     // A reader calls it once per vertex, in the order of Scene::positions.
     glm::vec3 store(const glm::dvec3& position);
+    // Vertex v of `stored` (what store() returned, in order) as the file held it: its binary32
+    // value and the residual, to ~2^-48 of it; until frameScene has placed the mesh.
+    glm::dvec3 fileCoordinates(const std::vector<glm::vec3>& stored, std::size_t v) const
+    {
+        return v < residual.size() ? glm::dvec3(stored[v]) + glm::dvec3(residual[v]) : glm::dvec3(stored[v]);
+    }
     bool material() const { return largestMove > kMaterial * size; }
     // "" unless material(); else one sentence naming `mesh`, the move, and where the mesh is held
     // (`origin`, Scene::origin; zero: at the file's coordinates, and the move is this check's own).
     std::string warning(const std::string& mesh, const glm::dvec3& origin = glm::dvec3(0.0)) const;
+};
+
+// How far the polygons of more than 3 corners that a mesh file held lie from one plane. A
+// reader splits such a polygon into a fan; a renderer may split it along other diagonals, and
+// where the polygon is not planar its depth then depends on the split.
+struct PolygonPlanarity {
+    // Corners off the polygon's plane by more than this fraction of its size count as non-planar
+    // (a planar polygon's corners written with binary32's digits or more stay near 1e-7).
+    static constexpr double kTolerance = 1e-5;
+    std::uint64_t polygons = 0;   // polygons of more than 3 corners
+    std::uint64_t nonPlanar = 0;  // of those, not planar
+    double worst = 0;             // the largest corner distance from the plane, relative to the polygon's size
+
+    // A polygon split by a reader into the fan of `cornerCount` − 2 consecutive triangles from
+    // `firstTriangle` (each sharing its first corner with the first triangle), its corners
+    // measured where the file put them (`rounding`'s fileCoordinates of `positions`), not where
+    // binary32 moved them: far from the origin that move alone would bend a planar polygon.
+    void addFan(const std::vector<glm::vec3>& positions, const PositionRounding& rounding,
+                const std::vector<glm::uvec3>& triangles, std::size_t firstTriangle, std::size_t cornerCount);
+    // "" when every polygon is planar; else one sentence naming `mesh`, the count and the worst.
+    std::string warning(const std::string& mesh) const;
 };
 
 // Bounding boxes of runs of consecutive triangles (meshes keep neighbours close), so that a
