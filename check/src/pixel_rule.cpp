@@ -123,7 +123,8 @@ ZCHECK_ALWAYS_INLINE inline void prefetchNextBlock(const Scene& scene, std::size
     for (std::size_t k = next; k < end; k += 64 / sizeof(glm::uvec3)) __builtin_prefetch(&scene.triangles[k]);
 }
 
-// Asks for every corner of triangles first .. first + n − 1, and the next block's index triples:
+// Asks for every corner of triangles first .. first + n − 1 (first + n ≤ the scene's triangle count, their
+// indices in range: validateScene), and the next block's index triples:
 // the loads of a block's corners then overlap, where reading them in order waited on each few in
 // turn (the scene's vertices are out of the caches after both routes rendered). Before the
 // gathered form did this too, its slopes were a third of an AVX-512 comparison, mostly waiting on

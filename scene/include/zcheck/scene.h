@@ -62,7 +62,8 @@ struct PositionRounding {
 // where the polygon is not planar its depth then depends on the split.
 struct PolygonPlanarity {
     // Corners off the polygon's plane by more than this fraction of its size count as non-planar
-    // (a planar polygon's corners written with binary32's digits or more stay near 1e-7).
+    // (a planar polygon's corners, as the file writes them, measure near 1e-7 or less when they
+    // carry binary32's digits or more and lie within some of the polygon's sizes of the origin).
     static constexpr double kTolerance = 1e-5;
     std::uint64_t polygons = 0;   // polygons of more than 3 corners
     std::uint64_t nonPlanar = 0;  // of those, not planar
@@ -71,7 +72,8 @@ struct PolygonPlanarity {
     // A polygon split by a reader into the fan of `cornerCount` − 2 consecutive triangles from
     // `firstTriangle` (each sharing its first corner with the first triangle), its corners
     // measured where the file put them (`rounding`'s fileCoordinates of `positions`), not where
-    // binary32 moved them: far from the origin that move alone would bend a planar polygon.
+    // binary32 moved them: far from the origin that move alone would bend a planar polygon. A
+    // reader calls it before frameScene, while `rounding` still holds the residuals.
     void addFan(const std::vector<glm::vec3>& positions, const PositionRounding& rounding,
                 const std::vector<glm::uvec3>& triangles, std::size_t firstTriangle, std::size_t cornerCount);
     // "" when every polygon is planar; else one sentence naming `mesh`, the count and the worst.
