@@ -249,12 +249,14 @@ TEST_CASE("regression: a planar polygon far from the origin was called non-plana
     // 0.5 at y ≈ 4.2e6 and moves the corners' y by +1/8, +1/8, −1/8 and 0: so rounded, they lie
     // 8.2e-5 of the quad's size off one plane (numpy, by the Newell plane below), over the
     // threshold of 1e-5; as the file holds them, on it.
-    const std::string planar = "v 512300.125 4212340.375 235.15625\n"
-                               "v 512360.625 4212345.875 266.78125\n"
-                               "v 512355.375 4212390.125 275.21875\n"
-                               "v 512296.875 4212384.5 244.5625\n"
-                               "f 1 2 3 4\n";
-    const Scene quad = frameScene(readObj("utm_quad.obj", planar), "utm_quad.obj");
+    const char* const corners[] = {"512300.125 4212340.375 235.15625", "512360.625 4212345.875 266.78125",
+                                   "512355.375 4212390.125 275.21875", "512296.875 4212384.5 244.5625"};
+    std::string objText, plyVertices;
+    for (const std::string corner : corners) {
+        objText += "v " + corner + "\n";
+        plyVertices += corner + "\n";
+    }
+    const Scene quad = frameScene(readObj("utm_quad.obj", objText + "f 1 2 3 4\n"), "utm_quad.obj");
     REQUIRE(quad.heldAboutOrigin());  // binary32's move was material: the case this is about
     REQUIRE(quad.planarity.polygons == 1);
     REQUIRE(quad.planarity.nonPlanar == 0);
@@ -262,10 +264,7 @@ TEST_CASE("regression: a planar polygon far from the origin was called non-plana
     // The same quad as a PLY face of doubles (the readers share the measure).
     const std::string header = "element vertex 4\nproperty double x\nproperty double y\nproperty double z\n"
                                "element face 1\nproperty list uchar int vertex_indices\n";
-    const Scene plyQuad = readPly("utm_quad.ply", ply("ascii", header) +
-                                                      "512300.125 4212340.375 235.15625\n512360.625 4212345.875 266.78125\n"
-                                                      "512355.375 4212390.125 275.21875\n512296.875 4212384.5 244.5625\n"
-                                                      "4 0 1 2 3\n");
+    const Scene plyQuad = readPly("utm_quad.ply", ply("ascii", header) + plyVertices + "4 0 1 2 3\n");
     REQUIRE(plyQuad.planarity.polygons == 1);
     REQUIRE(plyQuad.planarity.nonPlanar == 0);
     // A saddle there is still one, measured as near the origin: corners h off in turn, 1 apart.

@@ -123,13 +123,13 @@ ZCHECK_ALWAYS_INLINE inline void prefetchNextBlock(const Scene& scene, std::size
     for (std::size_t k = next; k < end; k += 64 / sizeof(glm::uvec3)) __builtin_prefetch(&scene.triangles[k]);
 }
 
-// Asks for every corner of triangles first .. first + n − 1 (first + n ≤ the scene's triangle count, their
-// indices in range: validateScene), and the next block's index triples:
-// the loads of a block's corners then overlap, where reading them in order waited on each few in
-// turn (the scene's vertices are out of the caches after both routes rendered). Before the
-// gathered form did this too, its slopes were a third of an AVX-512 comparison, mostly waiting on
-// its gathers; with it the comparison (`bench/zcheck_bench --phase compare`) took 4.3-4.6 ms
-// instead of 4.8-5.0 in six pairs (Zen 5).
+// Asks for every corner of triangles first .. first + n − 1 (first + n ≤ the scene's triangle
+// count, their indices in range: validateScene), and the next block's index triples: the loads of
+// a block's corners then overlap, where reading them in order waited on each few in turn (the
+// scene's vertices are out of the caches after both routes rendered). Before the gathered form did
+// this too, its slopes were a third of an AVX-512 comparison, mostly waiting on its gathers; with
+// it the comparison (`bench/zcheck_bench --phase compare`) took 4.3-4.6 ms instead of 4.8-5.0 in
+// six pairs (Zen 5).
 ZCHECK_ALWAYS_INLINE inline void prefetchCorners(const Scene& scene, std::uint32_t first, std::size_t n)
 {
     for (std::size_t k = 0; k < n; ++k)
